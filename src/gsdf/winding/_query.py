@@ -1,0 +1,44 @@
+"""Chunked evaluation of a kernel over query points, so memory stays bounded for very many queries."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..spatial.morton import morton_order
+
+CHUNK = 1 << 20
+
+
+def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, coherent: bool = False) -> np.ndarray:
+    """Validate ``Q`` chunk by chunk and call ``kernel(q_chunk, out_chunk)`` on each.
+
+    Only one float64 copy of one chunk exists at a time, so 10^8 float32 queries need ~chunk×24 bytes of
+    scratch beyond the output. ``progress(done, total)`` is called after each chunk when given.
+    ``coherent=True`` evaluates each chunk in Morton order (tree walks of neighbouring queries then share
+    cached nodes) and scatters the results back.
+    """
+    A = np.asarray(Q)
+    if A.ndim == 1 and A.shape[0] == dim:
+        A = A.reshape(1, dim)
+    if A.ndim != 2 or A.shape[1] != dim:
+        raise ValueError(f"Q: expected shape (q, {dim}), got {A.shape}")
+    if not (np.issubdtype(A.dtype, np.floating) or np.issubdtype(A.dtype, np.integer)):
+        raise ValueError(f"Q: expected a numeric array, got dtype {A.dtype}")
+    n = A.shape[0]
+    out = np.empty(n, dtype=np.float64)
+    for s in range(0, n, chunk):
+        e = min(n, s + chunk)
+        q = np.ascontiguousarray(A[s:e], dtype=np.float64)
+        if not np.isfinite(q).all():
+            bad = s + int(np.argmax(~np.isfinite(q).all(axis=1)))
+            raise ValueError(f"Q: contains NaN or infinite coordinates (first at row {bad})")
+        if coherent and e - s > 1:
+            o = morton_order(q)
+            tmp = np.empty(e - s)
+            kernel(np.ascontiguousarray(q[o]), tmp)
+            out[s:e][o] = tmp
+        else:
+            kernel(q, out[s:e])
+        if progress is not None:
+            progress(e, n)
+    return out

@@ -1,0 +1,342 @@
+"""Fast generalized winding numbers for triangle soups and oriented point clouds (Barill et al. 2018, §3.2–3.3).
+
+A tree (:mod:`gsdf.spatial.bvh`) is built once. Every node stores the Taylor expansion of the winding number
+of its elements about their area-weighted centre p̃ (Eqs. 13–15 for points, 18–20 with the closed-form
+triangle integrals of App. B, Eqs. 25–29 for triangles). A query walks the tree (Algorithm 1): when
+|q − p̃| > β r (r = largest distance from p̃ to the node's elements) the expansion is used, otherwise the node
+is opened, and leaves are summed exactly (solid angles or dipoles).
+
+Derivatives of the Green's function (App. A) with r = p̃ − q, d = |r|:
+    ∇G   = r / (4π d³)                                                           (Eq. 22)
+    ∇²G  = I / (4π d³) − 3 r⊗r / (4π d⁵)                                         (Eq. 23)
+    ∇³G  = −3 (r_a δ_bc + r_b δ_ac + r_c δ_ab) / (4π d⁵) + 15 r_a r_b r_c / (4π d⁷)
+The factor 3 in the first term of ∇³G is missing from Eq. 24 as printed in the seed text; it is what the
+derivative of Eq. 23 gives, and the tests confirm order-2 converges at third order with it.
+
+Per node we store (coefficients contracted so that evaluation needs no 27-term loop):
+    c0 = Σ a n                    (3)   order 0, Eq. 13 / 25
+    C1 = Σ a (x − p̃) ⊗ n          (3×3) order 1, Eq. 14 / 26
+    C2 = Σ a M ⊗ n, M = (x−p̃)⊗(x−p̃) for points, M = C_t (edge-midpoint rule, Eq. 29) for triangles
+         stored as u_a = Σ_b C2_abb, v_c = Σ_a C2_aac and the 6 symmetric entries of C2_··c per c.
+Then
+    w ≈ c0·r/d³ + (tr C1/d³ − 3 rᵀC1 r/d⁵) + ½(−3(2 r·u + r·v)/d⁵ + 15 Σ_c r_c rᵀC2_··c r / d⁷),  all / 4π.
+
+Cost: precompute O(m log m); a query O(log m) for well-distributed input (bench/ measures both).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from .._checks import as_mesh, as_points
+from ..spatial.bvh import BVH, build_bvh
+from ._query import map_queries
+from .exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w, triangle_corners
+
+# layout of the per-node coefficient row
+_CX, _R2, _C0, _C1, _U, _VV, _S = 0, 3, 4, 7, 16, 19, 22
+NODE_WIDTH = 40  # 3 centre + 1 r² + 3 c0 + 9 C1 + 3 u + 3 v + 18 symmetric C2
+
+
+@njit(cache=True, inline="always")
+def _far_field(D, i, qx, qy, qz, order):
+    rx = D[i, 0] - qx
+    ry = D[i, 1] - qy
+    rz = D[i, 2] - qz
+    d2 = rx * rx + ry * ry + rz * rz
+    inv_d2 = 1.0 / d2
+    inv_d = np.sqrt(inv_d2)
+    inv_d3 = inv_d * inv_d2
+    w = (D[i, 4] * rx + D[i, 5] * ry + D[i, 6] * rz) * inv_d3
+    if order >= 1:
+        tr = D[i, 7] + D[i, 11] + D[i, 15]
+        rCr = (rx * (D[i, 7] * rx + D[i, 8] * ry + D[i, 9] * rz)
+               + ry * (D[i, 10] * rx + D[i, 11] * ry + D[i, 12] * rz)
+               + rz * (D[i, 13] * rx + D[i, 14] * ry + D[i, 15] * rz))
+        w += tr * inv_d3 - 3.0 * rCr * inv_d3 * inv_d2
+        if order >= 2:
+            ru = rx * D[i, 16] + ry * D[i, 17] + rz * D[i, 18]
+            rv = rx * D[i, 19] + ry * D[i, 20] + rz * D[i, 21]
+            cub = 0.0
+            for c in range(3):
+                b = 22 + 6 * c  # xx, yy, zz, xy, xz, yz
+                quad = (D[i, b] * rx * rx + D[i, b + 1] * ry * ry + D[i, b + 2] * rz * rz
+                        + 2.0 * (D[i, b + 3] * rx * ry + D[i, b + 4] * rx * rz + D[i, b + 5] * ry * rz))
+                rc = rx if c == 0 else (ry if c == 1 else rz)
+                cub += rc * quad
+            inv_d5 = inv_d3 * inv_d2
+            w += 0.5 * (-3.0 * (2.0 * ru + rv) * inv_d5 + 15.0 * cub * inv_d5 * inv_d2)
+    return w * INV_4PI
+
+
+@njit(parallel=True, cache=True)
+def _node_moments(start, end, X, AN, M, R, width):
+    """Taylor coefficients per node.
+
+    X (m,3) expansion points of elements (centroids), AN (m,3) area-weighted normals, M (m,6) second
+    moments about the element's own centroid (0 for points; for triangles the edge-midpoint C_t about the
+    centroid), R (m,k*3) points whose distance bounds the node radius. All arrays in tree order.
+    """
+    k = start.shape[0]
+    D = np.zeros((k, width))
+    nr = R.shape[1] // 3
+    for i in prange(k):
+        s, e = start[i], end[i]
+        A = 0.0
+        cx = cy = cz = 0.0
+        for j in range(s, e):
+            a = np.sqrt(AN[j, 0] ** 2 + AN[j, 1] ** 2 + AN[j, 2] ** 2)
+            A += a
+            cx += a * X[j, 0]
+            cy += a * X[j, 1]
+            cz += a * X[j, 2]
+        if A > 0.0:
+            cx /= A
+            cy /= A
+            cz /= A
+        else:
+            cx = cy = cz = 0.0
+            for j in range(s, e):
+                cx += X[j, 0]
+                cy += X[j, 1]
+                cz += X[j, 2]
+            cx /= e - s
+            cy /= e - s
+            cz /= e - s
+        D[i, 0], D[i, 1], D[i, 2] = cx, cy, cz
+        r2 = 0.0
+        for j in range(s, e):
+            for v in range(nr):
+                dx = R[j, 3 * v] - cx
+                dy = R[j, 3 * v + 1] - cy
+                dz = R[j, 3 * v + 2] - cz
+                r2 = max(r2, dx * dx + dy * dy + dz * dz)
+            n0, n1, n2 = AN[j, 0], AN[j, 1], AN[j, 2]
+            D[i, 4] += n0
+            D[i, 5] += n1
+            D[i, 6] += n2
+            d0, d1, d2 = X[j, 0] - cx, X[j, 1] - cy, X[j, 2] - cz
+            # C1[a, b] = Σ (x − p̃)_a n_b
+            D[i, 7] += d0 * n0
+            D[i, 8] += d0 * n1
+            D[i, 9] += d0 * n2
+            D[i, 10] += d1 * n0
+            D[i, 11] += d1 * n1
+            D[i, 12] += d1 * n2
+            D[i, 13] += d2 * n0
+            D[i, 14] += d2 * n1
+            D[i, 15] += d2 * n2
+            # second moment about p̃ = own second moment + shift (parallel-axis theorem)
+            mxx = M[j, 0] + d0 * d0
+            myy = M[j, 1] + d1 * d1
+            mzz = M[j, 2] + d2 * d2
+            mxy = M[j, 3] + d0 * d1
+            mxz = M[j, 4] + d0 * d2
+            myz = M[j, 5] + d1 * d2
+            # u_a = Σ_b C2_abb = Σ M_ab n_b ; v_c = Σ_a C2_aac = tr(M) n_c
+            D[i, 16] += mxx * n0 + mxy * n1 + mxz * n2
+            D[i, 17] += mxy * n0 + myy * n1 + myz * n2
+            D[i, 18] += mxz * n0 + myz * n1 + mzz * n2
+            trm = mxx + myy + mzz
+            D[i, 19] += trm * n0
+            D[i, 20] += trm * n1
+            D[i, 21] += trm * n2
+            for c in range(3):
+                nc = n0 if c == 0 else (n1 if c == 1 else n2)
+                b = 22 + 6 * c
+                D[i, b] += mxx * nc
+                D[i, b + 1] += myy * nc
+                D[i, b + 2] += mzz * nc
+                D[i, b + 3] += mxy * nc
+                D[i, b + 4] += mxz * nc
+                D[i, b + 5] += myz * nc
+        D[i, 3] = r2
+    return D
+
+
+@njit(parallel=True, cache=True)
+def _eval_triangles(Q, T, B, D, right, skip, start, end, beta2, order, out):
+    k = D.shape[0]
+    for qi in prange(Q.shape[0]):
+        qx, qy, qz = Q[qi, 0], Q[qi, 1], Q[qi, 2]
+        acc = 0.0
+        i = 0
+        while i < k:
+            rx = B[i, 0] - qx
+            ry = B[i, 1] - qy
+            rz = B[i, 2] - qz
+            d2 = rx * rx + ry * ry + rz * rz
+            if d2 > beta2 * B[i, 3]:
+                acc += _far_field(D, i, qx, qy, qz, order)
+                i = skip[i]
+            elif right[i] < 0:
+                for t in range(start[i], end[i]):
+                    acc += solid_angle_w(T[t, 0] - qx, T[t, 1] - qy, T[t, 2] - qz,
+                                         T[t, 3] - qx, T[t, 4] - qy, T[t, 5] - qz,
+                                         T[t, 6] - qx, T[t, 7] - qy, T[t, 8] - qz)
+                i = skip[i]
+            else:
+                i += 1
+        out[qi] = acc
+
+
+@njit(parallel=True, cache=True)
+def _eval_points(Q, P, NA, B, D, right, skip, start, end, beta2, order, out):
+    k = D.shape[0]
+    for qi in prange(Q.shape[0]):
+        qx, qy, qz = Q[qi, 0], Q[qi, 1], Q[qi, 2]
+        acc = 0.0
+        i = 0
+        while i < k:
+            rx = B[i, 0] - qx
+            ry = B[i, 1] - qy
+            rz = B[i, 2] - qz
+            d2 = rx * rx + ry * ry + rz * rz
+            if d2 > beta2 * B[i, 3]:
+                acc += _far_field(D, i, qx, qy, qz, order)
+                i = skip[i]
+            elif right[i] < 0:
+                for j in range(start[i], end[i]):
+                    acc += dipole_w(P[j, 0], P[j, 1], P[j, 2], NA[j, 0], NA[j, 1], NA[j, 2], 1.0, qx, qy, qz)
+                i = skip[i]
+            else:
+                i += 1
+        out[qi] = acc
+
+
+def _check_params(beta, order):
+    try:
+        beta = float(beta)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"beta: expected a number, got {beta!r}") from exc
+    if not np.isfinite(beta) or beta <= 0:
+        raise ValueError(f"beta: must be a finite positive number, got {beta!r}")
+    if order not in (0, 1, 2):
+        raise ValueError(f"order: must be 0, 1 or 2, got {order!r}")
+    return beta, int(order)
+
+
+class _FastWindingBase:
+    tree: BVH
+    _D: np.ndarray
+
+    def __call__(self, Q, progress=None) -> np.ndarray:
+        """Winding numbers at query points ``Q`` (q, 3); evaluated in parallel chunks."""
+        return map_queries(self._kernel, Q, progress=progress, coherent=True)
+
+    query = __call__
+
+    @property
+    def n_nodes(self) -> int:
+        return self.tree.n_nodes
+
+
+class FastWindingNumber(_FastWindingBase):
+    """Reusable fast winding number of a triangle soup: precompute once, query many times.
+
+    Parameters
+    ----------
+    V : (n, 3) float
+        Vertex positions.
+    F : (m, 3) int
+        Triangles; soups, holes, self-intersections and flipped components are all fine. Zero-area faces
+        contribute nothing.
+    beta : float
+        Accuracy parameter β of Algorithm 1 (default 2: RMS error ~1e-3 in the paper).
+    order : {0, 1, 2}
+        Taylor order of the far-field expansion.
+    leaf_size : int
+        Triangles per tree leaf.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.]])
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    >>> fwn = gsdf.FastWindingNumber(V, F)
+    >>> fwn([[0.1, 0.1, 0.1], [5, 5, 5]]).round(3)
+    array([1., 0.])
+    """
+
+    def __init__(self, V, F, beta: float = 2.0, order: int = 2, leaf_size: int = 8):
+        V, F = as_mesh(V, F)
+        self.beta, self.order = _check_params(beta, order)
+        T = triangle_corners(V, F)
+        Tv = T.reshape(-1, 3, 3)
+        X = Tv.mean(axis=1)
+        self.tree = build_bvh(X, Tv.min(axis=1), Tv.max(axis=1), leaf_size)
+        o = self.tree.order
+        T, Tv, X = T[o], Tv[o], X[o]
+        AN = 0.5 * np.cross(Tv[:, 1] - Tv[:, 0], Tv[:, 2] - Tv[:, 0])
+        # Eq. 29: C_t = ⅓ Σ over edge midpoints of (m − p̃)(m − p̃)ᵀ; stored about the centroid and shifted
+        # to each node centre by the parallel-axis theorem in _node_moments.
+        mids = 0.5 * (Tv + Tv[:, [1, 2, 0]]) - X[:, None, :]
+        M = np.empty((len(X), 6))
+        for c, (a, b) in enumerate(((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))):
+            M[:, c] = (mids[:, :, a] * mids[:, :, b]).mean(axis=1)
+        self._T = np.ascontiguousarray(T)
+        self._D = _node_moments(self.tree.start, self.tree.end, np.ascontiguousarray(X), np.ascontiguousarray(AN),
+                                M, self._T, NODE_WIDTH)
+        self._B = np.ascontiguousarray(self._D[:, :4])  # hot data of the far-field test: centre, r²
+
+    def _kernel(self, q, out):
+        t = self.tree
+        _eval_triangles(q, self._T, self._B, self._D, t.right, t.skip, t.start, t.end, self.beta ** 2, self.order, out)
+
+
+class FastWindingNumberPoints(_FastWindingBase):
+    """Reusable fast winding number of an oriented point cloud (Eq. 5 approximated by Eqs. 13–15).
+
+    Parameters
+    ----------
+    P, N : (m, 3) float
+        Points and outward normals (normalized internally).
+    areas : (m,) float, optional
+        Point areas a_i; estimated by :func:`gsdf.point_areas` (k = 20) when omitted.
+    beta : float
+        Accuracy parameter (default 2.3: RMS error ~1e-2 in the paper).
+    order : {0, 1, 2}
+        Taylor order.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> i = np.arange(4000) + 0.5
+    >>> phi, th = np.arccos(1 - 2 * i / 4000), np.pi * (1 + 5 ** 0.5) * i
+    >>> P = np.column_stack([np.cos(th) * np.sin(phi), np.sin(th) * np.sin(phi), np.cos(phi)])
+    >>> fwn = gsdf.FastWindingNumberPoints(P, P, areas=np.full(4000, 4 * np.pi / 4000))
+    >>> fwn([[0, 0, 0], [3, 0, 0]]).round(2)
+    array([1., 0.])
+    """
+
+    def __init__(self, P, N, areas=None, beta: float = 2.3, order: int = 2, leaf_size: int = 8):
+        P, NA = oriented_area_normals(P, N, areas)
+        self.beta, self.order = _check_params(beta, order)
+        self.tree = build_bvh(P, P, P, leaf_size)
+        o = self.tree.order
+        self._P = np.ascontiguousarray(P[o])
+        self._NA = np.ascontiguousarray(NA[o])
+        self._D = _node_moments(self.tree.start, self.tree.end, self._P, self._NA,
+                                np.zeros((len(P), 6)), self._P, NODE_WIDTH)
+        self._B = np.ascontiguousarray(self._D[:, :4])
+
+    def _kernel(self, q, out):
+        t = self.tree
+        _eval_points(q, self._P, self._NA, self._B, self._D, t.right, t.skip, t.start, t.end, self.beta ** 2, self.order, out)
+
+
+def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarray:
+    """Fast generalized winding number of a triangle soup at ``Q`` (one call: build the tree, query).
+
+    See :class:`FastWindingNumber` to reuse the tree across calls.
+    """
+    return FastWindingNumber(V, F, beta=beta, order=order)(Q)
+
+
+def fast_winding_number_points(P, N, Q, areas=None, beta: float = 2.3, order: int = 2) -> np.ndarray:
+    """Fast winding number of an oriented point cloud at ``Q``; ``areas=None`` estimates point areas.
+
+    See :class:`FastWindingNumberPoints` to reuse the tree across calls.
+    """
+    return FastWindingNumberPoints(P, N, areas=areas, beta=beta, order=order)(Q)

@@ -1,0 +1,407 @@
+"""Per-point areas and normals for oriented point clouds (Barill et al. 2018, §3.1).
+
+The winding number of an oriented point cloud is the area-weighted sum of dipoles (Eq. 5),
+
+    w(q) = sum_i a_i (p_i - q) . n_i / (4 pi |p_i - q|^3),
+
+where ``a_i`` is the (geodesic) Voronoi area of ``p_i`` on the sampled surface.  When the
+acquisition does not provide the areas, §3.1 estimates them by projecting each point and its
+``k`` nearest neighbours (dropping neighbours with opposite normals) onto a plane through the
+point and taking the area of the point's 2D Voronoi cell.  :func:`point_areas` does exactly that
+in a parallel numba kernel; :func:`estimate_normals` gives PCA normals for unoriented clouds
+("for unoriented point clouds we can also use the plane to define normals", §3.1).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+from scipy.spatial import cKDTree
+
+from .._checks import as_normals, as_points
+
+__all__ = ["point_areas", "estimate_normals"]
+
+# Neighbours whose projection lies within _DUP_REL * (neighbourhood radius) of p_i are treated
+# as coincident with p_i (exact duplicates in particular), see point_areas' Notes.
+_DUP_REL = 1e-9
+
+
+def _check_k(k, name: str = "k") -> int:
+    try:
+        kk = int(k)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: expected a positive integer, got {k!r}") from exc
+    if kk != k or kk < 1:
+        raise ValueError(f"{name}: expected a positive integer, got {k!r}")
+    return kk
+
+
+def _knn(P: np.ndarray, k: int) -> np.ndarray:
+    """Indices of the ``k + 1`` nearest points of every point (itself usually first), (n, k+1) int64."""
+    tree = cKDTree(P)
+    _, idx = tree.query(P, k=k + 1, workers=-1)
+    return np.ascontiguousarray(idx.reshape(P.shape[0], k + 1), dtype=np.int64)
+
+
+# ----------------------------------------------------------------------------------------------
+# numba kernel
+# ----------------------------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _clip_halfplane(src, m, dst, a0, a1, b):
+    """Sutherland-Hodgman: clip convex polygon ``src[:m]`` to {x : a . x <= b}; result in ``dst``."""
+    out = 0
+    for s in range(m):
+        e = s + 1
+        if e == m:
+            e = 0
+        px = src[s, 0]
+        py = src[s, 1]
+        qx = src[e, 0]
+        qy = src[e, 1]
+        dp = a0 * px + a1 * py - b
+        dq = a0 * qx + a1 * qy - b
+        if dp <= 0.0:
+            dst[out, 0] = px
+            dst[out, 1] = py
+            out += 1
+            if dq > 0.0:
+                t = dp / (dp - dq)
+                dst[out, 0] = px + t * (qx - px)
+                dst[out, 1] = py + t * (qy - py)
+                out += 1
+        elif dq <= 0.0:
+            t = dp / (dp - dq)
+            dst[out, 0] = px + t * (qx - px)
+            dst[out, 1] = py + t * (qy - py)
+            out += 1
+    return out
+
+
+@njit(cache=True)
+def _polygon_area(poly, m):
+    s = 0.0
+    for a in range(m):
+        b = a + 1
+        if b == m:
+            b = 0
+        s += poly[a, 0] * poly[b, 1] - poly[b, 0] * poly[a, 1]
+    return 0.5 * abs(s)
+
+
+@njit(cache=True)
+def _convex_hull(pts, m, hull):
+    """Andrew's monotone chain on ``pts[:m]`` (small m); CCW hull into ``hull``, returns its size."""
+    # insertion sort by (x, y): m <= k + 1 is small
+    order = np.arange(m)
+    for a in range(1, m):
+        key = order[a]
+        b = a - 1
+        while b >= 0 and (
+            pts[order[b], 0] > pts[key, 0] or (pts[order[b], 0] == pts[key, 0] and pts[order[b], 1] > pts[key, 1])
+        ):
+            order[b + 1] = order[b]
+            b -= 1
+        order[b + 1] = key
+    h = 0
+    for pass_ in range(2):
+        start = h
+        for s in range(m):
+            j = order[s] if pass_ == 0 else order[m - 1 - s]
+            while h >= start + 2:
+                ox = hull[h - 2, 0]
+                oy = hull[h - 2, 1]
+                cr = (hull[h - 1, 0] - ox) * (pts[j, 1] - oy) - (hull[h - 1, 1] - oy) * (pts[j, 0] - ox)
+                if cr <= 0.0:
+                    h -= 1
+                else:
+                    break
+            hull[h, 0] = pts[j, 0]
+            hull[h, 1] = pts[j, 1]
+            h += 1
+        h -= 1  # last point of each chain is the first of the other
+    return h
+
+
+@njit(parallel=True, cache=True)
+def _voronoi_areas(P, N, idx, clip_hull, out):
+    n = P.shape[0]
+    m = idx.shape[1]
+    block = 256  # points per task: scratch buffers are allocated once per block
+    nblocks = (n + block - 1) // block
+    for bi in prange(nblocks):
+        cap = 2 * m + 16
+        Q = np.empty((m + 1, 2))
+        A0 = np.empty((cap, 2))
+        B0 = np.empty((cap, 2))
+        H = np.empty((2 * m + 4, 2))
+        for i in range(bi * block, min(n, (bi + 1) * block)):
+            _cell_area(P, N, idx, clip_hull, out, i, Q, A0, B0, H)
+
+
+@njit(cache=True)
+def _cell_area(P, N, idx, clip_hull, out, i, Q, A, B, H):
+    """Voronoi cell area of point ``i`` (see point_areas); writes ``out[i]``."""
+    n = P.shape[0]
+    m = idx.shape[1]
+    nx = N[i, 0]
+    ny = N[i, 1]
+    nz = N[i, 2]
+    nn = np.sqrt(nx * nx + ny * ny + nz * nz)
+    if nn == 0.0:
+        out[i] = 0.0
+        return
+    nx /= nn
+    ny /= nn
+    nz /= nn
+    # orthonormal tangent basis (u, v) of the plane with normal n through p_i
+    if abs(nx) < 0.9:
+        ax, ay, az = 1.0, 0.0, 0.0
+    else:
+        ax, ay, az = 0.0, 1.0, 0.0
+    d = ax * nx + ay * ny + az * nz
+    ux = ax - d * nx
+    uy = ay - d * ny
+    uz = az - d * nz
+    un = np.sqrt(ux * ux + uy * uy + uz * uz)
+    ux /= un
+    uy /= un
+    uz /= un
+    vx = ny * uz - nz * uy
+    vy = nz * ux - nx * uz
+    vz = nx * uy - ny * ux
+
+    # project kept neighbours
+    cnt = 0
+    r2max = 0.0
+    for s in range(m):
+        j = idx[i, s]
+        if j == i or j < 0 or j >= n:
+            continue
+        if N[j, 0] * nx + N[j, 1] * ny + N[j, 2] * nz < 0.0:
+            continue  # opposite orientation: other side of a thin sheet (§3.1)
+        dx = P[j, 0] - P[i, 0]
+        dy = P[j, 1] - P[i, 1]
+        dz = P[j, 2] - P[i, 2]
+        qx = dx * ux + dy * uy + dz * uz
+        qy = dx * vx + dy * vy + dz * vz
+        Q[cnt, 0] = qx
+        Q[cnt, 1] = qy
+        cnt += 1
+        r2 = qx * qx + qy * qy
+        if r2 > r2max:
+            r2max = r2
+    if cnt == 0 or r2max == 0.0:
+        out[i] = 0.0
+        return
+    R = np.sqrt(r2max)
+    tol2 = (_DUP_REL * R) ** 2
+
+    A[0, 0] = -R
+    A[0, 1] = -R
+    A[1, 0] = R
+    A[1, 1] = -R
+    A[2, 0] = R
+    A[2, 1] = R
+    A[3, 0] = -R
+    A[3, 1] = R
+    k = 4
+    ndup = 0
+    for s in range(cnt):
+        qx = Q[s, 0]
+        qy = Q[s, 1]
+        q2 = qx * qx + qy * qy
+        if q2 <= tol2:
+            ndup += 1
+            continue
+        # Voronoi half-plane of the origin against site q: x . q <= |q|^2 / 2
+        k = _clip_halfplane(A, k, B, qx, qy, 0.5 * q2)
+        A, B = B, A
+        if k == 0:
+            break
+    if clip_hull and k > 0:
+        # restrict the cell to the convex hull of p_i and its kept neighbours, so that a point on
+        # the border of an open surface only gets the part of its cell that lies on the surface
+        Q[cnt, 0] = 0.0
+        Q[cnt, 1] = 0.0
+        nh = _convex_hull(Q, cnt + 1, H)
+        if nh < 3:
+            k = 0
+        else:
+            for s in range(nh):
+                e = s + 1
+                if e == nh:
+                    e = 0
+                ex = H[e, 0] - H[s, 0]
+                ey = H[e, 1] - H[s, 1]
+                # inside = left of the CCW edge: ey*x - ex*y <= ey*Hs_x - ex*Hs_y
+                k = _clip_halfplane(A, k, B, ey, -ex, ey * H[s, 0] - ex * H[s, 1])
+                A, B = B, A
+                if k == 0:
+                    break
+    area = _polygon_area(A, k) if k >= 3 else 0.0
+    out[i] = area / (1.0 + ndup)
+
+
+# ----------------------------------------------------------------------------------------------
+# public API
+# ----------------------------------------------------------------------------------------------
+
+
+def point_areas(P, N, k: int = 20, boundary: str = "hull") -> np.ndarray:
+    """Voronoi area of every point of an oriented point cloud (Barill et al. 2018, §3.1).
+
+    For each point ``p_i``: take its ``k`` nearest neighbours, drop those whose normal has a
+    negative dot product with ``n_i`` (they belong to the other side of a thin sheet), project
+    the rest onto the plane through ``p_i`` with normal ``n_i``, and return the area of
+    ``p_i``'s cell in the 2D Voronoi diagram of the projected points.  The cell is computed by
+    clipping a square of half-size ``R`` (the projected distance to the farthest kept
+    neighbour) with the half-planes ``{x : x . q_j <= |q_j|^2 / 2}`` of the projected
+    neighbours ``q_j`` (§3.1 uses TRIANGLE; the half-plane intersection is the same cell).
+
+    Parameters
+    ----------
+    P : (n, 3) array_like
+        Points, n >= 2.
+    N : (n, 3) array_like
+        Normals (any length; only their direction is used).  Rows that are zero get area 0.
+    k : int, default 20
+        Neighbourhood size (the paper's value; its results are insensitive to it).  With fewer
+        than ``k + 1`` points, all other points are used (``min(k, n - 1)``).
+    boundary : {"hull", "square"}, default "hull"
+        How cells of points on the border of an open surface (or at the rim of the sampled
+        region) are bounded.  ``"hull"`` additionally clips the cell to the convex hull of
+        ``p_i`` and its kept neighbours — the same restriction libigl's implementation gets
+        from summing over the Delaunay triangles around ``p_i`` — so a border point of a
+        uniform grid gets half a cell and a corner a quarter, and the areas of a planar grid
+        sum to the area of the sampled square.  ``"square"`` only clips to the starting
+        square, so border cells extend up to ``R`` beyond the point (an overestimate).  For
+        interior points both give the plain Voronoi cell.
+
+    Returns
+    -------
+    (n,) float64 array of areas (units of length squared).
+
+    Raises
+    ------
+    ValueError
+        Bad shapes / NaN, ``N`` all zero, fewer than two points, ``k`` not a positive integer.
+
+    Notes
+    -----
+    *Projection plane.*  The cell is computed in the plane with normal ``n_i`` rather than the
+    PCA plane of the neighbourhood.  The area enters the winding number only through the dipole
+    ``a_i n_i`` (Eq. 5), i.e. as the flux of the patch through the plane orthogonal to
+    ``n_i`` — which is exactly the projected area onto that plane.  It is also cheaper (no
+    eigen-decomposition per point), and when the normals come from :func:`estimate_normals`
+    the two planes coincide.  With noisy normals the area shrinks by about ``cos`` of the
+    normal error (1.5 % at 10 degrees).
+
+    *Duplicates.*  Neighbours whose projection coincides with ``p_i`` (within ``1e-9 R``; exact
+    duplicates in particular) are not used as Voronoi sites; instead the cell is *split* equally
+    between ``p_i`` and those coincident neighbours, so duplicating every point halves each
+    area and keeps the total (and the winding number) unchanged.  No NaN is produced.
+
+    *Degenerate neighbourhoods* get area 0: zero normal; no kept neighbour (all opposite or all
+    coincident); and with ``boundary="hull"`` neighbourhoods whose projection is collinear (a
+    sampled curve has no area).
+
+    *Noisy, thick samples.*  The estimate assumes the points lie on a surface.  When the noise
+    across the surface is several times the point spacing, a 3D k-neighbourhood only sees a
+    slab of the noise layer, the projected sites are too sparse and the areas come out too
+    large.  On CGAL's ``sphere_20k_normal.xyz`` (radial noise std 4 % of r, about twice the
+    point spacing) the areas sum to 1.30 x 4 pi r^2 with k = 20, 1.15 with k = 40, 1.06 with
+    k = 80; on a clean sphere the sum is within 0.1 %.  Use a larger ``k`` for such scans.
+
+    Cost: one k-d tree query (scipy, all cores) plus O(n k^2) work in a parallel numba kernel.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gsdf.winding.point_areas import point_areas
+    >>> g = np.arange(10) * 0.1
+    >>> X, Y = np.meshgrid(g, g, indexing="ij")
+    >>> P = np.column_stack((X.ravel(), Y.ravel(), np.zeros(100)))
+    >>> N = np.tile([0.0, 0.0, 1.0], (100, 1))
+    >>> a = point_areas(P, N)
+    >>> round(float(a[55]), 6), round(float(a.sum()), 6)   # interior cell h^2; total = 0.9^2
+    (0.01, 0.81)
+    """
+    P = as_points(P, "P")
+    n = P.shape[0]
+    N = as_normals(N, n, "N")
+    k = _check_k(k)
+    if boundary not in ("hull", "square"):
+        raise ValueError(f"boundary: must be one of ['hull', 'square'], got {boundary!r}")
+    if n < 2:
+        raise ValueError(f"P: need at least 2 points to estimate point areas, got {n}")
+    kk = min(k, n - 1)
+    idx = _knn(P, kk)
+    out = np.zeros(n)
+    _voronoi_areas(P, N, idx, boundary == "hull", out)
+    return out
+
+
+def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) -> np.ndarray:
+    """Unit PCA normals of a point cloud (the "best-fit plane" of Barill et al. 2018, §3.1).
+
+    The normal of ``p_i`` is the eigenvector of the smallest eigenvalue of the covariance of
+    ``p_i`` and its ``k`` nearest neighbours (centred at their mean).
+
+    Parameters
+    ----------
+    P : (n, 3) array_like
+        Points, n >= 3.
+    k : int, default 20
+        Neighbourhood size (clamped to ``n - 1``).
+    orient_towards : None or (3,) array_like
+        ``None`` (default): the sign of each normal is arbitrary — consistent orientation of an
+        unoriented cloud is a global problem that is left to the user (the winding number needs
+        it; a wrong sign flips that dipole's contribution).  A point ``c``: normals are flipped to
+        point *away* from ``c`` (``n_i . (p_i - c) >= 0``), which orients any cloud that is
+        star-shaped around ``c`` (e.g. ``c`` = the centroid of a convex-ish scan).
+    chunk : int
+        Points processed per batch (bounds memory to ~``chunk * k * 72`` bytes).
+
+    Returns
+    -------
+    (n, 3) float64 unit normals.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gsdf.winding.point_areas import estimate_normals
+    >>> rng = np.random.default_rng(0)
+    >>> P = np.column_stack((rng.random((200, 2)), np.zeros(200)))
+    >>> N = estimate_normals(P, orient_towards=[0.5, 0.5, -1.0])
+    >>> bool(np.allclose(N, [0.0, 0.0, 1.0]))
+    True
+    """
+    P = as_points(P, "P")
+    n = P.shape[0]
+    k = _check_k(k)
+    chunk = _check_k(chunk, "chunk")
+    if n < 3:
+        raise ValueError(f"P: need at least 3 points to fit planes, got {n}")
+    c = None
+    if orient_towards is not None:
+        c = as_points(orient_towards, "orient_towards")
+        if c.shape[0] != 1:
+            raise ValueError(f"orient_towards: expected a single (3,) point, got shape {c.shape}")
+        c = c[0]
+    kk = min(k, n - 1)
+    idx = _knn(P, kk)
+    out = np.empty((n, 3))
+    for s in range(0, n, chunk):
+        nb = P[idx[s : s + chunk]]  # (c, kk+1, 3)
+        nb = nb - nb.mean(axis=1, keepdims=True)
+        C = np.einsum("nki,nkj->nij", nb, nb)
+        _, vecs = np.linalg.eigh(C)  # ascending eigenvalues
+        out[s : s + chunk] = vecs[:, :, 0]
+    out /= np.linalg.norm(out, axis=1, keepdims=True)
+    if c is not None:
+        flip = np.einsum("ij,ij->i", out, P - c) < 0
+        out[flip] *= -1.0
+    return out
