@@ -18,15 +18,14 @@ def _spread(x):
     return x
 
 
-@njit(parallel=True, cache=True)
 def morton_codes(Q):
     """63-bit Morton codes of points Q (n, 3), quantized on their own bounding box."""
+    return _codes(Q, Q.min(axis=0), Q.max(axis=0))
+
+
+@njit(parallel=True, cache=True)
+def _codes(Q, lo, hi):
     n = Q.shape[0]
-    lo = np.empty(3)
-    hi = np.empty(3)
-    for d in range(3):
-        lo[d] = Q[:, d].min()
-        hi[d] = Q[:, d].max()
     codes = np.empty(n, np.int64)
     scale = np.empty(3)
     for d in range(3):

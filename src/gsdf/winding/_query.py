@@ -32,7 +32,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         if not np.isfinite(q).all():
             bad = s + int(np.argmax(~np.isfinite(q).all(axis=1)))
             raise ValueError(f"Q: contains NaN or infinite coordinates (first at row {bad})")
-        if coherent and e - s > 1:
+        if coherent and e - s > 4096:
             o = morton_order(q)
             tmp = np.empty(e - s)
             kernel(np.ascontiguousarray(q[o]), tmp)

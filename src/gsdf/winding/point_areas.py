@@ -250,16 +250,16 @@ def _cell_area(P, N, idx, clip_hull, out, i, Q, A, B, H):
 # ----------------------------------------------------------------------------------------------
 
 
-def point_areas(P, N, k: int = 20, boundary: str = "hull") -> np.ndarray:
+def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 4) -> np.ndarray:
     """Voronoi area of every point of an oriented point cloud (Barill et al. 2018, §3.1).
 
-    For each point ``p_i``: take its ``k`` nearest neighbours, drop those whose normal has a
-    negative dot product with ``n_i`` (they belong to the other side of a thin sheet), project
-    the rest onto the plane through ``p_i`` with normal ``n_i``, and return the area of
-    ``p_i``'s cell in the 2D Voronoi diagram of the projected points.  The cell is computed by
-    clipping a square of half-size ``R`` (the projected distance to the farthest kept
-    neighbour) with the half-planes ``{x : x . q_j <= |q_j|^2 / 2}`` of the projected
-    neighbours ``q_j`` (§3.1 uses TRIANGLE; the half-plane intersection is the same cell).
+    For each point ``p_i``: take its nearest neighbours, drop those whose normal has a negative dot
+    product with ``n_i`` (they belong to the other side of a thin sheet), fit the best (PCA) plane to
+    ``p_i`` and the rest, project onto it, keep the ``k`` whose projections are nearest, and return the
+    area of ``p_i``'s cell in the 2D Voronoi diagram of the projected points. The cell is computed by
+    clipping a square of half-size ``R`` (the projected distance to the farthest kept neighbour) with the
+    half-planes ``{x : x . q_j <= |q_j|^2 / 2}`` of the projected neighbours ``q_j`` (§3.1 uses
+    TRIANGLE; the half-plane intersection is the same cell).
 
     Parameters
     ----------
@@ -279,6 +279,11 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull") -> np.ndarray:
         sum to the area of the sampled square.  ``"square"`` only clips to the starting
         square, so border cells extend up to ``R`` beyond the point (an overestimate).  For
         interior points both give the plain Voronoi cell.
+    candidates : int, default 4
+        The ``k`` neighbours are chosen among the ``candidates * k`` nearest in 3D by their distance
+        *in the fitted plane*. On a thin sample this picks the plain k nearest neighbours of §3.1; in a
+        noisy shell thicker than the point spacing it also picks points above and below, so the
+        projected density equals the surface density (see Notes). ``candidates=1`` is the plain rule.
 
     Returns
     -------
@@ -291,13 +296,9 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull") -> np.ndarray:
 
     Notes
     -----
-    *Projection plane.*  The cell is computed in the plane with normal ``n_i`` rather than the
-    PCA plane of the neighbourhood.  The area enters the winding number only through the dipole
-    ``a_i n_i`` (Eq. 5), i.e. as the flux of the patch through the plane orthogonal to
-    ``n_i`` — which is exactly the projected area onto that plane.  It is also cheaper (no
-    eigen-decomposition per point), and when the normals come from :func:`estimate_normals`
-    the two planes coincide.  With noisy normals the area shrinks by about ``cos`` of the
-    normal error (1.5 % at 10 degrees).
+    *Projection plane.*  The best-fit plane of §3.1: the PCA plane of ``p_i`` and its same-side
+    candidates, oriented like ``n_i`` (``n_i`` itself when they are collinear or too few). It is robust
+    to noisy input normals, which would otherwise shrink cells by the cosine of their error.
 
     *Duplicates.*  Neighbours whose projection coincides with ``p_i`` (within ``1e-9 R``; exact
     duplicates in particular) are not used as Voronoi sites; instead the cell is *split* equally
@@ -308,14 +309,13 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull") -> np.ndarray:
     coincident); and with ``boundary="hull"`` neighbourhoods whose projection is collinear (a
     sampled curve has no area).
 
-    *Noisy, thick samples.*  The estimate assumes the points lie on a surface.  When the noise
-    across the surface is several times the point spacing, a 3D k-neighbourhood only sees a
-    slab of the noise layer, the projected sites are too sparse and the areas come out too
-    large.  On CGAL's ``sphere_20k_normal.xyz`` (radial noise std 4 % of r, about twice the
-    point spacing) the areas sum to 1.30 x 4 pi r^2 with k = 20, 1.15 with k = 40, 1.06 with
-    k = 80; on a clean sphere the sum is within 0.1 %.  Use a larger ``k`` for such scans.
+    *Noisy, thick samples.*  When the noise across the surface exceeds the point spacing, the plain
+    3D k-neighbourhood only sees a slab of the noise layer, its projection is too sparse and the areas
+    come out too large: on CGAL's ``sphere_20k_normal.xyz`` (radial noise std 4 % of r, about twice the
+    spacing) the plain rule (``candidates=1``) sums to 1.30 x 4 pi r^2, the default to within 2 %
+    (``bench/bench_winding.py`` prints the figure). On a clean sphere both are within 0.1 %.
 
-    Cost: one k-d tree query (scipy, all cores) plus O(n k^2) work in a parallel numba kernel.
+    Cost: one k-d tree query (scipy, all cores) plus O(n (candidates k + k^2)) work in a parallel numba kernel.
 
     Examples
     --------
@@ -338,10 +338,83 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull") -> np.ndarray:
     if n < 2:
         raise ValueError(f"P: need at least 2 points to estimate point areas, got {n}")
     kk = min(k, n - 1)
-    idx = _knn(P, kk)
+    cand = _knn(P, min(n - 1, kk * int(candidates)))
+    sel = np.full((n, kk + 1), -1, np.int64)
+    plane = np.zeros((n, 3))
+    _tangent_neighbours(P, N, cand, kk, sel, plane)
     out = np.zeros(n)
-    _voronoi_areas(P, N, idx, boundary == "hull", out)
+    _voronoi_areas(P, plane, sel, boundary == "hull", out)
     return out
+
+
+@njit(parallel=True, cache=True)
+def _tangent_neighbours(P, N, cand, k, sel, plane):
+    """Per point: the best-fit (PCA) plane of its same-side candidates and their k nearest in that plane.
+
+    Writes the plane normal (oriented like n_i) to ``plane[i]`` and the chosen neighbour indices to
+    ``sel[i]`` (padded with -1). With a thin sample these are the k nearest neighbours of §3.1; in a
+    noisy shell thicker than the spacing they are the points whose *projections* are nearest, which keeps
+    the projected density equal to the surface density.
+    """
+    n = P.shape[0]
+    m = cand.shape[1]
+    for i in prange(n):
+        nx, ny, nz = N[i, 0], N[i, 1], N[i, 2]
+        nn = np.sqrt(nx * nx + ny * ny + nz * nz)
+        if nn == 0.0:
+            continue
+        nx /= nn
+        ny /= nn
+        nz /= nn
+        keep = np.empty(m, np.int64)
+        c = 0
+        for s in range(m):
+            j = cand[i, s]
+            if j == i:
+                continue
+            if N[j, 0] * nx + N[j, 1] * ny + N[j, 2] * nz < 0.0:
+                continue  # opposite normal: the other side of a thin sheet (§3.1)
+            keep[c] = j
+            c += 1
+        vx, vy, vz = nx, ny, nz
+        if c >= 2:
+            mx, my, mz = P[i, 0], P[i, 1], P[i, 2]
+            for s in range(c):
+                j = keep[s]
+                mx += P[j, 0]
+                my += P[j, 1]
+                mz += P[j, 2]
+            mx /= c + 1
+            my /= c + 1
+            mz /= c + 1
+            C = np.zeros((3, 3))
+            for s in range(c + 1):
+                j = keep[s] if s < c else np.int64(i)
+                d0, d1, d2 = P[j, 0] - mx, P[j, 1] - my, P[j, 2] - mz
+                C[0, 0] += d0 * d0
+                C[0, 1] += d0 * d1
+                C[0, 2] += d0 * d2
+                C[1, 1] += d1 * d1
+                C[1, 2] += d1 * d2
+                C[2, 2] += d2 * d2
+            C[1, 0] = C[0, 1]
+            C[2, 0] = C[0, 2]
+            C[2, 1] = C[1, 2]
+            w, U = np.linalg.eigh(C)
+            if w[1] > 0.0:  # a real plane (not collinear or coincident points)
+                vx, vy, vz = U[0, 0], U[1, 0], U[2, 0]
+                if vx * nx + vy * ny + vz * nz < 0.0:
+                    vx, vy, vz = -vx, -vy, -vz
+        plane[i, 0], plane[i, 1], plane[i, 2] = vx, vy, vz
+        dist = np.empty(c)
+        for s in range(c):
+            j = keep[s]
+            d0, d1, d2 = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
+            h = d0 * vx + d1 * vy + d2 * vz
+            dist[s] = d0 * d0 + d1 * d1 + d2 * d2 - h * h
+        o = np.argsort(dist)
+        for s in range(min(k, c)):
+            sel[i, s] = keep[o[s]]
 
 
 def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) -> np.ndarray:

@@ -1,0 +1,29 @@
+"""Operations on winding fields: voxelization and booleans of broken geometry.
+
+Barill et al. 2018, *Fast Winding Numbers for Soups and Clouds*, §4: voxelization by thresholding the fast
+winding number at voxel centers (Fig. 11) and booleans that trim each operand against the winding field of
+the other instead of intersecting triangles (Figs. 12-15).
+"""
+
+from .boolean import mesh_boolean, trim_mesh
+from .voxelize import (
+    load_voxels,
+    save_voxels,
+    voxel_centers,
+    voxel_grid,
+    voxelize,
+    voxels_to_mesh,
+    winding_grid,
+)
+
+__all__ = [
+    "voxelize",
+    "winding_grid",
+    "voxel_grid",
+    "voxel_centers",
+    "save_voxels",
+    "load_voxels",
+    "voxels_to_mesh",
+    "mesh_boolean",
+    "trim_mesh",
+]
