@@ -185,3 +185,18 @@ def test_bad_parameters_and_point_input():
 def test_empty_query_returns_empty():
     V, F = cube()
     assert gsdf.fast_winding_number(V, F, np.zeros((0, 3))).shape == (0,)
+
+
+def test_hierarchical_exact_matches_direct_on_a_broken_soup():
+    V, F = uv_sphere(20, 40)
+    rng = np.random.default_rng(7)
+    F = F[rng.random(len(F)) > 0.3]  # holes
+    F = np.vstack([F, F[:15], F[20:40, ::-1], [[0, 0, 1]]])  # duplicates, flipped copies, a degenerate face
+    Q = np.vstack([rng.uniform(-1.3, 1.3, (1500, 3)), V[:50]])  # include queries on vertices
+    direct = gsdf.winding_number(V, F, Q, method="direct")
+    hier = gsdf.winding_number(V, F, Q, method="hierarchical")
+    np.testing.assert_allclose(hier, direct, atol=1e-11)
+    ex = gsdf.ExactWindingNumber(V, F, leaf_size=2)
+    np.testing.assert_allclose(ex(Q), direct, atol=1e-11)
+    with pytest.raises(ValueError, match="method"):
+        gsdf.winding_number(V, F, Q, method="fast")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def field_to_rgb(values: np.ndarray, n_isolines: int = 16, zero_level: float = 0.0) -> np.ndarray:
+def field_to_rgb(values: np.ndarray, n_isolines: int = 10, zero_level: float = 0.0) -> np.ndarray:
     """Colour a 2D array: blue below ``zero_level`` (inside), red above, white at it; dark isolines.
 
     Returns an (h, w, 3) uint8 image whose first axis is the array's first axis.
@@ -16,7 +16,7 @@ def field_to_rgb(values: np.ndarray, n_isolines: int = 16, zero_level: float = 0
     if not np.isfinite(v).all():
         raise ValueError("values: contains NaN or infinite entries")
     s = v - zero_level
-    scale = np.abs(s).max() or 1.0
+    scale = float(np.percentile(np.abs(s), 99)) or float(np.abs(s).max()) or 1.0  # robust to singular spikes
     t = np.clip(s / scale, -1, 1)
     neg, pos = np.array([0.23, 0.30, 0.75]), np.array([0.71, 0.02, 0.15])
     white = np.ones(3)
@@ -57,4 +57,12 @@ def write_field_slice_png(path, field, axis: int = 2, index: int | None = None, 
         index = vals.shape[axis] // 2
     sl = np.take(vals, index, axis=axis)  # (u, v) with u the first remaining axis
     img = np.flipud(sl.T)  # rows = v (up), cols = u (right)
-    write_png(path, field_to_rgb(img, zero_level=zero_level))
+    write_png(path, field_to_rgb(upsample(img), zero_level=zero_level))
+
+
+def upsample(img: np.ndarray, min_size: int = 512) -> np.ndarray:
+    """Bilinear upsampling of a 2D array so that its shorter side has at least ``min_size`` samples."""
+    from scipy.ndimage import zoom
+
+    k = min_size / min(img.shape)
+    return zoom(img, k, order=1) if k > 1 else img

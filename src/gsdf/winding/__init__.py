@@ -1,5 +1,6 @@
 """Generalized winding numbers: exact direct sums, fast tree-based approximations, point areas."""
 from .exact import winding_number, winding_number_2d, winding_number_points
+from .hierarchical import ExactWindingNumber
 from .fast import (
     FastWindingNumber,
     FastWindingNumberPoints,
@@ -9,6 +10,7 @@ from .fast import (
 
 __all__ = [
     "winding_number",
+    "ExactWindingNumber",
     "winding_number_2d",
     "winding_number_points",
     "FastWindingNumber",

@@ -91,7 +91,7 @@ def triangle_corners(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(V[F].reshape(-1, 9))
 
 
-def winding_number(V, F, Q) -> np.ndarray:
+def winding_number(V, F, Q, method: str = "auto") -> np.ndarray:
     """Exact generalized winding number of a triangle soup at query points.
 
     Parameters
@@ -103,6 +103,10 @@ def winding_number(V, F, Q) -> np.ndarray:
         contributes zero).
     Q : (q, 3) float
         Query points.
+    method : {"auto", "direct", "hierarchical"}
+        ``direct``: the O(q m) sum; ``hierarchical``: the exact divide and conquer of Jacobson et al.
+        2013 (:class:`gsdf.winding.hierarchical.ExactWindingNumber`); ``auto`` picks the direct sum only
+        for a handful of queries.
 
     Returns
     -------
@@ -117,7 +121,14 @@ def winding_number(V, F, Q) -> np.ndarray:
     >>> gsdf.winding_number(V, F, [[0.1, 0.1, 0.1], [2, 2, 2]]).round(6)
     array([1., 0.])
     """
+    if method not in ("auto", "direct", "hierarchical"):
+        raise ValueError(f"method: must be 'auto', 'direct' or 'hierarchical', got {method!r}")
     V, F = as_mesh(V, F)
+    n_queries = np.shape(Q)[0] if np.ndim(Q) == 2 else 1
+    if method == "hierarchical" or (method == "auto" and n_queries > 64 and F.shape[0] > 64):
+        from .hierarchical import ExactWindingNumber
+
+        return ExactWindingNumber(V, F)(Q)
     T = triangle_corners(V, F)
     return map_queries(lambda q, out: _wn_triangles(T, q, out), Q)
 

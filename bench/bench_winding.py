@@ -1,0 +1,179 @@
+"""Winding numbers: gsdf against libigl on the CGAL meshes and clouds, in one process run.
+
+Run in a Python that has gsdf and the anchors (``../shared/tools/install-anchors VENV``):
+
+    VENV/bin/python bench/bench_winding.py            # full run (~15 min on 2 cores)
+    VENV/bin/python bench/bench_winding.py --quick    # fewer queries, no 100^3 voxel check
+
+Prints every table and writes them to bench/RESULTS.md (section "winding").
+Speed is a ratio of medians of 3 runs in this process; accuracy is against exact winding numbers
+(gsdf's hierarchical exact evaluation, cross-checked against igl.winding_number).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import data_dir, machine, median_time, table, write_section  # noqa: E402
+
+import gsdf  # noqa: E402
+
+MESHES = ["bunny00.off", "refined_elephant.off", "holes.off", "elephant-with-holes.off", "mech-holes-shark.off"]
+CLOUDS = ["kitten.xyz", "oni.pwn", "sphere_20k_normal.xyz"]
+
+
+def queries_in_box(X, n, rng, pad=0.1):
+    lo, hi = X.min(0), X.max(0)
+    return rng.uniform(lo - pad * (hi - lo), hi + pad * (hi - lo), (n, 3))
+
+
+def voxel_centres(X, res=100, pad=0.05):
+    lo, hi = X.min(0), X.max(0)
+    lo, hi = lo - pad * (hi - lo), hi + pad * (hi - lo)
+    axes = [lo[d] + (np.arange(res) + 0.5) * (hi[d] - lo[d]) / res for d in range(3)]
+    G = np.meshgrid(*axes, indexing="ij")
+    return np.column_stack([g.ravel() for g in G])
+
+
+def bench_triangles(igl, root, n_queries, voxels, rng):
+    rows = []
+    for name in MESHES:
+        V, F = gsdf.read_mesh(os.path.join(root, "meshes", name))
+        Q = queries_in_box(V, n_queries, rng)
+        Qa = Q[:10000]
+        # accuracy against exact (ours hierarchical; cross-check with libigl's exact)
+        exact = gsdf.ExactWindingNumber(V, F)(Qa)
+        exact_igl = igl.winding_number(V, F, Qa)
+        fast = gsdf.FastWindingNumber(V, F)(Qa)
+        fast_igl = igl.fast_winding_number(V, F, Qa)
+        rms = np.sqrt(np.mean((fast - exact) ** 2))
+        rms_igl = np.sqrt(np.mean((fast_igl - exact) ** 2))
+        # speed, 10^6 queries (build + query; libigl's call includes its own precompute)
+        igl.fast_winding_number(V, F, Q[:10])
+        t_pre, fwn = median_time(lambda: gsdf.FastWindingNumber(V, F))
+        t_q, _ = median_time(lambda: fwn(Q))
+        t_igl, _ = median_time(lambda: igl.fast_winding_number(V, F, Q))
+        # exact speed on 10^4 queries
+        t_ex, _ = median_time(lambda: gsdf.ExactWindingNumber(V, F)(Qa))
+        t_ex_igl, _ = median_time(lambda: igl.winding_number(V, F, Qa))
+        mis = "—"
+        if voxels:
+            C = voxel_centres(V)
+            ex_vox = gsdf.ExactWindingNumber(V, F)(C) > 0.5
+            mis = int(np.count_nonzero((fwn(C) > 0.5) != ex_vox))
+        rows.append([name, len(F), f"{rms:.1e}", f"{rms_igl:.1e}", f"{np.abs(exact - exact_igl).max():.0e}", mis,
+                     f"{t_pre:.3f}", f"{t_q:.3f}", f"{t_igl:.3f}", f"{(t_pre + t_q) / t_igl:.2f}",
+                     f"{t_ex:.3f}", f"{t_ex_igl:.3f}", f"{t_ex / t_ex_igl:.2f}"])
+        print(rows[-1], flush=True)
+    header = ["mesh", "faces", "RMS fast (gsdf)", "RMS fast (igl)", "exact gsdf−igl max", "voxels wrong /100³",
+              "gsdf pre s", f"gsdf {len(Q):.0e} q s", "igl fast s", "ratio gsdf/igl",
+              "gsdf exact 1e4 s", "igl exact 1e4 s", "exact ratio"]
+    return table(header, rows)
+
+
+def bench_points(igl, root, n_queries, rng):
+    rows = []
+    area_line = ""
+    for name in CLOUDS:
+        P, N = gsdf.read_points(os.path.join(root, "points_3", name))
+        t_area, A = median_time(lambda: gsdf.point_areas(P, N), repeat=1)
+        Q = queries_in_box(P, n_queries, rng)
+        Qa = Q[:10000]
+        exact = gsdf.winding_number_points(P, N, Qa, areas=A)
+        Nu = N / np.linalg.norm(N, axis=1, keepdims=True)
+        fast = gsdf.FastWindingNumberPoints(P, N, areas=A)(Qa)
+        fast_igl = igl.fast_winding_number(P, Nu, A, Qa, 2, 2.3)
+        rms = np.sqrt(np.mean((fast - exact) ** 2))
+        rms_igl = np.sqrt(np.mean((fast_igl - exact) ** 2))
+        t_pre, fwn = median_time(lambda: gsdf.FastWindingNumberPoints(P, N, areas=A))
+        t_q, _ = median_time(lambda: fwn(Q))
+        t_igl, _ = median_time(lambda: igl.fast_winding_number(P, Nu, A, Q, 2, 2.3))
+        rows.append([name, len(P), f"{t_area:.3f}", f"{rms:.1e}", f"{rms_igl:.1e}", f"{t_pre:.3f}", f"{t_q:.3f}",
+                     f"{t_igl:.3f}", f"{(t_pre + t_q) / t_igl:.2f}"])
+        print(rows[-1], flush=True)
+        if name.startswith("sphere_20k"):
+            r = np.linalg.norm(P - P.mean(0), axis=1).mean()
+            area_line = (f"Point areas on {name}: sum = {A.sum():.4f}, 4πr² = {4 * np.pi * r * r:.4f} "
+                         f"(r = mean distance to centroid = {r:.4f}): ratio {A.sum() / (4 * np.pi * r * r):.4f}. "
+                         f"The plain 3D k-NN rule (candidates=1) gives "
+                         f"{gsdf.point_areas(P, N, candidates=1).sum() / (4 * np.pi * r * r):.4f} on this noisy shell.")
+    header = ["cloud", "points", "areas s", "RMS fast (gsdf)", "RMS fast (igl, same areas)", "gsdf pre s",
+              f"gsdf {n_queries:.0e} q s", "igl s", "ratio gsdf/igl"]
+    return table(header, rows) + "\n\n" + area_line
+
+
+def bench_growth(igl, n_queries, rng):
+    import trimesh
+
+    rows = []
+    for sub in range(2, 9):
+        m = trimesh.creation.icosphere(subdivisions=sub)
+        V, F = np.asarray(m.vertices), np.asarray(m.faces, dtype=np.int64)
+        Q = queries_in_box(V, n_queries, rng)
+        igl.fast_winding_number(V, F, Q[:10])
+        t_pre, fwn = median_time(lambda: gsdf.FastWindingNumber(V, F))
+        t_q, _ = median_time(lambda: fwn(Q))
+        t_igl, _ = median_time(lambda: igl.fast_winding_number(V, F, Q))
+        P = V / np.linalg.norm(V, axis=1, keepdims=True)  # the vertices as a cloud: exact normals, areas
+        A = np.full(len(P), 4 * np.pi / len(P))
+        t_ppre, fwp = median_time(lambda: gsdf.FastWindingNumberPoints(P, P, areas=A))
+        t_pq, _ = median_time(lambda: fwp(Q))
+        rows.append([len(F), f"{t_pre:.3f}", f"{t_q / len(Q) * 1e6:.2f}", f"{t_igl / len(Q) * 1e6:.2f}",
+                     len(P), f"{t_ppre:.3f}", f"{t_pq / len(Q) * 1e6:.2f}"])
+        print(rows[-1], flush=True)
+    header = ["triangles", "gsdf pre s", "gsdf µs/query", "igl µs/query (incl. pre)", "points", "gsdf pts pre s",
+              "gsdf pts µs/query"]
+    return table(header, rows)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="10^5 queries, no 100^3 voxel check")
+    args = ap.parse_args()
+    import igl
+
+    root = data_dir()
+    rng = np.random.default_rng(0)
+    n_q = 100_000 if args.quick else 1_000_000
+    info = machine()
+    print("machine:", info, flush=True)
+    t0 = time.time()
+    # warm up numba (compile or load from cache) outside the timings
+    V, F = gsdf.read_mesh(os.path.join(root, "meshes", "holes.off"))
+    gsdf.FastWindingNumber(V, F)(V[:5000] + 1e-3)
+    gsdf.ExactWindingNumber(V, F)(V[:5000] + 1e-3)
+    gsdf.FastWindingNumberPoints(V, V, areas=np.ones(len(V)))(V[:5000])
+    tri = bench_triangles(igl, root, n_q, not args.quick, rng)
+    pts = bench_points(igl, root, n_q, rng)
+    growth = bench_growth(igl, 100_000, rng)
+    text = f"""## Winding numbers (bench/bench_winding.py{' --quick' if args.quick else ''})
+
+Machine: {info}. Run took {time.time() - t0:.0f} s. Times are medians of 3 runs in one process.
+
+### Triangle meshes and soups, β = 2, order 2 (RMS against exact on 10⁴ random queries in the padded box)
+
+{tri}
+
+"voxels wrong" counts voxel centres of a 100³ grid whose inside/outside (w > 1/2) differs from the exact
+winding number. "ratio" is (gsdf precompute + query) / libigl (which precomputes inside its call); < 1 is faster.
+
+### Oriented point clouds, β = 2.3, order 2, gsdf point areas given to both
+
+{pts}
+
+### Growth with element count (icosphere meshes / their vertices as a cloud, 10⁵ queries)
+
+{growth}
+"""
+    write_section("winding", text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,70 @@
+"""Shared helpers of the benchmarks: data location, machine description, timing, RESULTS.md sections."""
+
+from __future__ import annotations
+
+import os
+import platform
+import re
+import subprocess
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "RESULTS.md")
+
+
+def data_dir() -> str:
+    """The CGAL data folder (fetched by ../shared/tools/get-cgal-data when missing)."""
+    env = os.environ.get("GSDF_CGAL_DATA")
+    if env:
+        return env
+    default = os.path.expanduser("~/.cache/gsdf-data/cgal/data")
+    if os.path.isdir(os.path.join(default, "meshes")):
+        return default
+    tool = os.path.join(HERE, "..", "..", "shared", "tools", "get-cgal-data")
+    return subprocess.run(["bash", tool], check=True, capture_output=True, text=True).stdout.strip()
+
+
+def machine() -> str:
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            m = re.search(r"model name\s*:\s*(.*)", f.read())
+            if m:
+                cpu = m.group(1)
+    except OSError:
+        pass
+    import numba
+
+    return (f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, numpy {np.__version__}, "
+            f"numba {numba.__version__}, {platform.system()} {platform.release()}")
+
+
+def median_time(fn, repeat: int = 3):
+    """Median wall time of ``fn()`` over ``repeat`` runs, and the last result."""
+    times, out = [], None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t)
+    return float(np.median(times)), out
+
+
+def write_section(name: str, text: str) -> None:
+    """Replace (or append) the section between ``<!-- name:start -->`` and ``<!-- name:end -->``."""
+    start, end = f"<!-- {name}:start -->", f"<!-- {name}:end -->"
+    body = open(RESULTS).read() if os.path.exists(RESULTS) else "# gsdf benchmark results\n\n"
+    block = f"{start}\n{text.rstrip()}\n{end}"
+    if start in body and end in body:
+        body = body[: body.index(start)] + block + body[body.index(end) + len(end):]
+    else:
+        body = body.rstrip() + "\n\n" + block + "\n"
+    with open(RESULTS, "w") as f:
+        f.write(body)
+
+
+def table(header, rows) -> str:
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return "\n".join(out)

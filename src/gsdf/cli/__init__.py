@@ -1,0 +1,1 @@
+"""The ``gsdf`` command line (one module per subcommand)."""

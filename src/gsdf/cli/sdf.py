@@ -1,0 +1,79 @@
+"""``gsdf sdf``: a signed distance grid of a mesh/soup or oriented cloud, signed by the winding number."""
+
+from __future__ import annotations
+
+import os
+
+import click
+import numpy as np
+
+from ._common import bbox_of, beta_option, ensure_parent, load_geometry, normals_option, progress_bar, \
+    quiet_option, report_errors
+
+
+def signed_distance_grid(geo, resolution: int, pad: float, sign: str = "winding", beta=None, quiet=True):
+    """Signed distance on the nodes of a grid around ``geo``; returns a :class:`gsdf.GridField`."""
+    from ..distance import TriangleDistance, point_cloud_distance, signed_distance
+    from ..field import GridField, grid_points, grid_shape
+
+    lo, hi = bbox_of(geo.positions, pad)
+    shape = grid_shape(lo, hi, resolution)
+    hi = lo + (np.array(shape) - 1) * (hi - lo).max() / (resolution - 1)  # cubic cells
+    Q = grid_points(lo, hi, shape)
+    if sign == "pseudonormal":
+        if not geo.is_mesh:
+            raise ValueError("--sign pseudonormal needs a mesh, not a point cloud")
+        d = signed_distance(geo.V, geo.F, Q, sign="pseudonormal")
+    else:
+        bar, update = progress_bar(len(Q), "winding numbers", not quiet)
+        with bar:
+            w = geo.winding(beta)(Q, progress=update)
+        if geo.is_mesh:
+            dist = TriangleDistance(geo.V, geo.F).query(Q)[0]
+        else:
+            dist = point_cloud_distance(geo.P, Q)
+        d = np.where(w > 0.5, -dist, dist)  # Barill et al. 2018 §4: sign from the winding number at 1/2
+    return GridField(d.reshape(shape), lo, hi)
+
+
+@click.command("sdf", help="""Signed distance grid of INPUT (mesh, soup or oriented cloud); negative inside.
+
+|d| is the exact distance to the triangles (or nearest point); the sign comes from the fast winding number
+at 1/2 (robust to holes and soups), or from angle-weighted pseudonormals (closed manifold meshes only).
+Writes the grid as .npz (values, bbox_min, bbox_max); optionally a PNG slice and the zero level set.
+
+\b
+Example:
+  gsdf sdf bunny.off -o bunny_sdf.npz --resolution 128 --png slice.png --surface zero.ply
+""")
+@click.argument("input", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", required=True, help="Output grid (.npz).")
+@click.option("--resolution", type=click.IntRange(2, 2048), default=64, show_default=True,
+              help="Grid nodes along the longest side.")
+@click.option("--pad", type=click.FloatRange(0), default=0.05, show_default=True,
+              help="Box padding, fraction of the diagonal.")
+@click.option("--sign", type=click.Choice(["winding", "pseudonormal"]), default="winding", show_default=True)
+@click.option("--png", default=None, help="Also write a PNG of the middle slice (z) with isolines.")
+@click.option("--surface", "surface_out", default=None, help="Also write the zero level set as a mesh.")
+@beta_option
+@normals_option
+@quiet_option
+@report_errors
+def sdf(input, output, resolution, pad, sign, png, surface_out, beta, estimate_normals, quiet):
+    geo = load_geometry(input, estimate_normals)
+    field = signed_distance_grid(geo, resolution, pad, sign, beta, quiet)
+    ensure_parent(output)
+    field.save(output)
+    click.echo(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")
+    if png:
+        from ..io.image import write_field_slice_png
+
+        write_field_slice_png(png, field)
+        click.echo(f"slice image -> {os.path.abspath(png)}")
+    if surface_out:
+        from ..io import write_mesh
+
+        Vs, Fs = field.isosurface(0.0)
+        ensure_parent(surface_out)
+        write_mesh(surface_out, Vs, Fs)
+        click.echo(f"zero level set ({len(Fs)} triangles) -> {os.path.abspath(surface_out)}")

@@ -1,0 +1,39 @@
+"""Unsigned distance to a point cloud (k-d tree, :class:`scipy.spatial.cKDTree`, all cores).
+
+Cost: O(p log p) to build the tree, about O(log p) per query.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .._checks import as_points
+
+__all__ = ["PointCloudDistance", "point_cloud_distance"]
+
+
+class PointCloudDistance:
+    """Nearest-point distance to the points ``P`` (p, 3), with the k-d tree built once."""
+
+    def __init__(self, P):
+        self.P = as_points(P, "P")
+        self.tree = cKDTree(self.P)
+
+    def query(self, Q):
+        """Returns ``(d (q,), index (q,) int64, closest (q, 3))`` for the query points ``Q`` (q, 3)."""
+        Q = as_points(Q, "Q")
+        d, idx = self.tree.query(Q, k=1, workers=-1)
+        idx = np.asarray(idx, dtype=np.int64)
+        return np.asarray(d, dtype=np.float64), idx, self.P[idx]
+
+
+def point_cloud_distance(P, Q, return_closest: bool = False):
+    """Distance from every query ``Q`` (q, 3) to the nearest of the points ``P`` (p, 3).
+
+    Returns ``d`` (q,), or ``(d, index, closest)`` when ``return_closest`` is true.
+    """
+    d, idx, closest = PointCloudDistance(P).query(Q)
+    if return_closest:
+        return d, idx, closest
+    return d
