@@ -113,6 +113,17 @@ def positive(x, name: str) -> float:
     return v
 
 
+def integer(x, name: str, lo: int = 1) -> int:
+    """Validate an integer (not a bool, no fractional part) that is at least ``lo``."""
+    try:
+        v = int(x)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}") from exc
+    if isinstance(x, bool) or v != x or v < lo:
+        raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}")
+    return v
+
+
 def choice(x, name: str, options) -> str:
     if x not in options:
         raise ValueError(f"{name}: must be one of {sorted(options)}, got {x!r}")

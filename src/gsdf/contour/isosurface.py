@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_points, choice
+from .._checks import as_points, choice, integer
 from ..field import grid_shape
 
 __all__ = ["extract_isosurface", "refine_on_edges"]
@@ -30,16 +30,6 @@ def _check_func(func):
     if not callable(func):
         raise ValueError(f"func: expected a callable f(Q (q, 3)) -> (q,), got {type(func).__name__}")
     return func
-
-
-def _int_at_least(x, name: str, lo: int) -> int:
-    try:
-        v = int(x)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}") from exc
-    if isinstance(x, bool) or v != x or v < lo:
-        raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}")
-    return v
 
 
 def _finite(x, name: str) -> float:
@@ -161,8 +151,8 @@ def refine_on_edges(func, A, B, fa, fb, level: float = 0.5, steps: int = 10, chu
     if B.shape[0] != k:
         raise ValueError(f"A and B: expected the same number of rows, got {k} and {B.shape[0]}")
     level = _finite(level, "level")
-    steps = _int_at_least(steps, "steps", 0)
-    chunk = _int_at_least(chunk, "chunk", 1)
+    steps = integer(steps, "steps", 0)
+    chunk = integer(chunk, "chunk", 1)
     fa = np.asarray(fa, dtype=np.float64).copy()
     fb = np.asarray(fb, dtype=np.float64).copy()
     for name, f in (("fa", fa), ("fb", fb)):
@@ -266,10 +256,10 @@ def extract_isosurface(
 
     _check_func(func)
     lo, hi = _check_bbox(bbox_min, bbox_max)
-    resolution = _int_at_least(resolution, "resolution", 2)
+    resolution = integer(resolution, "resolution", 2)
     level = _finite(level, "level")
-    bisection_steps = _int_at_least(bisection_steps, "bisection_steps", 0)
-    chunk = _int_at_least(chunk, "chunk", 1)
+    bisection_steps = integer(bisection_steps, "bisection_steps", 0)
+    chunk = integer(chunk, "chunk", 1)
     choice(inside, "inside", {"above", "below"})
 
     shape = grid_shape(lo, hi, resolution)

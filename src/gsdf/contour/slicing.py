@@ -15,7 +15,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from .._checks import as_points, choice
+from .._checks import as_points, choice, integer
 from ..field import grid_shape
 from .isosurface import (
     _check_bbox,
@@ -23,7 +23,6 @@ from .isosurface import (
     _edges_of_vertices,
     _evaluate,
     _finite,
-    _int_at_least,
     refine_on_edges,
 )
 
@@ -179,7 +178,7 @@ def slice_contours(
     from skimage.measure import find_contours
 
     _check_func(func)
-    axis = _int_at_least(axis, "axis", 0)
+    axis = integer(axis, "axis", 0)
     if axis > 2:
         raise ValueError(f"axis: must be 0, 1 or 2, got {axis}")
     ua, va = (axis + 1) % 3, (axis + 2) % 3
@@ -190,10 +189,10 @@ def slice_contours(
     Z = Z.astype(np.float64)
     if not np.isfinite(Z).all():
         raise ValueError("z_values: contains NaN or infinite values")
-    resolution = _int_at_least(resolution, "resolution", 2)
+    resolution = integer(resolution, "resolution", 2)
     level = _finite(level, "level")
-    bisection_steps = _int_at_least(bisection_steps, "bisection_steps", 0)
-    chunk = _int_at_least(chunk, "chunk", 1)
+    bisection_steps = integer(bisection_steps, "bisection_steps", 0)
+    chunk = integer(chunk, "chunk", 1)
     choice(inside, "inside", {"above", "below"})
 
     flat_hi = hi.copy()

@@ -27,7 +27,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .._checks import as_mesh, as_points
+from .._checks import as_mesh, as_points, integer
+from ..spatial.morton import morton_order
 from ..spatial.bvh import build_triangle_bvh
 
 __all__ = ["TriangleDistance", "unsigned_distance", "closest_point_triangle", "brute_force_distance"]
@@ -423,37 +424,6 @@ def _pack(T, degenerate):
     return D
 
 
-@njit(parallel=True, cache=True)
-def _morton_codes(Q, lo, scale):
-    n = Q.shape[0]
-    code = np.empty(n, np.uint64)
-    for i in prange(n):
-        c = np.uint64(0)
-        for a in range(3):
-            g = (Q[i, a] - lo[a]) * scale[a]
-            if g < 0.0:
-                g = 0.0
-            elif g > 1023.0:
-                g = 1023.0
-            x = np.uint64(g)
-            # spread the 10 bits of x to every third bit
-            x = (x | (x << np.uint64(16))) & np.uint64(0x030000FF)
-            x = (x | (x << np.uint64(8))) & np.uint64(0x0300F00F)
-            x = (x | (x << np.uint64(4))) & np.uint64(0x030C30C3)
-            x = (x | (x << np.uint64(2))) & np.uint64(0x09249249)
-            c |= x << np.uint64(a)
-        code[i] = c
-    return code
-
-
-def _morton_order(Q: np.ndarray) -> np.ndarray:
-    """Permutation sorting the points along a 3D Morton (Z-order) curve, 10 bits per axis."""
-    lo = Q.min(axis=0)
-    ext = Q.max(axis=0) - lo
-    scale = np.where(ext > 0, 1023.0 / np.where(ext > 0, ext, 1.0), 0.0)
-    return np.argsort(_morton_codes(Q, lo, scale), kind="stable")
-
-
 class TriangleDistance:
     """Unsigned distance to a triangle mesh or soup, with the tree built once.
 
@@ -474,12 +444,7 @@ class TriangleDistance:
 
     def __init__(self, V, F, leaf_size: int = 8):
         V, F = as_mesh(V, F)
-        try:
-            leaf = int(leaf_size)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"leaf_size: expected a positive integer, got {leaf_size!r}") from exc
-        if leaf != leaf_size or leaf < 1:
-            raise ValueError(f"leaf_size: expected a positive integer, got {leaf_size!r}")
+        leaf = integer(leaf_size, "leaf_size", 1)
         self.V = V
         self.F = F
         self.bvh = build_triangle_bvh(V, F, leaf)
@@ -503,7 +468,7 @@ class TriangleDistance:
             e = min(nq, s + chunk)
             Qc = Q[s:e]
             _nearest_kernel(
-                Qc, _morton_order(Qc), self._D, b.order, b.start, b.end, b.right, b.lo, b.hi,
+                Qc, morton_order(Qc), self._D, b.order, b.start, b.end, b.right, b.lo, b.hi,
                 d2[s:e], face[s:e], closest[s:e], bary[s:e] if want_bary else scratch[: e - s],
             )
         return d2, face, closest, bary

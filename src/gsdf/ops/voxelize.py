@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_mesh, as_normals, as_points, as_weights, positive
+from .._checks import as_mesh, as_normals, as_points, as_weights, integer, positive
 
 __all__ = [
     "voxel_grid",
@@ -31,16 +31,6 @@ __all__ = [
 # ----------------------------------------------------------------------------------------------------------
 # grid geometry
 # ----------------------------------------------------------------------------------------------------------
-
-
-def _resolution(resolution) -> int:
-    try:
-        r = int(resolution)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"resolution: expected an integer, got {resolution!r}") from exc
-    if r != resolution or r < 1:
-        raise ValueError(f"resolution: must be a positive integer, got {resolution!r}")
-    return r
 
 
 def _bbox(bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
@@ -83,7 +73,7 @@ def voxel_grid(bbox_min, bbox_max, resolution) -> tuple[tuple[int, int, int], np
     (4, 2, 2)
     """
     lo, hi = _bbox(bbox_min, bbox_max)
-    r = _resolution(resolution)
+    r = integer(resolution, "resolution", 1)
     ext = hi - lo
     h = float(ext.max()) / r
     n = np.maximum(1, np.ceil(ext / h - 1e-9)).astype(np.int64)
@@ -194,7 +184,7 @@ def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max
     (8, 8, 8)
     """
     wn, X = _winding_object(mesh, points, beta)
-    r = _resolution(resolution)
+    r = integer(resolution, "resolution", 1)
     try:
         pad = float(pad)
     except (TypeError, ValueError) as exc:

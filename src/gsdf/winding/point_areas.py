@@ -18,23 +18,13 @@ import numpy as np
 from numba import njit, prange
 from scipy.spatial import cKDTree
 
-from .._checks import as_normals, as_points
+from .._checks import as_normals, as_points, integer
 
 __all__ = ["point_areas", "estimate_normals"]
 
 # Neighbours whose projection lies within _DUP_REL * (neighbourhood radius) of p_i are treated
 # as coincident with p_i (exact duplicates in particular), see point_areas' Notes.
 _DUP_REL = 1e-9
-
-
-def _check_k(k, name: str = "k") -> int:
-    try:
-        kk = int(k)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: expected a positive integer, got {k!r}") from exc
-    if kk != k or kk < 1:
-        raise ValueError(f"{name}: expected a positive integer, got {k!r}")
-    return kk
 
 
 def _knn(P: np.ndarray, k: int) -> np.ndarray:
@@ -332,7 +322,7 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 4) 
     P = as_points(P, "P")
     n = P.shape[0]
     N = as_normals(N, n, "N")
-    k = _check_k(k)
+    k = integer(k, "k", 1)
     if boundary not in ("hull", "square"):
         raise ValueError(f"boundary: must be one of ['hull', 'square'], got {boundary!r}")
     if n < 2:
@@ -454,8 +444,8 @@ def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) ->
     """
     P = as_points(P, "P")
     n = P.shape[0]
-    k = _check_k(k)
-    chunk = _check_k(chunk, "chunk")
+    k = integer(k, "k", 1)
+    chunk = integer(chunk, "chunk", 1)
     if n < 3:
         raise ValueError(f"P: need at least 3 points to fit planes, got {n}")
     c = None
