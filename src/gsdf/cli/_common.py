@@ -74,6 +74,20 @@ def progress_bar(total: int, desc: str, enabled: bool = True):
     return bar, update
 
 
+def counting(func, desc: str, enabled: bool = True):
+    """Wrap a field ``func(Q)`` so that a progress bar counts the evaluated points (total unknown up front)."""
+    from tqdm import tqdm
+
+    bar = tqdm(desc=desc, unit="pt", unit_scale=True, disable=not enabled, leave=False)
+
+    def wrapped(Q):
+        out = func(Q)
+        bar.update(len(Q))
+        return out
+
+    return bar, wrapped
+
+
 def report_errors(fn):
     """Turn the library's ValueError / FileNotFoundError into a clean CLI error (exit code 1)."""
 

@@ -7,8 +7,8 @@ import os
 import click
 import numpy as np
 
-from ._common import bbox_of, beta_option, ensure_parent, load_geometry, normals_option, parse_floats, \
-    report_errors
+from ._common import bbox_of, beta_option, counting, ensure_parent, load_geometry, normals_option, parse_floats, \
+    quiet_option, report_errors
 
 
 @click.command("slice", help="""Slice INPUT into closed contours of its winding-number solid, written as SVG.
@@ -31,8 +31,9 @@ Example:
               help="SVG layers on top of each other, or slices stacked side by side.")
 @beta_option
 @normals_option
+@quiet_option
 @report_errors
-def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, estimate_normals):
+def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, estimate_normals, quiet):
     from ..contour import slice_contours, write_svg
 
     geo = load_geometry(input, estimate_normals)
@@ -42,7 +43,9 @@ def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, es
     if zs is None:
         n = layers or 10
         zs = list(lo[ax] + (hi[ax] - lo[ax]) * (np.arange(n) + 0.5) / n)
-    contours = slice_contours(geo.winding(beta), zs, lo, hi, resolution=resolution, axis=ax)
+    bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
+    with bar:
+        contours = slice_contours(func, zs, lo, hi, resolution=resolution, axis=ax)
     ensure_parent(output)
     write_svg(output, contours, z_values=zs, layout=layout)
     n_loops = sum(len(c) for c in contours)

@@ -6,7 +6,8 @@ import os
 
 import click
 
-from ._common import bbox_of, beta_option, ensure_parent, load_geometry, normals_option, report_errors
+from ._common import bbox_of, beta_option, counting, ensure_parent, load_geometry, normals_option, quiet_option, \
+    report_errors
 
 
 @click.command("surface", help="""Extract the surface of INPUT as the winding number's 1/2 level set.
@@ -29,15 +30,17 @@ Example:
 @click.option("--pad", type=click.FloatRange(0), default=0.05, show_default=True)
 @beta_option
 @normals_option
+@quiet_option
 @report_errors
-def surface(input, output, resolution, level, bisection, pad, beta, estimate_normals):
+def surface(input, output, resolution, level, bisection, pad, beta, estimate_normals, quiet):
     from ..contour import extract_isosurface
     from ..io import write_mesh
 
     geo = load_geometry(input, estimate_normals)
     lo, hi = bbox_of(geo.positions, pad)
-    V, F = extract_isosurface(geo.winding(beta), lo, hi, resolution=resolution, level=level,
-                              bisection_steps=bisection)
+    bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
+    with bar:
+        V, F = extract_isosurface(func, lo, hi, resolution=resolution, level=level, bisection_steps=bisection)
     ensure_parent(output)
     write_mesh(output, V, F)
     click.echo(f"{geo.describe()}\nsurface: {len(V)} vertices, {len(F)} triangles -> {os.path.abspath(output)}")
