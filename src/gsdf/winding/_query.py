@@ -32,7 +32,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         if not np.isfinite(q).all():
             bad = s + int(np.argmax(~np.isfinite(q).all(axis=1)))
             raise ValueError(f"Q: contains NaN or infinite coordinates (first at row {bad})")
-        if coherent and e - s > 4096:
+        if coherent and e - s > 4096 and not _already_coherent(q):
             o = morton_order(q)
             tmp = np.empty(e - s)
             kernel(np.ascontiguousarray(q[o]), tmp)
@@ -42,3 +42,12 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         if progress is not None:
             progress(e, n)
     return out
+
+
+def _already_coherent(q: np.ndarray) -> bool:
+    """True when consecutive queries are already close (grids in C order, scanlines): sorting would not pay."""
+    step = max(1, q.shape[0] // 2048)
+    a = q[: -1 : step]
+    b = q[1::step][: a.shape[0]]
+    diag = float(np.linalg.norm(q.max(axis=0) - q.min(axis=0))) or 1.0
+    return float(np.median(np.linalg.norm(a - b, axis=1))) < 0.01 * diag
