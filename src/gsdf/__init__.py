@@ -25,6 +25,10 @@ _EXPORTS = {
     "write_svg": "contour",
     "voxelize": "ops", "winding_grid": "ops", "save_voxels": "ops", "voxels_to_mesh": "ops",
     "mesh_boolean": "ops",
+    # the signed heat method on surfaces (Feng & Crane 2024)
+    "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
+    "level_set_curves": "heat", "region_boundary_curves": "heat",
+    "read_curves": "io.curves", "write_curves": "io.curves",
 }
 
 __all__ = sorted(_EXPORTS)

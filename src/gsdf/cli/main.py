@@ -7,6 +7,7 @@ import click
 from .. import __version__
 from .boolean import boolean
 from .demo import demo
+from .heat_surface import heat_surface
 from .sdf import sdf
 from .slice import slice_cmd
 from .surface import surface
@@ -24,7 +25,7 @@ def main():
     """
 
 
-for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd):
+for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat_surface):
     main.add_command(command)
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,68 @@
+"""Small generated domains for examples, tests and benchmarks of the surface heat method."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def grid_mesh(n: int, size: float = 1.0, jitter: float = 0.0, seed: int = 0, delaunay: bool = False):
+    """Triangulated square ``[-size, size]²`` (z = 0) with ``n`` cells per side.
+
+    ``jitter`` moves interior vertices by up to ``jitter`` cell widths (uniform), ``delaunay`` re-triangulates
+    (scipy.spatial.Delaunay) instead of splitting every cell along its diagonal. Faces are counter-clockwise
+    (normals +z). Returns ``V (N, 3), F (M, 3)``.
+
+    Example
+    -------
+    >>> V, F = grid_mesh(4)
+    >>> V.shape, F.shape
+    ((25, 3), (32, 3))
+    """
+    x = np.linspace(-size, size, n + 1)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    V = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], 1)
+    if jitter:
+        rng = np.random.default_rng(seed)
+        inner = (np.abs(V[:, :2]) < size * (1 - 1e-9)).all(1)
+        V[inner, :2] += rng.uniform(-jitter, jitter, (int(inner.sum()), 2)) * (2 * size / n)
+    if delaunay:
+        from scipy.spatial import Delaunay
+
+        F = Delaunay(V[:, :2]).simplices.astype(np.int64)
+    else:
+        idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+        a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+        F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    e1, e2 = V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]
+    cw = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
+    F[cw] = F[cw][:, ::-1]
+    return V, F
+
+
+def sphere_mesh(subdivisions: int = 3, radius: float = 1.0):
+    """Icosphere (outward normals) with vertices on the sphere of ``radius``; 20·4^s faces.
+
+    Example
+    -------
+    >>> V, F = sphere_mesh(1)
+    >>> len(F)
+    80
+    """
+    t = (1 + 5 ** 0.5) / 2
+    V = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t], [0, 1, -t],
+                  [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], dtype=np.float64)
+    F = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
+                  [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
+                  [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]], dtype=np.int64)
+    for _ in range(subdivisions):
+        E = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+        uniq, inv = np.unique(E, axis=0, return_inverse=True)
+        inv = inv.ravel()
+        mid = len(V) + inv.reshape(3, -1).T                    # (m, 3): midpoints of edges 01, 12, 20
+        V = np.concatenate([V, 0.5 * (V[uniq[:, 0]] + V[uniq[:, 1]])])
+        a, b, c = F.T
+        ab, bc, ca = mid.T
+        F = np.concatenate([np.stack([a, ab, ca], 1), np.stack([b, bc, ab], 1), np.stack([c, ca, bc], 1),
+                            np.stack([ab, bc, ca], 1)])
+    V = V / np.linalg.norm(V, axis=1, keepdims=True) * radius
+    return V, F
