@@ -29,6 +29,9 @@ _EXPORTS = {
     "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
     "level_set_curves": "heat", "region_boundary_curves": "heat",
     "read_curves": "io.curves", "write_curves": "io.curves",
+    # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
+    "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
+    "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "tori",
 }
 
 __all__ = sorted(_EXPORTS)

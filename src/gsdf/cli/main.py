@@ -8,9 +8,11 @@ from .. import __version__
 from .boolean import boolean
 from .demo import demo
 from .heat_surface import heat_surface
+from .render import render
 from .sdf import sdf
 from .slice import slice_cmd
 from .surface import surface
+from .tori import tori
 from .voxelize import voxelize
 from .winding import winding
 
@@ -25,7 +27,7 @@ def main():
     """
 
 
-for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat_surface):
+for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat_surface, tori, render):
     main.add_command(command)
 
 if __name__ == "__main__":  # pragma: no cover
