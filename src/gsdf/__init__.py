@@ -29,6 +29,10 @@ _EXPORTS = {
     "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
     "level_set_curves": "heat", "region_boundary_curves": "heat",
     "read_curves": "io.curves", "write_curves": "io.curves",
+    # the signed heat method in volumes (grids, tets) and morphology
+    "signed_heat_volume": "heat.volume", "YukawaTree": "heat.volume",
+    "TetField": "field", "marching_tetrahedra": "field",
+    "offset_surface": "ops.morphology", "dilate_erode": "ops.morphology", "erode_dilate": "ops.morphology",
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
     "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
     "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "tori",

@@ -54,6 +54,7 @@ class GridField(Field):
         self.values = np.ascontiguousarray(values)
         self.bbox_min = lo
         self.bbox_max = hi
+        self.meta: dict = {}
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -86,10 +87,13 @@ class GridField(Field):
                     out += wx * wy * wz * v[i0[:, 0] + dx, i0[:, 1] + dy, i0[:, 2] + dz]
         return out
 
-    def isosurface(self, level: float = 0.0):
+    def isosurface(self, level: float = 0.0, close: bool = False):
         """Marching cubes (scikit-image) at ``level``; returns ``(V, F)`` in world coordinates.
 
-        Raises ValueError if the level is outside the range of the field.
+        With ``close=True`` a level set that reaches the box is capped on the box faces (the grid is padded
+        with one layer of nodes above the level and the cap vertices are projected back onto the box), so the
+        result is always a closed, edge-manifold surface. Raises ValueError if the level is outside the range
+        of the field.
         """
         from skimage.measure import marching_cubes
 
@@ -97,12 +101,38 @@ class GridField(Field):
         vmin, vmax = float(self.values.min()), float(self.values.max())
         if not (vmin < level < vmax):
             raise ValueError(f"level {level} is outside the field's range [{vmin:.6g}, {vmax:.6g}]: no surface")
-        verts, faces, _, _ = marching_cubes(self.values, level=level, spacing=tuple(self.spacing))
-        return verts + self.bbox_min, faces.astype(np.int64)
+        if not close:
+            verts, faces, _, _ = marching_cubes(self.values, level=level, spacing=tuple(self.spacing))
+            return verts + self.bbox_min, faces.astype(np.int64)
+        pad = level + max(vmax - level, 1e-12)
+        vals = np.pad(self.values, 1, mode="constant", constant_values=pad)
+        verts, faces, _, _ = marching_cubes(vals, level=level, spacing=tuple(self.spacing))
+        verts = np.clip(verts - self.spacing + self.bbox_min, self.bbox_min, self.bbox_max)
+        return verts, faces.astype(np.int64)
+
+    def isosurfaces(self, levels, close: bool = False):
+        """Several level sets at once: a list of ``(V, F)``, one per level (e.g. offsets ±1 %, ±3 %)."""
+        return [self.isosurface(float(v), close=close) for v in np.atleast_1d(np.asarray(levels, dtype=float))]
 
     def save(self, path) -> None:
-        """Write the field to a ``.npz`` file (``values``, ``bbox_min``, ``bbox_max``)."""
-        np.savez_compressed(path, values=self.values, bbox_min=self.bbox_min, bbox_max=self.bbox_max, kind="grid")
+        """Write the field: ``.npz`` (``values``, ``bbox_min``, ``bbox_max``), ``.vtk`` (legacy structured
+        points, binary, opens in ParaView) or ``.vtu`` (meshio hexahedra with point data ``values``)."""
+        p = str(path).lower()
+        if p.endswith(".vtk"):
+            _write_vtk_structured_points(path, self.values, self.bbox_min, self.spacing)
+        elif p.endswith(".vtu"):
+            import meshio
+
+            P = self.grid_points()
+            nx, ny, nz = self.shape
+            idx = np.arange(nx * ny * nz).reshape(self.shape)
+            c = idx[:-1, :-1, :-1].ravel()
+            sx, sy = ny * nz, nz
+            hexes = np.column_stack([c, c + sx, c + sx + sy, c + sy, c + 1, c + sx + 1, c + sx + sy + 1, c + sy + 1])
+            meshio.write(path, meshio.Mesh(P, [("hexahedron", hexes)], point_data={"values": self.values.ravel()}))
+        else:
+            np.savez_compressed(path, values=self.values, bbox_min=self.bbox_min, bbox_max=self.bbox_max,
+                                kind="grid")
 
     @classmethod
     def load(cls, path) -> "GridField":
@@ -128,3 +158,164 @@ def grid_shape(bbox_min, bbox_max, resolution) -> tuple[int, int, int]:
     ext = np.asarray(bbox_max, float) - np.asarray(bbox_min, float)
     h = positive(ext.max(), "bounding box size") / (r - 1)
     return tuple(int(max(2, np.ceil(e / h - 1e-9) + 1)) for e in ext)
+
+
+def _write_vtk_structured_points(path, values, origin, spacing) -> None:
+    """Legacy VTK STRUCTURED_POINTS, binary big-endian float64; x varies fastest as VTK expects."""
+    nx, ny, nz = values.shape
+    header = (f"# vtk DataFile Version 3.0\ngsdf field\nBINARY\nDATASET STRUCTURED_POINTS\n"
+              f"DIMENSIONS {nx} {ny} {nz}\nORIGIN {' '.join(repr(float(v)) for v in origin)}\n"
+              f"SPACING {' '.join(repr(float(v)) for v in spacing)}\nPOINT_DATA {nx * ny * nz}\n"
+              f"SCALARS values double 1\nLOOKUP_TABLE default\n")
+    with open(path, "wb") as f:
+        f.write(header.encode("ascii"))
+        f.write(np.ascontiguousarray(values.transpose(2, 1, 0)).astype(">f8").tobytes())
+        f.write(b"\n")
+
+
+class TetField(Field):
+    """Values on the vertices of a tetrahedral mesh: barycentric evaluation and marching tetrahedra.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    tets : (m, 4) int
+    values : (n,) float
+    delaunay : scipy.spatial.Delaunay, optional
+        Point locator whose simplices are ``tets`` (what :func:`gsdf.signed_heat_volume` with ``domain="tet"``
+        builds). Without it a Delaunay tetrahedralization of ``vertices`` is built on first evaluation, which
+        locates points exactly when ``tets`` is itself Delaunay.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gsdf.field import TetField
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.]])
+    >>> f = TetField(V, [[0, 1, 2, 3]], V[:, 0])
+    >>> float(f([[0.25, 0.25, 0.25]])[0])
+    0.25
+    """
+
+    def __init__(self, vertices, tets, values, delaunay=None):
+        self.vertices = as_points(vertices, "vertices")
+        T = np.asarray(tets)
+        if T.ndim != 2 or T.shape[1] != 4 or len(T) == 0:
+            raise ValueError(f"tets: expected shape (m, 4) with m > 0, got {T.shape}")
+        if not np.issubdtype(T.dtype, np.integer) or T.min() < 0 or T.max() >= len(self.vertices):
+            raise ValueError("tets: expected integer vertex indices within range")
+        self.tets = np.ascontiguousarray(T, dtype=np.int64)
+        v = np.asarray(values, dtype=np.float64).ravel()
+        if v.shape[0] != len(self.vertices) or not np.isfinite(v).all():
+            raise ValueError(f"values: expected {len(self.vertices)} finite values, got shape {np.shape(values)}")
+        self.values = v
+        self._delaunay = delaunay
+        self.meta: dict = {}
+
+    @property
+    def bbox_min(self):
+        return self.vertices.min(axis=0)
+
+    @property
+    def bbox_max(self):
+        return self.vertices.max(axis=0)
+
+    def _locator(self):
+        if self._delaunay is None:
+            from scipy.spatial import Delaunay
+
+            self._delaunay = Delaunay(self.vertices)
+        return self._delaunay
+
+    def __call__(self, Q) -> np.ndarray:
+        """Barycentric (piecewise linear) interpolation at ``Q`` (q, 3); outside the mesh: nearest vertex."""
+        Q = as_points(Q, "Q", allow_empty=True)
+        D = self._locator()
+        s = D.find_simplex(Q)
+        out = np.empty(len(Q))
+        inside = s >= 0
+        if inside.any():
+            Tr = D.transform[s[inside]]
+            b = np.einsum("qij,qj->qi", Tr[:, :3], Q[inside] - Tr[:, 3])
+            bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
+            out[inside] = (bary * self.values[D.simplices[s[inside]]]).sum(axis=1)
+        if (~inside).any():
+            from scipy.spatial import cKDTree
+
+            out[~inside] = self.values[cKDTree(self.vertices).query(Q[~inside])[1]]
+        return out
+
+    def isosurface(self, level: float = 0.0):
+        """Marching tetrahedra at ``level``: a shared-vertex triangle mesh ``(V, F)``, oriented so that
+        normals point toward increasing values (outward for a signed distance)."""
+        return marching_tetrahedra(self.vertices, self.tets, self.values, level)
+
+    def isosurfaces(self, levels):
+        return [self.isosurface(float(v)) for v in np.atleast_1d(np.asarray(levels, dtype=float))]
+
+    def save(self, path) -> None:
+        """``.npz`` (vertices, tets, values) or ``.vtu``/``.vtk`` (meshio tetra with point data ``values``)."""
+        p = str(path).lower()
+        if p.endswith(".vtu") or p.endswith(".vtk"):
+            import meshio
+
+            meshio.write(path, meshio.Mesh(self.vertices, [("tetra", self.tets)], point_data={"values": self.values}))
+        else:
+            np.savez_compressed(path, vertices=self.vertices, tets=self.tets, values=self.values, kind="tet")
+
+    @classmethod
+    def load(cls, path) -> "TetField":
+        try:
+            with np.load(path) as d:
+                return cls(d["vertices"], d["tets"], d["values"])
+        except (OSError, KeyError, ValueError) as exc:
+            raise ValueError(f"{path}: not a gsdf tet field file ({exc})") from exc
+
+
+def marching_tetrahedra(X, T, values, level: float = 0.0):
+    """Level set of a piecewise-linear function on a tet mesh (vectorized marching tetrahedra).
+
+    Each tet with vertices on both sides contributes one triangle (1 vertex apart) or a quad split in two
+    (2 and 2); crossing points are shared per mesh edge, so the result is closed and edge-manifold away from
+    the mesh boundary. Triangles are oriented along the gradient of ``values``.
+    """
+    X = np.asarray(X, float)
+    T = np.asarray(T, np.int64)
+    s = np.asarray(values, float) - float(level)
+    if not (s.min() < 0 < s.max()):
+        raise ValueError(f"level {level} is outside the field's range [{s.min() + level:.6g}, {s.max() + level:.6g}]: no surface")
+    pos = s[T] > 0
+    npos = pos.sum(axis=1)
+    tris = []
+    # one vertex apart: lone vertex and the three others
+    for k, lone_is_pos in ((1, True), (3, False)):
+        sel = npos == k
+        if not sel.any():
+            continue
+        P = pos[sel] if lone_is_pos else ~pos[sel]
+        order = np.argsort(~P, axis=1, kind="stable")  # lone vertex first
+        Ts = np.take_along_axis(T[sel], order, axis=1)
+        a = Ts[:, 0]
+        tris.append(np.stack([np.stack([a, Ts[:, 1]], 1), np.stack([a, Ts[:, 2]], 1), np.stack([a, Ts[:, 3]], 1)], 1))
+    sel = npos == 2
+    if sel.any():
+        order = np.argsort(~pos[sel], axis=1, kind="stable")  # two positive first
+        Ts = np.take_along_axis(T[sel], order, axis=1)
+        a, b, c, d = Ts.T
+        e_ac, e_ad, e_bd, e_bc = (np.stack(p, 1) for p in ((a, c), (a, d), (b, d), (b, c)))
+        tris.append(np.stack([e_ac, e_ad, e_bd], 1))
+        tris.append(np.stack([e_ac, e_bd, e_bc], 1))
+    E = np.concatenate(tris)  # (k, 3 corners, 2 endpoints)
+    Es = np.sort(E.reshape(-1, 2), axis=1)
+    uniq, inv = np.unique(Es, axis=0, return_inverse=True)
+    sa, sb = s[uniq[:, 0]], s[uniq[:, 1]]
+    t = sa / (sa - sb)
+    V = X[uniq[:, 0]] + t[:, None] * (X[uniq[:, 1]] - X[uniq[:, 0]])
+    F = inv.reshape(-1, 3)
+    # orient along the gradient: the endpoint with the larger value of any corner edge shows the direction
+    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    e = E[:, 0]
+    up = np.where((s[e[:, 1]] > s[e[:, 0]])[:, None], X[e[:, 1]] - X[e[:, 0]], X[e[:, 0]] - X[e[:, 1]])
+    flip = (n * up).sum(axis=1) < 0
+    F[flip] = F[flip][:, [0, 2, 1]]
+    keep = np.linalg.norm(n, axis=1) > 0
+    return V, F[keep].astype(np.int64)

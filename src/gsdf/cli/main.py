@@ -7,6 +7,7 @@ import click
 from .. import __version__
 from .boolean import boolean
 from .demo import demo
+from .heat import heat
 from .heat_surface import heat_surface
 from .render import render
 from .sdf import sdf
@@ -27,7 +28,7 @@ def main():
     """
 
 
-for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat_surface, tori, render):
+for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render):
     main.add_command(command)
 
 if __name__ == "__main__":  # pragma: no cover
