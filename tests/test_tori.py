@@ -197,7 +197,7 @@ def test_pat_bad_input():
     with pytest.raises(ValueError, match="rows"):
         PointsAsTori(P, N[:-1])
     with pytest.raises(ValueError, match="estimator"):
-        PointsAsTori(P, N, estimator="learned")
+        PointsAsTori(P, N, estimator="transformer")
     pat = PointsAsTori(P, N)
     with pytest.raises(ValueError, match="NaN"):
         pat.signed_distance([[0, 0, np.nan]])
@@ -252,6 +252,20 @@ def test_point_knn_matches_scipy_and_is_approximate_within_eps():
     np.testing.assert_array_equal(ir[fin], i2[fin])
     d, i = PointKNN(P[:5]).query(Q[:3], 10)  # k larger than the cloud: clipped
     assert d.shape == (3, 5)
+    # Morton-ordered dense queries: the bound seeded from the previous query of a block leaves results exact
+    from gsdf.spatial.morton import morton_order
+
+    Q = np.vstack([P[RNG.choice(3000, 2000)] + RNG.normal(scale=0.05, size=(2000, 3)), RNG.uniform(-4, 4, (500, 3))])
+    Q = Q[morton_order(Q)]
+    d2, i2 = cKDTree(P).query(Q, k=40)
+    d, i = PointKNN(P).query(Q, 40)
+    np.testing.assert_allclose(d, d2, atol=1e-12)
+    for rad in (0.2, 0.6):
+        dr, ir = PointKNN(P).query(Q, 40, k_min=8, radius=rad)
+        want = np.where((np.arange(40) < 8) | (d2 <= rad), d2, np.inf)
+        np.testing.assert_allclose(dr, want, atol=1e-12)
+        fin = np.isfinite(dr)
+        np.testing.assert_array_equal(ir[fin], i2[fin])
 
 
 def test_booleans_and_offsets_of_two_point_clouds():

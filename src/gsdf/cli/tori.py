@@ -39,8 +39,8 @@ Examples:
 """)
 @click.argument("points", type=click.Path(dir_okay=False))
 @click.option("-o", "--output", "out", required=True, help="Output: mesh (.ply/.obj/.off/.stl) or .npz.")
-@click.option("--estimator", type=click.Choice(["jet"]), default="jet", show_default=True,
-              help="Coefficient estimator (jet: weighted least squares).")
+@click.option("--estimator", type=click.Choice(["jet", "learned"]), default="jet", show_default=True,
+              help="Coefficient estimator (jet: weighted least squares; learned: the shipped network, §5.1.2).")
 @click.option("--grid", type=click.IntRange(4, 1024), default=None,
               help="Grid nodes along the longest side (default 64 for meshes; required for an .npz grid).")
 @click.option("--offsets", default=None, help="Comma-separated level values to contour (default 0).")

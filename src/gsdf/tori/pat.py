@@ -1,7 +1,8 @@
 """Points as Tori: pointwise generalized signed distance of an oriented point cloud (thesis ch. 5, §5.1).
 
 Precomputation: one torus per point from six height-field coefficients (§5.1.1, Eqs. 5.2–5.4) estimated on its
-k = 64 nearest neighbours (``estimator="jet"``: weighted least squares, :mod:`gsdf.tori.fit`).
+k = 64 nearest neighbours (``estimator="jet"``: weighted least squares, :mod:`gsdf.tori.fit`;
+``estimator="learned"``: the trained network of §5.1.2, :mod:`gsdf.tori.learned`).
 Evaluation (§5.1.3, Eqs. 5.6–5.7):
 
     φ(x) = Σ_i g_i(x) exp(−λ_x (‖x − p_i‖ − σ_x)) / Σ_i exp(−λ_x (‖x − p_i‖ − σ_x)),
@@ -135,8 +136,11 @@ class PointsAsTori:
     N : (n, 3) float
         Outward normals (normalized internally). Rows with zero normals are dropped and exact duplicate
         points are merged (their normals averaged); ``None`` raises ``ValueError``.
-    estimator : {"jet"}
-        Coefficient estimator: weighted least-squares jet fitting (:func:`gsdf.tori.fit.jet_coefficients`).
+    estimator : {"jet", "learned"}
+        Coefficient estimator: weighted least-squares jet fitting (:func:`gsdf.tori.fit.jet_coefficients`), or
+        the learned regressor of §5.1.2 (:mod:`gsdf.tori.learned`; a small network trained by
+        ``scripts/train_pat.py``, weights shipped in ``gsdf/tori/pat_weights.npz``, evaluated in numpy; it
+        corrects the jet coefficients, so ``normal_weight``/``ridge`` do not apply to it).
     k : int
         Neighbours per fit (64 in the thesis); the cloud needs at least ``k`` distinct points.
     C : float
@@ -165,7 +169,7 @@ class PointsAsTori:
     def __init__(self, P, N, estimator: str = "jet", k: int = 64, C: float = 64.0, r_eval=None,
                  k_eval: int = 64, k_fallback: int = 32, normal_weight: float = 1.0, ridge: float = 1e-3,
                  curvature_cap: float = 4.0, kd_eps: float = 0.0, _state=None):
-        self.estimator = choice(estimator, "estimator", {"jet"})
+        self.estimator = choice(estimator, "estimator", {"jet", "learned"})
         self.k = integer(k, "k", lo=6)
         self.C = positive(C, "C")
         self.k_eval = integer(k_eval, "k_eval", lo=1)
@@ -184,7 +188,12 @@ class PointsAsTori:
         self.P, self.N = _clean_cloud(P, N, self.k)
         self._blend = NeighbourBlend(self.P, self.C, r_eval, self.k_eval, self.k_fallback, kd_eps=kd_eps)
         d, idx = self._blend.knn.query(self.P, self.k)
-        self.coefficients = jet_coefficients(self.P, self.N, idx, d, normal_weight, ridge)
+        if self.estimator == "learned":
+            from .learned import learned_coefficients
+
+            self.coefficients = learned_coefficients(self.P, self.N, idx, d)
+        else:
+            self.coefficients = jet_coefficients(self.P, self.N, idx, d, normal_weight, ridge)
         scale = float(np.linalg.norm(self.P.max(0) - self.P.min(0))) or 1.0
         h = np.median(d[:, -1])
         self.tori = coefficients_to_tori(self.P, self.N, self.coefficients, k_floor=1e-6 / scale,
