@@ -66,3 +66,57 @@ def sphere_mesh(subdivisions: int = 3, radius: float = 1.0):
                             np.stack([ab, bc, ca], 1)])
     V = V / np.linalg.norm(V, axis=1, keepdims=True) * radius
     return V, F
+
+
+def anisotropic_mesh(n: int, stretch: float = 8.0, jitter: float = 0.3, seed: int = 0):
+    """A sliver mesh of ``[-1, 1]²``: a jittered (n+1)² grid triangulated by Delaunay *after* shrinking x by
+    ``stretch``, so in the true metric the triangles are long, very obtuse slivers spanning several columns
+    (far from Delaunay). Used to exercise intrinsic Delaunay flipping (§9.4, Fig. 22).
+
+    Example
+    -------
+    >>> V, F = anisotropic_mesh(8)
+    >>> V.shape
+    (81, 3)
+    """
+    from scipy.spatial import Delaunay
+
+    x = np.linspace(-1, 1, n + 1)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    V = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], 1)
+    rng = np.random.default_rng(seed)
+    inner = (np.abs(V[:, :2]) < 1 - 1e-9).all(1)
+    V[inner, :2] += rng.uniform(-jitter, jitter, (int(inner.sum()), 2)) * (2 / n)
+    F = Delaunay(V[:, :2] * [1 / stretch, 1]).simplices.astype(np.int64)
+    e1, e2 = V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]
+    cw = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
+    F[cw] = F[cw][:, ::-1]
+    return V, F
+
+
+def polygon_sdf_2d(P, loop_xy, chunk: int = 256):
+    """Exact signed distance (negative inside, winding number test) of 2D points P (n, 2) to the closed polygon
+    ``loop_xy`` (k, 2) (first point repeated at the end or not).
+
+    Example
+    -------
+    >>> sq = np.array([[0., 0], [1, 0], [1, 1], [0, 1], [0, 0]])
+    >>> [round(float(v), 3) for v in polygon_sdf_2d(np.array([[0.5, 0.5], [2, 0.5]]), sq)]
+    [-0.5, 1.0]
+    """
+    P = np.asarray(P, np.float64)[:, :2]
+    Q = np.asarray(loop_xy, np.float64)[:, :2]
+    if not np.allclose(Q[0], Q[-1]):
+        Q = np.concatenate([Q, Q[:1]])
+    A, B = Q[:-1], Q[1:]
+    d = np.full(len(P), np.inf)
+    wn = np.zeros(len(P))
+    for s in range(0, len(A), chunk):
+        a, b = A[s:s + chunk], B[s:s + chunk]
+        ab = b - a
+        ap = P[:, None, :] - a[None]
+        t = np.clip((ap * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-300), 0, 1)
+        d = np.minimum(d, np.linalg.norm(ap - t[..., None] * ab[None], axis=-1).min(1))
+        bp = P[:, None, :] - b[None]
+        wn += np.arctan2(ap[..., 0] * bp[..., 1] - ap[..., 1] * bp[..., 0], (ap * bp).sum(-1)).sum(1)
+    return np.where(np.abs(wn) > np.pi, -d, d)

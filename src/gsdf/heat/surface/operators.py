@@ -30,6 +30,9 @@ class TriangleMeshOperators:
     ----------
     V : (n, 3) float64
     F : (m, 3) int64, validated, no degenerate faces
+    P : (m, 3, 3) float64, optional
+        Per-face corner positions to use instead of ``V[F]`` (planar layouts of an intrinsic triangulation,
+        :mod:`gsdf.heat.surface.intrinsic`); then only vertex-based sources are meaningful.
 
     Attributes
     ----------
@@ -48,8 +51,11 @@ class TriangleMeshOperators:
     True
     """
 
-    def __init__(self, V: np.ndarray, F: np.ndarray):
+    def __init__(self, V: np.ndarray, F: np.ndarray, P: np.ndarray | None = None):
         self.V, self.F = V, F
+        # intrinsic triangulations (§9.4) pass per-face planar layouts P instead of using V[F]; the operators
+        # below only need per-face corner positions, so they run unchanged in these face frames
+        self.intrinsic = P is not None
         n, m = len(V), len(F)
         self.n_vertices, self.n_faces = n, m
         a, b = F, F[:, NEXT]                                   # slot a: edge (v_a, v_{a+1})
@@ -62,7 +68,8 @@ class TriangleMeshOperators:
         self.face_edges = inv.reshape(m, 3).astype(np.int64)
         self.slot_sign = np.where(a < b, 1.0, -1.0)
 
-        P = V[F]                                               # (m, 3, 3) corner positions
+        P = V[F] if P is None else P                           # (m, 3, 3) corner positions
+        self.P = P
         E = P[:, NEXT] - P                                     # slot vectors v_a -> v_{a+1}
         cr = np.cross(E[:, 0], -E[:, 2])                       # (v1-v0) x (v2-v0)
         dbl = np.linalg.norm(cr, axis=1)
@@ -132,7 +139,7 @@ class TriangleMeshOperators:
         Eq. 3; the boundary term n·Y is omitted as in the paper). With the PSD cotan Laplacian C, ``C φ = b``
         is the least-squares fit ∇φ ≈ Y of Eq. 2."""
         F = self.F
-        E = self.V[F[:, NEXT]] - self.V[F]                      # slot vectors
+        E = self.P[:, NEXT] - self.P                            # slot vectors
         # |f| ∇λ_k = ½ n × (v_{k+2} - v_{k+1}) = ½ n × E[:, k+1]
         G = 0.5 * np.cross(self.normals[:, None, :], E[:, NEXT])
         contrib = np.einsum("fkj,fj->fk", G, Y)

@@ -16,7 +16,7 @@ import scipy.sparse as sp
 def gradient_operator(ops) -> sp.csr_matrix:
     """Per-face gradient of vertex functions, (3m, n): rows 3f..3f+2 give ∇φ on face f."""
     F, V = ops.F, ops.V
-    E = V[F[:, [1, 2, 0]]] - V[F]                              # slot vectors
+    E = ops.P[:, [1, 2, 0]] - ops.P                            # slot vectors (per-face layouts if intrinsic)
     # ∇λ_k = n × (v_{k+2} - v_{k+1}) / (2 area) = n × E[:, k+1] / (2 area)
     G = np.cross(ops.normals[:, None, :], E[:, [1, 2, 0]]) / (2 * ops.areas[:, None, None])
     m = len(F)

@@ -33,7 +33,16 @@ class SurfaceSignedHeatSolver:
         express the orientation flip, so curve normals near the flip are arbitrary.
         Faces with repeated vertices or zero area raise ValueError (remove them first).
     t_coef : float
-        Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6).
+        Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6) of the input mesh.
+    intrinsic_delaunay : bool
+        Build the operators on an intrinsic Delaunay triangulation of the input (§9.4, Fig. 22): Lawson edge
+        flips on edge lengths only (:mod:`gsdf.heat.surface.intrinsic`), operators from per-face planar
+        layouts; output stays per input vertex. This helps on meshes with obtuse slivers. Sources are then
+        restricted to what lives on vertices and original edges: vertex polylines (or surface points that are
+        vertices), closed unsigned vertex polylines, vertex point sources; the original edges carrying curves
+        are kept unflippable (the triangulation is re-flipped, and refactorized, for a curve set whose edges
+        were flipped away; cached per edge set). Surface points inside faces/edges raise ValueError;
+        ``compute_distance_l1`` raises NotImplementedError.
 
     Components of the mesh without sources get an arbitrary (near-constant) value; unreferenced vertices
     get 0 before the final shift.
@@ -51,7 +60,7 @@ class SurfaceSignedHeatSolver:
     -0.5
     """
 
-    def __init__(self, V, F, t_coef: float = 1.0):
+    def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False):
         V, F = _checks.as_mesh(V, F)
         self.t_coef = _checks.positive(t_coef, "t_coef")
         rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
@@ -65,8 +74,27 @@ class SurfaceSignedHeatSolver:
             raise ValueError(f"F: face {int(np.flatnonzero(bad)[0])} has zero area ({int(bad.sum())} degenerate "
                              "faces); remove degenerate triangles first")
         self.V, self.F = V, F
-        self.ops = TriangleMeshOperators(V, F)
-        self.t = self.t_coef * self.ops.h ** 2
+        self.intrinsic_delaunay = bool(intrinsic_delaunay)
+        self.input_ops = TriangleMeshOperators(V, F)
+        self.t = self.t_coef * self.input_ops.h ** 2
+        self._states: dict = {}
+        self._state_key = None
+        if not self.intrinsic_delaunay:
+            self._set_ops(self.input_ops)
+        # with intrinsic_delaunay the triangulation is built on first use: by the first solve (with its curve
+        # edges kept unflippable), or without fixed edges when an operator is accessed before any solve
+
+    def __getattr__(self, name):
+        d = self.__dict__
+        if name in SurfaceSignedHeatSolver._STATE and d.get("intrinsic_delaunay") and d.get("_state_key") is None:
+            self._use_state(self._key(np.zeros((0, 2), np.int64)), None)
+            return getattr(self, name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    _STATE = ("ops", "C", "_Mv", "_eps", "_vec", "_poisson", "_cache")
+
+    def _set_ops(self, ops):
+        self.ops = ops
         self.C = self.ops.cotan_laplacian().tocsc()
         Mv = self.ops.vertex_mass()
         self._Mv = np.where(Mv > 0, Mv, Mv.mean())               # unreferenced vertices: keep the system regular
@@ -75,6 +103,27 @@ class SurfaceSignedHeatSolver:
         self._vec = None
         self._poisson = None
         self._cache: dict = {}
+
+    def _use_state(self, key, fixed_pairs):
+        """Switch to the intrinsic triangulation with the original edges ``fixed_pairs`` unflippable (built and
+        cached on first use, with its own factorizations)."""
+        if key == self._state_key:
+            return
+        if self._state_key is not None:
+            self._states[self._state_key] = tuple(getattr(self, a) for a in self._STATE)
+        if key in self._states:
+            for a, v in zip(self._STATE, self._states[key]):
+                setattr(self, a, v)
+        else:
+            from .intrinsic import intrinsic_delaunay, layout
+
+            Fi, L, nflips = intrinsic_delaunay(self.V, self.F, fixed_pairs)
+            ops = TriangleMeshOperators(self.V, Fi, P=layout(L))
+            ops.n_flips = nflips
+            self._set_ops(ops)
+            if len(self._states) >= 4:
+                self._states.pop(next(iter(self._states)))
+        self._state_key = key
 
     # ------------------------------------------------------------------ steps
     @property
@@ -106,7 +155,7 @@ class SurfaceSignedHeatSolver:
 
     # ------------------------------------------------------------------ public
     def compute_distance(self, curves, points=(), curve_signs=None, level_set_constraint: str = "zero",
-                         soft_weight=None) -> np.ndarray:
+                         soft_weight=None, curve_normals=None) -> np.ndarray:
         """Generalized signed distance at the vertices, negative inside.
 
         Parameters
@@ -129,6 +178,11 @@ class SurfaceSignedHeatSolver:
         soft_weight : float, optional
             Replace the hard constraint of ``"zero"`` / ``"multiple"`` by the penalty λ Σ (φ(p_i) - φ(p_0))²
             over the nodes (§7.1): solves ``(C + λAᵀA)φ = b``. Ignored with ``"none"``.
+        curve_normals : list, optional
+            Explicit surface normals for the signed curves (one entry per curve: None = face normals, a (3,)
+            vector, or one (3,) per curve point), used instead of the face normals in N = T × n (Eq. 11) — the
+            way to orient curves on nonorientable domains (§9.4), where face normals flip across the seam.
+            Negating them negates φ. Not available with ``intrinsic_delaunay=True``.
 
         Notes
         -----
@@ -155,8 +209,71 @@ class SurfaceSignedHeatSolver:
         lam = None
         if soft_weight is not None:
             lam = _checks.positive(soft_weight, "soft_weight")
-        S = build_sources(self.ops, curves, points, curve_signs)
+        if self.intrinsic_delaunay:
+            if curve_normals is not None:
+                raise ValueError("curve_normals: not available with intrinsic_delaunay=True")
+            curves, points = self._to_intrinsic(curves, points, curve_signs)
+        S = build_sources(self.ops, curves, points, curve_signs, curve_normals)
         return self._solve_sources(S, mode, lam)
+
+    def _to_intrinsic(self, curves, points, curve_signs):
+        """Express the sources as vertex polylines / vertex points of the input mesh and switch to an intrinsic
+        triangulation that contains all curve edges."""
+        from .sources import _parse_curve, parse_points
+
+        ops0 = self.input_ops
+        if curves is None:
+            curves = []
+        if isinstance(curves, np.ndarray) and curves.ndim == 1 and np.issubdtype(curves.dtype, np.integer):
+            curves = [curves]
+        curves = list(curves)
+        signs = [True] * len(curves) if curve_signs is None else [bool(x) for x in curve_signs]
+        out, pairs = [], []
+        for k, c in enumerate(curves):
+            parsed = _parse_curve(c, ops0, k)
+            if parsed[0] == "v":
+                vs = parsed[1]
+            else:
+                _, fs, bs = parsed
+                onehot = (bs > 0).sum(1) == 1
+                if not onehot.all():
+                    q = int(np.flatnonzero(~onehot)[0])
+                    raise ValueError(f"curves[{k}][{q}]: with intrinsic_delaunay=True curves must run along mesh "
+                                     "edges (vertex polylines, or surface points at vertices); this point lies "
+                                     "inside a face or an edge")
+                vs = ops0.F[fs, np.argmax(bs, axis=1)]
+            keep = np.concatenate([[True], vs[1:] != vs[:-1]])
+            vs = vs[keep]
+            e = ops0.edge_lookup(vs[:-1], vs[1:])
+            if np.any(e < 0):
+                q = int(np.flatnonzero(e < 0)[0])
+                raise ValueError(f"curves[{k}]: vertices {vs[q]} and {vs[q + 1]} (points {q}, {q + 1}) are not "
+                                 "joined by a mesh edge (intrinsic_delaunay=True needs curves along edges)")
+            if k < len(signs) and not signs[k] and vs[0] != vs[-1]:
+                raise ValueError(f"curves[{k}]: open unsigned curves are not supported with "
+                                 "intrinsic_delaunay=True (close the curve or use the input triangulation)")
+            out.append(vs)
+            pairs.append(np.stack([vs[:-1], vs[1:]], 1))
+        pts = parse_points(points, ops0) if points is not None else None
+        if pts is not None:
+            ids, w = pts
+            onehot = (w > 0).sum(1) == 1
+            if not onehot.all():
+                q = int(np.flatnonzero(~onehot)[0])
+                raise ValueError(f"points[{q}]: with intrinsic_delaunay=True point sources must be vertices")
+            points = ids[np.arange(len(ids)), np.argmax(w, 1)]
+        P = np.concatenate(pairs) if pairs else np.zeros((0, 2), np.int64)
+        P = np.unique(np.sort(P, axis=1), axis=0)
+        if self._state_key is None:
+            self._use_state(self._key(P), P)
+            return out, points
+        # are all curve edges (same vertex pair, same length) present in the current triangulation?
+        e = self.ops.edge_lookup(P[:, 0], P[:, 1])
+        ok = np.all(e >= 0) and np.allclose(self.ops.edge_len[e], ops0.edge_len[ops0.edge_lookup(P[:, 0], P[:, 1])],
+                                            rtol=1e-9, atol=0)
+        if not ok:
+            self._use_state(self._key(P), P)
+        return out, points
 
     def _solve_sources(self, S, mode, lam):
         """Steps I–III for parsed sources (Alg. 1), with the level-set handling of §7.1."""
@@ -191,6 +308,8 @@ class SurfaceSignedHeatSolver:
         """
         from .l1 import integrate_l1
 
+        if self.intrinsic_delaunay:
+            raise NotImplementedError("compute_distance_l1 is not available with intrinsic_delaunay=True")
         S = build_sources(self.ops, curves, points, curve_signs)
         Y = self.unit_field(self.diffuse(S))
         Phi = integrate_l1(self.ops, Y)
@@ -225,6 +344,8 @@ class SurfaceSignedHeatSolver:
         phi0 = np.asarray(phi0, dtype=np.float64)
         if phi0.shape != (self.ops.n_vertices,) or not np.isfinite(phi0).all():
             raise ValueError(f"phi0: expected {self.ops.n_vertices} finite values, got shape {phi0.shape}")
+        if self.intrinsic_delaunay:
+            curves, points = self._to_intrinsic(curves, points, None)
         S = build_sources(self.ops, curves, points, None)
         ids, w, isv = self._all_nodes(S)
         fixed = np.zeros(self.ops.n_vertices, bool)
@@ -239,11 +360,11 @@ class SurfaceSignedHeatSolver:
         consecutive nodes share a face (the form potpourri3d requires)."""
         from .sources import _bary_curve_segments, _parse_curve
 
-        parsed = _parse_curve(curve, self.ops, 0)
+        parsed = _parse_curve(curve, self.input_ops, 0)
         if parsed[0] == "v":
             vs = parsed[1]
             return [(int(v), np.zeros(0)) for v in vs]
-        ids, w, _, _, _ = _bary_curve_segments(self.ops, parsed[1], parsed[2], "curve", return_faces=True)
+        ids, w, _, _, _ = _bary_curve_segments(self.input_ops, parsed[1], parsed[2], "curve", return_faces=True)
         return list(zip(ids, w))
 
     def split_segments(self, curve) -> list:
@@ -253,7 +374,7 @@ class SurfaceSignedHeatSolver:
 
         nodes = self.split_curve(curve)
         if len(nodes[0][1]) == 0:
-            vf = self.ops.vertex_faces()
+            vf = self.input_ops.vertex_faces()
             nodes2 = []
             for v, _ in nodes:
                 r = vf.indptr[v]
@@ -263,10 +384,10 @@ class SurfaceSignedHeatSolver:
             nodes = nodes2
         out = []
         for (fa, ba), (fb, bb) in zip(nodes[:-1], nodes[1:]):
-            common = _faces_of_node(self.ops, fa, ba) & _faces_of_node(self.ops, fb, bb)
+            common = _faces_of_node(self.input_ops, fa, ba) & _faces_of_node(self.input_ops, fb, bb)
             f = min(common)
             pa, pb = ba @ self.V[self.F[fa]], bb @ self.V[self.F[fb]]
-            out.append([(f, _bary_in_face(self.ops, pa, f)), (f, _bary_in_face(self.ops, pb, f))])
+            out.append([(f, _bary_in_face(self.input_ops, pa, f)), (f, _bary_in_face(self.input_ops, pb, f))])
         return out
 
     # ------------------------------------------------------------------ constraints (§7.1)

@@ -258,8 +258,42 @@ def _bary_curve_segments(ops, faces, bary, name, return_faces=False):
 
 
 # ---------------------------------------------------------------------------------------------- X0
-def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs):
-    """Parse and validate all sources; return a :class:`Sources` with X0 (Eq. 11, App. A)."""
+def _parse_normals(curve_normals, k, n_nodes, name="curve_normals"):
+    """Normals of curve k: None, or unit (n_nodes, 3) per node (a single (3,) vector is broadcast)."""
+    if curve_normals is None:
+        return None
+    nk = curve_normals[k]
+    if nk is None:
+        return None
+    a = np.asarray(nk, dtype=np.float64)
+    if a.shape == (3,):
+        a = np.broadcast_to(a, (n_nodes, 3))
+    if a.shape != (n_nodes, 3):
+        raise ValueError(f"{name}[{k}]: expected a (3,) vector or one per curve point ({n_nodes}, 3), "
+                         f"got shape {a.shape}")
+    nrm = np.linalg.norm(a, axis=1)
+    if not np.isfinite(a).all() or np.any(nrm == 0):
+        raise ValueError(f"{name}[{k}]: normals must be finite and nonzero")
+    return a / nrm[:, None]
+
+
+def _edge_vectors_to_basis(ops, e, N):
+    """Complex edge-basis coordinates of 3D vectors N (k, 3) at edges e (k,), in the basis of the first face of
+    each edge (the faces agree except across orientation flips)."""
+    fe = ops.face_edges.ravel()
+    order = np.argsort(fe, kind="stable")
+    first = order[np.searchsorted(fe[order], e)]
+    f, a = first // 3, first % 3
+    return np.einsum("kj,kj->k", ops.slot_u[f, a], N) + 1j * np.einsum("kj,kj->k", ops.slot_w[f, a], N)
+
+
+def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve_normals=None):
+    """Parse and validate all sources; return a :class:`Sources` with X0 (Eq. 11, App. A).
+
+    ``curve_normals`` (optional, one entry per curve: None, a (3,) vector, or (k, 3) per curve point) replaces
+    the face normals n in N = T × n (Eq. 11) for signed curves, e.g. on nonorientable domains; segment normals
+    are the mean of the two end-point normals (for vertex polylines) or the normal of the input point nearest
+    to the segment midpoint (for surface-point curves, whose segments may be split)."""
     if curves is None:
         curves = []
     if isinstance(curves, np.ndarray) and curves.ndim == 1 and np.issubdtype(curves.dtype, np.integer):
@@ -271,6 +305,12 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs):
         signs = [bool(s) for s in curve_signs]
         if len(signs) != len(curves):
             raise ValueError(f"curve_signs: has {len(signs)} entries but there are {len(curves)} curves")
+    if curve_normals is not None:
+        if isinstance(curve_normals, np.ndarray) and curve_normals.shape == (3,):
+            curve_normals = [curve_normals] * len(curves)      # one vector for every curve
+        curve_normals = list(curve_normals)
+        if len(curve_normals) != len(curves):
+            raise ValueError(f"curve_normals: has {len(curve_normals)} entries but there are {len(curves)} curves")
     pts = parse_points(points, ops)
     if not curves and pts is None:
         raise ValueError("curves: no sources given (empty curve list and no points)")
@@ -296,7 +336,13 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs):
             keep = ~same
             a, b, e = vs[:-1][keep], vs[1:][keep], e[keep]
             ln = ops.edge_len[e]
-            if signs[k]:
+            nrm = _parse_normals(curve_normals, k, len(vs)) if signs[k] else None
+            if nrm is not None:
+                nseg = (nrm[:-1] + nrm[1:])[keep]
+                N = np.cross(ops.V[b] - ops.V[a], nseg / np.linalg.norm(nseg, axis=1, keepdims=True))
+                edge_e.append(e)
+                edge_val.append(_edge_vectors_to_basis(ops, e, N))
+            elif signs[k]:
                 s = np.where(a < b, 1.0, -1.0)
                 edge_e.append(e)
                 edge_val.append(-1j * s * ln)                 # along an edge: N = -i|γ| in the edge basis
@@ -319,12 +365,28 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs):
             if not signs[k]:
                 raise ValueError(f"curves[{k}]: unsigned curves must run along mesh edges (give vertex indices)")
             ids, w, P, seg_face, seg_edge = _bary_curve_segments(ops, fs, bs, f"curves[{k}]")
+            nrm = _parse_normals(curve_normals, k, len(fs))
+            if nrm is not None:
+                Pin = np.einsum("kj,kjd->kd", bs, ops.V[ops.F[fs]])
+
+                def seg_normal(mid):
+                    return nrm[np.argmin(np.linalg.norm(Pin[None] - mid[:, None], axis=2), axis=1)]
             if seg_face:
                 ff = np.array([s[0] for s in seg_face])
                 D = np.array([s[2] - s[1] for s in seg_face])
                 face_segs_f.append(ff)
-                face_segs_N.append(np.cross(D, ops.normals[ff]))   # N|γ| = (pB - pA) × n, Eq. 11
-            if seg_edge:
+                nf = ops.normals[ff] if nrm is None else seg_normal(
+                    0.5 * np.array([s[1] + s[2] for s in seg_face]))
+                face_segs_N.append(np.cross(D, nf))                # N|γ| = (pB - pA) × n, Eq. 11
+            if seg_edge and nrm is not None:
+                ee = np.array([s[0] for s in seg_edge], np.int64)
+                i, j = ops.edges[ee, 0], ops.edges[ee, 1]
+                sg = np.array([s[1] for s in seg_edge])
+                D = (ops.V[j] - ops.V[i]) * (sg * np.array([s[2] for s in seg_edge]) / ops.edge_len[ee])[:, None]
+                N = np.cross(D, seg_normal(0.5 * (ops.V[i] + ops.V[j])))
+                edge_e.append(ee)
+                edge_val.append(_edge_vectors_to_basis(ops, ee, N))
+            elif seg_edge:
                 edge_e.append(np.array([s[0] for s in seg_edge], np.int64))
                 edge_val.append(-1j * np.array([s[1] * s[2] for s in seg_edge]))
             onehot = (w > 0).sum(1) == 1
@@ -355,7 +417,7 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs):
 
 def _corner_frames(ops):
     """Per corner (f, k): unit direction e1 of slot k (from v_k to v_{k+1}) and w = n × e1."""
-    E = ops.V[ops.F[:, NEXT]] - ops.V[ops.F]
+    E = ops.P[:, NEXT] - ops.P
     e1 = E / ops.slot_len[..., None]
     w = np.cross(ops.normals[:, None, :], e1)
     return e1, w
@@ -395,7 +457,7 @@ def _unsigned_curve_source(ops, segs, ends, X0):
     cnt = count[ops.face_edges]                               # (m, 3)
     f, a = np.nonzero(cnt > 0)
     if len(f):
-        E = ops.V[F[f, NEXT[a]]] - ops.V[F[f, a]]
+        E = ops.P[f, NEXT[a]] - ops.P[f, a]
         N = np.cross(ops.normals[f], E) * cnt[f, a][:, None]  # into the face, length-weighted
         ee, zz = ops.slot_coords(f, N)
         mask = np.ones_like(ee, dtype=bool)
