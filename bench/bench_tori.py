@@ -206,10 +206,10 @@ def real_clouds(args):
 
     root = os.path.join(data_dir(), "points_3")
     rows = []
-    for name in ("kitten.xyz", "oni.pwn", "sphere_20k_normal.xyz"):
+    for name, est in [(n, e) for n in ("kitten.xyz", "oni.pwn", "sphere_20k_normal.xyz") for e in ("jet", "learned")]:
         P, N = gsdf.read_points(os.path.join(root, name))
         t = time.perf_counter()
-        pat = PointsAsTori(P, N)
+        pat = PointsAsTori(P, N, estimator=est)
         tfit = time.perf_counter() - t
         t = time.perf_counter()
         V, F = pat.isosurface(0.0, resolution=args.grid)
@@ -230,16 +230,18 @@ def real_clouds(args):
             near = np.abs(np.linalg.norm(X - c, axis=1) - rho) < 0.1 * rho
             extra = f"mean error vs exact sphere (ρ={rho:.4f}) {e.mean():.5f}, within 0.1ρ of the surface {e[near].mean():.5f}"
             for mname, cls in (("SSPD", SmoothedSignedPlanarDistance), ("SHC", SignedHopfCole)):
+                if est == "learned":
+                    break
                 ee = np.abs(cls(P, N)(X) - (np.linalg.norm(X - c, axis=1) - rho))
                 extra += f"; {mname} {ee.mean():.5f}"
-        png = os.path.join(HERE, f"tori_real_{os.path.splitext(name)[0]}.png")
+        png = os.path.join(HERE, f"tori_real_{os.path.splitext(name)[0]}_{est}.png")
         t = time.perf_counter()
         render_png(pat, png, width=240, height=240)
         trend = time.perf_counter() - t
-        rows.append([name, len(P), f"{tfit:.2f}", f"{tiso:.1f}", len(F), "yes" if closed else f"no: {bad} open edges inside the box, {cut} where it leaves the box",
+        rows.append([name, est, len(P), f"{tfit:.2f}", f"{tiso:.1f}", len(F), "yes" if closed else f"no: {bad} open edges inside the box, {cut} where it leaves the box",
                      f"{trend:.1f}", extra])
         print(rows[-1], flush=True)
-    return table(["cloud", "points", "fit s", f"zero set {args.grid}³ s", "triangles", "closed", "render s", "accuracy"], rows)
+    return table(["cloud", "estimator", "points", "fit s", f"zero set {args.grid}³ s", "triangles", "closed", "render s", "accuracy"], rows)
 
 
 # ---------------------------------------------------------------------------------------------- speed

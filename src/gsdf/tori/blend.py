@@ -2,8 +2,10 @@
 
 Per query x (Eq. 5.7): σ_x = ½ max_i ‖x − p_i‖ (the farthest point of a cloud is a vertex of its convex hull,
 so only hull vertices are scanned) and λ_x = C/σ_x with C = 64. The sums of Eqs. 5.6, 5.8, 5.9 run over the
-points within R_eval of x, falling back to the 32 nearest when fewer lie within R_eval (§5.1.3); candidates
-come from one tree query (:class:`PointKNN`, a BVH walked nearest-child first) of the ``k_eval`` (default 64) nearest points, which caps the work per query.
+points within R_eval of x (at most ``k_eval``, default 64, the nearest), falling back to the 32 nearest when
+fewer lie within R_eval (§5.1.3). Near the cloud the points within R_eval come from a fixed-radius grid
+(:mod:`gsdf.spatial.radius_grid`), far from it the 32 nearest from a BVH walk warm-started by the previous
+(Morton-sorted) query; both in one numba-parallel kernel.
 Exponents are shifted by the nearest distance d_min instead of σ_x: the self-normalized ratios are unchanged
 and the shift is exact in the LogSumExp formulas (we add d_min back), while no weight can underflow.
 """
@@ -16,6 +18,7 @@ from numba import njit, prange
 
 from .._checks import as_points
 from ..spatial.bvh import build_bvh
+from ..spatial.radius_grid import build_radius_grid, gather_within
 
 CHUNK = 1 << 16
 
@@ -75,6 +78,151 @@ def _knn_kernel(Q, Ps, order, lo, hi, right, start, end, k, shrink, k_min, r2, o
         for m in range(k):
             out_d[j, m] = np.sqrt(bd[m])
             out_i[j, m] = order[bi[m]]
+
+
+@njit(cache=True, inline="always")
+def _insert(bd, bi, k, d2, e):
+    m = k - 1
+    while m > 0 and bd[m - 1] > d2:
+        bd[m] = bd[m - 1]
+        bi[m] = bi[m - 1]
+        m -= 1
+    bd[m] = d2
+    bi[m] = e
+
+
+@njit(cache=True)
+def _select(cd, ci, n, k):
+    """Partially order (cd, ci)[:n] so that its k smallest cd come first (quickselect, Hoare partition)."""
+    lo, hi = 0, n - 1
+    while lo < hi:
+        piv = cd[(lo + hi) // 2]
+        i, j = lo, hi
+        while i <= j:
+            while cd[i] < piv:
+                i += 1
+            while cd[j] > piv:
+                j -= 1
+            if i <= j:
+                cd[i], cd[j] = cd[j], cd[i]
+                ci[i], ci[j] = ci[j], ci[i]
+                i += 1
+                j -= 1
+        if k - 1 <= j:
+            hi = j
+        elif k - 1 >= i:
+            lo = i
+        else:
+            return
+
+
+@njit(cache=True)
+def _nearest_walk(x0, x1, x2, Ps, lo, hi, right, start, end, k, wb, shrink, bd, bi, stack):
+    """k nearest points of x (tree order indices) into bd (squared distances, ascending) and bi: depth-first
+    over the BVH, nearer child first, boxes pruned against min(k-th distance, wb) (÷ shrink for approximate
+    search); only points with squared distance <= wb are accepted."""
+    for m in range(k):
+        bd[m] = np.inf
+        bi[m] = 0
+    stack[0] = 0
+    sp = 1
+    while sp > 0:
+        sp -= 1
+        node = stack[sp]
+        if _box_d2(lo, hi, node, x0, x1, x2) * shrink > min(bd[k - 1], wb):
+            continue
+        rr = right[node]
+        if rr < 0:
+            for e in range(start[node], end[node]):
+                u, v, w = Ps[e, 0] - x0, Ps[e, 1] - x1, Ps[e, 2] - x2
+                d2 = u * u + v * v + w * w
+                if d2 < bd[k - 1] and d2 <= wb:
+                    _insert(bd, bi, k, d2, e)
+        else:
+            l = node + 1
+            dl = _box_d2(lo, hi, l, x0, x1, x2)
+            dr = _box_d2(lo, hi, rr, x0, x1, x2)
+            if dl <= dr:
+                stack[sp] = rr
+                stack[sp + 1] = l
+            else:
+                stack[sp] = l
+                stack[sp + 1] = rr
+            sp += 2
+
+
+@njit(cache=True)
+def _blend_block(Q, j0, j1, Ps, order, lo, hi, right, start, end, g_org, g_cell, g_dims, g_keys, g_start, g_rows,
+                 g_pts, g_order, use_grid, k, k_min, r2, shrink, out_d, out_i):
+    bd = np.empty(k)
+    bi = np.empty(k, np.int64)
+    stack = np.empty(128, np.int64)
+    prev = np.empty(k_min, np.int64)
+    have_prev = False
+    cd = np.empty(2048)
+    ci = np.empty(2048, np.int64)
+    for j in range(j0, j1):
+        x0, x1, x2 = Q[j, 0], Q[j, 1], Q[j, 2]
+        nin = 0
+        if use_grid:
+            nin = gather_within(x0, x1, x2, g_org, g_cell, g_dims, g_keys, g_start, g_rows, g_pts, g_order, r2, cd, ci)
+        for m in range(k):
+            out_d[j, m] = np.inf
+            out_i[j, m] = 0
+        if nin >= k_min and nin <= cd.shape[0]:
+            c = min(nin, k)
+            if nin > k:
+                _select(cd, ci, nin, k)
+            jm = 0
+            for m in range(c):
+                if cd[m] < cd[jm]:
+                    jm = m
+            for m in range(c):
+                mm = jm if m == 0 else (0 if m == jm else m)
+                out_d[j, m] = np.sqrt(cd[mm])
+                out_i[j, m] = ci[mm]
+            continue
+        if (not use_grid) or nin > cd.shape[0]:  # no grid, or more within R_eval than the buffer: tree walk
+            _nearest_walk(x0, x1, x2, Ps, lo, hi, right, start, end, k, r2, shrink, bd, bi, stack)
+            if bd[k_min - 1] <= r2:
+                for m in range(k):
+                    if bd[m] <= r2:
+                        out_d[j, m] = np.sqrt(bd[m])
+                        out_i[j, m] = order[bi[m]]
+                continue
+        # far from the cloud: the k_min nearest
+        wb = np.inf
+        if have_prev:
+            wb = 0.0
+            for m in range(k_min):
+                e = prev[m]
+                u, v, w = Ps[e, 0] - x0, Ps[e, 1] - x1, Ps[e, 2] - x2
+                wb = max(wb, u * u + v * v + w * w)
+        _nearest_walk(x0, x1, x2, Ps, lo, hi, right, start, end, k_min, wb, shrink, bd, bi, stack)
+        for m in range(k_min):
+            prev[m] = bi[m]
+            out_d[j, m] = np.sqrt(bd[m])
+            out_i[j, m] = order[bi[m]]
+        have_prev = True
+
+
+@njit(parallel=True, cache=True)
+def _blend_kernel(Q, Ps, order, lo, hi, right, start, end, g_org, g_cell, g_dims, g_keys, g_start, g_rows, g_pts,
+                  g_order, use_grid, k, k_min, r2, shrink, out_d, out_i):
+    """Neighbours for the sums of §5.1.3: the (up to k) nearest within sqrt(r2) when at least k_min lie there,
+    else the k_min nearest; padded with (inf, 0). Rows start with the nearest point; the k_min-nearest rows
+    are ascending, the within-r rows are otherwise unordered (the sums do not need an order).
+
+    Phase 1 gathers the points within r from the grid cells around x (:mod:`gsdf.spatial.radius_grid`).
+    Phase 2 (too few within r: x is far from the cloud) is a k_min-nearest walk of the BVH, warm-started: the
+    previous far query of the same block of 64 (queries are Morton-sorted) gives k_min points whose largest
+    distance to x bounds the k_min-th nearest distance, so boxes beyond it are pruned from the start."""
+    q = Q.shape[0]
+    B = 64
+    nb = (q + B - 1) // B
+    for blk in prange(nb):
+        _blend_block(Q, blk * B, min(q, blk * B + B), Ps, order, lo, hi, right, start, end, g_org, g_cell, g_dims,
+                     g_keys, g_start, g_rows, g_pts, g_order, use_grid, k, k_min, r2, shrink, out_d, out_i)
 
 
 class PointKNN:
@@ -150,8 +298,9 @@ class NeighbourBlend:
     k_fallback : int
         Points summed when fewer than this many lie within R_eval (32 in §5.1.3).
     kd_eps : float
-        Approximate neighbour search: tree boxes farther than the current k-th distance / (1 + kd_eps) are
-        skipped, so every returned distance is within (1 + kd_eps) of the true one. 0 = exact.
+        Approximate search far from the cloud (the k_fallback-nearest tree walk): boxes farther than the current
+        k-th distance / (1 + kd_eps) are skipped, so every returned distance is within (1 + kd_eps) of the true
+        one. 0 = exact. Queries with k_fallback points within R_eval are always exact.
     """
 
     def __init__(self, P, C=64.0, r_eval=None, k_eval=64, k_fallback=32, tree=None, kd_eps=0.0):
@@ -167,9 +316,26 @@ class NeighbourBlend:
             d, _ = self.knn.query(P[:: max(1, len(P) // 4096)], k=kk + 1)
             r_eval = 2.0 * float(np.median(d[:, -1])) if kk > 0 else np.inf
         self.r_eval = float(r_eval)
+        # fixed-radius grid for the points within R_eval; not worth it when a cell holds a large part of the cloud
+        g = build_radius_grid(P, self.r_eval)
+        self.grid = g if g is not None and len(g.keys) * 64 >= len(P) else None
 
     def neighbours(self, Q: np.ndarray):
-        return self.knn.query(Q, self.k_eval, self.kd_eps, k_min=self.k_fallback, radius=self.r_eval)
+        """(d, i), each (q, k_eval): the k_eval nearest within R_eval when at least k_fallback lie there,
+        else the k_fallback nearest; ascending, padded with (inf, 0)."""
+        Q = np.ascontiguousarray(Q, dtype=np.float64)
+        k, k_min = self.k_eval, self.k_fallback
+        d, i = np.empty((len(Q), k)), np.empty((len(Q), k), np.int64)
+        t, g = self.knn.t, self.grid
+        if g is None:
+            z3, z1 = np.zeros(3), np.zeros(1, np.int64)
+            z2 = np.zeros(2, np.int64)
+            gargs = (z3, 1.0, np.ones(3, np.int64), z1, z2, z2, np.zeros((1, 3)), z1, False)
+        else:
+            gargs = (g.origin, g.cell, g.dims, g.keys, g.start, g.row_start, g.points, g.order, True)
+        _blend_kernel(Q, self.knn.Ps, t.order, t.lo, t.hi, t.right, t.start, t.end, *gargs, k, k_min,
+                      self.r_eval ** 2, (1.0 + self.kd_eps) ** 2, d, i)
+        return d, i
 
     def map(self, Q, fn, width: int = 0, name: str = "Q"):
         """Validate ``Q`` and call ``fn(q, d, i, out)`` chunk by chunk; ``out`` is (q,) or (q, width)."""
