@@ -13,6 +13,38 @@ from .operators import TriangleMeshOperators
 from .sources import build_sources
 
 LEVEL_SETS = ("zero", "multiple", "none")
+CONNECTIONS = ("auto", "complex", "real")
+
+
+class _RealBlockFactorization:
+    """Factorization of the real 2|E|×2|E| vector heat operator ``M ⊗ I₂ + t L∇`` (2×2 blocks, any orientation);
+    ``solve`` takes and returns complex edge vectors (reference-face coordinates)."""
+
+    def __init__(self, A):
+        A = sp.csr_matrix(A)
+        A.sum_duplicates()
+        self.n = A.shape[0] // 2
+        self._chol = None
+        try:
+            from cholespy import CholeskySolverD, MatrixType
+        except ImportError:
+            self._lu = Factorization(A.tocsc())
+            self.backend = "superlu"
+        else:
+            self._chol = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32), A.indices.astype(np.int32),
+                                         np.ascontiguousarray(A.data, dtype=np.float64), MatrixType.CSR)
+            self.backend = "cholmod"
+
+    def solve(self, b):
+        b = np.asarray(b, np.complex128)
+        r = np.empty(2 * self.n)
+        r[0::2], r[1::2] = b.real, b.imag
+        if self._chol is not None:
+            x = np.zeros_like(r)
+            self._chol.solve(r, x)
+        else:
+            x = self._lu.solve(r)
+        return x[0::2] + 1j * x[1::2]
 
 
 class SurfaceSignedHeatSolver:
@@ -29,20 +61,30 @@ class SurfaceSignedHeatSolver:
     V : (n, 3) float array
     F : (m, 3) int array
         Triangle mesh of any topology: boundary, several components, nonmanifold edges/vertices (operators are
-        per-face sums, §9.4). Nonorientable meshes give finite output, but the complex edge basis cannot
-        express the orientation flip, so curve normals near the flip are arbitrary.
+        per-face sums, §9.4). Nonorientable meshes (and faces whose orientation disagrees with a neighbour's)
+        are handled exactly: transport across such an edge is a reflection, so the connection Laplacian is then
+        assembled as a real 2|E|×2|E| block matrix (see ``connection``); give the curve normals
+        (``curve_normals=`` of :meth:`compute_distance`) there, since face normals flip across the seam.
         Faces with repeated vertices or zero area raise ValueError (remove them first).
     t_coef : float
         Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6) of the input mesh.
     intrinsic_delaunay : bool
         Build the operators on an intrinsic Delaunay triangulation of the input (§9.4, Fig. 22): Lawson edge
         flips on edge lengths only (:mod:`gsdf.heat.surface.intrinsic`), operators from per-face planar
-        layouts; output stays per input vertex. This helps on meshes with obtuse slivers. Sources are then
-        restricted to what lives on vertices and original edges: vertex polylines (or surface points that are
-        vertices), closed unsigned vertex polylines, vertex point sources; the original edges carrying curves
-        are kept unflippable (the triangulation is re-flipped, and refactorized, for a curve set whose edges
-        were flipped away; cached per edge set). Surface points inside faces/edges raise ValueError;
-        ``compute_distance_l1`` raises NotImplementedError.
+        layouts; output stays per input vertex. This helps on meshes with obtuse slivers. Curve segments along
+        input edges (vertex polylines, surface points on one edge) keep those edges unflippable (the
+        triangulation is re-flipped, and refactorized, for a curve set whose edges were flipped away; cached per
+        edge set). Segments inside input faces and point sources inside faces need no fixed edges: they are
+        carried through the flips (the logged flips are redone with the points in the planar layout of every
+        flipped quad) and the segments are re-split along the intrinsic edges by tracing, so that Eq. 11 is
+        applied per intrinsic face. Unsigned curves must be closed vertex polylines; ``curve_normals`` is not
+        available; ``compute_distance_l1`` raises NotImplementedError. On a mesh that is already Delaunay no
+        edge flips and the results equal those on the input triangulation.
+    connection : {"auto", "complex", "real"}
+        Form of the connection Laplacian of step I. ``"auto"``: complex |E|×|E| (Eq. 9) when all faces are
+        consistently oriented, else the real 2|E|×2|E| block form that also represents the reflections across
+        orientation flips. ``"real"`` forces the block form (same result on orientable meshes, ~2× slower);
+        ``"complex"`` forces Eq. 9 (wrong transport across orientation flips; for comparisons only).
 
     Components of the mesh without sources get an arbitrary (near-constant) value; unreferenced vertices
     get 0 before the final shift.
@@ -60,8 +102,9 @@ class SurfaceSignedHeatSolver:
     -0.5
     """
 
-    def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False):
+    def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False, connection: str = "auto"):
         V, F = _checks.as_mesh(V, F)
+        self.connection = _checks.choice(connection, "connection", CONNECTIONS)
         self.t_coef = _checks.positive(t_coef, "t_coef")
         rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
         if rep.any():
@@ -117,9 +160,9 @@ class SurfaceSignedHeatSolver:
         else:
             from .intrinsic import intrinsic_delaunay, layout
 
-            Fi, L, nflips = intrinsic_delaunay(self.V, self.F, fixed_pairs)
+            Fi, L, nflips, log = intrinsic_delaunay(self.V, self.F, fixed_pairs, return_log=True)
             ops = TriangleMeshOperators(self.V, Fi, P=layout(L))
-            ops.n_flips = nflips
+            ops.n_flips, ops.flip_log, ops.L_slots = nflips, log, L
             self._set_ops(ops)
             if len(self._states) >= 4:
                 self._states.pop(next(iter(self._states)))
@@ -127,11 +170,17 @@ class SurfaceSignedHeatSolver:
 
     # ------------------------------------------------------------------ steps
     @property
-    def vector_heat_factorization(self) -> HermitianFactorization:
-        """The factorization of ``M + t L∇`` (Eq. 12), built on first use."""
+    def vector_heat_factorization(self):
+        """The factorization of ``M + t L∇`` (Eq. 12), built on first use (complex, or the real 2×2 block form
+        on inconsistently oriented meshes)."""
         if self._vec is None:
-            A = self.ops.cr_mass() + self.t * self.ops.cr_connection_laplacian()
-            self._vec = HermitianFactorization(A)
+            if self.connection == "real" or (self.connection == "auto" and not self.ops.consistent):
+                M = self.ops.cr_mass().diagonal()
+                A = sp.diags(np.repeat(M, 2)) + self.t * self.ops.cr_connection_laplacian_real()
+                self._vec = _RealBlockFactorization(A)
+            else:
+                A = self.ops.cr_mass() + self.t * self.ops.cr_connection_laplacian()
+                self._vec = HermitianFactorization(A)
         return self._vec
 
     def _poisson_fact(self) -> Factorization:
@@ -217,63 +266,153 @@ class SurfaceSignedHeatSolver:
         return self._solve_sources(S, mode, lam)
 
     def _to_intrinsic(self, curves, points, curve_signs):
-        """Express the sources as vertex polylines / vertex points of the input mesh and switch to an intrinsic
-        triangulation that contains all curve edges."""
-        from .sources import _parse_curve, parse_points
+        """Re-express the sources on an intrinsic Delaunay triangulation (§9.4): vertex polylines and curve
+        segments along input edges stay on those edges (kept unflippable); segments inside input faces are
+        carried through the flips (their midpoints and directions, :func:`~gsdf.heat.surface.intrinsic.
+        locate_points`) and re-split along the intrinsic edges by tracing (:func:`~gsdf.heat.surface.intrinsic.
+        trace_paths`); point sources inside faces are carried through the flips. Switches to the triangulation
+        that keeps the needed edges and returns (curves, points) for :func:`build_sources` on it."""
+        from .intrinsic import face_coords, locate_points, trace_paths
+        from .sources import _bary_curve_segments, _faces_of_node, _parse_curve, _to_face
 
         ops0 = self.input_ops
+        F0, V0 = ops0.F, ops0.V
         if curves is None:
             curves = []
         if isinstance(curves, np.ndarray) and curves.ndim == 1 and np.issubdtype(curves.dtype, np.integer):
             curves = [curves]
         curves = list(curves)
         signs = [True] * len(curves) if curve_signs is None else [bool(x) for x in curve_signs]
-        out, pairs = [], []
+        specs, pairs = [], []
+        mids_f, mids_b, mids_v = [], [], []                  # face-segment midpoints to carry through the flips
         for k, c in enumerate(curves):
             parsed = _parse_curve(c, ops0, k)
+            vs = None
             if parsed[0] == "v":
                 vs = parsed[1]
-            else:
-                _, fs, bs = parsed
-                onehot = (bs > 0).sum(1) == 1
-                if not onehot.all():
-                    q = int(np.flatnonzero(~onehot)[0])
-                    raise ValueError(f"curves[{k}][{q}]: with intrinsic_delaunay=True curves must run along mesh "
-                                     "edges (vertex polylines, or surface points at vertices); this point lies "
-                                     "inside a face or an edge")
-                vs = ops0.F[fs, np.argmax(bs, axis=1)]
-            keep = np.concatenate([[True], vs[1:] != vs[:-1]])
-            vs = vs[keep]
-            e = ops0.edge_lookup(vs[:-1], vs[1:])
-            if np.any(e < 0):
-                q = int(np.flatnonzero(e < 0)[0])
-                raise ValueError(f"curves[{k}]: vertices {vs[q]} and {vs[q + 1]} (points {q}, {q + 1}) are not "
-                                 "joined by a mesh edge (intrinsic_delaunay=True needs curves along edges)")
-            if k < len(signs) and not signs[k] and vs[0] != vs[-1]:
-                raise ValueError(f"curves[{k}]: open unsigned curves are not supported with "
-                                 "intrinsic_delaunay=True (close the curve or use the input triangulation)")
-            out.append(vs)
-            pairs.append(np.stack([vs[:-1], vs[1:]], 1))
-        pts = parse_points(points, ops0) if points is not None else None
-        if pts is not None:
-            ids, w = pts
-            onehot = (w > 0).sum(1) == 1
-            if not onehot.all():
-                q = int(np.flatnonzero(~onehot)[0])
-                raise ValueError(f"points[{q}]: with intrinsic_delaunay=True point sources must be vertices")
-            points = ids[np.arange(len(ids)), np.argmax(w, 1)]
+            elif ((parsed[2] > 0).sum(1) == 1).all():          # surface points that are all vertices
+                vs = F0[parsed[1], np.argmax(parsed[2], axis=1)]
+            if vs is not None:
+                keep = np.concatenate([[True], vs[1:] != vs[:-1]])
+                vs = vs[keep]
+                e = ops0.edge_lookup(vs[:-1], vs[1:])
+                if np.any(e < 0):
+                    q = int(np.flatnonzero(e < 0)[0])
+                    raise ValueError(f"curves[{k}]: vertices {vs[q]} and {vs[q + 1]} (points {q}, {q + 1}) are not "
+                                     "joined by a mesh edge (give the curve as (face, barycentric) points)")
+                if k < len(signs) and not signs[k] and vs[0] != vs[-1]:
+                    raise ValueError(f"curves[{k}]: open unsigned curves are not supported with "
+                                     "intrinsic_delaunay=True (close the curve or use the input triangulation)")
+                specs.append(("v", vs))
+                pairs.append(np.stack([vs[:-1], vs[1:]], 1))
+                continue
+            if k < len(signs) and not signs[k]:
+                raise ValueError(f"curves[{k}]: unsigned curves must run along mesh edges (give vertex indices)")
+            nf, nb, *_ = _bary_curve_segments(ops0, parsed[1], parsed[2], f"curves[{k}]", return_faces=True)
+            segs = []
+            for q in range(len(nf) - 1):
+                fa, ba, fb, bb = nf[q], nb[q], nf[q + 1], nb[q + 1]
+                va, vb = set(F0[fa, ba > 0].tolist()), set(F0[fb, bb > 0].tolist())
+                both = va | vb
+                if len(both) <= 2:                             # on one input edge (or one vertex)
+                    if len(both) == 2 and ops0.edge_lookup(*sorted(both)) >= 0:
+                        pairs.append(np.array([sorted(both)]))
+                        segs.append(("e", (fa, ba), (fb, bb)))
+                        continue
+                    if len(both) == 1:
+                        continue                               # zero length
+                g = min(_faces_of_node(ops0, fa, ba) & _faces_of_node(ops0, fb, bb))
+                wa, wb = _to_face(F0, fa, ba, g), _to_face(F0, fb, bb, g)
+                if np.abs(wa - wb).max() == 0:
+                    continue
+                mids_f.append(g)
+                mids_b.append(0.5 * (wa + wb))
+                mids_v.append(0.5 * (wb - wa) @ V0[F0[g]])
+                segs.append(("f", len(mids_f) - 1))
+            if not segs:
+                raise ValueError(f"curves[{k}]: the curve has zero length")
+            specs.append(("b", segs))
+        # point sources: vertices stay, points inside faces / on edges are carried through the flips
+        pts_v, pts_track = [], []
+        if points is not None:
+            items = list(np.asarray(points).reshape(-1)) if isinstance(points, np.ndarray) else list(points)
+            for q, it in enumerate(items):
+                if np.isscalar(it):
+                    v = int(it)
+                    if v != it or not 0 <= v < ops0.n_vertices:
+                        raise ValueError(f"points[{q}]: vertex index {it!r} out of range for {ops0.n_vertices} "
+                                         "vertices")
+                    pts_v.append(v)
+                    continue
+                _, f, bq = _parse_curve([it, it], ops0, 0)
+                if (bq[0] > 0).sum() == 1:
+                    pts_v.append(int(F0[f[0], np.argmax(bq[0])]))
+                else:
+                    pts_track.append((int(f[0]), bq[0]))
         P = np.concatenate(pairs) if pairs else np.zeros((0, 2), np.int64)
         P = np.unique(np.sort(P, axis=1), axis=0)
         if self._state_key is None:
             self._use_state(self._key(P), P)
-            return out, points
-        # are all curve edges (same vertex pair, same length) present in the current triangulation?
-        e = self.ops.edge_lookup(P[:, 0], P[:, 1])
-        ok = np.all(e >= 0) and np.allclose(self.ops.edge_len[e], ops0.edge_len[ops0.edge_lookup(P[:, 0], P[:, 1])],
-                                            rtol=1e-9, atol=0)
-        if not ok:
-            self._use_state(self._key(P), P)
-        return out, points
+        else:
+            # are all curve edges (same vertex pair, same length) present in the current triangulation?
+            e = self.ops.edge_lookup(P[:, 0], P[:, 1])
+            ok = np.all(e >= 0) and np.allclose(self.ops.edge_len[e],
+                                                ops0.edge_len[ops0.edge_lookup(P[:, 0], P[:, 1])], rtol=1e-9, atol=0)
+            if not ok:
+                self._use_state(self._key(P), P)
+        ops = self.ops
+        # carry midpoints (with half-segment vectors) and point sources through the flips
+        nm = len(mids_f)
+        tf = np.array(mids_f + [f for f, _ in pts_track], np.int64)
+        tb = np.array(mids_b + [b for _, b in pts_track]).reshape(-1, 3)
+        tv = np.zeros((len(tf), 2))
+        if nm:
+            tv[:nm] = face_coords(V0, F0, tf[:nm], np.array(mids_v))
+        if len(tf):
+            tf, tb, tv = locate_points(V0, F0, ops.flip_log, tf, tb, tv)
+        paths = []
+        if nm:
+            paths = trace_paths(ops.F, ops.L_slots, np.concatenate([tf[:nm], tf[:nm]]),
+                                np.concatenate([tb[:nm], tb[:nm]]), np.concatenate([tv[:nm], -tv[:nm]]))
+
+        def on_edge(node):
+            """An input node on an input edge / vertex as an intrinsic (face, barycentric)."""
+            f, b = node
+            vs = F0[f, b > 0]
+            ws = b[b > 0]
+            if len(vs) == 2:
+                e = int(ops.edge_lookup(vs[0], vs[1]))
+            else:                                              # a vertex: any intrinsic face around it
+                vf = ops.vertex_faces()
+                g = int(vf.indices[vf.indptr[vs[0]]])
+                out = np.zeros(3)
+                out[vf.data[vf.indptr[vs[0]]] - 1] = 1.0
+                return g, out
+            g = int(ops.edge_ref_slot[e] // 3)
+            out = np.zeros(3)
+            for v, w in zip(vs, ws):
+                out[np.flatnonzero(ops.F[g] == v)[0]] += w
+            return g, out
+
+        out = []
+        for spec in specs:
+            if spec[0] == "v":
+                out.append(spec[1])
+                continue
+            nodes = []
+            for sg in spec[1]:
+                if sg[0] == "e":
+                    chain = [on_edge(sg[1]), on_edge(sg[2])]
+                else:
+                    i = sg[1]
+                    bf, bb = paths[nm + i]                      # backward: crossings ..., start point
+                    ff, fb = paths[i]                          # forward: crossings ..., end point
+                    chain = [(int(f), b) for f, b in zip(bf[::-1], bb[::-1])] + \
+                            [(int(f), b) for f, b in zip(ff, fb)]
+                nodes.extend(chain if not nodes else chain[1:])
+            out.append(nodes)
+        pts = pts_v + [(int(f), b) for f, b in zip(tf[nm:], tb[nm:])]
+        return out, (pts if pts else None)
 
     def _solve_sources(self, S, mode, lam):
         """Steps I–III for parsed sources (Alg. 1), with the level-set handling of §7.1."""
@@ -392,8 +531,8 @@ class SurfaceSignedHeatSolver:
 
     # ------------------------------------------------------------------ constraints (§7.1)
     def _all_nodes(self, S):
-        rows = [r for r in S.node_rows]
-        isv = [v for v in S.node_is_vertex]
+        rows = list(S.node_rows)
+        isv = list(S.node_is_vertex)
         if S.point_rows is not None:
             rows.append(S.point_rows)
             isv.append(S.point_is_vertex)

@@ -159,6 +159,8 @@ def _bary_in_face(ops, p, f):
 def _trace(ops, fa, ba, fb, bb, name):
     """Split the straight segment from (fa, ba) to (fb, bb) where it crosses edges: walk face by face, in each
     face heading for the target projected into the face's plane. Returns the crossing points (faces, bary)."""
+    if ops.intrinsic:
+        raise ValueError(f"{name}: consecutive points of a curve on an intrinsic triangulation must share a face")
     V, F = ops.V, ops.F
     target = bb @ V[F[fb]]
     target_faces = _faces_of_node(ops, fb, bb)
@@ -231,12 +233,22 @@ def _bary_curve_segments(ops, faces, bary, name, return_faces=False):
         nodes_b.append(bb)
     if return_faces:
         return [int(f) for f in nodes_f], nodes_b, None, None, None
-    # express consecutive pairs in a shared face
-    P = np.array([b @ ops.V[F[f]] for f, b in zip(nodes_f, nodes_b)])
+    # express consecutive pairs in a shared face; segment vectors from the face's corner positions ops.P (3D for
+    # an input mesh, a planar layout for an intrinsic triangulation)
+    nq = len(nodes_f)
+    L = np.zeros(max(nq - 1, 0))
     seg_face, seg_edge = [], []
-    for q in range(len(nodes_f) - 1):
+    for q in range(nq - 1):
         fa, ba, fb, bb = nodes_f[q], nodes_b[q], nodes_f[q + 1], nodes_b[q + 1]
-        if np.linalg.norm(P[q + 1] - P[q]) == 0:
+        common = _faces_of_node(ops, fa, ba) & _faces_of_node(ops, fb, bb)
+        if not common:
+            raise ValueError(f"{name}: points {q} and {q + 1} share no face")
+        g = min(common)
+        wa, wb = _to_face(F, fa, ba, g), _to_face(F, fb, bb, g)
+        D = (wb - wa) @ ops.P[g]
+        ln = float(np.linalg.norm(D))
+        L[q] = ln
+        if ln == 0:
             continue
         va = set(F[fa, ba > 0].tolist())
         vb = set(F[fb, bb > 0].tolist())
@@ -245,16 +257,24 @@ def _bary_curve_segments(ops, faces, bary, name, return_faces=False):
             i, j = sorted(both)
             e = int(ops.edge_lookup(i, j))
             if e >= 0:
-                s = 1.0 if (P[q + 1] - P[q]) @ (ops.V[j] - ops.V[i]) > 0 else -1.0
-                seg_edge.append((e, s, np.linalg.norm(P[q + 1] - P[q])))
+                ci, cj = int(np.flatnonzero(F[g] == i)[0]), int(np.flatnonzero(F[g] == j)[0])
+                s = 1.0 if D @ (ops.P[g, cj] - ops.P[g, ci]) > 0 else -1.0
+                seg_edge.append((e, s, ln))
                 continue
-        common = _faces_of_node(ops, fa, ba) & _faces_of_node(ops, fb, bb)
-        if not common:
-            raise ValueError(f"{name}: points {q} and {q + 1} share no face")
-        seg_face.append((min(common), P[q], P[q + 1]))
+        seg_face.append((g, D, 0.5 * (wa + wb)))
     ids = F[np.array(nodes_f)]
     w = np.array(nodes_b)
-    return ids, w, P, seg_face, seg_edge
+    return ids, w, L, seg_face, seg_edge
+
+
+def _to_face(F, f, b, g):
+    """Barycentric coordinates, in face g, of the point with barycentric b in face f (its support must be
+    vertices of g)."""
+    out = np.zeros(3)
+    for c in np.flatnonzero(b > 0):
+        hit = np.flatnonzero(F[g] == F[f, c])
+        out[hit[0]] += b[c]
+    return out
 
 
 # ---------------------------------------------------------------------------------------------- X0
@@ -279,10 +299,8 @@ def _parse_normals(curve_normals, k, n_nodes, name="curve_normals"):
 
 def _edge_vectors_to_basis(ops, e, N):
     """Complex edge-basis coordinates of 3D vectors N (k, 3) at edges e (k,), in the basis of the first face of
-    each edge (the faces agree except across orientation flips)."""
-    fe = ops.face_edges.ravel()
-    order = np.argsort(fe, kind="stable")
-    first = order[np.searchsorted(fe[order], e)]
+    each edge, the edge's reference basis (see ``TriangleMeshOperators.slot_sigma``)."""
+    first = ops.edge_ref_slot[e]
     f, a = first // 3, first % 3
     return np.einsum("kj,kj->k", ops.slot_u[f, a], N) + 1j * np.einsum("kj,kj->k", ops.slot_w[f, a], N)
 
@@ -364,19 +382,22 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve
             _, fs, bs = parsed
             if not signs[k]:
                 raise ValueError(f"curves[{k}]: unsigned curves must run along mesh edges (give vertex indices)")
-            ids, w, P, seg_face, seg_edge = _bary_curve_segments(ops, fs, bs, f"curves[{k}]")
+            ids, w, L, seg_face, seg_edge = _bary_curve_segments(ops, fs, bs, f"curves[{k}]")
             nrm = _parse_normals(curve_normals, k, len(fs))
             if nrm is not None:
+                if ops.intrinsic:
+                    raise ValueError(f"curve_normals[{k}]: not available for surface-point curves on an intrinsic "
+                                     "triangulation")
                 Pin = np.einsum("kj,kjd->kd", bs, ops.V[ops.F[fs]])
 
                 def seg_normal(mid):
                     return nrm[np.argmin(np.linalg.norm(Pin[None] - mid[:, None], axis=2), axis=1)]
             if seg_face:
                 ff = np.array([s[0] for s in seg_face])
-                D = np.array([s[2] - s[1] for s in seg_face])
+                D = np.array([s[1] for s in seg_face])
                 face_segs_f.append(ff)
                 nf = ops.normals[ff] if nrm is None else seg_normal(
-                    0.5 * np.array([s[1] + s[2] for s in seg_face]))
+                    np.einsum("kj,kjd->kd", np.array([s[2] for s in seg_face]), ops.V[ops.F[ff]]))
                 face_segs_N.append(np.cross(D, nf))                # N|γ| = (pB - pA) × n, Eq. 11
             if seg_edge and nrm is not None:
                 ee = np.array([s[0] for s in seg_edge], np.int64)
@@ -393,7 +414,6 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve
             isv = np.where(onehot, ids[np.arange(len(ids)), np.argmax(w, 1)], -1)
             S.node_rows.append((ids, w))
             S.node_is_vertex.append(isv)
-            L = np.linalg.norm(np.diff(P, axis=0), axis=1)
             S.seg_len.append(L)
             S.seg_mid.append((np.concatenate([ids[:-1], ids[1:]], 1), 0.5 * np.concatenate([w[:-1], w[1:]], 1)))
     if edge_e:
