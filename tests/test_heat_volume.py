@@ -55,6 +55,22 @@ def test_zero_constraint_and_explicit_box_and_shape(sphere):
     assert np.abs(f(V)).mean() < 0.02
 
 
+def test_grid_exact_constraint_zero_at_sources(sphere):
+    from gsdf.heat.volume.grid import cell_constraint_matrix
+
+    V, F = sphere
+    src = mesh_sources(V, F)
+    kw = dict(mesh=(V, F), resolution=20, level_set_constraint="zero")
+    f = signed_heat_volume(constraint="exact", **kw)
+    C, w = cell_constraint_matrix(src.B, src.a, f.bbox_min, f.spacing, f.shape)
+    h = f.spacing.max()
+    assert np.abs(C @ f.values.ravel()).max() < 1e-3 * h  # exact: every cell's fitted zero level
+    assert f.meta["constraint_residual"] < 1e-3 * h and f.meta["constraint_rows"] == C.shape[0]
+    assert np.abs(f(src.B)).mean() < 0.01 * h  # the trilinear interpolant ≈ 0 at the sources
+    exact = gsdf.signed_distance(V, F, f.grid_points())
+    assert np.abs(f.values.ravel() - exact).mean() < 0.15 * h
+
+
 def test_isosurfaces_closed_manifold(sphere):
     V, F = sphere
     f = signed_heat_volume(mesh=(V, F), resolution=32)
@@ -129,6 +145,7 @@ def test_polygon_soup_with_hole_still_signed():
     (dict(mesh=cube(), bbox_min=[1, 1, 1], bbox_max=[0, 0, 0]), "must exceed"),
     (dict(mesh=cube(), domain="octree"), "domain"),
     (dict(mesh=cube(), t_coef=-1), "t_coef"),
+    (dict(mesh=cube(), level_set_constraint="two"), "level_set_constraint"),
     (dict(mesh=cube(), resolution=2.5), "resolution"),
 ])
 def test_bad_input(kwargs, msg):

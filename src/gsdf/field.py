@@ -183,8 +183,8 @@ class TetField(Field):
     values : (n,) float
     delaunay : scipy.spatial.Delaunay, optional
         Point locator whose simplices are ``tets`` (what :func:`gsdf.signed_heat_volume` with ``domain="tet"``
-        builds). Without it a Delaunay tetrahedralization of ``vertices`` is built on first evaluation, which
-        locates points exactly when ``tets`` is itself Delaunay.
+        builds). Without it, points are located among ``tets`` themselves (any tet mesh, e.g. TetGen's): the
+        tets whose centroids are nearest to the query are tested by their barycentric coordinates.
 
     Examples
     --------
@@ -219,25 +219,23 @@ class TetField(Field):
     def bbox_max(self):
         return self.vertices.max(axis=0)
 
-    def _locator(self):
-        if self._delaunay is None:
-            from scipy.spatial import Delaunay
-
-            self._delaunay = Delaunay(self.vertices)
-        return self._delaunay
-
     def __call__(self, Q) -> np.ndarray:
         """Barycentric (piecewise linear) interpolation at ``Q`` (q, 3); outside the mesh: nearest vertex."""
         Q = as_points(Q, "Q", allow_empty=True)
-        D = self._locator()
-        s = D.find_simplex(Q)
         out = np.empty(len(Q))
-        inside = s >= 0
-        if inside.any():
-            Tr = D.transform[s[inside]]
-            b = np.einsum("qij,qj->qi", Tr[:, :3], Q[inside] - Tr[:, 3])
-            bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
-            out[inside] = (bary * self.values[D.simplices[s[inside]]]).sum(axis=1)
+        if self._delaunay is not None:
+            D = self._delaunay
+            s = D.find_simplex(Q)
+            inside = s >= 0
+            if inside.any():
+                Tr = D.transform[s[inside]]
+                b = np.einsum("qij,qj->qi", Tr[:, :3], Q[inside] - Tr[:, 3])
+                bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
+                out[inside] = (bary * self.values[D.simplices[s[inside]]]).sum(axis=1)
+        else:
+            s, bary = locate_in_tets(self.vertices, self.tets, Q)
+            inside = s >= 0
+            out[inside] = (bary[inside] * self.values[self.tets[s[inside]]]).sum(axis=1)
         if (~inside).any():
             from scipy.spatial import cKDTree
 
@@ -269,6 +267,45 @@ class TetField(Field):
                 return cls(d["vertices"], d["tets"], d["values"])
         except (OSError, KeyError, ValueError) as exc:
             raise ValueError(f"{path}: not a gsdf tet field file ({exc})") from exc
+
+
+def locate_in_tets(X, T, Q, k: int = 16, chunk: int = 1 << 15):
+    """Tet containing each query (−1 if none) among arbitrary tets, and its barycentric coordinates.
+
+    Candidates are the ``k`` tets with the nearest centroids (then 4k, 16k for queries not found yet); a tet
+    contains q when all four barycentric coordinates are ≥ −1e-10. Vectorized over chunks of queries.
+    """
+    from scipy.spatial import cKDTree
+
+    X = np.asarray(X, float)
+    T = np.asarray(T, np.int64)
+    Q = np.asarray(Q, float)
+    A = X[T[:, 1:]] - X[T[:, :1]]
+    det = np.linalg.det(A)
+    ok = np.abs(det) > 1e-14 * np.abs(A).max(axis=(1, 2)) ** 3
+    Ainv = np.zeros_like(A)
+    Ainv[ok] = np.linalg.inv(A[ok])  # λ_{1..3} = (q − x0) · Ainv (row vector convention)
+    kd = cKDTree(X[T].mean(axis=1))
+    s = np.full(len(Q), -1, np.int64)
+    bary = np.zeros((len(Q), 4))
+    todo = np.arange(len(Q))
+    for kk in (k, 4 * k, 16 * k):
+        kk = min(kk, len(T))
+        for c in range(0, len(todo), chunk):
+            qi = todo[c:c + chunk]
+            _, cand = kd.query(Q[qi], k=kk, workers=-1)
+            cand = cand.reshape(len(qi), kk)
+            b3 = np.einsum("qkj,qkji->qki", (Q[qi][:, None, :] - X[T[cand, 0]]), Ainv[cand])
+            b = np.concatenate([1.0 - b3.sum(axis=2, keepdims=True), b3], axis=2)
+            good = (b.min(axis=2) >= -1e-10) & ok[cand]
+            hit = good.any(axis=1)
+            j = np.argmax(good, axis=1)
+            s[qi[hit]] = cand[hit, j[hit]]
+            bary[qi[hit]] = b[hit, j[hit]]
+        todo = todo[s[todo] < 0]
+        if len(todo) == 0 or kk == len(T):
+            break
+    return s, bary
 
 
 def marching_tetrahedra(X, T, values, level: float = 0.0):

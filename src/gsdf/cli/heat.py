@@ -52,8 +52,9 @@ Example:
 @click.option("--relative", is_flag=True, help="Offsets are fractions of the bounding-box diagonal.")
 @click.option("--t-coef", type=click.FloatRange(min=0, min_open=True), default=1.0, show_default=True,
               help="Diffusion time t = t_coef · h².")
-@click.option("--constraint", type=click.Choice(["none", "zero"]), default="none", show_default=True,
-              help="Level set: shift by the source mean (none) or also pull φ to 0 at the sources (zero).")
+@click.option("--constraint", type=click.Choice(["zero", "none", "multiple"]), default="zero", show_default=True,
+              help="Level set (§7.1): pull φ to 0 at the sources (zero; a soft penalty on grids), shift by the "
+                   "source mean only (none), or one constant per connected input component (multiple, --tet).")
 @click.option("--surface-format", type=click.Choice(["ply", "obj", "off", "stl"]), default="ply",
               show_default=True)
 @normals_option

@@ -24,13 +24,13 @@ def _input_positions(mesh, points):
         except (TypeError, ValueError) as exc:
             raise ValueError("mesh: expected a pair (V, F)") from exc
         src = mesh_sources(V, F)
-        return src, as_points(V, "V")
+        return src, as_points(V, "V"), np.asarray(F, dtype=np.int64)
     try:
         P, N = points
     except (TypeError, ValueError) as exc:
         raise ValueError("points: expected a pair (P, N); N are the normals") from exc
     src = point_sources(P, N)
-    return src, as_points(P, "P")
+    return src, as_points(P, "P"), None
 
 
 def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = 0.1):
@@ -73,7 +73,7 @@ def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = 0.
 
 
 def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=64, bbox_min=None, bbox_max=None,
-                       t_coef: float = 1.0, level_set_constraint: str = "none", theta: float = 1.5,
+                       t_coef: float = 1.0, level_set_constraint: str = "zero", theta: float = 1.5,
                        max_memory=None, progress=None, **kwargs):
     """Generalized signed distance in a volume by the signed heat method (Feng & Crane 2024, §8).
 
@@ -84,16 +84,21 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     points : (P, N), optional
         Oriented point cloud; normals need not be unit length. Point areas are estimated (§3.1 of Barill 2018).
     domain : {"grid", "tet"}
-        Regular grid (§8.2, Yukawa step I by a tree walk) or tetrahedral mesh (§8.1).
+        Regular grid (§8.2, Yukawa step I by a tree walk) or tetrahedral mesh (§8.1: Delaunay of the input
+        points and an octree-like lattice graded toward them, h = the grid spacing near the input; see
+        :mod:`gsdf.heat.volume.tet` for its options ``step1``, ``mesher``, ``levels``, …).
     resolution : int or (3,) ints
         Grid nodes along the longest side (cubic cells), or exact node counts per axis.
     bbox_min, bbox_max : (3,) float, optional
         Box of the domain; defaults to the input's box padded by 10 % of its diagonal. Must contain the input.
     t_coef : float
         Diffusion time t = t_coef · h², h the grid spacing (§10 of the seed: t = h² is accurate).
-    level_set_constraint : {"none", "zero"}
-        "none": shift φ so its mean over the sources is 0; "zero": also pull φ toward 0 at every source point
-        (soft penalty on trilinear values).
+    level_set_constraint : {"zero", "multiple", "none"}
+        "zero" (default; measured more accurate than "none" on every benchmark input, bench/RESULTS.md): the
+        zero level set goes through the input — on grids a penalty on the trilinear values at the sources
+        (``constraint="exact"``: the exact per-cell constraint by an augmented Lagrangian, slow above 32³), on
+        tets φ = 0 exactly on every input vertex (and Steiner point). "multiple" (tets only): φ constant on
+        each connected component of the input. "none": φ shifted so its area-weighted mean over the sources is 0.
     theta : float
         Cluster error tolerance of the tree-accelerated Yukawa sum (see :class:`YukawaTree`).
     max_memory : int, optional
@@ -103,8 +108,8 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
 
     Returns
     -------
-    GridField
-        Signed distance on the grid nodes, negative inside; ``field(Q)``, ``field.isosurface(level)``.
+    GridField or TetField
+        Signed distance on the grid nodes (tet vertices), negative inside; ``field(Q)``, ``field.isosurface(level)``.
 
     Examples
     --------
@@ -121,13 +126,13 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     domain = choice(domain, "domain", {"grid", "tet"})
     t_coef = positive(t_coef, "t_coef")
     level_set_constraint = choice(level_set_constraint, "level_set_constraint", {"none", "zero", "multiple"})
-    src, X = _input_positions(mesh, points)
+    src, X, F = _input_positions(mesh, points)
     lo, hi, shape = volume_grid_box(X, resolution, bbox_min, bbox_max)
     if domain == "tet":
         from .tet import solve_tet
 
         return solve_tet(src, X, lo, hi, shape, t_coef=t_coef, level_set_constraint=level_set_constraint,
-                         max_memory=max_memory, progress=progress, **kwargs)
+                         max_memory=max_memory, progress=progress, theta=theta, faces=F, **kwargs)
     if level_set_constraint == "multiple":
         raise ValueError('level_set_constraint "multiple" is only available on tet domains; use "none" or "zero"')
     check_memory(int(np.prod(shape)), max_memory)

@@ -7,14 +7,20 @@ Step III Δφ = ∇·Y with the seven-point Laplacian, Neumann boundary and forw
          Σ_edges (φ_j − φ_i − h Ŷ_ij)² over the grid edges, Ŷ_ij the edge component of Y averaged over the
          edge's two nodes. Its normal equations are the 7-point graph Laplacian (natural Neumann boundary) against
          the forward-difference divergence of Y (the transpose of the forward-difference gradient).
-Level set: φ is shifted so that its area-weighted mean over the source points is 0 (as the anchor does), and
-         optionally ("zero") the zero level set is pulled through the sources by a penalty on the trilinear
-         values φ(b_f) (the soft version of the seed's constrained solve, Eq. 6 and §8.2's trilinear rows).
+Level set: "none": φ is shifted so that its area-weighted mean over the source points is 0 (as the anchor
+         does). "zero" with ``constraint="soft"`` (default): the zero level set is pulled through the sources by a
+         penalty on the trilinear values φ(b_f), then the same shift. "zero" with ``constraint="exact"``: the
+         seed's constrained solve with trilinear rows (§8.2), one row per grid cell holding sources (the
+         area-weighted mean of their trilinear rows — one row per source would force φ ≡ 0 on every cell
+         crossed by a dense input), imposed exactly by the augmented Lagrangian (:func:`solve_constrained`).
 
 Linear algebra: the Neumann 7-point Laplacian on a box is diagonal in the DCT-II basis, so Step III is solved
 *exactly* by two fast cosine transforms, O(N log N) at every size (128³ in well under a second) — faster than
 a sparse factorization or algebraic multigrid (pyamg took 7 s setup + 5 s solve at 64³ here). With the soft
-level-set constraint the system becomes L + P and is solved by CG preconditioned with that fast solver.
+level-set constraint the system becomes L + P and is solved by CG preconditioned with that fast solver between
+Gauss–Seidel sweeps over the penalized nodes. The
+exact constraint factorizes L + ρCᵀWC once (CHOLMOD / SuperLU, grids up to 50k nodes) and reuses it for every
+multiplier update; larger grids use the preconditioned CG per update, which is slow (minutes at 64³).
 """
 
 from __future__ import annotations
@@ -138,37 +144,122 @@ def dct_poisson(rhs, shape, spacing, shift: float = 0.0, lam=None) -> np.ndarray
     return idctn(c, type=2, norm="ortho", workers=-1).ravel()
 
 
-def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-6, maxiter: int = 300) -> np.ndarray:
+def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter: int = 300) -> np.ndarray:
     """Solve the Step III system.
 
     Without ``penalty`` the system is the singular Neumann Laplacian L φ = rhs, solved exactly by
     :func:`dct_poisson` (a direct solver, any size). With a penalty matrix P (the soft level-set
-    constraint), (L + P) φ = rhs is solved by conjugate gradients preconditioned with the exact inverse of
-    L + δI, δ = tr(P)/N (a fast-Poisson preconditioner: P only touches nodes next to the sources).
+    constraint), A φ = rhs with A = L + P is solved by conjugate gradients with a symmetric two-level
+    preconditioner: a forward Gauss–Seidel sweep over the "band" (the nodes P touches, next to the sources),
+    an exact fast-Poisson correction with L + δI (δ = tr(P)/N), and a backward Gauss–Seidel sweep. The band
+    sweeps resolve the stiff penalty the global DCT solve cannot see: ~40 instead of ~115 iterations at 64³
+    on the broken bunny, and far fewer transforms. ``tol`` is CG's relative residual (1e-5 moves the field by
+    ~1e-5 of the box diagonal, well under the discretization error).
     """
     shape = tuple(shape)
     if penalty is None:
         return dct_poisson(rhs, shape, spacing)
-    from scipy.sparse.linalg import LinearOperator, cg
+    from scipy.sparse.linalg import LinearOperator, cg, spsolve_triangular
 
     n = int(np.prod(shape))
     L = neumann_laplacian(shape, spacing)
     A = (L + penalty).tocsr()
     delta = float(penalty.diagonal().sum()) / n
     lam = _dct_eigenvalues(shape, spacing, delta)
-    M = LinearOperator((n, n), matvec=lambda r: dct_poisson(r, shape, spacing, delta, lam))
+    band = np.flatnonzero(np.diff(penalty.tocsr().indptr) > 0)
+    A_bb = A[band][:, band]
+    lower = sp.tril(A_bb, format="csr")
+    upper = sp.triu(A_bb, format="csr")
+
+    def precondition(r):
+        x = np.zeros(n)
+        x[band] = spsolve_triangular(lower, r[band], lower=True)  # forward Gauss–Seidel on the band
+        x += dct_poisson(r - A @ x, shape, spacing, delta, lam)  # global fast-Poisson correction
+        x[band] += spsolve_triangular(upper, (r - A @ x)[band], lower=False)  # backward sweep (keeps M symmetric)
+        return x
+
+    M = LinearOperator((n, n), matvec=precondition)
     x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
     x, info = cg(A, rhs, x0=x0, M=M, rtol=tol, maxiter=maxiter)
+    if info > 0:
+        import warnings
+
+        warnings.warn(f"step III: conjugate gradients stopped after {maxiter} iterations above rtol={tol:g}")
     return x
+
+
+def cell_constraint_matrix(B, a, bbox_min, spacing, shape):
+    """One constraint row per grid cell holding sources: the area-weighted mean of their trilinear rows.
+
+    Row c is Σ_{f in c} a_f T(b_f) / Σ a_f, T the trilinear weights, i.e. the least-squares fit of a zero level
+    through the sources of the cell; returns ``(C, w)``, w the source area of each row.
+    """
+    n = np.array(shape)
+    T = trilinear_matrix(B, bbox_min, spacing, shape)
+    t = np.clip((B - bbox_min) / spacing, 0.0, n - 1.0)
+    i0 = np.minimum(np.floor(t).astype(np.int64), n - 2)
+    cell = (i0[:, 0] * n[1] + i0[:, 1]) * n[2] + i0[:, 2]
+    cells, row = np.unique(cell, return_inverse=True)
+    row = row.ravel()
+    w = np.bincount(row, weights=a, minlength=len(cells))
+    R = sp.csr_matrix((a / w[row], (row, np.arange(len(B)))), shape=(len(cells), len(B)))
+    return (R @ T).tocsr(), w
+
+
+def solve_constrained(rhs, shape, spacing, C, w, rho: float, tol: float, max_outer: int = 200,
+                      inner_tol: float = 1e-8, direct_below: int = 50_000):
+    """min ½φᵀLφ − rhsᵀφ subject to Cφ = 0, by the augmented Lagrangian (method of multipliers).
+
+    Each outer step solves (L + ρ CᵀWC) φ = rhs − Cᵀμ by CG preconditioned with the exact DCT solve of
+    L + δI (warm-started), then updates μ ← μ + ρ W Cφ; stops when max |Cφ| ≤ ``tol``. W = diag(w).
+    Returns φ, the final max |Cφ| and the number of outer steps.
+    """
+    from scipy.sparse.linalg import LinearOperator, cg
+
+    shape = tuple(shape)
+    n = int(np.prod(shape))
+    L = neumann_laplacian(shape, spacing)
+    Wd = rho * w
+    A = (L + C.T @ sp.diags(Wd) @ C).tocsr()
+    direct = None
+    if n <= direct_below:
+        try:  # factorize once (CHOLMOD), every outer step is then two triangular solves
+            from .tet import SPDSolver
+
+            direct = SPDSolver(A)
+        except Exception:  # pragma: no cover - fall back to the iterative inner solver
+            direct = None
+    if direct is None:
+        delta = float(A.diagonal().sum() - L.diagonal().sum()) / n
+        lam = _dct_eigenvalues(shape, spacing, delta)
+        M = LinearOperator((n, n), matvec=lambda r: dct_poisson(r, shape, spacing, delta, lam))
+    mu = np.zeros(C.shape[0])
+    phi = dct_poisson(rhs - rhs.mean(), shape, spacing)
+    res = np.inf
+    k = 0
+    for k in range(1, max_outer + 1):
+        if direct is not None:
+            phi = direct.solve(rhs - C.T @ mu)
+        else:
+            phi, _ = cg(A, rhs - C.T @ mu, x0=phi, M=M, rtol=inner_tol, maxiter=500)
+        r = C @ phi
+        res = float(np.abs(r).max())
+        if res <= tol:
+            break
+        mu += Wd * r
+    return phi, res, k
 
 
 def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=None,
                level_set_constraint: str = "none", constraint_weight: float = 10.0, theta: float = 1.5,
-               eps: float = 1e-6, progress=None) -> GridField:
+               eps: float = 1e-4, progress=None, constraint: str = "soft", constraint_tol: float = 1e-4,
+               exact_rho: float = 1e5) -> GridField:
     """Run Steps I–III on the grid ``shape`` spanning ``[bbox_min, bbox_max]``; returns a :class:`GridField`.
 
     ``t`` defaults to ``t_coef · h²``, h the largest grid spacing (the seed's t = h², §10). ``progress`` is an
-    optional callable ``progress(stage: str, done: int, total: int)``.
+    optional callable ``progress(stage: str, done: int, total: int)``. ``eps`` prunes sources weighing less than
+    ``eps`` × the nearest one (Step I, :class:`YukawaTree`); 1e-4 instead of 1e-6 moves φ by < 3e-6 of the box
+    diagonal on the broken bunny at 64³ and saves ~25 % of Step I.
     """
     timings = {}
     lo = np.asarray(bbox_min, float)
@@ -208,19 +299,27 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     rhs = divergence_rhs(Y, spacing)
     del X, Y
     penalty = None
-    if level_set_constraint == "zero":
-        # soft level-set constraint: + (c / h) Σ_f a_f φ(b_f)² / h³ in the energy
-        A = trilinear_matrix(src.B, lo, spacing, shape)
-        w = constraint_weight * src.a / h ** 4
-        penalty = (A.T @ sp.diags(w) @ A).tocsr()
-    phi = solve_poisson(rhs, shape, spacing, penalty)
+    info = {}
+    if level_set_constraint == "zero" and constraint == "exact":
+        # exact: the trilinear interpolant's area-weighted mean over the sources of every cell is 0
+        C, w = cell_constraint_matrix(src.B, src.a, lo, spacing, shape)
+        phi, res, outer = solve_constrained(rhs, shape, spacing, C, w / h ** 4, exact_rho, constraint_tol * h)
+        info = {"constraint_residual": res, "constraint_rows": C.shape[0], "outer_iterations": outer}
+    else:
+        if level_set_constraint == "zero":
+            # soft level-set constraint: + (c / h) Σ_f a_f φ(b_f)² / h³ in the energy
+            A = trilinear_matrix(src.B, lo, spacing, shape)
+            w = constraint_weight * src.a / h ** 4
+            penalty = (A.T @ sp.diags(w) @ A).tocsr()
+        phi = solve_poisson(rhs, shape, spacing, penalty)
     del rhs, penalty
     field = GridField(phi.reshape(shape), lo, hi)
-    # shift so that the mean over the sources is zero (the anchor's evaluateAverageAlongSourceGeometry)
-    shift = float(np.sum(src.a * field(src.B)) / np.sum(src.a))
-    field.values -= shift
+    if not (level_set_constraint == "zero" and constraint == "exact"):
+        # shift so that the mean over the sources is zero (the anchor's evaluateAverageAlongSourceGeometry)
+        shift = float(np.sum(src.a * field(src.B)) / np.sum(src.a))
+        field.values -= shift
     report("poisson (step III)", 1, 1)
     timings["step3"] = time.perf_counter() - t0
     field.meta = {"method": "signed heat (grid)", "t": t, "theta": theta, "eps": eps, "timings": timings,
-                  "level_set_constraint": level_set_constraint, "n_sources": len(src.B)}
+                  "level_set_constraint": level_set_constraint, "n_sources": len(src.B), **info}
     return field
