@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["Factorization", "HermitianFactorization", "saddle_matrix", "solve_lp"]
+__all__ = ["Factorization", "HermitianFactorization", "cached_factorization", "saddle_matrix", "solve_lp"]
 
 
 class Factorization:
@@ -110,6 +110,16 @@ class HermitianFactorization:
         x = np.zeros_like(rb)
         self._chol.solve(rb, x)
         return x[0::2] + 1j * x[1::2]
+
+
+def cached_factorization(cache: dict, key, build, most: int = 8):
+    """``cache[key]``, building it with ``build()`` on a miss; the oldest entry is dropped beyond ``most``."""
+    fact = cache.get(key)
+    if fact is None:
+        if len(cache) >= most:
+            cache.pop(next(iter(cache)))
+        fact = cache[key] = build()
+    return fact
 
 
 def saddle_matrix(C, A, delta: float = 0.0):

@@ -31,6 +31,31 @@ def _box_d2(lo, hi, i, x0, x1, x2):
     return a * a + b * b + c * c
 
 
+@njit(cache=True, inline="always")
+def _insert(bd, bi, k, d2, e):
+    """Insert (d2, e) into the ascending top-k lists bd, bi (the last entry drops out)."""
+    m = k - 1
+    while m > 0 and bd[m - 1] > d2:
+        bd[m] = bd[m - 1]
+        bi[m] = bi[m - 1]
+        m -= 1
+    bd[m] = d2
+    bi[m] = e
+
+
+@njit(cache=True, inline="always")
+def _push_children(lo, hi, node, right_child, x0, x1, x2, stack, sp):
+    """Push both children of ``node``, the nearer one on top (visited first); returns the new stack size."""
+    left = node + 1
+    if _box_d2(lo, hi, left, x0, x1, x2) <= _box_d2(lo, hi, right_child, x0, x1, x2):
+        stack[sp] = right_child
+        stack[sp + 1] = left
+    else:
+        stack[sp] = left
+        stack[sp + 1] = right_child
+    return sp + 2
+
+
 @njit(parallel=True, cache=True)
 def _knn_kernel(Q, Ps, order, lo, hi, right, start, end, k, shrink, k_min, r2, out_d, out_i):
     """k nearest points of every query: depth-first over the BVH, nearer child first, boxes pruned against the
@@ -57,38 +82,12 @@ def _knn_kernel(Q, Ps, order, lo, hi, right, start, end, k, shrink, k_min, r2, o
                     a, b, c = Ps[e, 0] - x0, Ps[e, 1] - x1, Ps[e, 2] - x2
                     d2 = a * a + b * b + c * c
                     if d2 < bd[k - 1] and d2 < max(r2, bd[k_min - 1]):
-                        m = k - 1
-                        while m > 0 and bd[m - 1] > d2:
-                            bd[m] = bd[m - 1]
-                            bi[m] = bi[m - 1]
-                            m -= 1
-                        bd[m] = d2
-                        bi[m] = e
+                        _insert(bd, bi, k, d2, e)
             else:
-                l = node + 1
-                dl = _box_d2(lo, hi, l, x0, x1, x2)
-                dr = _box_d2(lo, hi, r, x0, x1, x2)
-                if dl <= dr:
-                    stack[sp] = r
-                    stack[sp + 1] = l
-                else:
-                    stack[sp] = l
-                    stack[sp + 1] = r
-                sp += 2
+                sp = _push_children(lo, hi, node, r, x0, x1, x2, stack, sp)
         for m in range(k):
             out_d[j, m] = np.sqrt(bd[m])
             out_i[j, m] = order[bi[m]]
-
-
-@njit(cache=True, inline="always")
-def _insert(bd, bi, k, d2, e):
-    m = k - 1
-    while m > 0 and bd[m - 1] > d2:
-        bd[m] = bd[m - 1]
-        bi[m] = bi[m - 1]
-        m -= 1
-    bd[m] = d2
-    bi[m] = e
 
 
 @njit(cache=True)
@@ -139,16 +138,7 @@ def _nearest_walk(x0, x1, x2, Ps, lo, hi, right, start, end, k, wb, shrink, bd, 
                 if d2 < bd[k - 1] and d2 <= wb:
                     _insert(bd, bi, k, d2, e)
         else:
-            l = node + 1
-            dl = _box_d2(lo, hi, l, x0, x1, x2)
-            dr = _box_d2(lo, hi, rr, x0, x1, x2)
-            if dl <= dr:
-                stack[sp] = rr
-                stack[sp + 1] = l
-            else:
-                stack[sp] = l
-                stack[sp + 1] = rr
-            sp += 2
+            sp = _push_children(lo, hi, node, rr, x0, x1, x2, stack, sp)
 
 
 @njit(cache=True)

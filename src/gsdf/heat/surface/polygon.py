@@ -40,8 +40,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ... import _checks
-from ...linalg import Factorization, HermitianFactorization, saddle_matrix
+from ...linalg import Factorization, HermitianFactorization, cached_factorization, saddle_matrix
 from .operators import TriangleMeshOperators
+from .sources import vertex_polyline
 
 LEVEL_SETS = ("zero", "multiple", "none")
 
@@ -238,18 +239,7 @@ class VertexSignedHeat:
             curves = [curves]
         out = []
         for k, c in enumerate(curves):
-            a = np.asarray(c)
-            if a.dtype == object or a.ndim != 1:
-                raise ValueError(f"curves[{k}]: expected a 1-D array of vertex indices (a polyline along edges)")
-            if a.size < 2:
-                raise ValueError(f"curves[{k}]: a curve needs at least 2 points, got {a.size}")
-            if not np.issubdtype(a.dtype, np.integer):
-                if not (np.issubdtype(a.dtype, np.floating) and np.all(a == np.round(a))):
-                    raise ValueError(f"curves[{k}]: vertex indices must be integers, got dtype {a.dtype}")
-            a = a.astype(np.int64)
-            if a.min() < 0 or a.max() >= self.n:
-                bad = int(a[(a < 0) | (a >= self.n)][0])
-                raise ValueError(f"curves[{k}]: vertex index {bad} out of range for {self.n} vertices")
+            a = vertex_polyline(c, self.n, f"curves[{k}]")
             a = a[np.concatenate([[True], a[1:] != a[:-1]])]
             if len(a) < 2:
                 raise ValueError(f"curves[{k}]: a curve needs at least 2 distinct points")
@@ -352,12 +342,7 @@ class VertexSignedHeat:
         return self._poisson
 
     def _cached(self, key, build):
-        fact = self._cache.get(key)
-        if fact is None:
-            if len(self._cache) >= 8:
-                self._cache.pop(next(iter(self._cache)))
-            fact = self._cache[key] = build()
-        return fact
+        return cached_factorization(self._cache, key, build)
 
     def _difference_rows(self, curves, points, single):
         """Rows φ(v) - φ(v0) = 0 per connected curve component (curves sharing vertices), or over all sources."""

@@ -8,7 +8,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ... import _checks
-from ...linalg import Factorization, HermitianFactorization, saddle_matrix
+from ...linalg import Factorization, HermitianFactorization, cached_factorization, saddle_matrix
 from .operators import TriangleMeshOperators
 from .sources import build_sources
 
@@ -555,12 +555,7 @@ class SurfaceSignedHeatSolver:
         return h.hexdigest()
 
     def _cached(self, key, build):
-        fact = self._cache.get(key)
-        if fact is None:
-            if len(self._cache) >= 8:
-                self._cache.pop(next(iter(self._cache)))
-            fact = self._cache[key] = build()
-        return fact
+        return cached_factorization(self._cache, key, build)
 
     def _zero(self, S, b):
         ids, w, isv = self._all_nodes(S)

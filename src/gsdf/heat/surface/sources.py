@@ -43,25 +43,30 @@ class Sources:
 
 
 # ---------------------------------------------------------------------------------------------- parsing
+def vertex_polyline(c, n: int, name: str) -> np.ndarray:
+    """``c`` as a validated int64 array of ≥ 2 vertex indices in [0, n); ValueError naming ``name`` otherwise."""
+    a = np.asarray(c)
+    if a.dtype == object or a.ndim != 1:
+        raise ValueError(f"{name}: a vertex polyline must be a 1-D index array, got shape {a.shape}")
+    if a.size < 2:
+        raise ValueError(f"{name}: a curve needs at least 2 points, got {a.size}")
+    if not np.issubdtype(a.dtype, np.integer):
+        if not (np.issubdtype(a.dtype, np.floating) and np.all(a == np.round(a))):
+            raise ValueError(f"{name}: vertex indices must be integers, got dtype {a.dtype}")
+    a = a.astype(np.int64)
+    if a.min() < 0 or a.max() >= n:
+        bad = int(a[(a < 0) | (a >= n)][0])
+        raise ValueError(f"{name}: vertex index {bad} out of range for {n} vertices")
+    return a
+
+
 def _parse_curve(c, ops: TriangleMeshOperators, k: int):
     """Return ('v', verts) or ('b', faces (q,), bary (q,3)) for curve number k, validating indices."""
     name = f"curves[{k}]"
     n, m = ops.n_vertices, ops.n_faces
     if isinstance(c, np.ndarray) and c.dtype != object or (
             isinstance(c, (list, tuple)) and len(c) > 0 and all(np.isscalar(x) for x in c)):
-        a = np.asarray(c)
-        if a.ndim != 1:
-            raise ValueError(f"{name}: a vertex polyline must be a 1-D index array, got shape {a.shape}")
-        if a.size < 2:
-            raise ValueError(f"{name}: a curve needs at least 2 points, got {a.size}")
-        if not np.issubdtype(a.dtype, np.integer):
-            if not (np.issubdtype(a.dtype, np.floating) and np.all(a == np.round(a))):
-                raise ValueError(f"{name}: vertex indices must be integers, got dtype {a.dtype}")
-        a = a.astype(np.int64)
-        if a.min() < 0 or a.max() >= n:
-            bad = int(a[(a < 0) | (a >= n)][0])
-            raise ValueError(f"{name}: vertex index {bad} out of range for {n} vertices")
-        return "v", a
+        return "v", vertex_polyline(c, n, name)
     try:
         items = list(c)
     except TypeError as exc:

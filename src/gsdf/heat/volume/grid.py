@@ -18,7 +18,7 @@ Linear algebra: the Neumann 7-point Laplacian on a box is diagonal in the DCT-II
 *exactly* by two fast cosine transforms, O(N log N) at every size (128³ in well under a second) — faster than
 a sparse factorization or algebraic multigrid (pyamg took 7 s setup + 5 s solve at 64³ here). With the soft
 level-set constraint the system becomes L + P and is solved by CG preconditioned with that fast solver between
-Gauss–Seidel sweeps over the penalized nodes. The
+Gauss–Seidel sweeps over the penalized nodes and a coarse block-aggregate correction. The
 exact constraint factorizes L + ρCᵀWC once (CHOLMOD / SuperLU, grids up to 50k nodes) and reuses it for every
 multiplier update; larger grids use the preconditioned CG per update, which is slow (minutes at 64³).
 """
@@ -144,22 +144,38 @@ def dct_poisson(rhs, shape, spacing, shift: float = 0.0, lam=None) -> np.ndarray
     return idctn(c, type=2, norm="ortho", workers=-1).ravel()
 
 
-def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter: int = 300) -> np.ndarray:
+def _aggregation(shape, block: int) -> sp.csr_matrix:
+    """Restriction R summing the nodes of each block³ of the grid into one coarse unknown (piecewise constants)."""
+    n = int(np.prod(shape))
+    coarse = [(s + block - 1) // block for s in shape]
+    agg = np.ravel_multi_index(tuple(np.indices(shape).reshape(3, -1) // block), coarse)
+    return sp.csr_matrix((np.ones(n), (agg, np.arange(n))), shape=(int(np.prod(coarse)), n))
+
+
+def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter: int = 300,
+                  coarse_size: int = 4096) -> np.ndarray:
     """Solve the Step III system.
 
     Without ``penalty`` the system is the singular Neumann Laplacian L φ = rhs, solved exactly by
     :func:`dct_poisson` (a direct solver, any size). With a penalty matrix P (the soft level-set
-    constraint), A φ = rhs with A = L + P is solved by conjugate gradients with a symmetric two-level
-    preconditioner: a forward Gauss–Seidel sweep over the "band" (the nodes P touches, next to the sources),
-    an exact fast-Poisson correction with L + δI (δ = tr(P)/N), and a backward Gauss–Seidel sweep. The band
-    sweeps resolve the stiff penalty the global DCT solve cannot see: ~40 instead of ~115 iterations at 64³
-    on the broken bunny, and far fewer transforms. ``tol`` is CG's relative residual (1e-5 moves the field by
-    ~1e-5 of the box diagonal, well under the discretization error).
+    constraint), A φ = rhs with A = L + P is solved by conjugate gradients with a symmetric multiplicative
+    preconditioner whose stages each handle what the others miss:
+
+    1. a coarse correction on piecewise-constant block aggregates (Galerkin Rᵀ(RARᵀ)⁻¹R, ≈ ``coarse_size``
+       blocks, sparse LU) — the smooth error modes the penalty couples globally, the constant among them;
+    2. a forward Gauss–Seidel sweep over the "band" (the nodes P touches, next to the sources) — the stiff
+       penalty rows;
+    3. an exact fast-Poisson (DCT) solve with L + δI, δ = tr(P)/N — everything away from the sources;
+    4. the backward band sweep and the coarse correction again (so the preconditioner is symmetric).
+
+    Iterations on the broken bunny at 64³: 14 (DCT alone: 116). The start is the unconstrained DCT solution
+    plus the best constant. ``tol`` is CG's relative residual (1e-5 moves φ by ~1e-5 of the box diagonal,
+    far under the discretization error).
     """
     shape = tuple(shape)
     if penalty is None:
         return dct_poisson(rhs, shape, spacing)
-    from scipy.sparse.linalg import LinearOperator, cg, spsolve_triangular
+    from scipy.sparse.linalg import LinearOperator, cg, splu, spsolve_triangular
 
     n = int(np.prod(shape))
     L = neumann_laplacian(shape, spacing)
@@ -170,16 +186,21 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     A_bb = A[band][:, band]
     lower = sp.tril(A_bb, format="csr")
     upper = sp.triu(A_bb, format="csr")
+    block = max(2, int(np.ceil((n / coarse_size) ** (1.0 / 3.0))))
+    R = _aggregation(shape, block)
+    coarse = splu((R @ A @ R.T).tocsc())  # SPD: P > 0 pins the constant
 
     def precondition(r):
-        x = np.zeros(n)
-        x[band] = spsolve_triangular(lower, r[band], lower=True)  # forward Gauss–Seidel on the band
-        x += dct_poisson(r - A @ x, shape, spacing, delta, lam)  # global fast-Poisson correction
-        x[band] += spsolve_triangular(upper, (r - A @ x)[band], lower=False)  # backward sweep (keeps M symmetric)
+        x = R.T @ coarse.solve(R @ r)
+        x[band] += spsolve_triangular(lower, (r - A @ x)[band], lower=True)
+        x += dct_poisson(r - A @ x, shape, spacing, delta, lam)
+        x[band] += spsolve_triangular(upper, (r - A @ x)[band], lower=False)
+        x += R.T @ coarse.solve(R @ (r - A @ x))
         return x
 
     M = LinearOperator((n, n), matvec=precondition)
     x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
+    x0 += (rhs.sum() - (A @ x0).sum()) / penalty.sum()  # best constant shift (L annihilates constants)
     x, info = cg(A, rhs, x0=x0, M=M, rtol=tol, maxiter=maxiter)
     if info > 0:
         import warnings
