@@ -143,3 +143,27 @@ def test_tet_tetgen_conforming_mesher(sphere):
     rng = np.random.default_rng(0)
     Q = rng.uniform(-1.2, 1.2, (1000, 3))
     assert np.abs(f(Q) - gsdf.signed_distance(V, F, Q)).mean() < 0.15 * f.meta["h"]
+
+
+def test_spd_solver_iterative_and_direct_agree():
+    """Above ``direct_max`` the solver runs preconditioned CG; it must match the factorization."""
+    import scipy.sparse as sp
+
+    from gsdf.heat.volume.tet import SPDSolver
+
+    n = 40
+    K1 = sp.diags([2.0 * np.ones(n), -np.ones(n - 1), -np.ones(n - 1)], [0, -1, 1])
+    I1 = sp.identity(n)
+    A = (sp.kron(K1, I1) + sp.kron(I1, K1) + 0.01 * sp.identity(n * n)).tocsr()
+    rng = np.random.default_rng(0)
+    b = rng.standard_normal((n * n, 3))
+    direct = SPDSolver(A)
+    iterative = SPDSolver(A, direct_max=10)
+    assert direct.direct and not iterative.direct
+    x = iterative.solve(b)
+    np.testing.assert_allclose(x, direct.solve(b), rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(iterative.solve(b[:, 0]), x[:, 0])
+    # an indefinite matrix defeats CG: the solver must fall back to the factorization, not return garbage
+    B = (A - 4.0 * sp.identity(n * n)).tocsr()
+    y = SPDSolver(B, direct_max=10).solve(b[:, 0])
+    np.testing.assert_allclose(B @ y, b[:, 0], atol=1e-8)

@@ -52,6 +52,9 @@ Example:
 @click.option("--relative", is_flag=True, help="Offsets are fractions of the bounding-box diagonal.")
 @click.option("--t-coef", type=click.FloatRange(min=0, min_open=True), default=1.0, show_default=True,
               help="Diffusion time t = t_coef · h².")
+@click.option("--t-scale", type=click.Choice(["grid", "input"]), default="grid", show_default=True,
+              help="h of t = t_coef·h²: the grid spacing (robust to flipped/noisy normals) or the input's mean "
+                   "edge length / point spacing (as signedheat3d; more accurate on clean input with holes).")
 @click.option("--constraint", type=click.Choice(["zero", "none", "multiple"]), default="zero", show_default=True,
               help="Level set (§7.1): pull φ to 0 at the sources (zero; a soft penalty on grids), shift by the "
                    "source mean only (none), or one constant per connected input component (multiple, --tet).")
@@ -60,7 +63,7 @@ Example:
 @normals_option
 @quiet_option
 @report_errors
-def heat(input, output, grid, tet, offsets, relative, t_coef, constraint, surface_format, estimate_normals, quiet):
+def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constraint, surface_format, estimate_normals, quiet):
     import numpy as np
 
     from ..heat.volume import signed_heat_volume
@@ -70,7 +73,7 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, constraint, surfac
     kw = dict(mesh=(geo.V, geo.F)) if geo.is_mesh else dict(points=(geo.P, geo.N))
     update, close = _stage_progress(not quiet)
     try:
-        field = signed_heat_volume(domain="tet" if tet else "grid", resolution=grid, t_coef=t_coef,
+        field = signed_heat_volume(domain="tet" if tet else "grid", resolution=grid, t_coef=t_coef, t_scale=t_scale,
                                    level_set_constraint=constraint, progress=update, **kw)
     finally:
         close()

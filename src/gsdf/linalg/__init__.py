@@ -62,8 +62,8 @@ class Factorization:
 class HermitianFactorization:
     """Factorization of a sparse Hermitian positive definite complex matrix, reused across solves.
 
-    Uses CHOLMOD through the optional package ``cholespy`` on the equivalent real symmetric system of size 2n
-    (the 2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved) when it is installed — about twice as fast as the
+    Uses CHOLMOD through ``cholespy`` (a dependency) on the equivalent real symmetric system of size 2n
+    (the 2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved) — about twice as fast as the
     fallback, SciPy's SuperLU on the complex matrix in symmetric mode.
 
     Example

@@ -10,7 +10,7 @@ from .grid import check_memory, solve_grid
 from .sources import Sources, mesh_sources, point_sources
 from .yukawa import YukawaTree
 
-__all__ = ["signed_heat_volume", "YukawaTree", "mesh_sources", "point_sources", "Sources", "volume_grid_box"]
+__all__ = ["signed_heat_volume", "YukawaTree", "mesh_sources", "point_sources", "Sources", "volume_grid_box", "input_spacing"]
 
 MAX_RESOLUTION = 4096
 
@@ -31,6 +31,29 @@ def _input_positions(mesh, points):
         raise ValueError("points: expected a pair (P, N); N are the normals") from exc
     src = point_sources(P, N)
     return src, as_points(P, "P"), None
+
+
+def input_spacing(X, F=None) -> float:
+    """The input's own length scale: mean edge length of the triangles ``F`` over ``X``, or for a cloud the mean
+    distance from each point to its 6 nearest neighbours (about the mean edge of its tufted cover, §8.4). This is
+    the ``h`` of t = t_coef · h² that signedheat3d uses on grids (``meanEdgeLength``)."""
+    X = np.asarray(X, float)
+    if F is not None and len(F):
+        E = np.unique(np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1), axis=0)
+        L = np.linalg.norm(X[E[:, 0]] - X[E[:, 1]], axis=1)
+        L = L[L > 0]
+        if len(L):
+            return float(L.mean())
+    from scipy.spatial import cKDTree
+
+    k = min(7, len(X))
+    if k < 2:
+        raise ValueError('t_scale="input" needs at least 2 distinct input points')
+    d = cKDTree(X).query(X, k)[0][:, 1:]
+    d = d[d > 0]
+    if not len(d):
+        raise ValueError('t_scale="input": all input points coincide')
+    return float(d.mean())
 
 
 def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = 0.1):
@@ -74,7 +97,7 @@ def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = 0.
 
 def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=64, bbox_min=None, bbox_max=None,
                        t_coef: float = 1.0, level_set_constraint: str = "zero", theta: float = 1.5,
-                       max_memory=None, progress=None, **kwargs):
+                       max_memory=None, progress=None, t_scale: str = "grid", **kwargs):
     """Generalized signed distance in a volume by the signed heat method (Feng & Crane 2024, §8).
 
     Parameters
@@ -92,7 +115,14 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     bbox_min, bbox_max : (3,) float, optional
         Box of the domain; defaults to the input's box padded by 10 % of its diagonal. Must contain the input.
     t_coef : float
-        Diffusion time t = t_coef · h², h the grid spacing (§10 of the seed: t = h² is accurate).
+        Diffusion time t = t_coef · h² (§10 of the seed: t = h² is accurate), h set by ``t_scale``.
+    t_scale : {"grid", "input"}
+        "grid" (default): h is the grid spacing (near the input, on tets). "input": h is the input's own
+        spacing (:func:`input_spacing`: mean edge length, or mean neighbour distance of a cloud), as signedheat3d
+        does. Step I is a convolution, so t is free of the grid: a shorter t follows the input more closely —
+        "input" is markedly more accurate on clean meshes and scans with holes (every real input of
+        bench/RESULTS.md) — while the longer default averages more sources and is more robust to flipped or
+        noisy normals (the Points-as-Tori corruption landscape).
     level_set_constraint : {"zero", "multiple", "none"}
         "zero" (default; measured more accurate than "none" on every benchmark input, bench/RESULTS.md): the
         zero level set goes through the input — on grids a penalty on the trilinear values at the sources
@@ -126,8 +156,11 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     domain = choice(domain, "domain", {"grid", "tet"})
     t_coef = positive(t_coef, "t_coef")
     level_set_constraint = choice(level_set_constraint, "level_set_constraint", {"none", "zero", "multiple"})
+    t_scale = choice(t_scale, "t_scale", {"grid", "input"})
     src, X, F = _input_positions(mesh, points)
     lo, hi, shape = volume_grid_box(X, resolution, bbox_min, bbox_max)
+    if t_scale == "input" and "t" not in kwargs:
+        kwargs["t"] = t_coef * input_spacing(X, F) ** 2
     if domain == "tet":
         from .tet import solve_tet
 

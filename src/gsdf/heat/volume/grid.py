@@ -31,6 +31,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from ..._checks import positive
 from ...field import GridField, grid_points
 from .sources import Sources
 from .yukawa import YukawaTree, grid_nearest_distance
@@ -288,7 +289,7 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     shape = tuple(int(s) for s in shape)
     spacing = (hi - lo) / (np.array(shape) - 1)
     h = float(spacing.max())
-    t = float(t_coef) * h * h if t is None else float(t)
+    t = float(t_coef) * h * h if t is None else positive(t, "t")
     n = int(np.prod(shape))
     report = progress or (lambda *a: None)
 
