@@ -16,9 +16,12 @@ def test_hermitian_backends_agree():
     assert abs(A - A.conj().T).max() < 1e-14                       # Hermitian (Eq. 9)
     b = np.random.default_rng(0).normal(size=A.shape[0]) * (1 + 1j)
     x1 = HermitianFactorization(A, backend="superlu").solve(b)
-    x2 = HermitianFactorization(A).solve(b)
+    x2 = HermitianFactorization(A, backend="cholmod").solve(b)
+    assert HermitianFactorization(A).backend == "superlu"  # the default: measured faster (linalg docstring)
     np.testing.assert_allclose(A @ x1, b, atol=1e-10)
     np.testing.assert_allclose(x1, x2, atol=1e-10)
+    with pytest.raises(ValueError, match="backend"):
+        HermitianFactorization(A, backend="mumps")
 
 
 def test_connection_laplacian_is_psd_and_kills_parallel_fields():

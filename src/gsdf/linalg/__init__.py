@@ -62,9 +62,11 @@ class Factorization:
 class HermitianFactorization:
     """Factorization of a sparse Hermitian positive definite complex matrix, reused across solves.
 
-    Uses CHOLMOD through ``cholespy`` (a dependency) on the equivalent real symmetric system of size 2n
-    (the 2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved) — about twice as fast as the
-    fallback, SciPy's SuperLU on the complex matrix in symmetric mode.
+    ``backend="superlu"`` (the default, ``"auto"``): SciPy's SuperLU on the complex matrix in symmetric mode.
+    ``backend="cholmod"``: CHOLMOD through ``cholespy`` on the equivalent real symmetric system of size 2n (the
+    2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved). Measured on the vector heat operators (bunny00 CR edges,
+    113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2.4–3.4× faster (0.51 vs 1.34 s,
+    0.16 vs 0.54 s) and solves as fast (0.019 vs 0.017 s), so the 2n embedding is not worth it.
 
     Example
     -------
@@ -80,23 +82,21 @@ class HermitianFactorization:
         n = A.shape[0]
         self.n = n
         self._chol = None
-        if backend in ("auto", "cholmod"):
-            try:
-                from cholespy import CholeskySolverD, MatrixType
-            except ImportError:
-                if backend == "cholmod":
-                    raise
-            else:
-                r, c, v = A.row, A.col, A.data.astype(np.complex128)
-                rows = np.concatenate([2 * r, 2 * r, 2 * r + 1, 2 * r + 1])
-                cols = np.concatenate([2 * c, 2 * c + 1, 2 * c, 2 * c + 1])
-                vals = np.concatenate([v.real, -v.imag, v.imag, v.real])
-                R = sp.csr_matrix((vals, (rows, cols)), shape=(2 * n, 2 * n))
-                R.sum_duplicates()
-                self._chol = CholeskySolverD(2 * n, R.indptr.astype(np.int32), R.indices.astype(np.int32),
-                                             np.ascontiguousarray(R.data), MatrixType.CSR)
-                self.backend = "cholmod"
-                return
+        if backend not in ("auto", "superlu", "cholmod"):
+            raise ValueError(f"backend: expected 'auto', 'superlu' or 'cholmod', got {backend!r}")
+        if backend == "cholmod":
+            from cholespy import CholeskySolverD, MatrixType
+
+            r, c, v = A.row, A.col, A.data.astype(np.complex128)
+            rows = np.concatenate([2 * r, 2 * r, 2 * r + 1, 2 * r + 1])
+            cols = np.concatenate([2 * c, 2 * c + 1, 2 * c, 2 * c + 1])
+            vals = np.concatenate([v.real, -v.imag, v.imag, v.real])
+            R = sp.csr_matrix((vals, (rows, cols)), shape=(2 * n, 2 * n))
+            R.sum_duplicates()
+            self._chol = CholeskySolverD(2 * n, R.indptr.astype(np.int32), R.indices.astype(np.int32),
+                                         np.ascontiguousarray(R.data), MatrixType.CSR)
+            self.backend = "cholmod"
+            return
         self._lu = Factorization(A.astype(np.complex128))
         self.backend = "superlu"
 
