@@ -72,6 +72,15 @@ def test_cli_heat(tmp_path):
     assert f([[0, 0, 0]])[0] < -0.8
     r = CliRunner().invoke(heat, [str(src), "--grid", "4000", "-o", str(out), "-q"])
     assert r.exit_code != 0 and ("absurd" in r.output or "GiB" in r.output)
+    # --t-scale input: t from the mesh's own edge length, a different (shorter) diffusion time
+    out2 = tmp_path / "s2.npz"
+    r = CliRunner().invoke(heat, [str(src), "--grid", "20", "--t-scale", "input", "-o", str(out2), "-q"])
+    assert r.exit_code == 0, r.output
+    f2 = GridField.load(out2)
+    assert f2([[0, 0, 0]])[0] < -0.8
+    assert not np.allclose(f2.values, f.values)
+    r = CliRunner().invoke(heat, [str(src), "--t-scale", "mesh", "-o", str(out2), "-q"])
+    assert r.exit_code != 0
 
 
 def test_isosurface_close_caps_at_the_box():
