@@ -248,7 +248,7 @@ def solve_constrained(rhs, shape, spacing, C, w, rho: float, tol: float, max_out
         try:  # factorize once (CHOLMOD), every outer step is then two triangular solves
             from .tet import SPDSolver
 
-            direct = SPDSolver(A)
+            direct = SPDSolver(A, direct_max=direct_below)  # many outer steps: factorize, never CG
         except Exception:  # pragma: no cover - fall back to the iterative inner solver
             direct = None
     if direct is None:

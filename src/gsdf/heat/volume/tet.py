@@ -238,7 +238,7 @@ def weak_divergence(T, vol, G, Y, n):
 class SPDSolver:
     """Solve with a sparse symmetric positive definite matrix, set up once for many right-hand sides.
 
-    Small systems (n ≤ ``direct_max``) are factorized: CHOLMOD via the optional cholespy, else SuperLU. Larger
+    Small systems (n ≤ ``direct_max``) are factorized: CHOLMOD via cholespy (SuperLU if it is missing). Larger
     ones use preconditioned conjugate gradients: the graded tet Laplacians are well conditioned (Jacobi-CG to
     1e-10 takes 0.1 s on the 23k-unknown mech-holes-shark system, where SuperLU's fill costs 4–70 s) — pyamg's
     smoothed aggregation preconditions when installed, Jacobi otherwise. If CG does not converge the matrix
@@ -287,6 +287,8 @@ class SPDSolver:
     def _solve_vector(self, b):
         from scipy.sparse.linalg import cg
 
+        if self.direct:  # a previous right-hand side defeated CG
+            return self._direct_solve(np.ascontiguousarray(b))
         x, info = cg(self.A, b, rtol=self.rtol, atol=0.0, maxiter=20 * int(np.sqrt(self.n)) + 500, M=self._M)
         if info == 0:
             return x
@@ -299,10 +301,7 @@ class SPDSolver:
             return self._direct_solve(b)
         if b.ndim == 1:
             return self._solve_vector(b)
-        cols = []
-        for j in range(b.shape[1]):
-            cols.append(self._direct_solve(np.ascontiguousarray(b[:, j])) if self.direct else self._solve_vector(b[:, j]))
-        return np.column_stack(cols)
+        return np.column_stack([self._solve_vector(b[:, j]) for j in range(b.shape[1])])
 
 
 # ----------------------------------------------------------------------------------------------- meshing
@@ -506,18 +505,7 @@ def _cr_heat(src, P, T, D, keep, vol, G, tt, amg_above):
     for a in range(4):
         np.add.at(X0, TF[si, a], theta[:, a, None] * src.W)
     A1 = (Mcr + tt * Lcr).tocsr()
-    if nF > amg_above:
-        from scipy.sparse.linalg import cg
-
-        try:
-            import pyamg
-
-            M = pyamg.smoothed_aggregation_solver(A1, symmetry="symmetric").aspreconditioner()
-        except ImportError:
-            M = sp.diags(1.0 / A1.diagonal())
-        Xf = np.column_stack([cg(A1, X0[:, c], rtol=1e-8, maxiter=500, M=M)[0] for c in range(3)])
-    else:
-        Xf = SPDSolver(A1).solve(X0)
+    Xf = SPDSolver(A1, direct_max=amg_above).solve(X0)  # factorized up to amg_above faces, CG above
     XT = np.zeros((len(T), 3))
     XT[okidx] = Xf[TF].mean(axis=1)
     return XT[keep]
