@@ -65,8 +65,8 @@ class HermitianFactorization:
     ``backend="superlu"`` (the default, ``"auto"``): SciPy's SuperLU on the complex matrix in symmetric mode.
     ``backend="cholmod"``: CHOLMOD through ``cholespy`` on the equivalent real symmetric system of size 2n (the
     2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved). Measured on the vector heat operators (bunny00 CR edges,
-    113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2.4–3.4× faster (0.51 vs 1.34 s,
-    0.16 vs 0.54 s) and solves as fast (0.019 vs 0.017 s), so the 2n embedding is not worth it.
+    113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2–3.5× faster (0.58 vs 1.14 s,
+    0.15 vs 0.53 s) and solves as fast (bench/bench_solver_choices.py), so the 2n embedding is not worth it.
 
     Example
     -------
