@@ -20,7 +20,8 @@ _EXPORTS = {
     "TriangleDistance": "distance", "PointCloudDistance": "distance", "unsigned_distance": "distance",
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",
     # fields, contouring, operations
-    "Field": "field", "GridField": "field",
+    "Field": "field", "GridField": "field", "SurfaceField": "field",
+    "signed_distance_grid": "distance.grid",
     "extract_isosurface": "contour", "refine_on_edges": "contour", "slice_contours": "contour",
     "write_svg": "contour",
     "voxelize": "ops", "winding_grid": "ops", "save_voxels": "ops", "voxels_to_mesh": "ops",

@@ -8,15 +8,40 @@ from ._checks import as_points, positive
 
 
 class Field:
-    """Abstract scalar field on a domain in R^3.
+    """The result protocol every gsdf method returns: values on a domain, evaluated anywhere, contoured, saved.
 
-    Subclasses implement ``__call__(Q) -> (q,)`` and ``isosurface(level) -> (V, F)``.
+    * ``field(Q)`` — values at query points ``Q`` (q, 3) → (q,);
+    * ``field.isosurface(level)`` → ``(V, F)`` for volume fields (:class:`GridField`, :class:`TetField`),
+      ``field.isolines(level)`` → list of (k, 3) polylines for fields on surfaces (:class:`SurfaceField`);
+    * ``field.save(path)`` — format by extension, one of ``type(field).SAVE_EXTENSIONS``; any other extension is a
+      ``ValueError`` listing those (the requested name is never changed). The file is written atomically
+      (:mod:`gsdf.io.safe_write`).
     """
+
+    #: Extensions :meth:`save` can write (lower case, with the dot).
+    SAVE_EXTENSIONS: tuple = ()
 
     def __call__(self, Q) -> np.ndarray:  # pragma: no cover - interface
         raise NotImplementedError
 
     def isosurface(self, level: float = 0.0):  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def save(self, path) -> None:
+        """Write the field to ``path``; the format follows the extension (see ``SAVE_EXTENSIONS``).
+
+        Raises
+        ------
+        ValueError
+            For an extension outside ``SAVE_EXTENSIONS`` (the message lists them), a directory, a parent that is
+            not a folder, or a failed write.
+        """
+        from .io.safe_write import atomic_output, extension_of
+
+        with atomic_output(path, extensions=self.SAVE_EXTENSIONS) as tmp:
+            self._write(tmp, extension_of(path))
+
+    def _write(self, path: str, ext: str) -> None:  # pragma: no cover - interface
         raise NotImplementedError
 
 
@@ -114,13 +139,18 @@ class GridField(Field):
         """Several level sets at once: a list of ``(V, F)``, one per level (e.g. offsets ±1 %, ±3 %)."""
         return [self.isosurface(float(v), close=close) for v in np.atleast_1d(np.asarray(levels, dtype=float))]
 
-    def save(self, path) -> None:
-        """Write the field: ``.npz`` (``values``, ``bbox_min``, ``bbox_max``), ``.vtk`` (legacy structured
-        points, binary, opens in ParaView) or ``.vtu`` (meshio hexahedra with point data ``values``)."""
-        p = str(path).lower()
-        if p.endswith(".vtk"):
+    SAVE_EXTENSIONS = (".npz", ".npy", ".vtk", ".vti", ".vtu")
+
+    def _write(self, path: str, ext: str) -> None:
+        """``.npz``: ``values``, ``bbox_min``, ``bbox_max`` (reload with :meth:`load`); ``.npy``: the values array
+        alone (nx, ny, nz) — the box is not stored; ``.vtk``: legacy binary STRUCTURED_POINTS; ``.vti``: VTK XML
+        ImageData (base64 binary); ``.vtu``: hexahedra with point data ``values`` (meshio). All VTK forms open in
+        ParaView with the field as point data ``values``."""
+        if ext == ".vtk":
             _write_vtk_structured_points(path, self.values, self.bbox_min, self.spacing)
-        elif p.endswith(".vtu"):
+        elif ext == ".vti":
+            _write_vti(path, self.values, self.bbox_min, self.spacing)
+        elif ext == ".vtu":
             import meshio
 
             P = self.grid_points()
@@ -129,18 +159,39 @@ class GridField(Field):
             c = idx[:-1, :-1, :-1].ravel()
             sx, sy = ny * nz, nz
             hexes = np.column_stack([c, c + sx, c + sx + sy, c + sy, c + 1, c + sx + 1, c + sx + sy + 1, c + sy + 1])
-            meshio.write(path, meshio.Mesh(P, [("hexahedron", hexes)], point_data={"values": self.values.ravel()}))
+            meshio.write(path, meshio.Mesh(P, [("hexahedron", hexes)], point_data={"values": self.values.ravel()}),
+                         file_format="vtu")
+        elif ext == ".npy":
+            np.save(path, self.values)
         else:
             np.savez_compressed(path, values=self.values, bbox_min=self.bbox_min, bbox_max=self.bbox_max,
                                 kind="grid")
 
     @classmethod
     def load(cls, path) -> "GridField":
-        try:
-            with np.load(path) as d:
-                return cls(d["values"], d["bbox_min"], d["bbox_max"])
-        except (OSError, KeyError, ValueError) as exc:
-            raise ValueError(f"{path}: not a gsdf grid field file ({exc})") from exc
+        """Read a field written by :meth:`save` to ``.npz`` (the only form that stores the box)."""
+        d = _load_npz(path, ("values", "bbox_min", "bbox_max"), "grid field")
+        return cls(d["values"], d["bbox_min"], d["bbox_max"])
+
+
+def _load_npz(path, keys, what: str) -> dict:
+    """The arrays ``keys`` of a gsdf ``.npz`` file; FileNotFoundError if missing, else ValueError naming the file."""
+    import os
+    import zipfile
+
+    p = os.fspath(path)
+    if not os.path.exists(p):
+        raise FileNotFoundError(2, "No such file or directory", p)
+    if os.path.isdir(p):
+        raise ValueError(f"{p}: is a directory, not a {what} file")
+    try:
+        with np.load(p, allow_pickle=False) as d:
+            missing = [k for k in keys if k not in d]
+            if missing:
+                raise ValueError(f"missing arrays {', '.join(missing)}")
+            return {k: d[k] for k in keys}
+    except (OSError, KeyError, ValueError, TypeError, AttributeError, EOFError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"{p}: not a gsdf {what} .npz file ({exc})") from exc
 
 
 def grid_points(bbox_min, bbox_max, shape) -> np.ndarray:
@@ -171,6 +222,34 @@ def _write_vtk_structured_points(path, values, origin, spacing) -> None:
         f.write(header.encode("ascii"))
         f.write(np.ascontiguousarray(values.transpose(2, 1, 0)).astype(">f8").tobytes())
         f.write(b"\n")
+
+
+def _write_vti(path, values, origin, spacing) -> None:
+    """VTK XML ImageData with the values as inline base64 binary point data (UInt64 byte-count header).
+
+    VTK orders points with x fastest, so the (nx, ny, nz) C-order array is written transposed.
+    """
+    import base64
+
+    nx, ny, nz = values.shape
+    data = np.ascontiguousarray(values.transpose(2, 1, 0)).astype("<f8").tobytes()
+    payload = base64.b64encode(np.array([len(data)], "<u8").tobytes() + data).decode("ascii")
+    ext = f"0 {nx - 1} 0 {ny - 1} 0 {nz - 1}"
+    text = (
+        '<?xml version="1.0"?>\n'
+        '<VTKFile type="ImageData" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n'
+        f'  <ImageData WholeExtent="{ext}" Origin="{" ".join(repr(float(v)) for v in origin)}" '
+        f'Spacing="{" ".join(repr(float(v)) for v in spacing)}">\n'
+        f'    <Piece Extent="{ext}">\n'
+        '      <PointData Scalars="values">\n'
+        f'        <DataArray type="Float64" Name="values" NumberOfComponents="1" format="binary">{payload}'
+        '</DataArray>\n'
+        '      </PointData>\n'
+        '    </Piece>\n'
+        '  </ImageData>\n'
+        '</VTKFile>\n')
+    with open(path, "w", encoding="ascii") as f:
+        f.write(text)
 
 
 class TetField(Field):
@@ -250,23 +329,199 @@ class TetField(Field):
     def isosurfaces(self, levels):
         return [self.isosurface(float(v)) for v in np.atleast_1d(np.asarray(levels, dtype=float))]
 
-    def save(self, path) -> None:
-        """``.npz`` (vertices, tets, values) or ``.vtu``/``.vtk`` (meshio tetra with point data ``values``)."""
-        p = str(path).lower()
-        if p.endswith(".vtu") or p.endswith(".vtk"):
+    SAVE_EXTENSIONS = (".npz", ".npy", ".vtk", ".vtu")
+
+    def _write(self, path: str, ext: str) -> None:
+        """``.npz``: vertices, tets, values (reload with :meth:`load`); ``.npy``: the values (n,) alone;
+        ``.vtk`` (legacy) / ``.vtu`` (XML): tetra cells with point data ``values`` (meshio). A tet field is not an
+        image, so ``.vti`` is refused."""
+        if ext in (".vtu", ".vtk"):
             import meshio
 
-            meshio.write(path, meshio.Mesh(self.vertices, [("tetra", self.tets)], point_data={"values": self.values}))
+            meshio.write(path, meshio.Mesh(self.vertices, [("tetra", self.tets)], point_data={"values": self.values}),
+                         file_format=ext[1:])
+        elif ext == ".npy":
+            np.save(path, self.values)
         else:
             np.savez_compressed(path, vertices=self.vertices, tets=self.tets, values=self.values, kind="tet")
 
     @classmethod
     def load(cls, path) -> "TetField":
-        try:
-            with np.load(path) as d:
-                return cls(d["vertices"], d["tets"], d["values"])
-        except (OSError, KeyError, ValueError) as exc:
-            raise ValueError(f"{path}: not a gsdf tet field file ({exc})") from exc
+        """Read a field written by :meth:`save` to ``.npz``."""
+        d = _load_npz(path, ("vertices", "tets", "values"), "tet field")
+        return cls(d["vertices"], d["tets"], d["values"])
+
+
+class SurfaceField(Field):
+    """Values on the vertices of a triangle mesh: evaluation at (closest) surface points and isolines.
+
+    What the surface methods (the signed heat method on meshes, surface winding numbers) can return.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    values : (n,) float
+        One finite value per vertex, interpolated linearly over each triangle.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gsdf.field import SurfaceField
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.]])
+    >>> f = SurfaceField(V, [[0, 1, 2], [0, 2, 3]], V[:, 0])
+    >>> float(f([[0.25, 0.5, 1.0]])[0])
+    0.25
+    >>> [np.round(p, 3).tolist() for p in f.isolines(0.5)]
+    [[[0.5, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 1.0, 0.0]]]
+    """
+
+    SAVE_EXTENSIONS = (".npz", ".npy", ".ply", ".vtk", ".vtu")
+
+    def __init__(self, vertices, faces, values):
+        from ._checks import as_mesh
+
+        self.vertices, self.faces = as_mesh(vertices, faces)
+        v = np.asarray(values)
+        if v.dtype == bool or not (np.issubdtype(v.dtype, np.number)) or v.shape != (len(self.vertices),):
+            raise ValueError(f"values: expected {len(self.vertices)} numbers (one per vertex), got "
+                             f"{v.dtype} {v.shape}")
+        v = v.astype(np.float64)
+        if not np.isfinite(v).all():
+            raise ValueError("values: contains NaN or infinite entries")
+        self.values = v
+        self._distance = None
+        self.meta: dict = {}
+
+    def at(self, face, bary) -> np.ndarray:
+        """Values at surface points given as a face index (q,) and barycentric coordinates (q, 3)."""
+        face = np.asarray(face)
+        bary = np.asarray(bary, dtype=np.float64)
+        if face.dtype == bool or not np.issubdtype(face.dtype, np.integer) or face.ndim != 1:
+            raise ValueError(f"face: expected a 1-d integer array, got {face.dtype} {face.shape}")
+        if len(face) and (face.min() < 0 or face.max() >= len(self.faces)):
+            raise ValueError(f"face: indices must be in [0, {len(self.faces)})")
+        if bary.shape != (len(face), 3) or not np.isfinite(bary).all():
+            raise ValueError(f"bary: expected finite shape ({len(face)}, 3), got {bary.shape}")
+        return (bary * self.values[self.faces[face]]).sum(axis=1)
+
+    def __call__(self, Q) -> np.ndarray:
+        """Values at the points of the surface closest to ``Q`` (q, 3) (on the surface: at ``Q`` itself)."""
+        Q = as_points(Q, "Q", allow_empty=True)
+        if len(Q) == 0:
+            return np.zeros(0)
+        if self._distance is None:
+            from .distance.triangles import TriangleDistance
+
+            self._distance = TriangleDistance(self.vertices, self.faces)
+        _, face, _, bary = self._distance.query_barycentric(Q)
+        return (bary * self.values[self.faces[face]]).sum(axis=1)
+
+    def isosurface(self, level: float = 0.0):
+        raise ValueError("a SurfaceField has level curves, not level surfaces: use isolines(level)")
+
+    def isolines(self, level: float = 0.0) -> list:
+        """The curves where the piecewise-linear field equals ``level`` (marching triangles).
+
+        Each triangle whose corners lie on both sides (above: ``value > level``) contributes one segment between
+        the crossing points of its two crossed edges; crossing points are shared per mesh edge and segments are
+        chained into polylines. Polylines are oriented with the region below ``level`` on their left, seen from
+        the face normals (so the zero isoline of a signed distance runs counter-clockwise around the negative
+        region, as the curves of the surface signed heat method do).
+
+        Returns
+        -------
+        list of (k, 3) float arrays
+            One per curve; a closed curve repeats its first point at the end. Empty when ``level`` is not
+            crossed.
+        """
+        level = float(level)
+        if not np.isfinite(level):
+            raise ValueError(f"level: expected a finite number, got {level}")
+        F = self.faces
+        s = self.values - level
+        pos = s[F] > 0
+        npos = pos.sum(axis=1)
+        cut = (npos == 1) | (npos == 2)
+        if not cut.any():
+            return []
+        Fc, Pc = F[cut], pos[cut]
+        lone_pos = npos[cut] == 1
+        lone = np.where(lone_pos, np.argmax(Pc, axis=1), np.argmax(~Pc, axis=1))
+        r = np.arange(len(Fc))
+        a, b, c = Fc[r, lone], Fc[r, (lone + 1) % 3], Fc[r, (lone + 2) % 3]
+        # p1 on edge (a, b), p2 on edge (c, a): p1 -> p2 has the lone corner a on its left
+        e1 = np.sort(np.column_stack([a, b]), axis=1)
+        e2 = np.sort(np.column_stack([c, a]), axis=1)
+        start = np.where(lone_pos[:, None], e2, e1)  # below-level side on the left
+        end = np.where(lone_pos[:, None], e1, e2)
+        uniq, inv = np.unique(np.vstack([start, end]), axis=0, return_inverse=True)
+        inv = inv.ravel()
+        u, v = inv[: len(Fc)], inv[len(Fc):]
+        sa, sb = s[uniq[:, 0]], s[uniq[:, 1]]
+        t = sa / (sa - sb)
+        X = self.vertices[uniq[:, 0]] + t[:, None] * (self.vertices[uniq[:, 1]] - self.vertices[uniq[:, 0]])
+        return [X[chain] for chain in _chain_segments(u, v, len(uniq))]
+
+    def _write(self, path: str, ext: str) -> None:
+        """``.npz``: vertices, faces, values (reload with :meth:`load`); ``.npy``: the values (n,) alone; ``.ply``:
+        the mesh with vertex property ``values``; ``.vtk``/``.vtu``: triangles with point data ``values``."""
+        if ext == ".ply":
+            from .io.mesh_io import write_mesh
+
+            write_mesh(path, self.vertices, self.faces, vertex_data={"values": self.values})
+        elif ext in (".vtk", ".vtu"):
+            import meshio
+
+            meshio.write(path, meshio.Mesh(self.vertices, [("triangle", self.faces)],
+                                           point_data={"values": self.values}), file_format=ext[1:])
+        elif ext == ".npy":
+            np.save(path, self.values)
+        else:
+            np.savez_compressed(path, vertices=self.vertices, faces=self.faces, values=self.values, kind="surface")
+
+    @classmethod
+    def load(cls, path) -> "SurfaceField":
+        """Read a field written by :meth:`save` to ``.npz``."""
+        d = _load_npz(path, ("vertices", "faces", "values"), "surface field")
+        return cls(d["vertices"], d["faces"], d["values"])
+
+
+def _chain_segments(u: np.ndarray, v: np.ndarray, n: int) -> list:
+    """Chain directed segments ``u[i] -> v[i]`` over ``n`` nodes into node sequences (open chains first from
+    their start, then cycles, closed by repeating the first node). A node with several outgoing segments
+    (non-manifold input) starts extra chains, so every segment is used exactly once."""
+    order = np.argsort(u, kind="stable")
+    first = np.searchsorted(u[order], np.arange(n + 1))
+    used = np.zeros(len(u), bool)
+    indeg = np.bincount(v, minlength=n)
+    outdeg = np.bincount(u, minlength=n)
+    nxt_ptr = first[:-1].copy()
+
+    def take(node):
+        while nxt_ptr[node] < first[node + 1]:
+            seg = order[nxt_ptr[node]]
+            nxt_ptr[node] += 1
+            if not used[seg]:
+                used[seg] = True
+                return seg
+        return -1
+
+    chains = []
+    starts = list(np.flatnonzero(outdeg > indeg)) + list(range(n))
+    for s0 in starts:
+        while True:
+            seg = take(s0)
+            if seg < 0:
+                break
+            chain = [s0, int(v[seg])]
+            while True:
+                seg = take(chain[-1])
+                if seg < 0:
+                    break
+                chain.append(int(v[seg]))
+            chains.append(np.array(chain, dtype=np.int64))
+    return chains
 
 
 def locate_in_tets(X, T, Q, k: int = 16, chunk: int = 1 << 15):

@@ -12,28 +12,21 @@ from ._common import bbox_of, beta_option, ensure_parent, load_geometry, normals
 
 
 def signed_distance_grid(geo, resolution: int, pad: float, sign: str = "winding", beta=None, quiet=True):
-    """Signed distance on the nodes of a grid around ``geo``; returns a :class:`gsdf.GridField`."""
-    from ..distance import TriangleDistance, point_cloud_distance, signed_distance
-    from ..field import GridField, grid_points, grid_shape
+    """Signed distance on the nodes of a grid around the loaded input ``geo`` (:func:`gsdf.signed_distance_grid`
+    with a progress bar); returns a :class:`gsdf.GridField`."""
+    from ..distance.grid import signed_distance_grid as grid_sdf
 
-    lo, hi = bbox_of(geo.positions, pad)
-    shape = grid_shape(lo, hi, resolution)
-    hi = lo + (np.array(shape) - 1) * (hi - lo).max() / (resolution - 1)  # cubic cells
-    Q = grid_points(lo, hi, shape)
-    if sign == "pseudonormal":
-        if not geo.is_mesh:
-            raise ValueError("--sign pseudonormal needs a mesh, not a point cloud")
-        d = signed_distance(geo.V, geo.F, Q, sign="pseudonormal")
-    else:
-        bar, update = progress_bar(len(Q), "winding numbers", not quiet)
-        with bar:
-            w = geo.winding(beta)(Q, progress=update)
-        if geo.is_mesh:
-            dist = TriangleDistance(geo.V, geo.F).query(Q)[0]
-        else:
-            dist = point_cloud_distance(geo.P, Q)
-        d = np.where(w > 0.5, -dist, dist)  # Barill et al. 2018 §4: sign from the winding number at 1/2
-    return GridField(d.reshape(shape), lo, hi)
+    if sign == "pseudonormal" and not geo.is_mesh:
+        raise ValueError("--sign pseudonormal needs a mesh, not a point cloud")
+    kw = dict(V=geo.V, F=geo.F) if geo.is_mesh else dict(V=None, points=(geo.P, geo.N))
+    bar, update = progress_bar(1, "winding numbers", not quiet and sign == "winding")
+
+    def progress(done, total):
+        bar.total = total
+        update(done, total)
+
+    with bar:
+        return grid_sdf(resolution=resolution, pad=pad, sign=sign, beta=beta, progress=progress, **kw)
 
 
 @click.command("sdf", help="""Signed distance grid of INPUT (mesh, soup or oriented cloud); negative inside.

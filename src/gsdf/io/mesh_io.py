@@ -27,6 +27,7 @@ import re
 import numpy as np
 
 from .._checks import as_faces, as_points
+from .safe_write import atomic_output
 
 __all__ = ["read_mesh", "write_mesh"]
 
@@ -702,11 +703,13 @@ def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
     if vertex_data and ext != ".ply":
         raise ValueError(f"{p}: vertex_data can only be written to PLY files (only PLY stores vertex data)")
     extra = _vertex_data(vertex_data, len(V))
-    if ext == ".off":
-        _write_text(p, f"OFF\n{len(V)} {len(sizes)} 0\n" + _format_rows(V) + _polygon_lines(flat, sizes, "", 0, True))
-    elif ext == ".obj":
-        _write_text(p, _format_rows(V, "v ") + _polygon_lines(flat, sizes, "f ", 1, False))
-    elif ext == ".ply":
-        _write_ply(p, {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2], **extra}, (flat, sizes), binary=binary)
-    else:
-        _write_stl(p, V, _fan(flat, sizes))
+    with atomic_output(p, extensions=MESH_FORMATS) as tmp:
+        if ext == ".off":
+            _write_text(tmp, f"OFF\n{len(V)} {len(sizes)} 0\n" + _format_rows(V)
+                        + _polygon_lines(flat, sizes, "", 0, True))
+        elif ext == ".obj":
+            _write_text(tmp, _format_rows(V, "v ") + _polygon_lines(flat, sizes, "f ", 1, False))
+        elif ext == ".ply":
+            _write_ply(tmp, {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2], **extra}, (flat, sizes), binary=binary)
+        else:
+            _write_stl(tmp, V, _fan(flat, sizes))

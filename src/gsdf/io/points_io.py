@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 
 from .._checks import as_points
+from .safe_write import atomic_output
 from .mesh_io import (
     _check_file,
     _extension,
@@ -190,18 +191,19 @@ def write_points(path, P, N=None, *, binary: bool = True) -> None:
         N = as_points(N, "N")
         if len(N) != len(P):
             raise ValueError(f"N: has {len(N)} rows but there are {len(P)} points")
-    if ext in (".xyz", ".pwn"):
-        _write_text(p, _format_rows(P if N is None else np.hstack([P, N])))
-    elif ext in (".obj", ".pc"):
-        _write_text(p, _format_rows(P, "v ") + ("" if N is None else _format_rows(N, "vn ")))
-    elif ext == ".ply":
-        fields = dict(zip("xyz", P.T))
-        if N is not None:
-            fields.update(zip(("nx", "ny", "nz"), N.T))
-        _write_ply(p, fields, None, binary=binary)
-    elif ext == ".npy":
-        with open(p, "wb") as fh:
-            np.save(fh, P if N is None else np.hstack([P, N]))
-    else:
-        with open(p, "wb") as fh:
-            np.savez(fh, P=P) if N is None else np.savez(fh, P=P, N=N)
+    with atomic_output(p, extensions=POINTS_WRITE_FORMATS) as tmp:
+        if ext in (".xyz", ".pwn"):
+            _write_text(tmp, _format_rows(P if N is None else np.hstack([P, N])))
+        elif ext in (".obj", ".pc"):
+            _write_text(tmp, _format_rows(P, "v ") + ("" if N is None else _format_rows(N, "vn ")))
+        elif ext == ".ply":
+            fields = dict(zip("xyz", P.T))
+            if N is not None:
+                fields.update(zip(("nx", "ny", "nz"), N.T))
+            _write_ply(tmp, fields, None, binary=binary)
+        elif ext == ".npy":
+            with open(tmp, "wb") as fh:
+                np.save(fh, P if N is None else np.hstack([P, N]))
+        else:
+            with open(tmp, "wb") as fh:
+                np.savez(fh, P=P) if N is None else np.savez(fh, P=P, N=N)
