@@ -1,12 +1,33 @@
-"""Shared helpers of the subcommands: loading inputs, progress bars, clean error reporting."""
+"""Shared helpers of the subcommands: loading inputs, progress bars, clean error reporting, safe outputs.
+
+Output policy (the same for every subcommand; see :mod:`gsdf.io.safe_write`):
+
+* an output that is one of the command's inputs (same file after resolving symlinks / hard links) is always
+  refused, before any work is done;
+* an existing output that is not an input is **overwritten**, as ``-o`` does in most command-line tools; pass
+  ``--no-clobber`` to refuse instead;
+* the requested name is never changed: an extension the output cannot have is refused with the list of the ones
+  it can;
+* every file is written to a temporary name in the target folder and renamed when complete; missing parent
+  folders are created.
+
+Subcommands get this by decorating with :func:`report_errors` (which adds ``--no-clobber``, checks every output
+option named in ``OUTPUT_PARAMS`` up front and turns library errors into one-line messages) and by writing each
+file inside ``with output_file(path) as tmp:``. Inputs are the values of the command's ``click.Path``
+parameters, so outputs must be declared as plain strings.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import functools
 import os
 
 import click
 import numpy as np
+
+from ..io.safe_write import atomic_output, check_output_path
 
 POINT_EXTENSIONS = {".xyz", ".pwn", ".pc", ".npy", ".npz"}
 
@@ -88,17 +109,81 @@ def counting(func, desc: str, enabled: bool = True):
     return bar, wrapped
 
 
+#: Names of the subcommands' parameters that hold output file names (checked before the work starts).
+OUTPUT_PARAMS = ("output", "out", "mesh_out", "png", "surface_out")
+
+_POLICY: contextvars.ContextVar = contextvars.ContextVar("gsdf_output_policy", default=None)
+
+
+def _input_paths(ctx) -> list:
+    """The values of every ``click.Path`` parameter of the running command: its input files."""
+    if ctx is None:
+        return []
+    out = []
+    for param in ctx.command.params:
+        if isinstance(param.type, click.Path) and ctx.params.get(param.name):
+            v = ctx.params[param.name]
+            out.extend(v if isinstance(v, (tuple, list)) else [v])
+    return out
+
+
+def _one_line(exc) -> str:
+    msg = str(exc)
+    if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        msg = f"{exc.filename}: {exc.strerror}"
+    return " ".join(msg.split()) or type(exc).__name__
+
+
+@contextlib.contextmanager
+def output_file(path, extensions=None, what: str = "output"):
+    """Write one output of the running command safely: yields a temporary path in the target folder (same
+    extension) that is renamed onto ``path`` when the block succeeds. Applies the command's policy: never one of
+    its inputs, existing files replaced unless ``--no-clobber``, parent folders created."""
+    policy = _POLICY.get() or {"inputs": [], "overwrite": True}
+    with atomic_output(path, inputs=policy["inputs"], extensions=extensions, overwrite=policy["overwrite"],
+                       make_parents=True, what=what) as tmp:
+        yield tmp
+
+
 def report_errors(fn):
-    """Turn the library's ValueError / FileNotFoundError into a clean CLI error (exit code 1)."""
+    """Decorate a subcommand (innermost, below the click options): adds ``--no-clobber``, checks every output
+    parameter (``OUTPUT_PARAMS``) against the inputs before the work starts, and turns the library's ValueError /
+    FileNotFoundError / OSError into a one-line CLI error (exit code 1) without a traceback."""
 
     @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
+    def wrapper(*args, no_clobber=False, **kwargs):
+        ctx = click.get_current_context(silent=True)
+        policy = {"inputs": _input_paths(ctx), "overwrite": not no_clobber}
+        token = _POLICY.set(policy)
         try:
+            for name in OUTPUT_PARAMS:
+                if kwargs.get(name):
+                    check_output_path(kwargs[name], inputs=policy["inputs"], overwrite=policy["overwrite"],
+                                      make_parents=True, what=f"--{name.replace('_', '-')}")
             return fn(*args, **kwargs)
-        except (ValueError, FileNotFoundError) as exc:
-            raise click.ClickException(str(exc)) from exc
+        except (ValueError, OSError) as exc:  # FileNotFoundError is an OSError
+            raise click.ClickException(_one_line(exc)) from exc
+        finally:
+            _POLICY.reset(token)
 
-    return wrapper
+    return click.option("--no-clobber", is_flag=True,
+                        help="Refuse to replace existing output files (default: replace them; an input is never "
+                             "replaced).")(wrapper)
+
+
+def check_output(path, extensions=None, what: str = "-o"):
+    """Check an output name up front (extension, not an input, ``--no-clobber``) under the running command's
+    policy, before any expensive work; returns it unchanged. ``None`` passes (an optional output not asked for)."""
+    if path is None:
+        return None
+    policy = _POLICY.get() or {"inputs": [], "overwrite": True}
+    return check_output_path(path, inputs=policy["inputs"], extensions=extensions, overwrite=policy["overwrite"],
+                             make_parents=True, what=what)
+
+
+def ensure_parent(path: str) -> None:
+    """Create the parent folder of ``path`` (kept for older subcommands; :func:`output_file` does this itself)."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
 
 
 def bbox_of(X: np.ndarray, pad: float) -> tuple[np.ndarray, np.ndarray]:
@@ -114,11 +199,6 @@ def parse_floats(text: str | None, name: str) -> list[float] | None:
         return [float(t) for t in text.split(",") if t.strip()]
     except ValueError as exc:
         raise click.BadParameter(f"expected comma-separated numbers, got {text!r}", param_hint=name) from exc
-
-
-def ensure_parent(path: str) -> None:
-    d = os.path.dirname(os.path.abspath(path))
-    os.makedirs(d, exist_ok=True)
 
 
 beta_option = click.option("--beta", type=float, default=None,

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from ._common import ensure_parent, report_errors
+from ._common import check_output, output_file, report_errors
 
 
 @click.command("boolean", help="""Boolean of meshes A and B, robust to holes and soups (Barill et al. 2018, Figs. 12-15).
@@ -26,12 +26,13 @@ Example:
 @click.option("--beta", type=float, default=2.0, show_default=True)
 @report_errors
 def boolean(a, b, op, output, exact, beta):
-    from ..io import read_mesh, write_mesh
+    from ..io import MESH_FORMATS, read_mesh, write_mesh
     from ..ops import mesh_boolean
 
+    check_output(output, MESH_FORMATS)
     VA, FA = read_mesh(a)
     VB, FB = read_mesh(b)
     V, F = mesh_boolean(VA, FA, VB, FB, op, beta=beta, exact=exact)
-    ensure_parent(output)
-    write_mesh(output, V, F)
+    with output_file(output) as tmp:
+        write_mesh(tmp, V, F)
     click.echo(f"{op}: {len(FA)} + {len(FB)} triangles -> {len(F)} triangles -> {os.path.abspath(output)}")

@@ -8,7 +8,7 @@ import time
 import click
 import numpy as np
 
-from ._common import Geometry, bbox_of, report_errors
+from ._common import Geometry, bbox_of, output_file, report_errors
 
 
 @click.command("demo", help="""Run gsdf on the bundled examples and say where the outputs went.
@@ -33,8 +33,12 @@ def demo(output_dir, resolution):
     from ..winding.point_areas import point_areas
     from .sdf import signed_distance_grid
 
-    os.makedirs(output_dir, exist_ok=True)
-    out = lambda name: os.path.join(output_dir, name)  # noqa: E731
+    def save(name, writer):
+        with output_file(os.path.join(output_dir, name)) as tmp:
+            writer(tmp)
+
+    if os.path.exists(output_dir) and not os.path.isdir(output_dir):
+        raise ValueError(f"{output_dir}: exists and is not a folder")
     written = []
     t0 = time.perf_counter()
 
@@ -47,24 +51,24 @@ def demo(output_dir, resolution):
     rng = np.random.default_rng(0)
     Q = rng.uniform(lo, hi, (2000, 3))
     w_fast, w_exact = fwn(Q), winding_number(V, F, Q)
-    np.savez(out("soup_winding_samples.npz"), queries=Q, winding_fast=w_fast, winding_exact=w_exact)
+    save("soup_winding_samples.npz", lambda p: np.savez(p, queries=Q, winding_fast=w_fast, winding_exact=w_exact))
     written.append(("winding numbers at 2000 random points (fast and exact)", "soup_winding_samples.npz"))
     click.echo(f"        fast vs exact winding number on 2000 points: RMS {np.sqrt(np.mean((w_fast - w_exact)**2)):.2e},"
                f" inside/outside agree on {np.mean((w_fast > 0.5) == (w_exact > 0.5)) * 100:.2f} %")
 
     field = signed_distance_grid(soup, resolution, 0.05)
-    field.save(out("soup_sdf.npz"))
+    save("soup_sdf.npz", field.save)
     written.append((f"signed distance grid {field.shape} (negative inside)", "soup_sdf.npz"))
-    write_field_slice_png(out("soup_sdf_slice.png"), field)
+    save("soup_sdf_slice.png", lambda p: write_field_slice_png(p, field))
     written.append(("PNG of the middle z slice of the signed distance, zero contour in black", "soup_sdf_slice.png"))
 
     Vs, Fs = extract_isosurface(fwn, lo, hi, resolution=resolution, level=0.5, bisection_steps=10)
-    write_mesh(out("soup_surface.ply"), Vs, Fs)
+    save("soup_surface.ply", lambda p: write_mesh(p, Vs, Fs))
     written.append((f"watertight surface of the soup (w = 1/2), {len(Fs)} triangles", "soup_surface.ply"))
 
     zs = list(np.linspace(lo[2], hi[2], 12)[1:-1])
     contours = slice_contours(fwn, zs, lo, hi, resolution=192)
-    write_svg(out("soup_slices.svg"), contours, z_values=zs, layout="stack")
+    save("soup_slices.svg", lambda p: write_svg(p, contours, z_values=zs, layout="stack"))
     written.append((f"{len(zs)} closed print slices ({sum(map(len, contours))} contours)", "soup_slices.svg"))
 
     # --- the point cloud -------------------------------------------------------------------------------
@@ -78,7 +82,7 @@ def demo(output_dir, resolution):
     fwp = FastWindingNumberPoints(P, N, areas=A)
     plo, phi = bbox_of(P, 0.05)
     Vc, Fc = extract_isosurface(fwp, plo, phi, resolution=resolution, level=0.5, bisection_steps=10)
-    write_mesh(out("cloud_surface.ply"), Vc, Fc)
+    save("cloud_surface.ply", lambda p: write_mesh(p, Vc, Fc))
     written.append((f"point-set surface of the cloud (w = 1/2), {len(Fc)} triangles", "cloud_surface.ply"))
     # winding number on the z = 0 plane
     n = 256
@@ -86,7 +90,7 @@ def demo(output_dir, resolution):
     ys = np.linspace(plo[1], phi[1], n)
     X, Y = np.meshgrid(xs, ys, indexing="xy")
     W = fwp(np.column_stack([X.ravel(), Y.ravel(), np.zeros(n * n)])).reshape(n, n)
-    write_png(out("cloud_winding_slice.png"), field_to_rgb(np.flipud(-(W - 0.5)), zero_level=0.0))
+    save("cloud_winding_slice.png", lambda p: write_png(p, field_to_rgb(np.flipud(-(W - 0.5)), zero_level=0.0)))
     written.append(("PNG of the cloud's winding number on z = 0 (1/2 contour in black)", "cloud_winding_slice.png"))
 
     click.echo(f"\nDone in {time.perf_counter() - t0:.1f} s. Outputs in {os.path.abspath(output_dir)}:")

@@ -6,7 +6,8 @@ import os
 
 import click
 
-from ._common import ensure_parent, load_geometry, normals_option, parse_floats, quiet_option, report_errors
+from ._common import check_output, load_geometry, normals_option, output_file, parse_floats, quiet_option, \
+    report_errors
 
 
 def _stage_progress(enabled: bool):
@@ -35,7 +36,7 @@ def _stage_progress(enabled: bool):
 @click.command("heat", help="""Signed distance of INPUT (mesh, soup or oriented cloud) in a volume by the
 signed heat method: negative inside, robust to holes, flips and noise.
 
-Writes the field to OUTPUT (.npz, .vtk or .vtu) and, with --offsets, one surface per offset next to it
+Writes the field to OUTPUT (.npz, .npy, .vtk, .vtu; .vti for grids) and, with --offsets, one surface per offset next to it
 (OUTPUT stem + _offset_<value>.ply, or --surface-format). Offsets are distances, or fractions of the input's
 bounding-box diagonal with --relative.
 
@@ -44,7 +45,7 @@ Example:
   gsdf heat bunny.off --grid 128 --offsets 0,0.01,-0.01 --relative -o bunny_heat.npz
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, help="Output field (.npz, .vtk, .vtu).")
+@click.option("-o", "--output", required=True, help="Output field: .npz, .npy, .vtk, .vtu, or .vti (grid only).")
 @click.option("--grid", "grid", type=click.IntRange(2, 4096), default=64, show_default=True,
               help="Regular grid with this many nodes along the longest side (§8.2).")
 @click.option("--tet", is_flag=True, help="Tetrahedral domain instead of a grid (§8.1).")
@@ -68,7 +69,14 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
 
     from ..heat.volume import signed_heat_volume
 
+    from ..field import GridField, TetField
+
+    check_output(output, TetField.SAVE_EXTENSIONS if tet else GridField.SAVE_EXTENSIONS)
     levels = parse_floats(offsets, "--offsets")
+    stem = os.path.splitext(output)[0]
+    surface_paths = [f"{stem}_offset_{v:g}.{surface_format}" for v in levels or []]
+    for path in surface_paths:
+        check_output(path, None, "--offsets")
     geo = load_geometry(input, estimate_normals)
     kw = dict(mesh=(geo.V, geo.F)) if geo.is_mesh else dict(points=(geo.P, geo.N))
     update, close = _stage_progress(not quiet)
@@ -77,8 +85,8 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
                                    level_set_constraint=constraint, progress=update, **kw)
     finally:
         close()
-    ensure_parent(output)
-    field.save(output)
+    with output_file(output) as tmp:
+        field.save(tmp)
     click.echo(f"{geo.describe()}\nsigned heat field on {getattr(field, 'shape', '?')} nodes "
                f"-> {os.path.abspath(output)}")
     if levels:
@@ -86,10 +94,9 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
 
         X = geo.positions
         scale = float(np.linalg.norm(X.max(axis=0) - X.min(axis=0))) if relative else 1.0
-        stem = os.path.splitext(output)[0]
-        for v in levels:
+        for v, path in zip(levels, surface_paths):
             Vs, Fs = field.isosurface(v * scale, close=True) if hasattr(field, "spacing") \
                 else field.isosurface(v * scale)
-            path = f"{stem}_offset_{v:g}.{surface_format}"
-            write_mesh(path, Vs, Fs)
+            with output_file(path, what="--offsets") as tmp:
+                write_mesh(tmp, Vs, Fs)
             click.echo(f"level {v * scale:.6g}: {len(Fs)} triangles -> {os.path.abspath(path)}")

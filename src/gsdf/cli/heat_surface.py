@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from ._common import ensure_parent, quiet_option, report_errors
+from ._common import check_output, output_file, quiet_option, report_errors
 
 
 @click.command("heat-surface", help="""Signed distance to curves on the surface MESH (signed heat method).
@@ -40,15 +40,15 @@ def heat_surface(mesh, curves_path, output, level_set, t_coef, soft_weight, png,
     from ..io import read_mesh, write_mesh
     from ..io.curves import read_curves
 
-    if not output.lower().endswith(".ply"):
-        raise ValueError(f"{output}: the output must be a .ply file (it stores the distance per vertex)")
+    check_output(output, (".ply",))  # only PLY stores the distance per vertex
+    check_output(png, (".png",), "--png")
     V, F = read_mesh(mesh)
     src = read_curves(curves_path, F)
     solver = SurfaceSignedHeatSolver(V, F, t_coef=t_coef)
     phi = solver.compute_distance(src.curves, points=src.points, curve_signs=src.curve_signs,
                                   level_set_constraint=level_set, soft_weight=soft_weight)
-    ensure_parent(output)
-    write_mesh(output, V, F, vertex_data={"distance": phi})
+    with output_file(output) as tmp:
+        write_mesh(tmp, V, F, vertex_data={"distance": phi})
     click.echo(f"{mesh}: {len(V)} vertices, {len(F)} triangles; {len(src.curves)} curves, {len(src.points)} "
                f"points\ndistance in [{phi.min():.6g}, {phi.max():.6g}] -> {os.path.abspath(output)}")
     if png:
@@ -60,6 +60,6 @@ def heat_surface(mesh, curves_path, output, level_set, t_coef, soft_weight, png,
                 raise ValueError
         except ValueError:
             raise click.BadParameter(f"expected x,y,z (not all zero), got {view!r}", param_hint="--view")
-        ensure_parent(png)
-        render_function_png(png, V, F, phi, view=d)
+        with output_file(png, what="--png") as tmp:
+            render_function_png(tmp, V, F, phi, view=d)
         click.echo(f"image -> {os.path.abspath(png)}")

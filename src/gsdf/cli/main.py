@@ -25,6 +25,10 @@ def main():
 
     Meshes: OBJ, OFF, PLY, STL. Point clouds: XYZ/PWN (3 or 6 columns), PLY, OBJ v/vn, PC, NPY.
     Start with `gsdf demo`.
+
+    Outputs, in every subcommand: written under exactly the name given (an extension the output cannot have is
+    refused, listing the ones it can), atomically (temporary file + rename), never onto an input of the
+    command; an existing output file is replaced unless --no-clobber is given.
     """
 
 

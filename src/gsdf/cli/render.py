@@ -6,7 +6,7 @@ import os
 
 import click
 
-from ._common import ensure_parent, normals_option, parse_floats, report_errors
+from ._common import check_output, normals_option, output_file, parse_floats, report_errors
 
 
 @click.command("render", help="""Sphere-trace a level set of the Points as Tori SDF of POINTS into a PNG.
@@ -31,6 +31,7 @@ def render(points, out, level, size, view, up, estimate_normals):
     from ..tori.render import render_png
     from .tori import _load_cloud
 
+    check_output(out, (".png",))
     v, u = parse_floats(view, "--view"), parse_floats(up, "--up")
     if len(v) != 3 or len(u) != 3:
         raise click.BadParameter("--view and --up need three numbers")
@@ -39,6 +40,6 @@ def render(points, out, level, size, view, up, estimate_normals):
     else:
         P, N = _load_cloud(points, estimate_normals)
         pat = PointsAsTori(P, N)
-    ensure_parent(out)
-    render_png(pat, out, size, size, level=level, view=v, up=u)
+    with output_file(out) as tmp:
+        render_png(pat, tmp, size, size, level=level, view=v, up=u)
     click.echo(f"{len(pat.P)} tori, level {level:g} -> {os.path.abspath(out)}")

@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from ._common import bbox_of, beta_option, ensure_parent, load_geometry, normals_option, progress_bar, \
+from ._common import beta_option, check_output, load_geometry, normals_option, output_file, progress_bar, \
     quiet_option, report_errors
 
 
@@ -40,7 +40,8 @@ Example:
   gsdf sdf bunny.off -o bunny_sdf.npz --resolution 128 --png slice.png --surface zero.ply
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, help="Output grid (.npz).")
+@click.option("-o", "--output", required=True, help="Output grid: .npz (reload with gsdf.GridField.load), .npy, "
+              ".vtk, .vti or .vtu.")
 @click.option("--resolution", type=click.IntRange(2, 2048), default=64, show_default=True,
               help="Grid nodes along the longest side.")
 @click.option("--pad", type=click.FloatRange(0), default=0.05, show_default=True,
@@ -53,20 +54,27 @@ Example:
 @quiet_option
 @report_errors
 def sdf(input, output, resolution, pad, sign, png, surface_out, beta, estimate_normals, quiet):
+    from ..field import GridField
+    from ..io import MESH_FORMATS
+
+    check_output(output, GridField.SAVE_EXTENSIONS)
+    check_output(png, (".png",), "--png")
+    check_output(surface_out, MESH_FORMATS, "--surface")
     geo = load_geometry(input, estimate_normals)
     field = signed_distance_grid(geo, resolution, pad, sign, beta, quiet)
-    ensure_parent(output)
-    field.save(output)
+    with output_file(output) as tmp:
+        field.save(tmp)
     click.echo(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")
     if png:
         from ..io.image import write_field_slice_png
 
-        write_field_slice_png(png, field)
+        with output_file(png, what="--png") as tmp:
+            write_field_slice_png(tmp, field)
         click.echo(f"slice image -> {os.path.abspath(png)}")
     if surface_out:
         from ..io import write_mesh
 
         Vs, Fs = field.isosurface(0.0)
-        ensure_parent(surface_out)
-        write_mesh(surface_out, Vs, Fs)
+        with output_file(surface_out, what="--surface") as tmp:
+            write_mesh(tmp, Vs, Fs)
         click.echo(f"zero level set ({len(Fs)} triangles) -> {os.path.abspath(surface_out)}")

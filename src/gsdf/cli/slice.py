@@ -7,8 +7,8 @@ import os
 import click
 import numpy as np
 
-from ._common import bbox_of, beta_option, counting, ensure_parent, load_geometry, normals_option, parse_floats, \
-    quiet_option, report_errors
+from ._common import bbox_of, beta_option, check_output, counting, load_geometry, normals_option, output_file, \
+    parse_floats, quiet_option, report_errors
 
 
 @click.command("slice", help="""Slice INPUT into closed contours of its winding-number solid, written as SVG.
@@ -36,6 +36,7 @@ Example:
 def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, estimate_normals, quiet):
     from ..contour import slice_contours, write_svg
 
+    check_output(output, (".svg",))
     geo = load_geometry(input, estimate_normals)
     ax = "xyz".index(axis)
     lo, hi = bbox_of(geo.positions, 0.02)
@@ -46,8 +47,8 @@ def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, es
     bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
     with bar:
         contours = slice_contours(func, zs, lo, hi, resolution=resolution, axis=ax)
-    ensure_parent(output)
-    write_svg(output, contours, z_values=zs, layout=layout)
+    with output_file(output) as tmp:
+        write_svg(tmp, contours, z_values=zs, layout=layout)
     n_loops = sum(len(c) for c in contours)
     click.echo(f"{geo.describe()}\n{len(zs)} slices along {axis}, {n_loops} closed contours -> "
                f"{os.path.abspath(output)}")

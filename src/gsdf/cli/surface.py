@@ -6,8 +6,8 @@ import os
 
 import click
 
-from ._common import bbox_of, beta_option, counting, ensure_parent, load_geometry, normals_option, quiet_option, \
-    report_errors
+from ._common import bbox_of, beta_option, check_output, counting, load_geometry, normals_option, output_file, \
+    quiet_option, report_errors
 
 
 @click.command("surface", help="""Extract the surface of INPUT as the winding number's 1/2 level set.
@@ -34,13 +34,14 @@ Example:
 @report_errors
 def surface(input, output, resolution, level, bisection, pad, beta, estimate_normals, quiet):
     from ..contour import extract_isosurface
-    from ..io import write_mesh
+    from ..io import MESH_FORMATS, write_mesh
 
+    check_output(output, MESH_FORMATS)
     geo = load_geometry(input, estimate_normals)
     lo, hi = bbox_of(geo.positions, pad)
     bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
     with bar:
         V, F = extract_isosurface(func, lo, hi, resolution=resolution, level=level, bisection_steps=bisection)
-    ensure_parent(output)
-    write_mesh(output, V, F)
+    with output_file(output) as tmp:
+        write_mesh(tmp, V, F)
     click.echo(f"{geo.describe()}\nsurface: {len(V)} vertices, {len(F)} triangles -> {os.path.abspath(output)}")

@@ -7,7 +7,9 @@ import os
 import click
 import numpy as np
 
-from ._common import ensure_parent, normals_option, parse_floats, quiet_option, report_errors
+from ._common import check_output, normals_option, output_file, parse_floats, quiet_option, report_errors
+
+GRID_EXTENSIONS = (".npz", ".npy", ".vtk", ".vti", ".vtu")
 
 
 def _load_cloud(path, estimate_normals):
@@ -28,7 +30,7 @@ def _load_cloud(path, estimate_normals):
 
 Fits one torus per point (k = 64 neighbours, §5.1.1) and blends their distances (Eqs. 5.6–5.7). OUT by
 extension: .npz with --grid: a signed distance grid (values, bbox_min, bbox_max); .npz without --grid: the fitted
-tori (reload with gsdf.tori.PointsAsTori.load); a mesh extension (.ply/.obj/.off/.stl): the zero level set, or one
+tori (reload with gsdf.tori.PointsAsTori.load); .npy/.vtk/.vti/.vtu: the grid (as gsdf.GridField.save); a mesh extension (.ply/.obj/.off/.stl): the zero level set, or one
 file per offset with --offsets (name_<offset>.ext).
 
 \b
@@ -50,37 +52,44 @@ Examples:
 @quiet_option
 @report_errors
 def tori(points, out, estimator, grid, offsets, pad, k, estimate_normals, quiet):
+    from ..io import MESH_FORMATS
     from ..tori import PointsAsTori
 
-    P, N = _load_cloud(points, estimate_normals)
-    pat = PointsAsTori(P, N, estimator=estimator, k=k)
-    ensure_parent(out)
+    check_output(out, GRID_EXTENSIONS + MESH_FORMATS)
     ext = os.path.splitext(out)[1].lower()
     levels = parse_floats(offsets, "--offsets") or [0.0]
+    base, e = os.path.splitext(out)
+    mesh_paths = [out if len(levels) == 1 else f"{base}_{v:g}{e}" for v in levels]
+    if ext in MESH_FORMATS:
+        for path in mesh_paths:
+            check_output(path, MESH_FORMATS)
+    P, N = _load_cloud(points, estimate_normals)
+    pat = PointsAsTori(P, N, estimator=estimator, k=k)
     click.echo(f"{points}: {len(pat.P)} oriented points, {len(pat.tori)} tori fitted (estimator={estimator})")
     if ext == ".npz" and grid is None:
-        pat.save(out)
+        with output_file(out) as tmp:
+            pat.save(tmp)
         click.echo(f"fitted tori -> {os.path.abspath(out)}")
         return
     res = grid or 64
     lo, hi = pat.P.min(0), pat.P.max(0)
     m = pad * np.linalg.norm(hi - lo) + max(abs(v) for v in levels)
     lo, hi = lo - m, hi + m
-    if ext == ".npz":
+    if ext in GRID_EXTENSIONS:
         from ..field import GridField, grid_points, grid_shape
 
         shape = grid_shape(lo, hi, res)
         hi = lo + (np.array(shape) - 1) * (hi - lo).max() / (res - 1)
         field = GridField(pat.signed_distance(grid_points(lo, hi, shape)).reshape(shape), lo, hi)
-        field.save(out)
+        with output_file(out) as tmp:
+            field.save(tmp)
         click.echo(f"signed distance grid {field.shape} -> {os.path.abspath(out)}")
         return
     from ..contour import extract_isosurface
     from ..io import write_mesh
 
-    base, e = os.path.splitext(out)
-    for v in levels:
+    for v, path in zip(levels, mesh_paths):
         V, F = extract_isosurface(pat.signed_distance, lo, hi, res, level=v, inside="below")
-        path = out if len(levels) == 1 else f"{base}_{v:g}{e}"
-        write_mesh(path, V, F)
+        with output_file(path) as tmp:
+            write_mesh(tmp, V, F)
         click.echo(f"level {v:g}: {len(F)} triangles -> {os.path.abspath(path)}")

@@ -6,8 +6,8 @@ import os
 
 import click
 
-from ._common import beta_option, ensure_parent, load_geometry, normals_option, progress_bar, quiet_option, \
-    report_errors
+from ._common import beta_option, check_output, load_geometry, normals_option, output_file, progress_bar, \
+    quiet_option, report_errors
 
 
 @click.command("voxelize", help="""Voxelize INPUT: a voxel is inside where the winding number at its centre is >= 1/2.
@@ -30,8 +30,11 @@ Example:
 @quiet_option
 @report_errors
 def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, quiet):
+    from ..io import MESH_FORMATS
     from ..ops import save_voxels, voxelize as run, voxels_to_mesh
 
+    check_output(output, (".npz",))
+    check_output(mesh_out, MESH_FORMATS, "--mesh-out")
     geo = load_geometry(input, estimate_normals)
     kw = {"mesh": (geo.V, geo.F)} if geo.is_mesh else {"points": (geo.P, geo.N)}
     bar, update = progress_bar(1, "voxelizing", not quiet)
@@ -40,14 +43,14 @@ def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, q
             bar.total = total
             update(done, total)
         occ, lo, hi = run(resolution=resolution, pad=pad, beta=beta, progress=progress, **kw)
-    ensure_parent(output)
-    save_voxels(output, occ, lo, hi)
+    with output_file(output, (".npz",)) as tmp:
+        save_voxels(tmp, occ, lo, hi)
     click.echo(f"{geo.describe()}\n{int(occ.sum())} of {occ.size} voxels inside, grid {occ.shape} -> "
                f"{os.path.abspath(output)}")
     if mesh_out:
         from ..io import write_mesh
 
         Vv, Fv = voxels_to_mesh(occ, lo, hi)
-        ensure_parent(mesh_out)
-        write_mesh(mesh_out, Vv, Fv)
+        with output_file(mesh_out, what="--mesh-out") as tmp:
+            write_mesh(tmp, Vv, Fv)
         click.echo(f"voxel boundary mesh -> {os.path.abspath(mesh_out)}")

@@ -7,27 +7,39 @@ import os
 import click
 import numpy as np
 
-from ._common import beta_option, ensure_parent, load_geometry, normals_option, progress_bar, quiet_option, \
-    report_errors
+from ._common import beta_option, check_output, load_geometry, normals_option, output_file, progress_bar, \
+    quiet_option, report_errors
+
+VALUE_EXTENSIONS = (".npy", ".txt", ".csv")
 
 
 def read_queries(path: str) -> np.ndarray:
+    """Query points (q, 3), q > 0, finite: an .npy array or any point file :func:`gsdf.read_points` reads."""
+    from .._checks import as_points
     from ..io import read_points
 
     if path.lower().endswith(".npy"):
+        if not os.path.exists(path):
+            raise FileNotFoundError(2, "No such file or directory", path)
         try:
-            return np.load(path)
-        except (OSError, ValueError) as exc:
+            Q = np.load(path, allow_pickle=False)
+        except (OSError, ValueError, EOFError) as exc:
             raise ValueError(f"{path}: cannot read queries ({exc})") from exc
+        if Q.dtype == bool or not np.issubdtype(Q.dtype, np.number):
+            raise ValueError(f"{path}: expected a numeric (q, 3) array of query points, got dtype {Q.dtype}")
+        if Q.size == 0:
+            raise ValueError(f"{path}: contains no query points")
+        return as_points(Q, f"{path}: queries")
     return read_points(path)[0]
 
 
 def write_values(path: str, values: np.ndarray) -> None:
-    ensure_parent(path)
-    if path.lower().endswith(".npy"):
-        np.save(path, values)
-    else:
-        np.savetxt(path, values, fmt="%.10g")
+    """One value per query: ``.npy``, or text (``.txt``/``.csv``, one value per line), written safely."""
+    with output_file(path, VALUE_EXTENSIONS) as tmp:
+        if path.lower().endswith(".npy"):
+            np.save(tmp, values)
+        else:
+            np.savetxt(tmp, values, fmt="%.10g")
 
 
 @click.command("winding", help="""Winding numbers of INPUT (mesh, soup or oriented cloud) at the points of QUERIES.
@@ -41,7 +53,7 @@ Example:
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
 @click.argument("queries", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, help="Output file: .npy or text (one value per line).")
+@click.option("-o", "--output", required=True, help="Output file: .npy, or text (.txt/.csv, one value per line).")
 @click.option("--exact", is_flag=True, help="Exact direct sum instead of the fast tree approximation.")
 @click.option("--order", type=click.IntRange(0, 2), default=2, show_default=True, help="Taylor order.")
 @beta_option
@@ -51,6 +63,7 @@ Example:
 def winding(input, queries, output, exact, order, beta, estimate_normals, quiet):
     from ..winding import FastWindingNumber, FastWindingNumberPoints, winding_number, winding_number_points
 
+    check_output(output, VALUE_EXTENSIONS)
     geo = load_geometry(input, estimate_normals)
     Q = read_queries(queries)
     if exact:

@@ -144,9 +144,12 @@ def _as_surface_point(node, F, where):
 
 
 def write_curves(path: str, curves, curve_signs=None, points=()) -> None:
-    """Write sources in the demo format (vertex-index curves as ``v`` nodes, surface points as ``f`` nodes)."""
+    """Write sources in the demo format (vertex-index curves as ``v`` nodes, surface points as ``f`` nodes) to a
+    ``.txt`` file (atomically, :mod:`gsdf.io.safe_write`)."""
     signs = [True] * len(curves) if curve_signs is None else list(curve_signs)
-    with open(path, "w") as fh:
+    from .safe_write import atomic_output
+
+    with atomic_output(path, extensions=(".txt",)) as tmp, open(tmp, "w") as fh:
         for c, s in zip(curves, signs):
             fh.write("signed_curve\n" if s else "unsigned_curve\n")
             if isinstance(c, np.ndarray) or all(np.isscalar(x) for x in c):

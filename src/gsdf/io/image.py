@@ -1,4 +1,5 @@
-"""PNG pictures of scalar fields: a diverging colour map with isolines and a bold zero contour."""
+"""PNG pictures: gsdf's one PNG writer (:func:`write_png`, atomic, ``.png`` only) and the diverging colour map
+with isolines and a bold zero contour that the field pictures use."""
 
 from __future__ import annotations
 
@@ -37,14 +38,28 @@ def field_to_rgb(values: np.ndarray, n_isolines: int = 10, zero_level: float = 0
 
 
 def write_png(path, rgb: np.ndarray, min_size: int = 512) -> None:
-    """Write an (h, w, 3) uint8 image, upscaled (nearest) so its shorter side is at least ``min_size``."""
+    """Write an (h, w, 3) uint8 (or (h, w) grey) image as PNG, upscaled (nearest) so its shorter side is at least
+    ``min_size``. The file is written atomically; a name not ending in ``.png`` is a ValueError.
+
+    Example
+    -------
+    >>> import os, tempfile, numpy as np
+    >>> write_png(os.path.join(tempfile.mkdtemp(), "a.png"), np.zeros((4, 4, 3), np.uint8), min_size=4)
+    """
     from PIL import Image
 
-    img = Image.fromarray(np.ascontiguousarray(rgb))
+    from .safe_write import atomic_output, check_output_path
+
+    check_output_path(path, extensions=(".png",))
+    a = np.asarray(rgb)
+    if a.dtype != np.uint8 or not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] in (3, 4))) or min(a.shape[:2]) < 1:
+        raise ValueError(f"rgb: expected an (h, w), (h, w, 3) or (h, w, 4) uint8 image, got {a.dtype} {a.shape}")
+    img = Image.fromarray(np.ascontiguousarray(a))
     k = max(1, int(np.ceil(min_size / min(img.size))))
     if k > 1:
         img = img.resize((img.size[0] * k, img.size[1] * k), Image.NEAREST)
-    img.save(str(path))
+    with atomic_output(path, extensions=(".png",)) as tmp:
+        img.save(tmp, format="PNG")
 
 
 def write_field_slice_png(path, field, axis: int = 2, index: int | None = None, zero_level: float = 0.0) -> None:
