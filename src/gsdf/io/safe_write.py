@@ -29,6 +29,7 @@ Example
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import tempfile
 
@@ -149,12 +150,18 @@ def atomic_output(path, *, inputs=(), extensions=None, overwrite: bool = True, m
         if make_parents:
             os.makedirs(parent, exist_ok=True)
         base = os.path.basename(p)
-        fd, tmp = tempfile.mkstemp(prefix=f".{base}.", suffix=f".tmp{os.path.splitext(base)[1]}", dir=parent)
+        # lower-case extension: writers such as numpy's savez append ".npz" unless the name ends exactly so
+        fd, tmp = tempfile.mkstemp(prefix=f".{base}.", suffix=f".tmp{extension_of(base)}", dir=parent)
         os.close(fd)
     except OSError as exc:
         raise ValueError(f"{p}: cannot write ({exc.strerror or exc})") from exc
     try:
         yield tmp
+        strays = [q for q in glob.glob(glob.escape(tmp) + "?*")]
+        if strays:  # the writer changed the name it was given: never publish a different (or empty) file
+            for q in strays:
+                _remove(q)
+            raise ValueError(f"{p}: the writer wrote {os.path.basename(strays[0])} instead of the name it was given")
         if not os.path.exists(tmp):
             raise ValueError(f"{p}: the writer produced no file")
         os.chmod(tmp, _FILE_MODE)
