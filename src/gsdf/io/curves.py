@@ -72,57 +72,69 @@ def read_curves(path: str, F=None) -> CurveSources:
     mode = None                      # None: no block; "curve"; "points"
     Fa = None if F is None else np.asarray(F, dtype=np.int64)
     edges = first = None
-    with open(path) as fh:
-        for lineno, line in enumerate(fh, 1):
-            tok = line.split("#", 1)[0].split()
-            if not tok:
-                continue
-            key, args = tok[0], tok[1:]
-            where = f"{path}:{lineno}"
-            try:
-                if key in ("signed_curve", "unsigned_curve"):
-                    curves.append([])
-                    signs.append(key == "signed_curve")
-                    flips.append(bool(int(args[0])) if args else False)
-                    mode = "curve"
-                elif key in ("unsigned_point", "signed_point"):
-                    mode = "points"
-                elif key == "l":
-                    idx = [int(t.split("/")[0]) for t in args]
-                    if any(i <= 0 for i in idx):
-                        raise ValueError("OBJ line indices must be positive (1-based)")
-                    nodes = [("v", i - 1) for i in idx]
-                    if mode == "curve":
-                        curves[-1].extend(nodes)
-                    else:
-                        curves.append(nodes)
-                        signs.append(True)
-                        flips.append(False)
-                elif key in ("v", "e", "f") and mode is not None:
-                    if key == "v":
-                        node = ("v", int(args[0]))
-                    elif key == "e":
-                        if Fa is None:
-                            raise ValueError("edge nodes 'e i t' need the mesh faces (pass F)")
-                        if edges is None:
-                            edges, first = gc_edges(Fa)
-                        i, t = int(args[0]), float(args[1])
-                        if not 0 <= i < len(edges):
-                            raise ValueError(f"edge index {i} out of range for {len(edges)} edges")
-                        f, s = divmod(int(first[i]), 3)
-                        bary = np.zeros(3)
-                        bary[s], bary[(s + 1) % 3] = 1 - t, t
-                        node = ("f", f, bary)
-                    else:
-                        node = ("f", int(args[0]), np.array([float(x) for x in args[1:4]]))
-                        if len(args) < 4:
-                            raise ValueError("face nodes need 'f i a b c'")
-                    if mode == "curve":
-                        curves[-1].append(node)
-                    else:
-                        points.append(node)
-            except (IndexError, ValueError) as exc:
-                raise ValueError(f"{where}: cannot parse {line.strip()!r} ({exc})") from exc
+    import os
+
+    if os.path.isdir(path):
+        raise ValueError(f"{path}: is a directory, not a curve file")
+    with open(path, "rb") as fb:
+        raw = fb.read()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise ValueError(f"{path}:{line}: not a text curve file (undecodable byte 0x{raw[exc.start]:02x})") from None
+    if "\x00" in text:
+        raise ValueError(f"{path}:{text[:text.index(chr(0))].count(chr(10)) + 1}: not a text curve file (NUL byte)")
+    for lineno, line in enumerate(text.splitlines(), 1):
+        tok = line.split("#", 1)[0].split()
+        if not tok:
+            continue
+        key, args = tok[0], tok[1:]
+        where = f"{path}:{lineno}"
+        try:
+            if key in ("signed_curve", "unsigned_curve"):
+                curves.append([])
+                signs.append(key == "signed_curve")
+                flips.append(bool(int(args[0])) if args else False)
+                mode = "curve"
+            elif key in ("unsigned_point", "signed_point"):
+                mode = "points"
+            elif key == "l":
+                idx = [int(t.split("/")[0]) for t in args]
+                if any(i <= 0 for i in idx):
+                    raise ValueError("OBJ line indices must be positive (1-based)")
+                nodes = [("v", i - 1) for i in idx]
+                if mode == "curve":
+                    curves[-1].extend(nodes)
+                else:
+                    curves.append(nodes)
+                    signs.append(True)
+                    flips.append(False)
+            elif key in ("v", "e", "f") and mode is not None:
+                if key == "v":
+                    node = ("v", int(args[0]))
+                elif key == "e":
+                    if Fa is None:
+                        raise ValueError("edge nodes 'e i t' need the mesh faces (pass F)")
+                    if edges is None:
+                        edges, first = gc_edges(Fa)
+                    i, t = int(args[0]), float(args[1])
+                    if not 0 <= i < len(edges):
+                        raise ValueError(f"edge index {i} out of range for {len(edges)} edges")
+                    f, s = divmod(int(first[i]), 3)
+                    bary = np.zeros(3)
+                    bary[s], bary[(s + 1) % 3] = 1 - t, t
+                    node = ("f", f, bary)
+                else:
+                    node = ("f", int(args[0]), np.array([float(x) for x in args[1:4]]))
+                    if len(args) < 4:
+                        raise ValueError("face nodes need 'f i a b c'")
+                if mode == "curve":
+                    curves[-1].append(node)
+                else:
+                    points.append(node)
+        except (IndexError, ValueError) as exc:
+            raise ValueError(f"{where}: cannot parse {line.strip()!r} ({exc})") from exc
     out = []
     for k, (nodes, flip) in enumerate(zip(curves, flips)):
         if flip:

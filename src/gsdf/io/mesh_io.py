@@ -213,12 +213,17 @@ def _ply_header(p: str, data: bytes):
             if w[0] == "format":
                 fmt = w[1]
             elif w[0] == "element":
-                elements.append((w[1], int(w[2]), []))
+                count = int(w[2])
+                if count < 0:
+                    raise ValueError(f"{p}: line {i}: negative element count {count} for PLY element {w[1]!r}")
+                elements.append((w[1], count, []))
             elif w[0] == "property":
                 elements[-1][2].append((w[-1], w[1] == "list"))
             else:
                 raise ValueError
-        except (ValueError, IndexError):
+        except (ValueError, IndexError) as exc:
+            if str(exc).startswith(p):
+                raise
             raise ValueError(f"{p}: line {i}: malformed PLY header line {line.strip()!r}") from None
     if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
         raise ValueError(f"{p}: unknown PLY format {fmt!r}")
