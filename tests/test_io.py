@@ -341,8 +341,8 @@ def test_missing_file(tmp_path, reader, ext):
 
 
 def test_unsupported_extension(tmp_path):
-    p = write(tmp_path / "m.vtk", "x")
-    with pytest.raises(ValueError, match=errmsg(p) + ".*unsupported.*'.vtk'.*\\.obj, \\.off, \\.ply, \\.stl"):
+    p = write(tmp_path / "m.vdb", "x")  # (was .vtk, which read_mesh now reads through meshio)
+    with pytest.raises(ValueError, match=errmsg(p) + ".*unsupported.*'.vdb'.*\\.obj, \\.off, \\.ply, \\.stl"):
         read_mesh(p)
     with pytest.raises(ValueError, match=errmsg(p) + ".*supported: \\.xyz"):
         read_points(p)
@@ -494,3 +494,126 @@ def test_writer_argument_errors(tmp_path):
         write_points(tmp_path / "a.xyz", P0, N0[:3])
     with pytest.raises(ValueError, match="at least 3"):
         write_mesh(tmp_path / "a.off", TET_V, [[0, 1]])
+
+
+# ------------------------------------------------------------------------------------------
+# soups survive exactly; formats read through trimesh / meshio; malformed files of every kind
+# ------------------------------------------------------------------------------------------
+
+# a broken soup: a quad, a pentagon, a duplicated triangle, a degenerate triangle (repeated index), a zero-area
+# sliver, and an unreferenced vertex (index 6)
+SOUP_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 1.5, 0], [0, 0, 1], [7, 7, 7], [2, 0, 0]])
+SOUP_P = [np.array([0, 1, 2, 3]), np.array([1, 2, 4, 3, 0]), np.array([0, 1, 5]), np.array([0, 1, 5]),
+          np.array([0, 0, 1]), np.array([0, 1, 7])]
+SOUP_FAN = np.array([[0, 1, 2], [0, 2, 3], [1, 2, 4], [1, 4, 3], [1, 3, 0], [0, 1, 5], [0, 1, 5], [0, 0, 1],
+                     [0, 1, 7]])
+
+
+@pytest.mark.parametrize("ext", [".obj", ".off", ".ply", ".vtk", ".vtu"])
+def test_soup_round_trip_is_exact(tmp_path, ext):
+    p = tmp_path / f"soup{ext}"
+    write_mesh(p, SOUP_V, SOUP_P)
+    V, polys = read_mesh(p, triangulate=False)
+    np.testing.assert_array_equal(V, SOUP_V)  # unreferenced vertex kept, order kept
+    assert [q.tolist() for q in polys] == [q.tolist() for q in SOUP_P]  # polygons stay polygons, in order
+    V, F = read_mesh(p)
+    np.testing.assert_array_equal(F, SOUP_FAN)  # fan triangulation; duplicates and degenerate faces kept
+
+
+def test_vtk_vertex_data(tmp_path):
+    import meshio
+
+    write_mesh(tmp_path / "m.vtu", TET_V, TET_F, vertex_data={"d": TET_V[:, 1]})
+    np.testing.assert_array_equal(meshio.read(tmp_path / "m.vtu").point_data["d"], TET_V[:, 1])
+    with pytest.raises(ValueError, match="vertex_data"):
+        write_mesh(tmp_path / "m.obj", TET_V, TET_F, vertex_data={"d": TET_V[:, 1]})
+
+
+def test_glb_through_trimesh(tmp_path):
+    import trimesh
+
+    F = SOUP_FAN
+    scene = trimesh.Scene()
+    scene.add_geometry(trimesh.Trimesh(SOUP_V, F, process=False), node_name="a", geom_name="a")
+    shift = np.eye(4)
+    shift[:3, 3] = [10, 0, 0]
+    scene.add_geometry(trimesh.Trimesh(TET_V, TET_F, process=False), node_name="b", geom_name="b", transform=shift)
+    p = tmp_path / "s.glb"
+    scene.export(p)
+    V, G = read_mesh(p)
+    # GLB stores float32 positions; every vertex (also the unreferenced one) and every face comes back in order
+    np.testing.assert_allclose(V, np.vstack([SOUP_V, TET_V + [10, 0, 0]]), rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(G, np.vstack([F, TET_F + len(SOUP_V)]))
+
+
+def test_gmsh_and_medit_through_meshio(tmp_path):
+    import meshio
+
+    cells = [("triangle", np.array([[0, 1, 5], [0, 1, 5]])), ("quad", np.array([[0, 1, 2, 3]])),
+             ("tetra", np.array([[0, 1, 2, 5]])), ("line", np.array([[0, 1]]))]
+    for name, fmt in (("m.msh", "gmsh22"), ("m.mesh", "medit")):
+        meshio.write(tmp_path / name, meshio.Mesh(SOUP_V, cells), file_format=fmt)
+        V, polys = read_mesh(tmp_path / name, triangulate=False)
+        np.testing.assert_allclose(V, SOUP_V)
+        assert [q.tolist() for q in polys] == [[0, 1, 5], [0, 1, 5], [0, 1, 2, 3]]  # tetra and line ignored
+    meshio.write(tmp_path / "vol.vtu", meshio.Mesh(SOUP_V, [("tetra", np.array([[0, 1, 2, 5]]))]))
+    with pytest.raises(ValueError, match=errmsg(tmp_path / "vol.vtu") + ".*only volume cells \\(tetra\\)"):
+        read_mesh(tmp_path / "vol.vtu")
+
+
+GARBAGE = bytes(range(256)) * 4 + b"\xff\xfe\x00"
+
+
+@pytest.mark.parametrize("ext", [".obj", ".off", ".ply", ".stl", ".glb", ".gltf", ".vtk", ".vtu", ".msh", ".mesh"])
+@pytest.mark.parametrize("kind", ["garbage", "truncated"])
+def test_malformed_files_of_every_format(tmp_path, ext, kind):
+    p = tmp_path / f"m{ext}"
+    if kind == "garbage":
+        p.write_bytes(GARBAGE)
+    else:
+        if ext in (".glb", ".gltf"):
+            import trimesh
+
+            trimesh.Trimesh(SOUP_V, SOUP_FAN, process=False).export(p)
+        elif ext in (".msh", ".mesh"):
+            import meshio
+
+            meshio.write(p, meshio.Mesh(SOUP_V, [("triangle", SOUP_FAN)]), file_format="gmsh22" if ext == ".msh"
+                         else "medit")
+        else:
+            write_mesh(p, SOUP_V, SOUP_FAN)
+        data = p.read_bytes()
+        p.write_bytes(data[: len(data) // 2 + 3])
+    with pytest.raises(ValueError, match=errmsg(p)):
+        read_mesh(p)
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_negative_ply_counts(tmp_path, binary):
+    fmt = "binary_little_endian" if binary else "ascii"
+    p = tmp_path / "neg.ply"
+    p.write_bytes(f"ply\nformat {fmt} 1.0\nelement vertex -3\nproperty float x\nproperty float y\n"
+                  "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                  .encode() + b"3 0 1 2\n")
+    with pytest.raises(ValueError, match=errmsg(p) + ": line 3: negative element count -3"):
+        read_mesh(p)
+    with pytest.raises(ValueError, match=errmsg(p)):
+        read_points(p)
+
+
+def test_binary_curve_file(tmp_path):
+    from gsdf.io.curves import read_curves
+
+    p = tmp_path / "c.txt"
+    p.write_bytes(b"signed_curve\nv 0\n" + GARBAGE)  # GARBAGE holds a newline (byte 10) before byte 0x80
+    with pytest.raises(ValueError, match=errmsg(p) + ":4: not a text curve file"):
+        read_curves(p)
+    with pytest.raises(ValueError, match="is a directory"):
+        read_curves(tmp_path)
+
+
+def test_directory_as_mesh(tmp_path):
+    d = tmp_path / "d.vtu"
+    d.mkdir()
+    with pytest.raises(ValueError, match="directory"):
+        read_mesh(d)

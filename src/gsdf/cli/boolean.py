@@ -26,10 +26,10 @@ Example:
 @click.option("--beta", type=float, default=2.0, show_default=True)
 @report_errors
 def boolean(a, b, op, output, exact, beta):
-    from ..io import MESH_FORMATS, read_mesh, write_mesh
+    from ..io import MESH_WRITE_FORMATS, read_mesh, write_mesh
     from ..ops import mesh_boolean
 
-    check_output(output, MESH_FORMATS)
+    check_output(output, MESH_WRITE_FORMATS)
     VA, FA = read_mesh(a)
     VB, FB = read_mesh(b)
     V, F = mesh_boolean(VA, FA, VB, FB, op, beta=beta, exact=exact)

@@ -55,11 +55,11 @@ Example:
 @report_errors
 def sdf(input, output, resolution, pad, sign, png, surface_out, beta, estimate_normals, quiet):
     from ..field import GridField
-    from ..io import MESH_FORMATS
+    from ..io import MESH_WRITE_FORMATS
 
     check_output(output, GridField.SAVE_EXTENSIONS)
     check_output(png, (".png",), "--png")
-    check_output(surface_out, MESH_FORMATS, "--surface")
+    check_output(surface_out, MESH_WRITE_FORMATS, "--surface")
     geo = load_geometry(input, estimate_normals)
     field = signed_distance_grid(geo, resolution, pad, sign, beta, quiet)
     with output_file(output) as tmp:

@@ -34,9 +34,9 @@ Example:
 @report_errors
 def surface(input, output, resolution, level, bisection, pad, beta, estimate_normals, quiet):
     from ..contour import extract_isosurface
-    from ..io import MESH_FORMATS, write_mesh
+    from ..io import MESH_WRITE_FORMATS, write_mesh
 
-    check_output(output, MESH_FORMATS)
+    check_output(output, MESH_WRITE_FORMATS)
     geo = load_geometry(input, estimate_normals)
     lo, hi = bbox_of(geo.positions, pad)
     bar, func = counting(geo.winding(beta), "winding numbers", not quiet)

@@ -52,17 +52,17 @@ Examples:
 @quiet_option
 @report_errors
 def tori(points, out, estimator, grid, offsets, pad, k, estimate_normals, quiet):
-    from ..io import MESH_FORMATS
+    from ..io import MESH_WRITE_FORMATS
     from ..tori import PointsAsTori
 
-    check_output(out, GRID_EXTENSIONS + MESH_FORMATS)
+    check_output(out, GRID_EXTENSIONS + MESH_WRITE_FORMATS)
     ext = os.path.splitext(out)[1].lower()
     levels = parse_floats(offsets, "--offsets") or [0.0]
     base, e = os.path.splitext(out)
     mesh_paths = [out if len(levels) == 1 else f"{base}_{v:g}{e}" for v in levels]
-    if ext in MESH_FORMATS:
+    if ext in MESH_WRITE_FORMATS:
         for path in mesh_paths:
-            check_output(path, MESH_FORMATS)
+            check_output(path, MESH_WRITE_FORMATS)
     P, N = _load_cloud(points, estimate_normals)
     pat = PointsAsTori(P, N, estimator=estimator, k=k)
     click.echo(f"{points}: {len(pat.P)} oriented points, {len(pat.tori)} tori fitted (estimator={estimator})")

@@ -30,11 +30,11 @@ Example:
 @quiet_option
 @report_errors
 def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, quiet):
-    from ..io import MESH_FORMATS
+    from ..io import MESH_WRITE_FORMATS
     from ..ops import save_voxels, voxelize as run, voxels_to_mesh
 
     check_output(output, (".npz",))
-    check_output(mesh_out, MESH_FORMATS, "--mesh-out")
+    check_output(mesh_out, MESH_WRITE_FORMATS, "--mesh-out")
     geo = load_geometry(input, estimate_normals)
     kw = {"mesh": (geo.V, geo.F)} if geo.is_mesh else {"points": (geo.P, geo.N)}
     bar, update = progress_bar(1, "voxelizing", not quiet)

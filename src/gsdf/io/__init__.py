@@ -1,6 +1,8 @@
-"""File input/output for meshes (OBJ, OFF, PLY, STL) and point clouds (XYZ, PWN, PLY, OBJ, PC, NPY/NPZ)."""
+"""File input/output: meshes (OBJ, OFF, PLY, STL parsed by gsdf; GLB/GLTF/3MF through trimesh; VTK, VTU, Gmsh,
+Medit, Abaqus, Nastran, SU2 through meshio), point clouds (XYZ, PWN, PLY, OBJ, PC, NPY/NPZ), curves, PNG images,
+and the safe, atomic writing every writer uses (:mod:`gsdf.io.safe_write`)."""
 
-from .mesh_io import MESH_FORMATS, read_mesh, write_mesh
+from .mesh_io import MESH_FORMATS, MESH_READ_FORMATS, MESH_WRITE_FORMATS, read_mesh, write_mesh
 from .points_io import POINTS_READ_FORMATS, POINTS_WRITE_FORMATS, read_points, write_points
 
 __all__ = [
@@ -9,6 +11,8 @@ __all__ = [
     "read_points",
     "write_points",
     "MESH_FORMATS",
+    "MESH_READ_FORMATS",
+    "MESH_WRITE_FORMATS",
     "POINTS_READ_FORMATS",
     "POINTS_WRITE_FORMATS",
 ]

@@ -27,11 +27,17 @@ import re
 import numpy as np
 
 from .._checks import as_faces, as_points
+from .external import MESHIO_FORMATS, TRIMESH_FORMATS, read_external
 from .safe_write import atomic_output
 
 __all__ = ["read_mesh", "write_mesh"]
 
+#: Formats gsdf parses itself (exactly as stored: order, duplicates, unreferenced vertices, polygons).
 MESH_FORMATS = (".obj", ".off", ".ply", ".stl")
+#: Every extension :func:`read_mesh` accepts (the others through trimesh / meshio, :mod:`gsdf.io.external`).
+MESH_READ_FORMATS = MESH_FORMATS + TRIMESH_FORMATS + MESHIO_FORMATS
+#: Every extension :func:`write_mesh` accepts (``.vtk``/``.vtu`` through meshio).
+MESH_WRITE_FORMATS = MESH_FORMATS + (".vtk", ".vtu")
 
 # ----------------------------------------------------------------------------------------------
 # helpers shared with points_io
@@ -557,13 +563,18 @@ def _merge_equal_rows(X: np.ndarray):
 
 
 def read_mesh(path, triangulate: bool = True):
-    """Read a triangle or polygon mesh from an OBJ, OFF, PLY or STL file.
+    """Read a triangle or polygon mesh (or soup) exactly as stored: vertex order, duplicate and degenerate
+    faces, unreferenced vertices all kept.
 
     Parameters
     ----------
     path : str or os.PathLike
         File to read; the format is chosen from the (case-insensitive) extension:
-        ``.obj``, ``.off``, ``.ply`` (ASCII or binary) or ``.stl`` (ASCII or binary).
+        ``.obj``, ``.off``, ``.ply`` (ASCII or binary), ``.stl`` (ASCII or binary) — parsed by gsdf —;
+        ``.glb``, ``.gltf``, ``.3mf`` through trimesh (``process=False``; scene meshes placed by their
+        transforms, in scene order); ``.vtk``, ``.vtu``, ``.msh``, ``.mesh``, ``.inp``, ``.bdf``, ``.nas``,
+        ``.su2`` through meshio (triangle, quad and polygon cells in file order; volume cells ignored).
+        ``MESH_READ_FORMATS`` lists them.
     triangulate : bool, default True
         Fan-triangulate polygons: ``(a, b, c, d, ...)`` gives ``(a, b, c), (a, c, d), ...``.
         With ``False`` the polygons are returned unchanged.
@@ -595,14 +606,21 @@ def read_mesh(path, triangulate: bool = True):
       positions are merged; V lists the distinct corners in order of first appearance.
     * Degenerate and duplicate faces are kept.  Faces with fewer than 3 vertices are kept with
       ``triangulate=False`` and give no triangle otherwise.
+    * Malformed files of any format (binary garbage, truncated data, negative PLY counts) raise a
+      ``ValueError`` naming the file (and, for gsdf's text parsers, the line).
 
     Examples
     --------
     >>> V, F = read_mesh("bunny.off")                                # doctest: +SKIP
     >>> V, polys = read_mesh("quads.obj", triangulate=False)         # doctest: +SKIP
     """
-    p, ext = _extension(path, MESH_FORMATS, "mesh")
-    if ext == ".off":
+    p, ext = _extension(path, MESH_READ_FORMATS, "mesh")
+    if ext not in MESH_FORMATS:
+        _check_file(p)
+        if os.path.isdir(p):
+            raise ValueError(f"{p}: is a directory, not a mesh file")
+        V, flat, sizes = read_external(p, ext)
+    elif ext == ".off":
         V, _, flat, sizes = _parse_off(p, _read_bytes(p))
     elif ext == ".obj":
         V, flat, sizes, _ = _parse_obj(p, _read_bytes(p))
@@ -673,13 +691,31 @@ def _write_stl(p: str, V: np.ndarray, F: np.ndarray) -> None:
         fh.write(rec.tobytes())
 
 
+def _write_meshio(p: str, ext: str, V, flat, sizes, extra: dict) -> None:
+    """VTK/VTU through meshio; runs of equal-size polygons become cell blocks, so the face order is kept."""
+    import meshio
+
+    names = {3: "triangle", 4: "quad"}
+    cuts = np.flatnonzero(np.diff(sizes)) + 1
+    starts = np.concatenate(([0], cuts))
+    ends = np.concatenate((cuts, [len(sizes)]))
+    offsets = np.concatenate(([0], np.cumsum(sizes)))
+    cells = []
+    for a, b in zip(starts, ends):
+        k = int(sizes[a])
+        cells.append((names.get(k, "polygon"), flat[offsets[a]:offsets[b]].reshape(b - a, k)))
+    meshio.write(p, meshio.Mesh(V, cells, point_data=extra or None), file_format=ext[1:])
+
+
 def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
-    """Write a mesh to an OBJ, OFF, PLY or STL file (chosen by extension).
+    """Write a mesh to an OBJ, OFF, PLY, STL, VTK or VTU file (chosen by extension), atomically.
 
     Parameters
     ----------
     path : str or os.PathLike
-        Output file: ``.obj``, ``.off``, ``.ply`` or ``.stl`` (binary STL).
+        Output file: ``.obj``, ``.off``, ``.ply``, ``.stl`` (binary STL), ``.vtk``/``.vtu`` (meshio; polygon
+        cells, face order kept). Any other extension is a ValueError listing these; the name is never changed
+        and the file appears only when complete (:mod:`gsdf.io.safe_write`).
     V : (n, 3) array_like of float
         Vertex positions.
     F : (m, k) array_like of int, or list of 1-d int sequences
@@ -687,7 +723,7 @@ def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
         STL stores triangles only, so polygons are fan-triangulated for it.
     vertex_data : dict of str -> (n,) float array, optional
         Extra per-vertex scalars (e.g. a distance field) written as PLY vertex properties
-        (doubles).  Only PLY can store them; other formats raise ValueError.
+        (doubles), or VTK/VTU point data.  Other formats raise ValueError.
     binary : bool, default True
         PLY only: binary little-endian (default) or ASCII.
 
@@ -702,14 +738,16 @@ def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
     >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     >>> write_mesh("tet.ply", V, F, vertex_data={"d": V[:, 0]})     # doctest: +SKIP
     """
-    p, ext = _extension(path, MESH_FORMATS, "mesh")
+    p, ext = _extension(path, MESH_WRITE_FORMATS, "mesh")
     V = as_points(V, "V")
     flat, sizes = _faces_arg(F, len(V))
-    if vertex_data and ext != ".ply":
-        raise ValueError(f"{p}: vertex_data can only be written to PLY files (only PLY stores vertex data)")
+    if vertex_data and ext not in (".ply", ".vtk", ".vtu"):
+        raise ValueError(f"{p}: vertex_data: only PLY, VTK and VTU files store vertex data")
     extra = _vertex_data(vertex_data, len(V))
-    with atomic_output(p, extensions=MESH_FORMATS) as tmp:
-        if ext == ".off":
+    with atomic_output(p, extensions=MESH_WRITE_FORMATS) as tmp:
+        if ext in (".vtk", ".vtu"):
+            _write_meshio(tmp, ext, V, flat, sizes, extra)
+        elif ext == ".off":
             _write_text(tmp, f"OFF\n{len(V)} {len(sizes)} 0\n" + _format_rows(V)
                         + _polygon_lines(flat, sizes, "", 0, True))
         elif ext == ".obj":
