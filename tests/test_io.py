@@ -617,3 +617,46 @@ def test_directory_as_mesh(tmp_path):
     d.mkdir()
     with pytest.raises(ValueError, match="directory"):
         read_mesh(d)
+
+
+@pytest.mark.parametrize("ext,binary", [(".ply", True), (".ply", False), (".vtk", True), (".vtu", True)])
+def test_read_vertex_data(tmp_path, ext, binary):
+    from gsdf.io import read_vertex_data
+
+    d = {"distance": TET_V[:, 0] - 0.25, "flag": np.array([1, 0, 0, 1])}
+    p = tmp_path / f"m{ext}"
+    write_mesh(p, TET_V, TET_F, vertex_data=d, binary=binary)
+    got = read_vertex_data(p)
+    assert list(got) == ["distance", "flag"]
+    np.testing.assert_array_equal(got["distance"], d["distance"])
+    np.testing.assert_array_equal(got["flag"], [1.0, 0, 0, 1])
+    np.testing.assert_array_equal(read_mesh(p)[0], TET_V)
+
+
+def test_read_vertex_data_errors(tmp_path):
+    from gsdf.io import read_vertex_data
+
+    with pytest.raises(ValueError, match="supported"):
+        read_vertex_data(tmp_path / "m.obj")
+    with pytest.raises(FileNotFoundError):
+        read_vertex_data(tmp_path / "missing.ply")
+    (tmp_path / "g.ply").write_bytes(b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n1\n")
+    with pytest.raises(ValueError, match=errmsg(tmp_path / "g.ply")):
+        read_vertex_data(tmp_path / "g.ply")
+    (tmp_path / "g.vtu").write_bytes(GARBAGE)
+    with pytest.raises(ValueError, match=errmsg(tmp_path / "g.vtu")):
+        read_vertex_data(tmp_path / "g.vtu")
+
+
+def test_3mf_without_its_optional_packages_is_a_clear_error(tmp_path):
+    pytest.importorskip("trimesh")
+    try:
+        import lxml  # noqa: F401
+
+        pytest.skip("lxml is installed: 3MF is readable")
+    except ImportError:
+        pass
+    p = tmp_path / "m.3mf"
+    p.write_bytes(b"PK\x03\x04" + GARBAGE)
+    with pytest.raises(ValueError, match=errmsg(p) + ".*lxml"):
+        read_mesh(p)

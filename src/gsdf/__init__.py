@@ -11,6 +11,7 @@ __version__ = "0.1.0"
 _EXPORTS = {
     # I/O
     "read_mesh": "io", "write_mesh": "io", "read_points": "io", "write_points": "io",
+    "read_vertex_data": "io",
     # winding numbers
     "winding_number": "winding", "winding_number_2d": "winding", "winding_number_points": "winding",
     "FastWindingNumber": "winding", "ExactWindingNumber": "winding", "FastWindingNumberPoints": "winding",

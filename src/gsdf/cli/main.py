@@ -23,7 +23,8 @@ from .winding import winding
 def main():
     """gsdf: generalized winding numbers and signed distance for broken geometry.
 
-    Meshes: OBJ, OFF, PLY, STL. Point clouds: XYZ/PWN (3 or 6 columns), PLY, OBJ v/vn, PC, NPY.
+    Meshes: OBJ, OFF, PLY, STL; also GLB/GLTF/3MF (trimesh) and VTK, VTU, MSH, MESH, INP, BDF, NAS, SU2
+    (meshio) as inputs, VTK/VTU as outputs. Point clouds: XYZ/PWN (3 or 6 columns), PLY, OBJ v/vn, PC, NPY.
     Start with `gsdf demo`.
 
     Outputs, in every subcommand: written under exactly the name given (an extension the output cannot have is

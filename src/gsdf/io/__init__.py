@@ -2,12 +2,13 @@
 Medit, Abaqus, Nastran, SU2 through meshio), point clouds (XYZ, PWN, PLY, OBJ, PC, NPY/NPZ), curves, PNG images,
 and the safe, atomic writing every writer uses (:mod:`gsdf.io.safe_write`)."""
 
-from .mesh_io import MESH_FORMATS, MESH_READ_FORMATS, MESH_WRITE_FORMATS, read_mesh, write_mesh
+from .mesh_io import MESH_FORMATS, MESH_READ_FORMATS, MESH_WRITE_FORMATS, read_mesh, read_vertex_data, write_mesh
 from .points_io import POINTS_READ_FORMATS, POINTS_WRITE_FORMATS, read_points, write_points
 
 __all__ = [
     "read_mesh",
     "write_mesh",
+    "read_vertex_data",
     "read_points",
     "write_points",
     "MESH_FORMATS",

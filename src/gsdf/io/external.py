@@ -67,27 +67,7 @@ def _read_trimesh(p: str, ext: str):
 
 
 def _read_meshio(p: str, ext: str):
-    import contextlib
-    import io
-    import logging
-    import warnings
-
-    import meshio
-
-    said = io.StringIO()
-    log = logging.getLogger("meshio")
-    level = log.level
-    try:
-        # meshio prints its complaints and calls sys.exit(1) when no reader succeeds: capture both
-        log.setLevel(logging.CRITICAL)
-        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said), warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            m = meshio.read(p)
-    except (Exception, SystemExit) as exc:  # ReadError, ValueError, KeyError, struct errors, SystemExit ...
-        why = " ".join(said.getvalue().split()) or f"{type(exc).__name__}: {exc}"
-        raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({why})") from None
-    finally:
-        log.setLevel(level)
+    m = _read_meshio_raw(p, ext)
     P = np.asarray(m.points, dtype=np.float64)
     if P.ndim != 2 or P.shape[1] not in (2, 3):
         raise ValueError(f"{p}: expected 2D or 3D points, got an array of shape {P.shape}")
@@ -113,3 +93,29 @@ def _read_meshio(p: str, ext: str):
             raise ValueError(f"{p}: has only volume cells ({', '.join(sorted(volume))}), no surface faces")
         raise ValueError(f"{p}: no faces; is this a point cloud? use read_points")
     return P, np.concatenate(flats), np.concatenate(sizes)
+
+
+def _read_meshio_raw(p: str, ext: str):
+    """meshio.read with its prints and sys.exit turned into a ValueError naming the file."""
+    import contextlib
+    import io
+    import logging
+    import warnings
+
+    import meshio
+
+    said = io.StringIO()
+    log = logging.getLogger("meshio")
+    level = log.level
+    try:
+        # meshio prints its complaints and calls sys.exit(1) when no reader succeeds: capture both
+        log.setLevel(logging.CRITICAL)
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            m = meshio.read(p)
+    except (Exception, SystemExit) as exc:  # ReadError, ValueError, KeyError, struct errors, SystemExit ...
+        why = " ".join(said.getvalue().split()) or f"{type(exc).__name__}: {exc}"
+        raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({why})") from None
+    finally:
+        log.setLevel(level)
+    return m

@@ -30,7 +30,7 @@ from .._checks import as_faces, as_points
 from .external import MESHIO_FORMATS, TRIMESH_FORMATS, read_external
 from .safe_write import atomic_output
 
-__all__ = ["read_mesh", "write_mesh"]
+__all__ = ["read_mesh", "write_mesh", "read_vertex_data"]
 
 #: Formats gsdf parses itself (exactly as stored: order, duplicates, unreferenced vertices, polygons).
 MESH_FORMATS = (".obj", ".off", ".ply", ".stl")
@@ -629,6 +629,58 @@ def read_mesh(path, triangulate: bool = True):
     else:
         V, flat, sizes = _read_stl(p)
     return _finish(p, V, flat, sizes, triangulate)
+
+
+def read_vertex_data(path) -> dict:
+    """Per-vertex scalar properties stored with a mesh: PLY vertex properties other than x, y, z (e.g. the
+    ``distance`` that ``gsdf heat-surface`` writes), or VTK/VTU point data (one component each).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.ply`` (ASCII or binary), ``.vtk`` or ``.vtu`` file.
+
+    Returns
+    -------
+    dict of str -> (n,) float64 ndarray
+        In file order; aligned with the ``V`` of :func:`read_mesh` on the same file.
+
+    Examples
+    --------
+    >>> write_mesh("m.ply", V, F, vertex_data={"distance": d})      # doctest: +SKIP
+    >>> read_vertex_data("m.ply")["distance"]                       # doctest: +SKIP
+    """
+    p, ext = _extension(path, (".ply", ".vtk", ".vtu"), "vertex data")
+    _check_file(p)
+    if os.path.isdir(p):
+        raise ValueError(f"{p}: is a directory, not a mesh file")
+    if ext == ".ply":
+        import plyfile
+
+        try:
+            ply = plyfile.PlyData.read(p)
+        except Exception as exc:  # plyfile raises PlyParseError and assorted errors on broken files
+            raise ValueError(f"{p}: malformed PLY file ({exc})") from exc
+        if "vertex" not in ply:
+            raise ValueError(f"{p}: PLY file has no 'vertex' element")
+        v = ply["vertex"].data
+        out = {}
+        for name in v.dtype.names:
+            if name in ("x", "y", "z"):
+                continue
+            if v[name].dtype == object:
+                raise ValueError(f"{p}: vertex property {name!r} is a list, not a scalar")
+            out[name] = np.asarray(v[name], dtype=np.float64)
+        return out
+    from .external import _read_meshio_raw
+
+    m = _read_meshio_raw(p, ext)
+    out = {}
+    for name, a in m.point_data.items():
+        a = np.asarray(a)
+        if a.ndim == 1 or (a.ndim == 2 and a.shape[1] == 1):
+            out[name] = a.reshape(-1).astype(np.float64)
+    return out
 
 
 # ----------------------------------------------------------------------------------------------
