@@ -27,8 +27,11 @@ Example:
 @normals_option
 @report_errors
 def render(points, out, level, size, view, up, estimate_normals):
+    import numpy as np
+
+    from ..io.image import write_png
     from ..tori import PointsAsTori
-    from ..tori.render import render_png
+    from ..tori.render import sphere_trace
     from .tori import _load_cloud
 
     check_output(out, (".png",))
@@ -40,6 +43,9 @@ def render(points, out, level, size, view, up, estimate_normals):
     else:
         P, N = _load_cloud(points, estimate_normals)
         pat = PointsAsTori(P, N)
+    lo, hi = pat.P.min(0), pat.P.max(0)
+    m = 0.1 * np.linalg.norm(hi - lo) + abs(level)  # the box of tori.render_png: cloud + 10 % of its diagonal
+    img = sphere_trace(pat, lo - m, hi + m, size, size, level, view=v, up=u)
     with output_file(out) as tmp:
-        render_png(pat, tmp, size, size, level=level, view=v, up=u)
+        write_png(tmp, img, min_size=1)  # gsdf's one PNG writer
     click.echo(f"{len(pat.P)} tori, level {level:g} -> {os.path.abspath(out)}")
