@@ -11,9 +11,10 @@ Output policy (the same for every subcommand; see :mod:`gsdf.io.safe_write`):
 * every file is written to a temporary name in the target folder and renamed when complete; missing parent
   folders are created.
 
-Subcommands get this by decorating with :func:`report_errors` (which adds ``--no-clobber``, checks every output
-option named in ``OUTPUT_PARAMS`` up front and turns library errors into one-line messages) and by writing each
-file inside ``with output_file(path) as tmp:``. Inputs are the values of the command's ``click.Path``
+Subcommands get this by decorating with :data:`no_clobber_option` and :func:`report_errors` (which sets the
+policy, refuses any ``OUTPUT_PARAMS`` option naming an input and turns library errors into one-line messages),
+by calling :func:`check_output` on every output name before the work starts, and by writing each file inside
+``with output_file(path) as tmp:``. Inputs are the values of the command's ``click.Path``
 parameters, so outputs must be declared as plain strings.
 """
 
@@ -27,7 +28,7 @@ import os
 import click
 import numpy as np
 
-from ..io.safe_write import atomic_output, check_output_path
+from ..io.safe_write import atomic_output, check_output_path, same_file
 
 POINT_EXTENSIONS = {".xyz", ".pwn", ".pc", ".npy", ".npz"}
 
@@ -146,29 +147,36 @@ def output_file(path, extensions=None, what: str = "output"):
 
 
 def report_errors(fn):
-    """Decorate a subcommand (innermost, below the click options): adds ``--no-clobber``, checks every output
-    parameter (``OUTPUT_PARAMS``) against the inputs before the work starts, and turns the library's ValueError /
-    FileNotFoundError / OSError into a one-line CLI error (exit code 1) without a traceback."""
+    """Decorate a subcommand (innermost, below the click options): sets the output policy (inputs = the
+    command's ``click.Path`` parameters; ``--no-clobber`` when the command has :data:`no_clobber_option`), refuses
+    up front any parameter of ``OUTPUT_PARAMS`` that names one of the inputs, and turns the library's
+    ValueError / FileNotFoundError / OSError into a one-line CLI error (exit code 1) without a traceback."""
 
     @functools.wraps(fn)
-    def wrapper(*args, no_clobber=False, **kwargs):
+    def wrapper(*args, **kwargs):
+        no_clobber = bool(kwargs.pop("no_clobber", False))
         ctx = click.get_current_context(silent=True)
         policy = {"inputs": _input_paths(ctx), "overwrite": not no_clobber}
         token = _POLICY.set(policy)
         try:
             for name in OUTPUT_PARAMS:
-                if kwargs.get(name):
-                    check_output_path(kwargs[name], inputs=policy["inputs"], overwrite=policy["overwrite"],
-                                      make_parents=True, what=f"--{name.replace('_', '-')}")
+                value = kwargs.get(name)
+                if isinstance(value, str) and value and any(same_file(value, src) for src in policy["inputs"]):
+                    raise ValueError(f"{value}: refusing to overwrite an input of this command; choose another "
+                                     "output name")
             return fn(*args, **kwargs)
         except (ValueError, OSError) as exc:  # FileNotFoundError is an OSError
             raise click.ClickException(_one_line(exc)) from exc
         finally:
             _POLICY.reset(token)
 
-    return click.option("--no-clobber", is_flag=True,
-                        help="Refuse to replace existing output files (default: replace them; an input is never "
-                             "replaced).")(wrapper)
+    return wrapper
+
+
+#: The one ``--no-clobber`` flag (every subcommand that writes files has it; see the module docstring).
+no_clobber_option = click.option("--no-clobber", is_flag=True,
+                                 help="Refuse to replace existing output files (default: replace them; an input "
+                                      "of the command is never replaced).")
 
 
 def check_output(path, extensions=None, what: str = "-o"):

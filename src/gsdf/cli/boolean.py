@@ -6,7 +6,7 @@ import os
 
 import click
 
-from ._common import check_output, output_file, report_errors
+from ._common import check_output, no_clobber_option, output_file, report_errors
 
 
 @click.command("boolean", help="""Boolean of meshes A and B, robust to holes and soups (Barill et al. 2018, Figs. 12-15).
@@ -24,6 +24,7 @@ Example:
 @click.option("-o", "--output", required=True, help="Output mesh.")
 @click.option("--exact", is_flag=True, help="Exact winding numbers instead of the fast approximation.")
 @click.option("--beta", type=float, default=2.0, show_default=True)
+@no_clobber_option
 @report_errors
 def boolean(a, b, op, output, exact, beta):
     from ..io import MESH_WRITE_FORMATS, read_mesh, write_mesh

@@ -8,7 +8,7 @@ import time
 import click
 import numpy as np
 
-from ._common import Geometry, bbox_of, output_file, report_errors
+from ._common import Geometry, bbox_of, no_clobber_option, output_file, report_errors
 
 
 @click.command("demo", help="""Run gsdf on the bundled examples and say where the outputs went.
@@ -23,6 +23,7 @@ Example:
 """)
 @click.option("-o", "--output-dir", default="gsdf-demo-output", show_default=True, help="Folder for the outputs.")
 @click.option("--resolution", type=click.IntRange(8, 512), default=64, show_default=True)
+@no_clobber_option
 @report_errors
 def demo(output_dir, resolution):
     from .. import data

@@ -6,8 +6,8 @@ import os
 
 import click
 
-from ._common import check_output, load_geometry, normals_option, output_file, parse_floats, quiet_option, \
-    report_errors
+from ._common import check_output, load_geometry, no_clobber_option, normals_option, output_file, parse_floats, \
+    quiet_option, report_errors
 
 
 def _stage_progress(enabled: bool):
@@ -63,6 +63,7 @@ Example:
               show_default=True)
 @normals_option
 @quiet_option
+@no_clobber_option
 @report_errors
 def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constraint, surface_format, estimate_normals, quiet):
     import numpy as np
@@ -87,8 +88,8 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
         close()
     with output_file(output) as tmp:
         field.save(tmp)
-    click.echo(f"{geo.describe()}\nsigned heat field on {getattr(field, 'shape', '?')} nodes "
-               f"-> {os.path.abspath(output)}")
+    where = f"a {len(field.vertices)}-node tet mesh" if tet else f"{field.shape} grid nodes"
+    click.echo(f"{geo.describe()}\nsigned heat field on {where} -> {os.path.abspath(output)}")
     if levels:
         from ..io import write_mesh
 

@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from ._common import check_output, output_file, quiet_option, report_errors
+from ._common import check_output, no_clobber_option, output_file, quiet_option, report_errors
 
 
 @click.command("heat-surface", help="""Signed distance to curves on the surface MESH (signed heat method).
@@ -34,6 +34,7 @@ Example:
 @click.option("--png", default=None, help="Also write a PNG of the distance with isolines.")
 @click.option("--view", default="0,0,1", show_default=True, help="View direction for the PNG (x,y,z).")
 @quiet_option
+@no_clobber_option
 @report_errors
 def heat_surface(mesh, curves_path, output, level_set, t_coef, soft_weight, png, view, quiet):
     from ..heat import SurfaceSignedHeatSolver

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from ._common import check_output, normals_option, output_file, parse_floats, report_errors
+from ._common import check_output, no_clobber_option, normals_option, output_file, parse_floats, report_errors
 
 
 @click.command("render", help="""Sphere-trace a level set of the Points as Tori SDF of POINTS into a PNG.
@@ -25,6 +25,7 @@ Example:
 @click.option("--view", default="1,0.6,1.4", show_default=True, help="Direction from the centre to the camera.")
 @click.option("--up", default="0,1,0", show_default=True, help="Up vector.")
 @normals_option
+@no_clobber_option
 @report_errors
 def render(points, out, level, size, view, up, estimate_normals):
     import numpy as np

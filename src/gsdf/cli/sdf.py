@@ -7,8 +7,8 @@ import os
 import click
 import numpy as np
 
-from ._common import beta_option, check_output, load_geometry, normals_option, output_file, progress_bar, \
-    quiet_option, report_errors
+from ._common import beta_option, check_output, load_geometry, no_clobber_option, normals_option, output_file, \
+    progress_bar, quiet_option, report_errors
 
 
 def signed_distance_grid(geo, resolution: int, pad: float, sign: str = "winding", beta=None, quiet=True):
@@ -52,6 +52,7 @@ Example:
 @beta_option
 @normals_option
 @quiet_option
+@no_clobber_option
 @report_errors
 def sdf(input, output, resolution, pad, sign, png, surface_out, beta, estimate_normals, quiet):
     from ..field import GridField

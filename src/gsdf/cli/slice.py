@@ -7,8 +7,8 @@ import os
 import click
 import numpy as np
 
-from ._common import bbox_of, beta_option, check_output, counting, load_geometry, normals_option, output_file, \
-    parse_floats, quiet_option, report_errors
+from ._common import bbox_of, beta_option, check_output, counting, load_geometry, no_clobber_option, \
+    normals_option, output_file, parse_floats, quiet_option, report_errors
 
 
 @click.command("slice", help="""Slice INPUT into closed contours of its winding-number solid, written as SVG.
@@ -32,6 +32,7 @@ Example:
 @beta_option
 @normals_option
 @quiet_option
+@no_clobber_option
 @report_errors
 def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, estimate_normals, quiet):
     from ..contour import slice_contours, write_svg

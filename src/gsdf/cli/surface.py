@@ -6,8 +6,8 @@ import os
 
 import click
 
-from ._common import bbox_of, beta_option, check_output, counting, load_geometry, normals_option, output_file, \
-    quiet_option, report_errors
+from ._common import bbox_of, beta_option, check_output, counting, load_geometry, no_clobber_option, \
+    normals_option, output_file, quiet_option, report_errors
 
 
 @click.command("surface", help="""Extract the surface of INPUT as the winding number's 1/2 level set.
@@ -31,6 +31,7 @@ Example:
 @beta_option
 @normals_option
 @quiet_option
+@no_clobber_option
 @report_errors
 def surface(input, output, resolution, level, bisection, pad, beta, estimate_normals, quiet):
     from ..contour import extract_isosurface

@@ -7,7 +7,8 @@ import os
 import click
 import numpy as np
 
-from ._common import check_output, normals_option, output_file, parse_floats, quiet_option, report_errors
+from ._common import check_output, no_clobber_option, normals_option, output_file, parse_floats, quiet_option, \
+    report_errors
 
 GRID_EXTENSIONS = (".npz", ".npy", ".vtk", ".vti", ".vtu")
 
@@ -50,6 +51,7 @@ Examples:
 @click.option("-k", "k", type=click.IntRange(6, 1024), default=64, show_default=True, help="Neighbours per torus fit.")
 @normals_option
 @quiet_option
+@no_clobber_option
 @report_errors
 def tori(points, out, estimator, grid, offsets, pad, k, estimate_normals, quiet):
     from ..io import MESH_WRITE_FORMATS

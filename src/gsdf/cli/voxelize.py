@@ -6,8 +6,8 @@ import os
 
 import click
 
-from ._common import beta_option, check_output, load_geometry, normals_option, output_file, progress_bar, \
-    quiet_option, report_errors
+from ._common import beta_option, check_output, load_geometry, no_clobber_option, normals_option, output_file, \
+    progress_bar, quiet_option, report_errors
 
 
 @click.command("voxelize", help="""Voxelize INPUT: a voxel is inside where the winding number at its centre is >= 1/2.
@@ -28,6 +28,7 @@ Example:
 @beta_option
 @normals_option
 @quiet_option
+@no_clobber_option
 @report_errors
 def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, quiet):
     from ..io import MESH_WRITE_FORMATS

@@ -7,8 +7,8 @@ import os
 import click
 import numpy as np
 
-from ._common import beta_option, check_output, load_geometry, normals_option, output_file, progress_bar, \
-    quiet_option, report_errors
+from ._common import beta_option, check_output, load_geometry, no_clobber_option, normals_option, output_file, \
+    progress_bar, quiet_option, report_errors
 
 VALUE_EXTENSIONS = (".npy", ".txt", ".csv")
 
@@ -59,6 +59,7 @@ Example:
 @beta_option
 @normals_option
 @quiet_option
+@no_clobber_option
 @report_errors
 def winding(input, queries, output, exact, order, beta, estimate_normals, quiet):
     from ..winding import FastWindingNumber, FastWindingNumberPoints, winding_number, winding_number_points
