@@ -177,7 +177,6 @@ class GridField(Field):
 def _load_npz(path, keys, what: str) -> dict:
     """The arrays ``keys`` of a gsdf ``.npz`` file; FileNotFoundError if missing, else ValueError naming the file."""
     import os
-    import zipfile
 
     p = os.fspath(path)
     if not os.path.exists(p):
@@ -190,7 +189,8 @@ def _load_npz(path, keys, what: str) -> dict:
             if missing:
                 raise ValueError(f"missing arrays {', '.join(missing)}")
             return {k: d[k] for k in keys}
-    except (OSError, KeyError, ValueError, TypeError, AttributeError, EOFError, zipfile.BadZipFile) as exc:
+    except Exception as exc:  # numpy/zipfile raise ValueError, EOFError, BadZipFile, zlib.error, TokenError,
+        # NotImplementedError ... for broken headers, archives and compressed data: all mean a malformed file
         raise ValueError(f"{p}: not a gsdf {what} .npz file ({exc})") from exc
 
 

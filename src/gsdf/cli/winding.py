@@ -23,7 +23,7 @@ def read_queries(path: str) -> np.ndarray:
             raise FileNotFoundError(2, "No such file or directory", path)
         try:
             Q = np.load(path, allow_pickle=False)
-        except (OSError, ValueError, EOFError) as exc:
+        except Exception as exc:  # numpy raises ValueError, EOFError, TokenError ... for a broken .npy
             raise ValueError(f"{path}: cannot read queries ({exc})") from exc
         if Q.dtype == bool or not np.issubdtype(Q.dtype, np.number):
             raise ValueError(f"{path}: expected a numeric (q, 3) array of query points, got dtype {Q.dtype}")

@@ -82,7 +82,6 @@ def _read_obj_points(p: str, data: bytes):
 
 
 def _read_numpy(p: str, ext: str):
-    import zipfile
 
     _check_file(p)
     try:
@@ -98,8 +97,9 @@ def _read_numpy(p: str, ext: str):
                 raise ValueError(f"{p}: expected arrays named 'P'/'N' or 'points'/'normals', found {sorted(arrays)}")
             A = arrays[pk]
             N = next((arrays[k] for k in ("N", "normals") if k in arrays), None)
-    except (ValueError, EOFError, zipfile.BadZipFile) as exc:
-        if str(exc).startswith(p):
+    except Exception as exc:  # numpy/zipfile raise ValueError, EOFError, BadZipFile, zlib.error, TokenError,
+        # NotImplementedError ... for broken headers, archives and compressed data: all mean a malformed file
+        if isinstance(exc, FileNotFoundError) or str(exc).startswith(p):
             raise
         raise ValueError(f"{p}: cannot read numpy file ({exc})") from exc
     A = np.asarray(A)
