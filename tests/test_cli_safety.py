@@ -220,3 +220,19 @@ def test_demo_output_folder_that_is_a_file(tmp_path):
     f.write_text("keep me")
     assert_clean_failure(invoke(["demo", "-o", str(f)]))
     assert f.read_text() == "keep me"
+
+
+@pytest.mark.parametrize("ext", [".npz", ".npy", ".vtk", ".vti", ".vtu"])
+def test_sdf_writes_every_field_format_under_the_name_given(ext, inputs, tmp_path):
+    out = tmp_path / f"s{ext}"
+    r = invoke(args_for("sdf", inputs, out))
+    assert r.exit_code == 0, r.output
+    assert os.listdir(tmp_path) == [out.name]
+
+
+def test_heat_tet_reports_its_nodes_and_refuses_vti(inputs, tmp_path):
+    r = invoke(["heat", inputs["mesh"], "--tet", "--grid", "6", "-q", "-o", str(tmp_path / "t.vtu")])
+    assert r.exit_code == 0, r.output
+    assert "-node tet mesh" in r.output and "?" not in r.output
+    line = assert_clean_failure(invoke(["heat", inputs["mesh"], "--tet", "-q", "-o", str(tmp_path / "t.vti")]))
+    assert ".npz, .npy, .vtk, .vtu" in line
