@@ -726,3 +726,36 @@ def test_damaged_files_of_every_reader_give_value_errors(tmp_path):
             assert all(np.isfinite(a).all() for a in arrays), (name, trial)
             outcomes["ok"] += 1
     assert outcomes["ValueError"] > 0.7 * sum(outcomes.values())
+
+
+@pytest.mark.parametrize("byte_order", ["<", ">"])
+@pytest.mark.parametrize("layout", ["plain", "scalars_around_the_list"])
+def test_binary_ply_mixed_polygons_fast_path(tmp_path, byte_order, layout):
+    """Mixed polygon sizes in binary PLY (the compiled face scan) equal what plyfile's row-by-row reader gives,
+    whatever the count / index types, byte order and scalar properties around the list."""
+    rng = np.random.default_rng(3)
+    V = rng.normal(size=(50, 3))
+    polys = [rng.integers(0, 50, k) for k in rng.integers(3, 9, 300)]
+    vert = np.array([tuple(r) for r in V], dtype=[("x", "f4"), ("y", "f4"), ("z", "f4")])
+    if layout == "plain":
+        face = np.empty(len(polys), dtype=[("vertex_indices", "O")])
+        face["vertex_indices"] = [q.astype(np.int32) for q in polys]
+        lt = {"vertex_indices": ("u1", "i4")}
+    else:
+        face = np.empty(len(polys), dtype=[("flag", "u1"), ("vertex_index", "O"), ("q", "f8")])
+        face["flag"] = 7
+        face["vertex_index"] = [q.astype(np.uint32) for q in polys]
+        face["q"] = 0.5
+        lt = {"vertex_index": ("u2", "u4")}
+    el_v = plyfile.PlyElement.describe(vert, "vertex")
+    el_f = plyfile.PlyElement.describe(face, "face", len_types={k: v[0] for k, v in lt.items()},
+                                       val_types={k: v[1] for k, v in lt.items()})
+    p = tmp_path / "m.ply"
+    plyfile.PlyData([el_v, el_f], text=False, byte_order=byte_order).write(str(p))
+    V2, polys2 = read_mesh(p, triangulate=False)
+    np.testing.assert_array_equal(V2, V.astype(np.float32).astype(np.float64))
+    assert [q.tolist() for q in polys2] == [q.tolist() for q in polys]
+    data = p.read_bytes()
+    p.write_bytes(data[:-5])
+    with pytest.raises(ValueError, match=errmsg(p) + ".*ends early"):
+        read_mesh(p)

@@ -299,7 +299,7 @@ def _ply_ascii_faces(tab: _Table, rows, props):
     return flat, sizes
 
 
-def _ply_binary(p: str):
+def _ply_binary(p: str, head: bytes):
     import plyfile
 
     known = {"face": {n: 3 for n in _FACE_LISTS}}  # lets plyfile memory-map triangle lists
@@ -309,7 +309,14 @@ def _ply_binary(p: str):
         except plyfile.PlyElementParseError as exc:
             if "unexpected list length" not in str(exc):
                 raise
-            ply = plyfile.PlyData.read(p, mmap="c")  # polygons: plyfile's slower row-by-row path
+            from ._ply_binary import read_binary_ply
+
+            fast = read_binary_ply(p, head)  # mixed polygon sizes: one compiled scan of the face records
+            if fast is not None:
+                v, flat, sizes = fast
+                V, N = _ply_pick(p, list(v.dtype.names), lambda i: v[v.dtype.names[i]])
+                return V, N, (flat if len(sizes) else None), (sizes if len(sizes) else None)
+            ply = plyfile.PlyData.read(p, mmap="c")  # other layouts: plyfile's slower row-by-row path
     except OSError:
         raise
     except Exception as exc:  # plyfile raises PlyParseError and assorted errors on broken files
@@ -344,7 +351,7 @@ def _read_ply(p: str):
             data += fh.read()
     if fmt == "ascii":
         return _ply_ascii(p, data, elements, body, header_lines)
-    return _ply_binary(p)
+    return _ply_binary(p, data)
 
 
 def _write_ply(p: str, vertex_fields: dict, faces=None, binary: bool = True) -> None:
