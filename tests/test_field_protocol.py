@@ -271,3 +271,20 @@ def test_signed_distance_grid_points_and_bad_input():
         gsdf.signed_distance_grid(None, points=(P, P), sign="pseudonormal")
     with pytest.raises(ValueError):
         gsdf.signed_distance_grid(V)
+
+
+def test_load_field_dispatches_on_the_arrays(tmp_path):
+    g = _grid_field()
+    g.save(tmp_path / "g.npz")
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    TetField(V, [[0, 1, 2, 3]], V[:, 0]).save(tmp_path / "t.npz")
+    SurfaceField(V, [[0, 1, 2], [0, 1, 3]], V[:, 1]).save(tmp_path / "s.npz")
+    assert isinstance(gsdf.load_field(tmp_path / "g.npz"), GridField)
+    assert isinstance(gsdf.load_field(tmp_path / "t.npz"), TetField)
+    s = gsdf.load_field(tmp_path / "s.npz")
+    assert isinstance(s, SurfaceField) and np.array_equal(s.values, V[:, 1])
+    np.savez(tmp_path / "other.npz", a=1)
+    with pytest.raises(ValueError, match="not a gsdf field"):
+        gsdf.load_field(tmp_path / "other.npz")
+    with pytest.raises(FileNotFoundError):
+        gsdf.load_field(tmp_path / "missing.npz")

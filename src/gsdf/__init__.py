@@ -21,7 +21,7 @@ _EXPORTS = {
     "TriangleDistance": "distance", "PointCloudDistance": "distance", "unsigned_distance": "distance",
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",
     # fields, contouring, operations
-    "Field": "field", "GridField": "field", "SurfaceField": "field",
+    "Field": "field", "GridField": "field", "SurfaceField": "field", "load_field": "field",
     "signed_distance_grid": "distance.grid",
     "extract_isosurface": "contour", "refine_on_edges": "contour", "slice_contours": "contour",
     "write_svg": "contour",

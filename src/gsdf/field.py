@@ -174,6 +174,30 @@ class GridField(Field):
         return cls(d["values"], d["bbox_min"], d["bbox_max"])
 
 
+def load_field(path) -> Field:
+    """Read any field written by ``field.save(path)`` to ``.npz``: a :class:`GridField`, :class:`TetField` or
+    :class:`SurfaceField`, chosen by the arrays the file holds.
+
+    Example
+    -------
+    >>> import numpy as np, os, tempfile
+    >>> p = os.path.join(tempfile.mkdtemp(), "f.npz")
+    >>> GridField(np.zeros((2, 2, 2)), [0, 0, 0], [1, 1, 1]).save(p)
+    >>> type(load_field(p)).__name__
+    'GridField'
+    """
+    d = _load_npz(path, (), "field")
+    keys = set(d["__files__"])
+    if {"values", "bbox_min", "bbox_max"} <= keys:
+        return GridField.load(path)
+    if {"vertices", "tets", "values"} <= keys:
+        return TetField.load(path)
+    if {"vertices", "faces", "values"} <= keys:
+        return SurfaceField.load(path)
+    raise ValueError(f"{path}: not a gsdf field file (arrays {sorted(keys)}; a grid has values/bbox_min/bbox_max, "
+                     "a tet field vertices/tets/values, a surface field vertices/faces/values)")
+
+
 def _load_npz(path, keys, what: str) -> dict:
     """The arrays ``keys`` of a gsdf ``.npz`` file; FileNotFoundError if missing, else ValueError naming the file."""
     import os
@@ -188,7 +212,7 @@ def _load_npz(path, keys, what: str) -> dict:
             missing = [k for k in keys if k not in d]
             if missing:
                 raise ValueError(f"missing arrays {', '.join(missing)}")
-            return {k: d[k] for k in keys}
+            return {"__files__": list(d.files), **{k: d[k] for k in keys}}
     except Exception as exc:  # numpy/zipfile raise ValueError, EOFError, BadZipFile, zlib.error, TokenError,
         # NotImplementedError ... for broken headers, archives and compressed data: all mean a malformed file
         raise ValueError(f"{p}: not a gsdf {what} .npz file ({exc})") from exc
