@@ -536,7 +536,8 @@ def _read_stl(p: str):
     ascii = data.lstrip()[:5].lower() == b"solid"
     if len(data) == 84 + 50 * n or (not ascii and n >= 0 and len(data) > 84 + 50 * n):  # binary (maybe padded)
         rec = np.frombuffer(data, dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")], count=n, offset=84)
-        soup = rec["v"].reshape(-1, 3).astype(np.float64)
+        with np.errstate(invalid="ignore"):  # NaN payloads of damaged files: refused below as non-finite
+            soup = rec["v"].reshape(-1, 3).astype(np.float64)
     elif ascii:  # only the 'vertex x y z' lines matter
         tab = _Table(p, data, comments=False)
         rows = np.union1d(tab.keyword_rows(b"vertex"), tab.keyword_rows(b"VERTEX"))
