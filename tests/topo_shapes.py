@@ -32,7 +32,7 @@ def annulus(nr=6, nt=32, r0=0.5, r1=1.0):
     b = (i * nt + (k + 1) % nt).ravel()
     c = ((i + 1) * nt + (k + 1) % nt).ravel()
     d = ((i + 1) * nt + k).ravel()
-    F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    F = np.concatenate([np.stack([a, c, b], 1), np.stack([a, d, c], 1)])
     return V, F, np.arange((nr + 1) * nt).reshape(nr + 1, nt)
 
 

@@ -37,7 +37,7 @@ from .._checks import as_mesh
 from ..linalg import Factorization, cached_factorization
 from ..mesh.connectivity import MeshTopology
 
-__all__ = ["TriangleDEC", "JumpCoordinates", "COT_CLAMP"]
+__all__ = ["TriangleDEC", "JumpCoordinates", "COT_CLAMP", "forest_potentials"]
 
 COT_CLAMP = (1e-3, 1e3)
 REG = 1e-8          # diagonal added to the Laplacians before factorization (spec §1(b) "Mollify")
@@ -61,7 +61,7 @@ class JumpCoordinates:
     walked: np.ndarray
 
 
-def _pointer_potential(n_nodes: int, a: np.ndarray, b: np.ndarray, delta: np.ndarray) -> np.ndarray:
+def forest_potentials(n_nodes: int, a: np.ndarray, b: np.ndarray, delta: np.ndarray) -> np.ndarray:
     """Potentials p on the nodes of the graph with directed links a -> b such that p[b] - p[a] = delta along a
     spanning forest (0 at one node per component). Vectorised: BFS from a virtual root, then pointer doubling
     sums the deltas along each tree path in O(log depth) numpy passes."""
@@ -255,7 +255,7 @@ class TriangleDEC:
             b_list.append(node_of[3 * f2 + k2])
             d_list.append(-sg[ok] * J[e[ok]])                # c^{other} = c^{f} - sign · J
         a, b, d = np.concatenate(a_list), np.concatenate(b_list), np.concatenate(d_list)
-        pot = _pointer_potential(len(flat), a, b, d)
+        pot = forest_potentials(len(flat), a, b, d)
         mis = np.abs(pot[b] - pot[a] - d)
         if mis.size and mis.max() > 1e-6 * max(1.0, np.abs(J).max()):
             bad = F[fi[a[np.argmax(mis)]], ki[a[np.argmax(mis)]]]
