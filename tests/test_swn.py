@@ -238,3 +238,105 @@ def test_lp_time_limit_names_the_fallback(tor):
     V, F, idx, swn = tor
     with pytest.raises(ValueError, match="method='reduced'"):
         swn.solve([idx[5, :12], idx[30, 3:15]], time_limit=1e-4)
+
+
+# ------------------------------------------------------------------------------------------ files and CLI
+DATA = "/work/shared/data/swn"
+
+
+def _write(tmp_path, name, text):
+    p = tmp_path / name
+    p.write_text(text)
+    return str(p)
+
+
+def test_curve_file_reader_and_insertion(tmp_path):
+    from gsdf.io.swn_curves import read_swn_curves
+    from gsdf.mesh.connectivity import MeshTopology
+    from gsdf.winding.surface_curves import insert_curves
+
+    V, F, idx = torus(16, 8)
+    # a loop around the tube through face interiors: midpoints of the edges (3, j)-(4, j) and of the diagonals
+    # (3, j)-(4, j+1) between them
+    from gsdf.io.curves import gc_edges
+    gce, _ = gc_edges(F)
+    lines = ["#offset 0"]
+    for j in range(8):
+        for a, b in ((idx[3, j], idx[4, j]), (idx[3, j], idx[4, (j + 1) % 8])):
+            e = int(np.flatnonzero(((gce[:, 0] == a) & (gce[:, 1] == b)) | ((gce[:, 0] == b) & (gce[:, 1] == a)))[0])
+            lines.append(f"e {e} 0.5")
+    lines.append("l " + " ".join(str(k) for k in list(range(16)) + [0]))
+    lines.append("#l 0 3")                                     # commented-out segments are ignored
+    c = read_swn_curves(_write(tmp_path, "c.txt", "\n".join(lines) + "\n"), F)
+    assert list(c.kinds) == ["e"] * 16 and len(c.segments) == 16
+    V2, F2, segs, parent = insert_curves(V, F, c)
+    assert len(V2) == len(V) + 16
+    A = lambda V, F: np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)  # noqa
+    assert np.isclose(A(V2, F2).sum(), A(V, F).sum()) and A(V2, F2).min() > 1e-8
+    t = MeshTopology(F2)
+    assert t.is_manifold and t.is_consistently_oriented and t.euler_characteristic == 0
+    res = SurfaceWindingNumbers(V2, F2).solve(list(segs))
+    assert np.allclose(np.abs(res.residual[res.chain != 0]), 1, atol=1e-6)     # a nonbounding meridian
+    # single-edge curves are split so the endpoint exclusion does not swallow them
+    from gsdf.winding.surface_curves import polylines_to_curves
+    V3, F3, s3, _ = insert_curves(V, F, polylines_to_curves([np.array([idx[3, 2], idx[3, 3]])]))
+    assert len(V3) == len(V) + 1 and len(s3) == 2
+
+
+@pytest.mark.parametrize("text, match", [
+    ("#offset 0\nv 0\nl 0 7\n", "node 7"),
+    ("#offset 0\nv 100000\nl 0 0\n", "out of range"),
+    ("#offset 0\ne 0 1.5\nv 0\nl 0 1\n", "outside"),
+    ("#offset 0\ne 0 abc\nv 0\nl 0 1\n", "not a number"),
+    ("#offset 0\nv 0\nv 1\n", "no curve segments"),
+    ("#offset 0\nq 1 2\n", "unknown directive"),
+    ("#offset 0\nv 0\nv 1\nc 0 1\nl 0 1\n", "dual chains"),
+    ("l 1 99999\n", "out of range"),
+])
+def test_curve_file_errors(tmp_path, text, match):
+    from gsdf.io.swn_curves import read_swn_curves
+
+    _, F, _ = torus(16, 8)
+    with pytest.raises(ValueError, match=match):
+        read_swn_curves(_write(tmp_path, "bad.txt", text), F)
+
+
+def test_insertion_rejects_disconnected_segments(tmp_path):
+    from gsdf.io.swn_curves import read_swn_curves
+    from gsdf.winding.surface_curves import insert_curves
+
+    V, F, idx = torus(16, 8)
+    c = read_swn_curves(_write(tmp_path, "c.txt", f"#offset 0\nv {idx[0, 0]}\nv {idx[8, 4]}\nl 0 1\n"), F)
+    with pytest.raises(ValueError, match="share no face"):
+        insert_curves(V, F, c)
+
+
+def test_cli_swn(tmp_path):
+    import os
+
+    from click.testing import CliRunner
+    from plyfile import PlyData
+
+    from gsdf.cli.main import main
+
+    if not os.path.isdir(DATA):
+        pytest.skip("author data not present")
+    out = str(tmp_path / "dt.ply")
+    r = CliRunner().invoke(main, ["swn", f"{DATA}/double-torus.obj", f"{DATA}/double-torus.txt", "-o", out,
+                                  "--method", "reduced", "--png", str(tmp_path / "dt.png"), "-q"])
+    assert r.exit_code == 0, r.output
+    ply = PlyData.read(out)
+    lab = np.asarray(ply["face"]["label"])
+    assert len(lab) == ply["face"].count and set(np.unique(lab)) == {0, 1}
+    assert os.path.getsize(tmp_path / "dt.png") > 1000
+    out2 = str(tmp_path / "dt.obj")
+    r = CliRunner().invoke(main, ["swn", f"{DATA}/double-torus.obj", f"{DATA}/double-torus.txt", "-o", out2, "-q"])
+    assert r.exit_code == 0, r.output
+    txt = open(out2).read()
+    assert txt.count("\nvt ") == 3 * ply["face"].count and "f 1/" in txt or "/1 " in txt
+    bad = CliRunner().invoke(main, ["swn", f"{DATA}/double-torus.obj", f"{DATA}/double-torus.txt", "-o",
+                                    str(tmp_path / "x.vtk")])
+    assert bad.exit_code != 0 and ".ply or .obj" in bad.output
+    badc = CliRunner().invoke(main, ["swn", f"{DATA}/double-torus.obj", _write(tmp_path, "b.txt", "zz\n"),
+                                     "-o", out])
+    assert badc.exit_code != 0 and "unknown directive" in badc.output

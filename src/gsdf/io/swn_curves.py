@@ -36,6 +36,9 @@ import numpy as np
 
 __all__ = ["SWNCurves", "read_swn_curves"]
 
+_OBJ_KEYS = {"v", "vt", "vn", "vp", "f", "g", "o", "s", "usemtl", "mtllib", "p", "cstype", "deg", "curv", "parm",
+             "end", "mg", "lod", "bevel", "c_interp", "d_interp", "shadow_obj", "trace_obj", "usemap", "maplib"}
+
 
 @dataclass
 class SWNCurves:
@@ -105,8 +108,8 @@ def read_swn_curves(path, F) -> SWNCurves:
         raise ValueError(f"{p}: not a text curve file") from None
     lines = text.splitlines()
     # format: barycentric nodes when some 'v' line has exactly one field
-    bary = any(ln.split()[:1] in (["e"], ["f"]) or (ln.split()[:1] == ["v"] and len(ln.split()) == 2)
-               for ln in lines)
+    bary = any(ln.split()[:1] in (["e"], ["#offset"]) or (ln.split()[:1] == ["v"] and len(ln.split()) == 2)
+               or (ln.split()[:1] == ["f"] and len(ln.split()) == 5 and "/" not in ln) for ln in lines)
     kinds, index, params, segs = [], [], [], []
     offset = 0
     gce = None
@@ -139,6 +142,8 @@ def read_swn_curves(path, F) -> SWNCurves:
                     index.append(i)
                     params.append((0.0, 0.0, 0.0))
                 segs += [(base + k, base + k + 1) for k in range(len(idx) - 1)]
+            if key not in _OBJ_KEYS:
+                raise ValueError(f"{p}: line {ln_no}: unknown directive {key!r}")
             continue                                           # other OBJ statements (v x y z, f, vn, ...)
         if key == "v":
             if len(tok) != 2:
