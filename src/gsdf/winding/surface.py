@@ -18,10 +18,10 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    faces are flood-filled across the completed chain, γ integrated along a BFS tree in each piece, and the LP
    has one shift per piece;
 5. the jumps of v (Jv, the completed nonbounding part) are removed from the input, g − Jv, and the jump Laplace
-   equation solved again: w. Faces are labelled ``round(w − s)`` with the offset s the area-weighted circular
-   mean of w (``arg Σ A_f e^{2πi w_f} / 2π``: w is known up to a constant and a 50/50 split leaves w ≈ ±½),
-   then shifted so that the faces to the right of the curves get label 0 (the thesis' "+1 crossing from the
-   right").
+   equation solved again: w. Faces are labelled ``round(w − s)`` with the offset s the level of w on the
+   input curves minus ½ (circular mean of the mean of the two faces of every bounding input edge; see
+   :meth:`SurfaceWindingNumbers.rounding_offset`), then shifted so that the faces to the right of the curves get
+   label 0 (the thesis' "+1 crossing from the right").
 
 Boundaries (spec §1(e).5): the jump Laplace problem has zero-Neumann conditions, so a loop around a hole bounds
 (together with the boundary) and an arc joining two boundary circles does not; curves ending on the boundary are
@@ -90,11 +90,11 @@ class SWNResult:
     timings: dict = field(default_factory=dict)
 
 
-def circular_offset(w_face: np.ndarray, area: np.ndarray) -> float:
-    """The rounding offset s ∈ (-½, ½]: area-weighted circular mean of ``w`` modulo 1."""
-    z = np.sum(area * np.exp(2j * np.pi * w_face))
-    if abs(z) < 1e-12 * max(area.sum(), 1e-300):
-        return 0.0
+def circular_mean(x: np.ndarray, weight: np.ndarray) -> float | None:
+    """Weighted circular mean of ``x`` modulo 1, in (-½, ½]; None when the weights cancel out."""
+    z = np.sum(weight * np.exp(2j * np.pi * x))
+    if not np.isfinite(z) or abs(z) < 1e-9 * max(float(np.sum(weight)), 1e-300):
+        return None
     return float(np.angle(z) / (2 * np.pi))
 
 
@@ -275,7 +275,7 @@ class SurfaceWindingNumbers:
         dec, topo = self.dec, self.topology
         t0 = time.perf_counter()
         wf = w.mean(axis=1)
-        s = circular_offset(wf, dec.face_area)
+        s = self.rounding_offset(wf, g, Jv)
         W = np.round(wf - s)
         # label 0 on the right of the curves: the length-weighted most frequent label of the right faces
         ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
@@ -291,6 +291,29 @@ class SurfaceWindingNumbers:
         T["round"] = time.perf_counter() - t0
         T["total"] = float(sum(T.values()))
         return SWNResult(w - off, W, Jv, bounding, u, g, ends, om, gamma, float(off), method, timings=T)
+
+    def rounding_offset(self, wf: np.ndarray, g: np.ndarray, Jv: np.ndarray) -> float:
+        """The offset s of ``W = round(w - s)``: the level of w *on the curves*, minus ½.
+
+        Across a bounding input edge w jumps by ≈ 1, so the mean of its two faces' values is the half-integer
+        level separating them (thesis §7.1 takes the half-integer level from the values along the input curves).
+        s is the circular mean (mod 1) of these mid-values minus ½, weighted by edge length times the bounding
+        part |g − Jv|, over the edges whose bounding part rounds to a nonzero jump (edges found mostly
+        nonbounding should not separate labels and carry no information). Without bounding input edges:
+        the area-weighted circular mean of w (w is known up to a constant; a 50/50 split leaves w ≈ ±½).
+        On generated cases (bench/bench_swn.py) this beat the area-weighted circular mean of w (mean error
+        5.4 % vs 10.9 % on 48 hard cases) and a vote over thresholds along the curves (7.0 %)."""
+        dec, topo = self.dec, self.topology
+        ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
+        b = g[ce] - Jv[ce]
+        wt = dec.edge_length[ce] * np.abs(b) * (np.round(b) != 0)      # edges whose labels should jump
+        if len(ce) and wt.sum() > 1e-9 * dec.edge_length[ce].sum():
+            mid = 0.5 * (wf[topo.edge_faces[ce, 0]] + wf[topo.edge_faces[ce, 1]])
+            c = circular_mean(mid, wt)
+            if c is not None:
+                return c - 0.5
+        c = circular_mean(wf, dec.face_area)
+        return 0.0 if c is None else c
 
     # ------------------------------------------------------------------------------------------ residuals
     def _face_integrals(self, gamma: np.ndarray) -> np.ndarray:
