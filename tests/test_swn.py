@@ -340,3 +340,12 @@ def test_cli_swn(tmp_path):
     badc = CliRunner().invoke(main, ["swn", f"{DATA}/double-torus.obj", _write(tmp_path, "b.txt", "zz\n"),
                                      "-o", out])
     assert badc.exit_code != 0 and "unknown directive" in badc.output
+
+
+def test_progress_callback(tor):
+    V, F, idx, swn = tor
+    seen = []
+    swn.solve([idx[5, :12]], progress=lambda d, t: seen.append((d, t)))
+    assert seen[-1] == (5, 5) and all(t == 5 for _, t in seen) and [d for d, _ in seen] == sorted(d for d, _ in seen)
+    with pytest.raises(ValueError, match="progress"):
+        swn.solve([idx[5, :12]], progress=3)

@@ -84,7 +84,13 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     V2, F2, segs, _ = insert_curves(V, F, c)
     say("building operators")
     solver = SurfaceWindingNumbers(V2, F2)
-    res = solver.solve(list(segs), method=method, epsilon=epsilon, time_limit=time_limit, progress=say)
+    from ._common import progress_bar
+
+    bar, update = progress_bar(5, "swn steps", enabled=not quiet)
+    try:
+        res = solver.solve(list(segs), method=method, epsilon=epsilon, time_limit=time_limit, progress=update)
+    finally:
+        bar.close()
     ensure_parent(output)
     (write_swn_ply if ext == ".ply" else write_swn_obj)(output, V2, F2, res.corner_values, res.face_labels)
     A = solver.dec.face_area

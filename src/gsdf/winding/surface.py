@@ -125,7 +125,6 @@ class SurfaceWindingNumbers:
         self.betti_1 = self.topology.betti_1()
         self.simply_connected = self.betti_1 == 0
         self._hodge = None
-        self._graph = None
         n = self.dec.n_vertices
         self._edge_key = self.dec.edges[:, 0] * n + self.dec.edges[:, 1]
 
@@ -198,7 +197,8 @@ class SurfaceWindingNumbers:
         method : "lp" (full residual LP, §6.1), "reduced" (reduced LP, §6.3) or "none" (naive rounding of u)
         epsilon : float in (0, 1], LP weight of jumps on the input's edges relative to gap-closing ones
         time_limit : float, seconds HiGHS may take; beyond it a ValueError names ``method="reduced"``
-        progress : callable(step: str), optional, called before each step
+        progress : callable(done, total), optional — the package's progress signature; called after each of the
+            steps (jump solve, Darboux derivative, Hodge decomposition, residual LP, final solve)
 
         Returns
         -------
@@ -209,7 +209,14 @@ class SurfaceWindingNumbers:
         if isinstance(epsilon, bool) or not isinstance(epsilon, (int, float, np.floating)) or \
                 not (0 < float(epsilon) <= 1):
             raise ValueError(f"epsilon: expected a number in (0, 1], got {epsilon!r}")
-        say = progress if callable(progress) else (lambda s: None)
+        if progress is not None and not callable(progress):
+            raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
+        steps = iter(range(1, 6))
+
+        def say(_name):
+            if progress is not None:
+                k = next(steps, 5)
+                progress(k - 1, 5)
         dec, topo = self.dec, self.topology
         T = {}
         t0 = time.perf_counter()
@@ -229,15 +236,18 @@ class SurfaceWindingNumbers:
         zero = np.zeros(nE)
         if method == "none" or self.simply_connected:
             om = dec.darboux(u, ends) if method != "none" else zero
-            return self._finish(u, u, g, zero, ends, om, om, method if method == "none" else method, T)
+            res = self._finish(u, u, g, zero, ends, om, om, method, T)
+            if progress is not None:
+                progress(5, 5)
+            return res
 
         say("Darboux derivative")
         t0 = time.perf_counter()
         om = dec.darboux(u, ends)
         T["darboux"] = time.perf_counter() - t0
         t0 = time.perf_counter()
+        say("Hodge decomposition")
         if ends.any():
-            say("Hodge decomposition")
             co, _ = self._hodge_decomposition().coexact_part(om)
             gamma = om - co
         else:
@@ -269,6 +279,8 @@ class SurfaceWindingNumbers:
         T["final_solve"] = time.perf_counter() - t0
         res = self._finish(w, u, g, Jv, ends, om, gamma, method, T)
         res.lp_objective = obj
+        if progress is not None:
+            progress(5, 5)
         return res
 
     def _finish(self, w, u, g, Jv, ends, om, gamma, method, T) -> SWNResult:
@@ -353,14 +365,6 @@ class SurfaceWindingNumbers:
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
 
-    def _vertex_graph(self):
-        if self._graph is None:
-            dec = self.dec
-            E = dec.edges
-            n = dec.n_vertices
-            self._graph = (E, n)
-        return self._graph
-
     def _complete_chain(self, g: np.ndarray, ends: np.ndarray) -> np.ndarray:
         """Complete the chain by shortest paths (edge lengths) from each endpoint where curves arrive
         (``(d0ᵀg)_i > 0``) to the nearest endpoint where curves leave, greedily by distance, along edges that are
@@ -373,7 +377,7 @@ class SurfaceWindingNumbers:
         comp = np.zeros(dec.n_edges)
         if len(pos) == 0 or len(neg) == 0:
             return comp
-        E, n = self._vertex_graph()
+        E, n = dec.edges, dec.n_vertices
         free = (g == 0)
         # endpoints of other curves may be passed through; the input's own edges may not
         Gm = sp.coo_matrix((dec.edge_length[free], (E[free, 0], E[free, 1])), shape=(n, n)).tocsr()
@@ -406,7 +410,6 @@ class SurfaceWindingNumbers:
 
     def _residual_reduced(self, gamma, g, ends, time_limit):
         dec, topo = self.dec, self.topology
-        t_all = time.perf_counter()
         comp = self._complete_chain(g, ends)
         cut = (g != 0) | (comp != 0)
         interior = topo.edge_face_count == 2
@@ -434,7 +437,6 @@ class SurfaceWindingNumbers:
             Jv[ce[inter]] = r.jumps
             obj += r.objective
             lp_s = r.seconds
-        del t_all
         return Jv, obj, lp_s
 
 
