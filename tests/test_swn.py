@@ -349,3 +349,24 @@ def test_progress_callback(tor):
     assert seen[-1] == (5, 5) and all(t == 5 for _, t in seen) and [d for d, _ in seen] == sorted(d for d, _ in seen)
     with pytest.raises(ValueError, match="progress"):
         swn.solve([idx[5, :12]], progress=3)
+
+
+def test_cli_heat_surface_swn(tmp_path):
+    from click.testing import CliRunner
+    from plyfile import PlyData
+
+    from gsdf.cli.main import main
+    from gsdf.io import write_mesh
+
+    V, F, idx = torus(48, 24)
+    write_mesh(str(tmp_path / "t.obj"), V, F)
+    loops = [np.r_[idx[5], idx[5, 0]], np.r_[idx[20], idx[20, 0]][::-1], np.r_[idx[35], idx[35, 0]]]
+    (tmp_path / "c.obj").write_text("".join("l " + " ".join(str(i + 1) for i in L) + "\n" for L in loops))
+    out = str(tmp_path / "d.ply")
+    r = CliRunner().invoke(main, ["heat-surface", str(tmp_path / "t.obj"), "--curves", str(tmp_path / "c.obj"),
+                                  "-o", out, "--swn", "-q"])
+    assert r.exit_code == 0, r.output
+    assert "67% of the curve edges bound a region" in r.output
+    phi = np.asarray(PlyData.read(out)["vertex"]["distance"])
+    on = [np.abs(phi[L]).max() < 1e-6 for L in loops]
+    assert on[1] and sum(on) == 2                # the reversed loop and one + loop remain; the other + is dropped

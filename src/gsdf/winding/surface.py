@@ -49,7 +49,7 @@ from ..dec.hodge import HodgeDecomposition
 from ..dec.lp import dual_graph_l1
 from ..dec.triangle import TriangleDEC, forest_potentials
 
-__all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "METHODS"]
+__all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "bounding_segments", "METHODS"]
 
 METHODS = ("lp", "reduced", "none")
 NEXT = np.array([1, 2, 0])
@@ -438,6 +438,26 @@ class SurfaceWindingNumbers:
             obj += r.objective
             lp_s = r.seconds
         return Jv, obj, lp_s
+
+
+def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
+    """The bounding part of the input (thesis §6.4.1: filter the nonbounding components before computing a
+    distance) as oriented 2-vertex polylines: every input edge whose bounding multiplicity ``round(g − Jv)`` is
+    nonzero, repeated that many times, in its direction.
+
+    Example
+    -------
+    >>> res = swn.solve(curves)                                               # doctest: +SKIP
+    >>> segs = bounding_segments(swn, res)                                    # doctest: +SKIP
+    >>> phi = SurfaceSignedHeatSolver(V, F).compute_distance(segs)            # doctest: +SKIP
+    """
+    b = np.round(res.bounding)
+    E = swn.dec.edges
+    out = []
+    for e in np.flatnonzero(b):
+        a, c = (E[e, 0], E[e, 1]) if b[e] > 0 else (E[e, 1], E[e, 0])
+        out += [np.array([a, c], dtype=np.int64)] * int(abs(b[e]))
+    return out
 
 
 def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
