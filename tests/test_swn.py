@@ -107,6 +107,9 @@ def test_torus_broken_meridian_gap_closes(tor):
         gl = swn.dec.edge_length[gap].sum()
         assert gl < 1.3 * (24 - keep + 1) * swn.dec.edge_length[on].mean()   # ... by the short arc
         jv.append(np.median(np.abs(r.residual[on])))
+        # spec §1(f): the LP optimum is at most ε·(nonbounding input length) + gap length (closing by Jv = 1)
+        el = swn.dec.edge_length
+        assert r.lp_objective <= 1e-2 * el[on].sum() + (24 - keep + 1) * el[on].mean() * 1.001
         assert mislabeled(r, np.zeros(len(F), int), swn.dec.face_area) == 0.0
     assert jv[0] < jv[1] <= 1.0 + 1e-9 and jv[1] > 0.85         # Jv -> 1 as the breakage shrinks (Fig. 6.6)
 
