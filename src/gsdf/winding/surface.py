@@ -114,9 +114,15 @@ class SurfaceWindingNumbers:
 
     Example
     -------
-    >>> import numpy as np
-    >>> u = 2 * np.pi * np.arange(24) / 24
-    >>> # (see tests/test_swn.py for complete examples on tori, spheres, annuli)
+    A closed loop on a flat grid bounds the square it runs around (counter-clockwise: label 1 inside):
+
+    >>> from gsdf.heat.surface.meshes import grid_mesh
+    >>> V, F = grid_mesh(8)                                  # 9 x 9 vertices, vertex (i, j) = 9 i + j
+    >>> swn = SurfaceWindingNumbers(V, F)
+    >>> sq = [list(range(a, b, s)) for a, b, s in ((20, 56, 9), (56, 60, 1), (60, 24, -9), (24, 20, -1))]
+    >>> res = swn.solve([sum(sq, []) + [20]])                # (-.5,-.5) -> (.5,-.5) -> (.5,.5) -> (-.5,.5)
+    >>> int(res.face_labels.sum())                           # the 4 x 4 square: 32 triangles
+    32
     """
 
     def __init__(self, V, F):
