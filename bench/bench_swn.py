@@ -507,11 +507,39 @@ def author_data():
     return "\n".join(rows)
 
 
+def offsets_diagnostic(per_mesh=10):
+    """How much of the error is the rounding offset: error with the offset of the solver vs the best offset in
+    hindsight (an oracle over 101 offsets), full LP, on fresh cases of five meshes."""
+    from gsdf.winding.surface import circular_mean
+
+    meshes = dict(mesh_list())
+    rows = {"solver offset (level on the curves)": [], "area circular mean of w": [], "oracle offset": []}
+    for name, seed in [("cow", 1), ("sphere-uv", 3), ("torus", 4), ("author-annulus", 5), ("dino", 7)]:
+        V, F = meshes[name]()
+        mc = MeshCases(name, V, F, seed=seed)
+        for c in range(per_mesh):
+            truth, g = mc.region("eigen" if c % 2 == 0 else "grow")
+            if truth is None:
+                continue
+            gb = mc.break_chain(g, mc.rng.uniform(0.1, 0.5), int(mc.rng.integers(1, 5)))
+            r = mc.swn.solve(gb, method="lp")
+            w = r.corner_values.mean(1) + r.offset
+            E = lambda s: mislabeled(np.round(w - s).astype(int), truth, mc.area)  # noqa: E731
+            rows["solver offset (level on the curves)"].append(E(r.offset))
+            rows["area circular mean of w"].append(E(circular_mean(w, mc.area) or 0.0))
+            rows["oracle offset"].append(min(E(s) for s in np.linspace(-0.5, 0.5, 101)))
+    out = ["| rounding offset | mean error | max error | cases < 0.5 % |", "|---|---|---|---|"]
+    for k, v in rows.items():
+        v = np.array(v)
+        out.append(f"| {k} | {100 * v.mean():.2f} % | {100 * v.max():.1f} % | {100 * (v < 0.005).mean():.0f} % |")
+    return f"{len(v)} cases (cow, sphere, torus, author annulus, dino; full LP):\n\n" + "\n".join(out)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="50 cases on 10 meshes, small scaling run")
     ap.add_argument("--per-mesh", type=int, default=None)
-    ap.add_argument("--only", choices=["cases", "scaling", "author", "summary"], default=None)
+    ap.add_argument("--only", choices=["cases", "scaling", "author", "summary", "offsets"], default=None)
     ap.add_argument("--time-limit", type=float, default=120.0)
     ap.add_argument("--fresh", action="store_true", help="discard bench/swn_cases.csv first")
     a = ap.parse_args()
@@ -532,6 +560,8 @@ def main():
         parts["scaling"] = scaling(a.time_limit * 3, sizes)
     if a.only in (None, "author"):
         parts["author"] = author_data()
+    if a.only == "offsets":
+        parts["offsets"] = offsets_diagnostic()
     text = [f"Machine: {machine()}. Load at start: `{load}` (shared with other helpers; times are indicative).",
             f"Command: `PYTHONPATH=src python3 bench/bench_swn.py{' --quick' if a.quick else ''}"
             f"{' --only ' + a.only if a.only else ''}` ({time.perf_counter() - t0:.0f} s).", ""]
@@ -542,6 +572,8 @@ def main():
                  parts["scaling"], ""]
     if "author" in parts:
         text += ["### Author data (/work/shared/data/swn; PNGs bench/swn_author_*.png)", "", parts["author"], ""]
+    if "offsets" in parts:
+        text += ["### Rounding offset: solver rule vs oracle", "", parts["offsets"], ""]
     name = "swn" if not a.quick else "swn-quick"
     if a.only:
         name += "-" + a.only
