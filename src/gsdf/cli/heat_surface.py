@@ -31,12 +31,15 @@ Example:
               help="Diffusion time t = t_coef · h² (h: mean spacing of edge midpoints).")
 @click.option("--soft-weight", type=click.FloatRange(min=0, min_open=True), default=None,
               help="Soft level-set penalty λ instead of the hard constraint.")
+@click.option("--swn", is_flag=True,
+              help="First classify the curves with surface winding numbers and keep only their bounding part "
+                   "(thesis §6.4.1); curves must run along mesh edges.")
 @click.option("--png", default=None, help="Also write a PNG of the distance with isolines.")
 @click.option("--view", default="0,0,1", show_default=True, help="View direction for the PNG (x,y,z).")
 @quiet_option
 @no_clobber_option
 @report_errors
-def heat_surface(mesh, curves_path, output, level_set, t_coef, soft_weight, png, view, quiet):
+def heat_surface(mesh, curves_path, output, level_set, t_coef, soft_weight, png, view, quiet, swn=False):
     from ..heat import SurfaceSignedHeatSolver
     from ..io import read_mesh, write_mesh
     from ..io.curves import read_curves
@@ -45,6 +48,22 @@ def heat_surface(mesh, curves_path, output, level_set, t_coef, soft_weight, png,
     check_output(png, (".png",), "--png")
     V, F = read_mesh(mesh)
     src = read_curves(curves_path, F)
+    if swn:
+        from ..winding.surface import SurfaceWindingNumbers, bounding_segments
+
+        if not all(isinstance(c, np.ndarray) and c.ndim == 1 for c in src.curves) or not src.curves:
+            raise ValueError(f"{curves_path}: --swn needs curves along mesh vertices ('v' nodes or OBJ 'l' lines)")
+        if src.curve_signs is not None and not all(src.curve_signs):
+            raise ValueError(f"{curves_path}: --swn needs signed (oriented) curves")
+        sw = SurfaceWindingNumbers(V, F)
+        res = sw.solve(list(src.curves))
+        segs = bounding_segments(sw, res)
+        kept = len(segs) / max(int(np.abs(res.chain).sum()), 1)
+        click.echo(f"surface winding numbers: {100 * kept:.0f}% of the curve edges bound a region, the rest is "
+                   "dropped as nonbounding")
+        if not segs:
+            raise ValueError(f"{curves_path}: no part of the curves bounds a region (all nonbounding)")
+        src.curves, src.curve_signs = segs, None
     solver = SurfaceSignedHeatSolver(V, F, t_coef=t_coef)
     phi = solver.compute_distance(src.curves, points=src.points, curve_signs=src.curve_signs,
                                   level_set_constraint=level_set, soft_weight=soft_weight)
