@@ -26,7 +26,7 @@ Example
 >>> K = TetComplex(V, np.array([[0, 1, 2, 3]]))
 >>> K.d0.shape, K.d1.shape, K.d2.shape
 ((6, 4), (4, 6), (1, 4))
->>> abs(K.d1 @ K.d0).sum(), abs(K.d2 @ K.d1).sum()
+>>> float(abs(K.d1 @ K.d0).sum()), float(abs(K.d2 @ K.d1).sum())
 (0.0, 0.0)
 """
 

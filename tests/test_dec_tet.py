@@ -1,0 +1,155 @@
+"""Tests of gsdf.dec.tet: incidence, FEM weights, Hodge canary (harmonic dimension = b1), jump Laplace."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.spatial import Delaunay
+
+from gsdf.dec.tet import TetComplex, chain_boundary_vertices
+
+
+def _ball(n=300, seed=0):
+    P = np.random.default_rng(seed).uniform(-1, 1, (n, 3))
+    return TetComplex(P, Delaunay(P).simplices)
+
+
+def _solid_torus(seed=1):
+    rng = np.random.default_rng(seed)
+    # a jittered grid filling a solid torus (R = 1, r = 0.45), Delaunay, tets with centroid outside removed
+    g = np.linspace(-1.5, 1.5, 17)
+    X = np.stack(np.meshgrid(g, g, np.linspace(-0.5, 0.5, 7), indexing="ij"), -1).reshape(-1, 3)
+    X = X + rng.uniform(-0.02, 0.02, X.shape)
+    inside = lambda Y: np.hypot(np.hypot(Y[:, 0], Y[:, 1]) - 1.0, Y[:, 2]) < 0.45  # noqa: E731
+    X = X[inside(X)]
+    T = Delaunay(X).simplices
+    T = T[inside(X[T].mean(axis=1))]
+    used = np.unique(T)
+    remap = -np.ones(len(X), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    return TetComplex(X[used], remap[T])
+
+
+def _harmonic_dim(K):
+    """dim ker(d0 d0ᵀ + d1ᵀ d1) on edges (unit metric), by dense eigenvalues — an independent b1."""
+    d0, d1 = K.d0.toarray(), K.d1.toarray()
+    L1 = d0 @ d0.T + d1.T @ d1
+    ev = np.linalg.eigvalsh(L1)
+    return int(np.sum(ev < 1e-8 * ev.max()))
+
+
+def _hodge_gamma(K, omega):
+    """Harmonic part of omega in the ⋆1 inner product: ω − d0α − ⋆1⁻¹ d1ᵀ β (seed 003 Eq. 5)."""
+    s1 = K.star1
+    d0, d1 = K.d0, K.d1
+    L0 = (d0.T @ sp.diags(s1) @ d0).tocsc()
+    a = np.zeros(K.n_vertices)
+    a[1:] = spla.spsolve(L0[1:, 1:], (d0.T @ (s1 * omega))[1:])
+    L2 = (d1 @ sp.diags(1.0 / s1) @ d1.T).tocsc()
+    b = spla.lsqr(L2, d1 @ omega, atol=1e-14, btol=1e-14, iter_lim=20000)[0]
+    return omega - d0 @ a - (d1.T @ b) / s1
+
+
+def test_incidence_complex_and_orientation():
+    K = _ball()
+    assert abs(K.d1 @ K.d0).max() == 0 and abs(K.d2 @ K.d1).max() == 0
+    # Euler characteristic of a ball
+    assert K.n_vertices - K.n_edges + K.n_faces - K.n_tets == 1
+    assert (K.volumes > 0).all()
+    # every interior face has one tet on each side; divergence of a tet's boundary sums to +-1 per face
+    interior = (K.face_tets >= 0).all(axis=1)
+    col = np.asarray(abs(K.d2).sum(axis=0)).ravel()
+    assert np.array_equal(col == 2, interior)
+
+
+def test_fem_weights_are_the_p1_stiffness():
+    K = _ball(200)
+    w = K.fem_tet_weights()
+    # an independent P1 stiffness from barycentric gradients: K_ij = |T| ∇λ_i·∇λ_j, w_ij = −K_ij
+    V, T = K.V, K.T
+    M = np.concatenate([np.ones((len(T), 4, 1)), V[T]], axis=2)            # rows [1 x y z]
+    Gr = np.linalg.inv(M)[:, 1:, :]                                         # ∇λ_k as columns
+    Kst = K.volumes[:, None, None] * np.einsum("tik,tjk->tij", Gr.transpose(0, 2, 1), Gr.transpose(0, 2, 1))
+    pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    ref = np.stack([-Kst[:, i, j] for i, j in pairs], axis=1)
+    assert np.allclose(w, ref, rtol=1e-8, atol=1e-12)
+    # regular tet: |e| cot(θ) / 6 with θ = arccos(1/3)
+    R = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1.0]])
+    Kr = TetComplex(R, np.array([[0, 1, 2, 3]]))
+    th = np.arccos(1 / 3)
+    assert np.allclose(Kr.fem_tet_weights(), np.sqrt(8) / np.tan(th) / 6)
+    assert (K.star1 > 0).all() and (K.star0 > 0).all() and (K.star2 > 0).all()
+
+
+def test_hodge_canary_ball_and_solid_torus():
+    K = _ball(120)
+    assert _harmonic_dim(K) == 0
+    # the Darboux derivative of a jump field on a ball has no harmonic part (notes 2(b).4)
+    c = K.V[K.T].mean(axis=1)
+    inside = np.linalg.norm(c, axis=1) < 0.6
+    ft = K.face_tets
+    sel = (ft >= 0).all(axis=1) & (inside[np.maximum(ft[:, 0], 0)] != inside[np.maximum(ft[:, 1], 0)])
+    G = np.zeros(K.n_faces)
+    G[sel] = np.where(inside[ft[sel, 0]], 1.0, -1.0)
+    cc, _ = K.jump_coordinates(G)
+    omega = K.darboux_derivative(cc)
+    gamma = _hodge_gamma(K, omega)
+    assert np.linalg.norm(omega) > 1
+    assert np.linalg.norm(gamma) / np.linalg.norm(omega) < 1e-8
+    Kt = _solid_torus()
+    assert Kt.n_vertices - Kt.n_edges + Kt.n_faces - Kt.n_tets == 0   # χ(solid torus) = 0
+    assert _harmonic_dim(Kt) == 1
+
+
+def test_jump_laplace_dense_sphere_recovers_indicator():
+    rng = np.random.default_rng(0)
+    S = rng.normal(size=(1500, 3))
+    S /= np.linalg.norm(S, axis=1)[:, None]
+    P = np.vstack([S, rng.uniform(-1.5, 1.5, (2500, 3))])
+    K = TetComplex(P, Delaunay(P).simplices)
+    inside = np.linalg.norm(K.V[K.T].mean(axis=1), axis=1) < 1
+    ft = K.face_tets
+    sel = (ft >= 0).all(axis=1) & (inside[np.maximum(ft[:, 0], 0)] != inside[np.maximum(ft[:, 1], 0)])
+    G = np.zeros(K.n_faces)
+    G[sel] = np.where(inside[ft[sel, 0]], 1.0, -1.0)
+    assert not chain_boundary_vertices(K, G).any()
+    u, info = K.jump_laplace(G)
+    w = u.mean(axis=1)
+    assert np.abs(w - inside).max() < 1e-8
+    # ∂W = F0: the faces where the rounded labelling changes are exactly the chain
+    W = w > 0.5
+    ch = (ft >= 0).all(axis=1) & (W[np.maximum(ft[:, 0], 0)] != W[np.maximum(ft[:, 1], 0)])
+    assert np.array_equal(ch, G != 0)
+
+
+def test_jump_coordinates_exclude_chain_boundary():
+    K = _ball(200)
+    G = np.zeros(K.n_faces)
+    G[np.flatnonzero((K.face_tets >= 0).all(axis=1))[0]] = 1.0     # a single face: its 3 vertices are ∂Γ
+    ex = chain_boundary_vertices(K, G)
+    assert ex.sum() == 3
+    c, ex2 = K.jump_coordinates(G)
+    assert np.array_equal(ex, ex2)
+    assert np.all(c[np.isin(K.T, np.flatnonzero(ex))] == 0)
+
+
+@pytest.mark.parametrize("T, msg", [
+    (np.zeros((2, 3), dtype=int), "shape"),
+    (np.array([[0, 1, 2, 99]]), "indices"),
+    (np.array([[0, 1, 2, 2]]), "repeats"),
+    (np.array([[0.0, 1, 2, 3]]), "integer"),
+    (np.array([[True, False, True, False]]), "integer"),
+    (np.zeros((0, 4), dtype=int), "empty"),
+])
+def test_bad_tets(T, msg):
+    V = np.eye(4)[:, :3]
+    with pytest.raises(ValueError, match=msg):
+        TetComplex(V, T)
+
+
+def test_bad_chain():
+    K = _ball(50)
+    with pytest.raises(ValueError, match="G"):
+        K.jump_coordinates(np.zeros(3))
+    with pytest.raises(ValueError, match="G"):
+        K.jump_coordinates(np.full(K.n_faces, np.nan))
