@@ -97,8 +97,14 @@ def test_hodge_canary_ball_and_solid_torus():
     assert np.linalg.norm(omega) > 1
     assert np.linalg.norm(gamma) / np.linalg.norm(omega) < 1e-8
     Kt = _solid_torus()
-    assert Kt.n_vertices - Kt.n_edges + Kt.n_faces - Kt.n_tets == 0   # χ(solid torus) = 0
-    assert _harmonic_dim(Kt) == 1
+    chi = Kt.n_vertices - Kt.n_edges + Kt.n_faces - Kt.n_tets
+    assert chi == 0                                                    # χ(solid torus) = 0
+    # b1 by Alexander duality, independently of any solver: b1 = b0 − χ + b2, b2 = #∂-components − b0
+    from gsdf.recon.topology import mesh_topology
+    hull = (Kt.face_tets < 0).any(axis=1)
+    top = mesh_topology(Kt.V, Kt.faces[hull])
+    assert top["closed"] and top["genus"] == [1]
+    assert 1 - chi + (top["components"] - 1) == 1
 
 
 def test_jump_laplace_dense_sphere_recovers_indicator():
@@ -153,3 +159,51 @@ def test_bad_chain():
         K.jump_coordinates(np.zeros(3))
     with pytest.raises(ValueError, match="G"):
         K.jump_coordinates(np.full(K.n_faces, np.nan))
+
+
+def _disk_chain(K):
+    """The meridian disk {φ = 0, x > 0} of the solid torus as an oriented face chain."""
+    c = K.V[K.T].mean(axis=1)
+    lab = np.arctan2(c[:, 1], c[:, 0]) > 0
+    ft = K.face_tets
+    l0, l1 = lab[np.maximum(ft[:, 0], 0)], lab[np.maximum(ft[:, 1], 0)]
+    fc = K.V[K.faces].mean(axis=1)
+    sel = (ft >= 0).all(axis=1) & (l0 != l1) & (fc[:, 0] > 0)
+    G = np.zeros(K.n_faces)
+    G[sel] = np.where(l0[sel], 1.0, -1.0)
+    return G
+
+
+def test_hodge_decomposition_of_gsdf_dec_on_tets():
+    K = _ball(150)
+    H = K.hodge()
+    assert H.harmonic_basis().shape[1] == 0
+    omega = np.random.default_rng(3).normal(size=K.n_edges)
+    assert np.linalg.norm(H.decompose(omega).harmonic) < 1e-6 * np.linalg.norm(omega)
+    Kt = _solid_torus()
+    assert Kt.hodge().harmonic_basis().shape[1] == 1
+    # the disk's boundary lies on the hull: no star walk is path dependent
+    G = _disk_chain(Kt)
+    assert not chain_boundary_vertices(Kt, G).any()
+
+
+def test_correction_chain_removes_the_harmonic_part_on_a_solid_torus():
+    from gsdf.dec.tet import correction_chain
+    K = _solid_torus()
+    H = K.hodge()
+    G = _disk_chain(K)
+    c, _ = K.jump_coordinates(G)
+    omega = K.darboux_derivative(c)
+    gamma = H.decompose(omega).harmonic
+    r0 = np.linalg.norm(gamma) / np.linalg.norm(omega)
+    assert r0 > 0.1                      # the disk's jump winds around the hole
+    # the period of γ around the core circle is the jump of the disk, 1
+    Lam, info = correction_chain(K, gamma)
+    big = np.abs(Lam) > 0.5
+    assert 0 < big.sum() < 0.05 * K.n_faces          # concentrated on a cut surface (L0), not spread
+    assert np.all(np.abs(np.abs(Lam[big]) - 1) < 0.05)
+    c2, _ = K.jump_coordinates(G + Lam)
+    om2 = K.darboux_derivative(c2)
+    assert np.linalg.norm(H.decompose(om2).harmonic) < 0.2 * r0 * np.linalg.norm(om2)
+    with pytest.raises(ValueError, match="gamma"):
+        correction_chain(K, np.zeros(3))

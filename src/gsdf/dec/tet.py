@@ -38,7 +38,7 @@ import scipy.sparse as sp
 
 from .._checks import as_points
 
-__all__ = ["TetComplex", "chain_boundary_vertices"]
+__all__ = ["TetComplex", "chain_boundary_vertices", "correction_chain"]
 
 # local vertex pairs of the 6 edges of a tet and, for each, the opposite pair
 _EDGE_PAIRS = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
@@ -177,12 +177,17 @@ class TetComplex:
 
     @property
     def star1(self) -> np.ndarray:
-        """(nE,) positive diagonal ⋆1: summed FEM weights clamped to ≥ 1e-3 × their positive median."""
+        """(nE,) positive diagonal ⋆1: summed FEM weights clamped to [1e-3, 1e3] × their positive median.
+
+        The lower clamp makes ⋆1 positive (notes 2(b).3); the upper one bounds the conditioning of the face
+        Laplacian ``d1 ⋆1⁻¹ d1ᵀ``, which sliver tets (dihedral angles near 0 or π) would otherwise ruin.  Any
+        positive diagonal keeps the Hodge decomposition exact.
+        """
         if self._star1 is None:
             w = np.bincount(self.tet_edges.ravel(), self.fem_tet_weights().ravel(), minlength=self.n_edges)
             pos = w[w > 0]
-            floor = 1e-3 * (np.median(pos) if pos.size else 1.0)
-            self._star1 = np.maximum(w, floor)
+            med = np.median(pos) if pos.size else 1.0
+            self._star1 = np.clip(w, 1e-3 * med, 1e3 * med)
         return self._star1
 
     @property
@@ -293,10 +298,100 @@ class TetComplex:
         return u, {"c": c, "omega": omega, "u0": u0 - off, "excluded": excluded}
 
 
+    def hodge(self):
+        """A :class:`gsdf.dec.hodge.HodgeDecomposition` of 1-forms on this complex (⋆1 = clamped FEM weights)."""
+        from .hodge import HodgeDecomposition
+        return HodgeDecomposition(self.d0, self.d1, self.star1, self.star0, self.star2)
+
+    def face_areas(self) -> np.ndarray:
+        """(nF,) triangle areas."""
+        V, Fc = self.V, self.faces
+        return 0.5 * np.linalg.norm(np.cross(V[Fc[:, 1]] - V[Fc[:, 0]], V[Fc[:, 2]] - V[Fc[:, 0]]), axis=1)
+
+
+def correction_chain(K: TetComplex, gamma, eps_start: float = 1.0, eps_end: float = 1e-2, eps_factor: float = 4.0,
+                     max_iter: int = 30, tol: float = 1e-4) -> tuple[np.ndarray, dict]:
+    """The L0 correction chain Λ of a harmonic 1-form γ (seed 003 §4.2.2, Eqs. 7–9, notes 2(b).2).
+
+    A per-tet potential ``v^T = vInit^T + σ_T`` integrates γ: ``vInit`` along the edges from the tet's first
+    vertex (exact inside one tet, as γ is closed), the per-tet constant σ is free.  Across an interior face f
+    from ``t0 = face_tets[f, 0]`` (the face points out of it) to ``t1`` the potential jumps by
+    ``Λ_f = d_f + σ_t1 − σ_t0`` with ``d_f = vInit^t1_a − vInit^t0_a`` at a shared vertex a, so ``D σ = γ``
+    holds by construction.  ``Σ_f |f| |Λ_f|⁰`` is minimised by IRLS: weighted dual-graph Laplacian solves of
+    ``Σ_f |f| w_f Λ_f²`` with ``w_f = ε² / (ε² + Λ_f²)``, ε decreasing from ``eps_start`` to ``eps_end``, until
+    ``max |Δσ| < tol`` or ``max_iter`` solves (one tet fixed: σ_0 = 0).
+
+    Parameters
+    ----------
+    K : TetComplex; gamma : (nE,) closed 1-form (the harmonic part of a Darboux derivative).
+
+    Returns
+    -------
+    Lam : (nF,) float — jump of the potential along each face's canonical normal (0 on hull faces);
+    info : dict with ``sigma`` (nT,), ``iterations``, ``d`` (nF,).
+
+    Subtracting the potential from the winding field changes the face chain G to ``G + Λ`` (a drop by G along
+    the normal becomes a drop by G + Λ), whose Darboux derivative has no harmonic part.
+    """
+    import scipy.sparse.linalg as spla
+
+    gamma = np.asarray(gamma, dtype=np.float64)
+    if gamma.shape != (K.n_edges,) or not np.isfinite(gamma).all():
+        raise ValueError(f"gamma: expected a finite array of shape ({K.n_edges},), got {gamma.shape}")
+    T = K.T
+    vinit = np.zeros((K.n_tets, 4))
+    for k in (1, 2, 3):  # edges (0,1), (0,2), (0,3) are tet_edges[:, 0..2]
+        g = gamma[K.tet_edges[:, k - 1]]
+        vinit[:, k] = np.where(T[:, 0] < T[:, k], g, -g)
+    ft = K.face_tets
+    interior = np.flatnonzero((ft >= 0).all(axis=1))
+    t0, t1 = ft[interior, 0], ft[interior, 1]
+    a = K.faces[interior, 0]
+    k0 = np.argmax(T[t0] == a[:, None], axis=1)
+    k1 = np.argmax(T[t1] == a[:, None], axis=1)
+    d = vinit[t1, k1] - vinit[t0, k0]
+    area = K.face_areas()[interior]
+    area = area / max(area.mean(), 1e-300)
+    nI = len(interior)
+    B = sp.csr_matrix((np.concatenate([np.ones(nI), -np.ones(nI)]),
+                       (np.concatenate([np.arange(nI)] * 2), np.concatenate([t1, t0]))), shape=(nI, K.n_tets))
+    sigma = np.zeros(K.n_tets)
+    wf = np.ones(nI)
+    eps = eps_start
+    it = 0
+    for it in range(1, max_iter + 1):
+        W = sp.diags(area * wf)
+        A = (B.T @ W @ B).tocsc()[1:, 1:]
+        rhs = -(B.T @ (area * wf * d))[1:]
+        new = np.zeros(K.n_tets)
+        if A.shape[0] <= 60000:
+            new[1:] = spla.spsolve(A, rhs)
+        else:  # pragma: no cover - large complexes: Jacobi CG
+            new[1:] = spla.cg(A, rhs, rtol=1e-10, maxiter=5000, M=sp.diags(1.0 / A.diagonal()))[0]
+        change = np.abs(new - sigma).max()
+        sigma = new
+        lam = d + B @ sigma
+        wf = eps * eps / (eps * eps + lam * lam)
+        if change < tol and eps <= eps_end:
+            break
+        eps = max(eps / eps_factor, eps_end)
+    Lam = np.zeros(K.n_faces)
+    Lam[interior] = d + B @ sigma
+    return Lam, {"sigma": sigma, "iterations": it, "d": np.concatenate([d])}
+
+
 def chain_boundary_vertices(K: TetComplex, G) -> np.ndarray:
-    """(nV,) bool: vertices of edges where the boundary ``d1ᵀ G`` of the chain is nonzero."""
+    """(nV,) bool: vertices of interior edges where the boundary ``d1ᵀ G`` of the chain is nonzero.
+
+    Boundary edges of the chain that lie on the hull of the complex do not make a star walk path dependent
+    (the star of a hull vertex is a half-ball, cut by the chain into pieces), so they are not counted.
+    """
     b = K.d1.T @ np.asarray(G, dtype=np.float64)
-    bad = np.abs(b) > 1e-9
+    hull_f = (K.face_tets < 0).any(axis=1)
+    on_hull = np.zeros(K.n_edges, dtype=bool)
+    if hull_f.any():
+        on_hull[np.unique(np.abs(K.d1[np.flatnonzero(hull_f)]).indices)] = True
+    bad = (np.abs(b) > 1e-9) & ~on_hull
     out = np.zeros(K.n_vertices, dtype=bool)
     out[K.edges[bad].ravel()] = True
     return out

@@ -33,7 +33,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
 from .._checks import as_normals, as_points, choice, integer
-from ..dec.tet import TetComplex
+from ..dec.tet import TetComplex, correction_chain
 from .grow import grow_regions, region_boundary
 from .orient import face_chain, orient_normals
 from .steiner import octree_steiner_points
@@ -106,7 +106,7 @@ def _solver(A, b):
 
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
-                                 band: float = 4.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 hodge: bool = False, band: float = 4.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -120,6 +120,10 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         §6.1) and output one sphere per cluster (vertex-disjoint); False: exactly one sphere.
     max_iterations : int ≥ 1 — alternation rounds (the paper reports 1–4).
     steiner : bool — add the octree Steiner points (recommended; without them the outside has few tets).
+    hodge : bool — run the Hodge decomposition of the Darboux derivative and the IRLS L0 correction chain of
+        §4.2 (costly: it factorizes the face Laplacian).  On the Delaunay tetrahedralisation used here (a ball)
+        the harmonic part is zero up to solver tolerance (reported as ``gamma_ratio``), so the correction is the
+        identity and the default skips it.
     band : float — F0 lies within ``band`` × median spacing of the inliers (:func:`.orient.face_chain`).
     outlier_gap : float — in the alternation, points farther than this × median spacing from the output are
         judged outliers for the next round.
@@ -217,7 +221,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     use = np.ones(n_p, dtype=bool)
     f0_sizes, inlier_counts, rejected_hist = [], [], []
     timings["core"] = timings["grow"] = timings["alternation"] = 0.0
-    label = G = best = None
+    label = G = best = H = None
+    gamma_ratios = []
     rounds = max_iterations if outliers == "auto" else 1
     for it in range(rounds):
         t = time.perf_counter()
@@ -228,6 +233,16 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         if f0_sizes[-1] == 0:
             raise ValueError("P: no candidate surface faces (the cloud is too sparse or too noisy for a surface)")
         u, info = K.jump_laplace(G, solver=_solver)
+        if hodge:
+            # §4.2: harmonic part of the Darboux derivative, and the L0 correction chain that removes it
+            say(f"Hodge decomposition (round {it + 1})")
+            H = H or K.hodge()
+            gamma = H.decompose(info["omega"]).harmonic
+            ratio = float(np.linalg.norm(gamma) / max(np.linalg.norm(info["omega"]), 1e-300))
+            gamma_ratios.append(ratio)
+            if ratio > 1e-6:
+                Lam, _ = correction_chain(K, gamma)
+                u, info = K.jump_laplace(G + Lam, solver=_solver)
         w = u.mean(axis=1)
         timings["core"] += time.perf_counter() - t
         t = time.perf_counter()
@@ -271,7 +286,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     dup = np.ones(n_in, dtype=bool)
     dup[keep] = False
     report = {
-        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "rejected_non_simple": rejected_hist,
+        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "rejected_non_simple": rejected_hist,
         "outliers": outlier_mask & ~dup, "prefiltered": int((~inl).sum()), "duplicates": int(dup.sum()),
         "n_steiner": int(len(S)), "n_tets": int(K.n_tets), "n_regions": int(n_regions),
         "region_tets": int((label >= 0).sum()), "timings": timings,
