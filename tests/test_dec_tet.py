@@ -14,20 +14,31 @@ def _ball(n=300, seed=0):
     return TetComplex(P, Delaunay(P).simplices)
 
 
-def _solid_torus(seed=1):
-    rng = np.random.default_rng(seed)
-    # a jittered grid filling a solid torus (R = 1, r = 0.45), Delaunay, tets with centroid outside removed
-    g = np.linspace(-1.5, 1.5, 17)
-    X = np.stack(np.meshgrid(g, g, np.linspace(-0.5, 0.5, 7), indexing="ij"), -1).reshape(-1, 3)
-    X = X + rng.uniform(-0.02, 0.02, X.shape)
-    inside = lambda Y: np.hypot(np.hypot(Y[:, 0], Y[:, 1]) - 1.0, Y[:, 2]) < 0.45  # noqa: E731
-    X = X[inside(X)]
-    T = Delaunay(X).simplices
-    T = T[inside(X[T].mean(axis=1))]
+def _solid_torus(n=6, hole=2, nz=2):
+    """A solid torus: an n×n×nz block of unit cubes minus a central hole×hole column, each cube cut into the
+    6 Kuhn tets along its main diagonal (consistent across cubes, so the complex is a manifold)."""
+    g = np.arange(n + 1)
+    V = np.stack(np.meshgrid(g, g, np.arange(nz + 1), indexing="ij"), -1).reshape(-1, 3).astype(float)
+    vid = lambda x, y, z: (x * (n + 1) + y) * (nz + 1) + z  # noqa: E731
+    lo = (n - hole) // 2
+    cubes = np.array([(x, y, z) for x in range(n) for y in range(n) for z in range(nz)
+                      if not (lo <= x < lo + hole and lo <= y < lo + hole)])
+    import itertools
+    T = []
+    for perm in itertools.permutations(range(3)):
+        path = [np.zeros(3, dtype=int)]
+        for ax in perm:
+            step = path[-1].copy()
+            step[ax] += 1
+            path.append(step)
+        T.append(np.stack([vid(*(cubes + p).T) for p in path], axis=1))
+    T = np.concatenate(T)
     used = np.unique(T)
-    remap = -np.ones(len(X), dtype=np.int64)
+    remap = -np.ones(len(V), dtype=np.int64)
     remap[used] = np.arange(len(used))
-    return TetComplex(X[used], remap[T])
+    c = (n / 2.0, n / 2.0, nz / 2.0)
+    Vw = (V[used] - c) * 0.2 + np.random.default_rng(1).uniform(-0.01, 0.01, (len(used), 3))
+    return TetComplex(Vw, remap[T])
 
 
 def _harmonic_dim(K):
@@ -164,7 +175,7 @@ def test_bad_chain():
 def _disk_chain(K):
     """The meridian disk {φ = 0, x > 0} of the solid torus as an oriented face chain."""
     c = K.V[K.T].mean(axis=1)
-    lab = np.arctan2(c[:, 1], c[:, 0]) > 0
+    lab = np.arctan2(c[:, 1] + 1e-3, c[:, 0]) > 0
     ft = K.face_tets
     l0, l1 = lab[np.maximum(ft[:, 0], 0)], lab[np.maximum(ft[:, 1], 0)]
     fc = K.V[K.faces].mean(axis=1)
