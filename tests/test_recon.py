@@ -206,3 +206,14 @@ def test_tiny_valid_inputs_still_give_a_sphere():
     for P in (np.eye(4)[:, :3], cube()[0], uv_sphere(6, 8)[0]):
         V, F = gsdf.reconstruct_simply_connected(P, outliers="none")
         assert is_sphere(V, F)
+
+
+def test_comparison_reconstructions_report_topology():
+    from gsdf.recon.compare import reconstruct_winding
+    P = np.concatenate([_sphere(1200), _sphere(600, 3, r=0.3, c=(2.0, 0, 0))])
+    V, F, rep = reconstruct_winding(P, resolution=32, return_report=True)
+    # two separate blobs: the level set has two components, and the report says so (no promise there)
+    assert rep["components"] == 2 and rep["genus"] == [0, 0] and rep["manifold"]
+    assert mesh_topology(V, F)["components"] == 2
+    with pytest.raises(ValueError, match="resolution"):
+        reconstruct_winding(P, resolution=True)

@@ -129,7 +129,7 @@ def _solver(A, b):
 
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
-                                 hodge: bool = False, band: float = 4.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 hodge: bool = False, project: bool = True, band: float = 4.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -147,6 +147,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         §4.2 (costly: it factorizes the face Laplacian).  On the Delaunay tetrahedralisation used here (a ball)
         the harmonic part is zero up to solver tolerance (reported as ``gamma_ratio``), so the correction is the
         identity and the default skips it.
+    project : bool — move the Steiner vertices of the output onto the tangent planes of their nearest inliers
+        (vertex positions only; the mesh's combinatorics and topology are those of the grown ball).
     band : float — F0 lies within ``band`` × median spacing of the inliers (:func:`.orient.face_chain`).
     outlier_gap : float — in the alternation, points farther than this × median spacing from the output are
         judged outliers for the next round.
@@ -304,7 +306,21 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     used = np.unique(Fout)
     remap = -np.ones(K.n_vertices, dtype=np.int64)
     remap[used] = np.arange(len(used))
-    Vout = K.V[used] * scale + centre
+    Vn = K.V[used].copy()
+    if project:
+        # geometry only (the combinatorics, hence the topology, is untouched): Steiner vertices of the output
+        # move onto the mean tangent plane of their 3 nearest inliers, removing the staircase through the
+        # Steiner grid
+        st = used >= n_p
+        if st.any():
+            _, I = cKDTree(Xi[use]).query(Vn[st], k=min(3, int(use.sum())))
+            I = I.reshape(int(st.sum()), -1)
+            Pn, Nn = Xi[use][I], Ni[use][I]
+            off = np.einsum("qkx,qkx->qk", Nn, Vn[st][:, None, :] - Pn).mean(axis=1)
+            nrm = Nn.mean(axis=1)
+            nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
+            Vn[st] = Vn[st] - off[:, None] * nrm
+    Vout = Vn * scale + centre
     Fout = remap[Fout]
     # exact input coordinates for input vertices
     orig_rows = keep[np.flatnonzero(inl)]
