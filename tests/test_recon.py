@@ -217,3 +217,21 @@ def test_comparison_reconstructions_report_topology():
     assert mesh_topology(V, F)["components"] == 2
     with pytest.raises(ValueError, match="resolution"):
         reconstruct_winding(P, resolution=True)
+
+
+def test_cli_reconstruct(tmp_path):
+    from click.testing import CliRunner
+
+    from gsdf.cli.main import main
+    cloud = tmp_path / "s.xyz"
+    np.savetxt(cloud, _sphere(1500))
+    out, png = tmp_path / "o" / "s.ply", tmp_path / "s.png"
+    r = CliRunner().invoke(main, ["reconstruct", str(cloud), "-o", str(out), "--png", str(png), "-q"])
+    assert r.exit_code == 0, r.output
+    assert "components 1, genus [0], closed manifold" in r.output
+    V, F = gsdf.read_mesh(str(out))
+    assert is_sphere(V, F) and png.stat().st_size > 1000
+    bad = CliRunner().invoke(main, ["reconstruct", str(cloud), "-o", str(tmp_path / "x.txt")])
+    assert bad.exit_code == 1 and "extension" in bad.output
+    missing = CliRunner().invoke(main, ["reconstruct", str(tmp_path / "nope.xyz"), "-o", str(out)])
+    assert missing.exit_code != 0
