@@ -40,6 +40,8 @@ _EXPORTS = {
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
     "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
     "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "tori",
+    # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
+    "reconstruct_simply_connected": "recon", "mesh_topology": "recon",
 }
 
 __all__ = sorted(_EXPORTS)

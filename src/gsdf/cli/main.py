@@ -9,6 +9,7 @@ from .boolean import boolean
 from .demo import demo
 from .heat import heat
 from .heat_surface import heat_surface
+from .reconstruct import reconstruct
 from .render import render
 from .sdf import sdf
 from .slice import slice_cmd
@@ -34,7 +35,7 @@ def main():
     """
 
 
-for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn):
+for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn, reconstruct):
     main.add_command(command)
 
 if __name__ == "__main__":  # pragma: no cover

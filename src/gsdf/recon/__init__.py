@@ -1,0 +1,12 @@
+"""Guaranteed simply connected reconstruction (Chen, Li & Huang 2026, seed 003) and comparison reconstructions.
+
+Modules: :mod:`.pipeline` (``reconstruct_simply_connected``), :mod:`.steiner` (octree Steiner points),
+:mod:`.orient` (normal orientation and the face chain F0), :mod:`.grow` (the guarantee layer: simple-tet
+region growing), :mod:`.topology` (closed / manifold / χ / genus checks), :mod:`.compare` (winding-number,
+signed-heat and Points-as-Tori reconstructions on the same API shape).
+"""
+
+from .pipeline import reconstruct_simply_connected
+from .topology import is_sphere, mesh_topology
+
+__all__ = ["reconstruct_simply_connected", "mesh_topology", "is_sphere"]
