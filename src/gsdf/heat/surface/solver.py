@@ -8,43 +8,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from ... import _checks
-from ...linalg import Factorization, HermitianFactorization, cached_factorization, saddle_matrix
+from ...linalg import BlockHermitianFactorization, Factorization, HermitianFactorization, cached_factorization, saddle_matrix
 from .operators import TriangleMeshOperators
 from .sources import build_sources
 
 LEVEL_SETS = ("zero", "multiple", "none")
 CONNECTIONS = ("auto", "complex", "real")
-
-
-class _RealBlockFactorization:
-    """Factorization of the real 2|E|×2|E| vector heat operator ``M ⊗ I₂ + t L∇`` (2×2 blocks, any orientation);
-    ``solve`` takes and returns complex edge vectors (reference-face coordinates)."""
-
-    def __init__(self, A):
-        A = sp.csr_matrix(A)
-        A.sum_duplicates()
-        self.n = A.shape[0] // 2
-        self._chol = None
-        try:
-            from cholespy import CholeskySolverD, MatrixType
-        except ImportError:
-            self._lu = Factorization(A.tocsc())
-            self.backend = "superlu"
-        else:
-            self._chol = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32), A.indices.astype(np.int32),
-                                         np.ascontiguousarray(A.data, dtype=np.float64), MatrixType.CSR)
-            self.backend = "cholmod"
-
-    def solve(self, b):
-        b = np.asarray(b, np.complex128)
-        r = np.empty(2 * self.n)
-        r[0::2], r[1::2] = b.real, b.imag
-        if self._chol is not None:
-            x = np.zeros_like(r)
-            self._chol.solve(r, x)
-        else:
-            x = self._lu.solve(r)
-        return x[0::2] + 1j * x[1::2]
 
 
 class SurfaceSignedHeatSolver:
@@ -177,7 +146,7 @@ class SurfaceSignedHeatSolver:
             if self.connection == "real" or (self.connection == "auto" and not self.ops.consistent):
                 M = self.ops.cr_mass().diagonal()
                 A = sp.diags(np.repeat(M, 2)) + self.t * self.ops.cr_connection_laplacian_real()
-                self._vec = _RealBlockFactorization(A)
+                self._vec = BlockHermitianFactorization(A)
             else:
                 A = self.ops.cr_mass() + self.t * self.ops.cr_connection_laplacian()
                 self._vec = HermitianFactorization(A)
