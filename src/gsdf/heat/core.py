@@ -205,31 +205,46 @@ class SignedHeatCore:
     poisson : PoissonSolver — the domain's own, or :class:`FactorizedPoisson` of its Laplacian.
     """
 
+    MAX_STATES = 4
+
     def __init__(self, domain):
         self.domain = domain
-        self._vec = None
-        self._poisson = None
+        self._states: dict = {}
+
+    def _state(self) -> dict:
+        """Factorizations of the domain's current operators (domains that switch triangulations, like the
+        intrinsic one, expose ``state_key``; a few states are kept)."""
+        key = getattr(self.domain, "state_key", None)
+        st = self._states.get(key)
+        if st is None:
+            if len(self._states) >= self.MAX_STATES:
+                self._states.pop(next(iter(self._states)))
+            st = self._states[key] = {"vec": None, "poisson": None}
+        return st
 
     # ------------------------------------------------------------------ steps
     @property
     def vector_heat_factorization(self):
         """The factorization of ``M + t L∇`` (Eq. 12), built on first use."""
-        if self._vec is None:
+        st = self._state()
+        if st["vec"] is None:
             form = self.domain.heat_form
             if form == "complex":
-                self._vec = HermitianFactorization(self.domain.vector_heat_matrix())
+                st["vec"] = HermitianFactorization(self.domain.vector_heat_matrix())
             elif form == "real2":
-                self._vec = BlockHermitianFactorization(self.domain.vector_heat_matrix())
+                st["vec"] = BlockHermitianFactorization(self.domain.vector_heat_matrix())
             else:
                 raise ValueError(f"domain: heat_form {form!r} has no vector heat operator")
-        return self._vec
+        return st["vec"]
 
     @property
     def poisson(self) -> PoissonSolver:
-        if self._poisson is None:
-            self._poisson = self.domain.poisson_solver() or FactorizedPoisson(self.domain.laplacian(),
+        """The domain's Step III solver (its own, or :class:`FactorizedPoisson` of its Laplacian)."""
+        st = self._state()
+        if st["poisson"] is None:
+            st["poisson"] = self.domain.poisson_solver() or FactorizedPoisson(self.domain.laplacian(),
                                                                               self.domain.mass())
-        return self._poisson
+        return st["poisson"]
 
     def diffuse(self, S: Sources) -> np.ndarray:
         """Step I."""
@@ -292,9 +307,10 @@ class SignedHeatCore:
             return P.penalized(A, w, b), True
         if mode == "zero":
             A, vert = self.domain.zero_rows(S)
+            again = getattr(self.domain, "shift_hard_zero", True)
             if len(vert) and np.all(vert >= 0):
-                return P.dirichlet(vert, b), False
-            return P.constrained(unique_rows(A), b, "zero"), False
+                return P.dirichlet(vert, b), again
+            return P.constrained(unique_rows(A), b, "zero"), again
         A = self.difference_rows(S, single=False)
         if A.shape[0] == 0:
             return P.free(b), True

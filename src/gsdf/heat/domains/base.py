@@ -79,6 +79,7 @@ class HeatDomain:
     t: float = 1.0
     heat_form: str = "complex"
     difference_order: str = "first"
+    shift_hard_zero: bool = True        # apply the shift of Alg. 13 after a hard "zero" constraint too
 
     # ---- sources
     def assemble_sources(self, curves: list, points: list, **options) -> Sources:
