@@ -22,3 +22,100 @@ def test_surface_core_matches_pre_core_solvers(name, build, curves, kw):
     ref = REF[name]
     scale = max(1.0, float(np.abs(ref).max()))
     assert np.abs(phi - ref).max() <= 1e-8 * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
+
+
+# ------------------------------------------------------------------------------------------ typed sources
+def _grid_solver():
+    from gsdf.heat import SurfaceSignedHeatSolver
+    from gsdf.heat.surface.curves import region_boundary_curves
+    from gsdf.heat.surface.meshes import grid_mesh
+
+    V, F = grid_mesh(12)
+    inside = (np.abs(V[F][:, :, :2]) <= 0.5 + 1e-9).all(axis=(1, 2))
+    (loop,) = region_boundary_curves(F, inside)
+    return SurfaceSignedHeatSolver(V, F), loop
+
+
+def test_curve_is_exported_and_equals_raw_arrays():
+    import gsdf
+
+    solver, loop = _grid_solver()
+    raw = solver.compute_distance([loop])
+    np.testing.assert_array_equal(solver.compute_distance([gsdf.Curve(loop)]), raw)
+    np.testing.assert_array_equal(solver.compute_distance(gsdf.Curve(loop)), raw)       # one curve alone
+    edges = np.stack([loop[:-1], loop[1:]], 1)[::-1]                                    # shuffled edge set
+    np.testing.assert_allclose(solver.compute_distance([gsdf.Curve(edges)]), raw, atol=1e-12)
+    uns = solver.compute_distance([loop], curve_signs=[False])
+    np.testing.assert_array_equal(solver.compute_distance([gsdf.Curve(loop, signed=False)]), uns)
+    assert uns.min() > -1e-9 and raw.min() < -0.3                                       # unsigned vs signed
+
+
+def test_points_and_curve_signs_are_keyword_only():
+    solver, loop = _grid_solver()
+    with pytest.raises(TypeError):
+        solver.compute_distance([loop], [True])            # potpourri3d's curve_signs position: refused
+
+
+@pytest.mark.parametrize("kw,match", [
+    (dict(points=[True]), r"points\[0\]"),
+    (dict(points=np.array([True, False])), "points"),
+    (dict(points=[1.5]), r"points\[0\]"),
+    (dict(points=["3"]), r"points\[0\]"),
+    (dict(curve_signs=[1.0]), r"curve_signs\[0\]"),
+    (dict(curve_signs=["yes"]), r"curve_signs\[0\]"),
+    (dict(curve_signs=[True, False]), "curve_signs"),
+])
+def test_bad_source_types_name_the_argument(kw, match):
+    solver, loop = _grid_solver()
+    with pytest.raises(ValueError, match=match):
+        solver.compute_distance([loop], **kw)
+
+
+def test_bad_curves_name_the_argument():
+    import gsdf
+
+    solver, loop = _grid_solver()
+    for bad, match in [([np.array([True, False, True])], r"curves\[0\]"), ([True, False], r"curves\[0\]"),
+                       ([[0.5, 1.5]], r"curves\[0\]"), ([loop, 7], r"curves\[1\]"), ("abc", "curves"),
+                       ([np.array([0, 10_000])], r"curves\[0\]")]:
+        with pytest.raises(ValueError, match=match):
+            solver.compute_distance(bad)
+    with pytest.raises(ValueError, match="signed"):
+        gsdf.Curve(loop, signed=1)
+    with pytest.raises(ValueError, match="contradicts"):
+        solver.compute_distance([gsdf.Curve(loop)], curve_signs=[False])
+
+
+def test_every_front_end_takes_curve_and_rejects_bools():
+    import gsdf
+
+    n = 8
+    x = np.linspace(-1, 1, n + 1)
+    V = np.array([[a, b, 0.0] for a in x for b in x])
+    i = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    Q = np.stack([i[:-1, :-1].ravel(), i[1:, :-1].ravel(), i[1:, 1:].ravel(), i[:-1, 1:].ravel()], 1)
+    loop = np.concatenate([i[2, 2:6], i[2:6, 6], i[6, 6:2:-1], i[6:1:-1, 2]])
+    s = gsdf.PolygonMeshSignedHeatSolver(V, Q)
+    np.testing.assert_array_equal(s.compute_distance([gsdf.Curve(loop)]), s.compute_distance([loop]))
+    with pytest.raises(ValueError, match=r"points\[0\]"):
+        s.compute_distance([loop], points=[True])
+    with pytest.raises(ValueError, match=r"curves\[0\]"):
+        s.compute_distance([gsdf.Curve([(0, np.array([1.0, 0, 0])), (1, np.array([1.0, 0, 0]))])])
+
+
+def test_chain_edges():
+    from gsdf.heat.sources import chain_edges
+
+    assert [p.tolist() for p in chain_edges(np.array([[2, 3], [0, 1], [1, 2]]))] == [[0, 1, 2, 3]]
+    loops = chain_edges(np.array([[0, 1], [1, 2], [2, 0], [5, 6]]))
+    assert sorted(len(p) for p in loops) == [2, 4] and any(p[0] == p[-1] for p in loops)
+    und = chain_edges(np.array([[1, 0], [1, 2]]), directed=False)
+    assert len(und) == 1 and sorted(und[0].tolist()) == [0, 1, 2]
+
+
+def test_core_progress_signature():
+    solver, loop = _grid_solver()
+    seen = []
+    solver.compute_distance([loop], progress=lambda stage, fraction: seen.append((stage, fraction)))
+    assert ("heat (step I)", 1.0) in seen and ("poisson (step III)", 1.0) in seen
+    assert all(0.0 <= f <= 1.0 for _, f in seen)
