@@ -119,3 +119,58 @@ def test_core_progress_signature():
     solver.compute_distance([loop], progress=lambda stage, fraction: seen.append((stage, fraction)))
     assert ("heat (step I)", 1.0) in seen and ("poisson (step III)", 1.0) in seen
     assert all(0.0 <= f <= 1.0 for _, f in seen)
+
+
+# ------------------------------------------------------------------------------------------ volumes
+# old default "zero" on grids was the soft penalty (weight 10); "zero" is now hard and soft_weight= the penalty
+_NEW_SPELLING = {"grid_mesh_soft": dict(soft_weight=10.0),
+                 "grid_mesh_exact": dict(level_set_constraint="zero")}
+VOLUME = volume_cases()
+
+
+@pytest.mark.parametrize("name,kw", VOLUME, ids=[c[0] for c in VOLUME])
+def test_volume_core_matches_pre_core_solvers(name, kw):
+    from gsdf.heat.volume import signed_heat_volume
+
+    kw = dict(kw)
+    if name in _NEW_SPELLING:
+        kw.pop("constraint", None)
+        kw.update(_NEW_SPELLING[name])
+    phi = np.asarray(signed_heat_volume(**kw).values).ravel()
+    ref = REF[name]
+    scale = max(1.0, float(np.abs(ref).max()))
+    assert np.abs(phi - ref).max() <= 1e-8 * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
+
+
+def test_grid_multiple_and_hard_zero():
+    """Two disjoint spheres: "multiple" makes φ one constant per sphere (cell rows), "zero" makes it 0 on both,
+    the soft penalty only nearly; inside is negative in every case."""
+    from gsdf.heat.volume import signed_heat_volume
+    from gsdf.heat.volume.grid import cell_constraint_matrix
+
+    from shapes import uv_sphere
+
+    V, F = uv_sphere(10, 20, radius=0.5)
+    V2 = np.concatenate([V - [0.8, 0, 0], V + [0.8, 0, 0]])
+    F2 = np.concatenate([F, F + len(V)])
+    kw = dict(mesh=(V2, F2), resolution=(20, 12, 12), bbox_min=[-1.5, -0.7, -0.7], bbox_max=[1.5, 0.7, 0.7])
+    fields = {m: signed_heat_volume(level_set_constraint=m, **kw) for m in ("zero", "multiple")}
+    fields["soft"] = signed_heat_volume(soft_weight=10.0, **kw)
+    T = V2[F2]
+    B = T.mean(axis=1)
+    a = 0.5 * np.linalg.norm(np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]), axis=1)
+    side = B[:, 0] > 0
+    for name, f in fields.items():
+        assert f([[-0.8, 0, 0]])[0] < -0.3 and f([[0.8, 0, 0]])[0] < -0.3, name
+        assert f([[0, 0.65, 0]])[0] > 0.05, name
+    lo, sp_ = fields["zero"].bbox_min, fields["zero"].spacing
+    for s in (side, ~side):
+        C, _ = cell_constraint_matrix(B[s], a[s], lo, sp_, fields["zero"].shape)
+        z = C @ fields["zero"].values.ravel()
+        m = C @ fields["multiple"].values.ravel()
+        soft = C @ fields["soft"].values.ravel()
+        h = float(sp_.max())
+        assert np.abs(z).max() < 1e-3 * h                     # hard: zero on every cell row
+        assert np.ptp(m) < 1e-3 * h                           # multiple: one constant per component
+        assert np.ptp(soft) > 10 * np.ptp(m)                  # the penalty only pulls
+    assert fields["multiple"].meta["constraint_rows"] > 0

@@ -21,7 +21,7 @@ never normalizes vectors. The core calls, in order:
    :class:`PoissonSolver` from ``poisson_solver()``; otherwise None and the core factorizes.
 
 Optional hooks (defaults here): ``zero_rows(S)`` — the rows of the hard ``"zero"`` constraint (default: every
-source node); ``soft_rows(S, mode)`` — rows and weights of the ``soft_weight=`` penalty (default: differences
+source node); ``soft_rows(S, mode, lam)`` — rows and weights of the ``soft_weight=`` penalty (default: differences
 φ(p_i) − φ(p_0) over all nodes, or per connected curve for ``"multiple"``); ``difference_order`` — which node is
 p_0 (``"first"``: the first node given; ``"sorted"``: the lowest vertex index).
 
@@ -64,8 +64,10 @@ class PoissonSolver:
     def dirichlet(self, fixed, b):              # L φ = b on the other nodes, φ = 0 on the node indices ``fixed``
         raise NotImplementedError
 
-    def constrained(self, A, b, tag):           # min ½φᵀLφ − bᵀφ subject to A φ = 0 (Eq. 14)
+    def constrained(self, A, b, tag, weights=None):   # min ½φᵀLφ − bᵀφ subject to A φ = 0 (Eq. 14)
         raise NotImplementedError
+
+    # optional: merged(groups, b) — "multiple" for vertex sources by substitution (one unknown per group)
 
     def penalized(self, A, w, b):               # (L + Aᵀ diag(w) A) φ = b
         raise NotImplementedError
@@ -113,11 +115,13 @@ class HeatDomain:
 
     # ---- constraint rows (defaults)
     def zero_rows(self, S: Sources):
-        """Rows of the hard "zero" constraint and, for one-hot rows, their vertices (-1 otherwise)."""
+        """Rows of the hard "zero" constraint and, for one-hot rows, their vertices (-1 otherwise); a domain may
+        return a third entry, per-row weights, to have its rows used as they are (the grid's cell rows)."""
         return S.all_rows()
 
-    def soft_rows(self, S: Sources, mode: str):
-        """Rows A and weights w of the soft penalty Σ w (A φ)²; None: the core's difference rows."""
+    def soft_rows(self, S: Sources, mode: str, lam: float):
+        """Rows A and weights w (λ included) of the soft penalty Σ w (A φ)²; None: the core's difference rows
+        with weight λ."""
         return None
 
 
