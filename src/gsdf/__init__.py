@@ -16,6 +16,8 @@ _EXPORTS = {
     "FastWindingNumber": "winding", "ExactWindingNumber": "winding", "FastWindingNumberPoints": "winding",
     "fast_winding_number": "winding", "fast_winding_number_points": "winding",
     "point_areas": "winding.point_areas", "estimate_normals": "winding.point_areas",
+    # surface winding numbers (thesis ch. 6)
+    "SurfaceWindingNumbers": "winding.surface", "surface_winding_number": "winding.surface",
     # distance
     "TriangleDistance": "distance", "PointCloudDistance": "distance", "unsigned_distance": "distance",
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",
