@@ -1,4 +1,5 @@
-"""The signed heat method on a regular grid (Feng & Crane 2024, §8.2).
+"""Operators and Poisson solvers of the grid signed-heat domain (Feng & Crane 2024, §8.2). The steps run in
+:mod:`gsdf.heat.core` over :class:`gsdf.heat.domains.grid.GridDomain`; ``solve_grid`` is in :mod:`.solve`.
 
 Step I   X_t(x) = Σ_f |f| N_f G_t(x, b_f), the Yukawa potential of the sources (the fundamental solution of
          id − tΔ, λ = 1/√t), by a tree walk (:mod:`.yukawa`) instead of the anchor's O(nodes × faces) sum.
@@ -8,11 +9,12 @@ Step III Δφ = ∇·Y with the seven-point Laplacian, Neumann boundary and forw
          edge's two nodes. Its normal equations are the 7-point graph Laplacian (natural Neumann boundary) against
          the forward-difference divergence of Y (the transpose of the forward-difference gradient).
 Level set: "none": φ is shifted so that its area-weighted mean over the source points is 0 (as the anchor
-         does). "zero" with ``constraint="soft"`` (default): the zero level set is pulled through the sources by a
-         penalty on the trilinear values φ(b_f), then the same shift. "zero" with ``constraint="exact"``: the
-         seed's constrained solve with trilinear rows (§8.2), one row per grid cell holding sources (the
-         area-weighted mean of their trilinear rows — one row per source would force φ ≡ 0 on every cell
-         crossed by a dense input), imposed exactly by the augmented Lagrangian (:func:`solve_constrained`).
+         does). ``soft_weight=c``: the zero level set is pulled through the sources by a penalty on the
+         trilinear values φ(b_f), then the same shift. "zero" (hard): the seed's constrained solve with
+         trilinear rows (§8.2), one row per grid cell holding sources (the area-weighted mean of their trilinear
+         rows — one row per source would force φ ≡ 0 on every cell crossed by a dense input), imposed exactly by
+         the augmented Lagrangian (:func:`solve_constrained`); "multiple": the same rows made equal per input
+         component.
 
 Linear algebra: the Neumann 7-point Laplacian on a box is diagonal in the DCT-II basis, so Step III is solved
 *exactly* by two fast cosine transforms, O(N log N) at every size (128³ in well under a second) — faster than

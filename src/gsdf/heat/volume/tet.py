@@ -1,4 +1,5 @@
-"""The signed heat method on tetrahedral meshes (Feng & Crane 2024, §8.1 and App. B).
+"""Meshing and operators of the tetrahedral signed-heat domain (Feng & Crane 2024, §8.1 and App. B). The steps
+run in :mod:`gsdf.heat.core` over :class:`gsdf.heat.domains.tet.TetDomain`; ``solve_tet`` is in :mod:`.solve`.
 
 Mesh (``mesher="delaunay"``, default, no extra dependency). The vertex set is
 
