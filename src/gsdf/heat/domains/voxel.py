@@ -29,7 +29,8 @@ Pipeline (notes wave2-swn-recon-voxel §3):
 7. **Sources**: a segment s of a curve (an edge or a quad diagonal) with length ℓ_s, unit tangent t̂_s and
    n_s the mean corrected normal of the quads containing it contributes ``(ℓ_s / 2) t̂_s × n_s`` (the tangent
    turned clockwise: left of the curve negative, gsdf's convention) to X⁰ at both its end vertices, projected
-   onto their tangent bases (§8.5). Points and unsigned curves: the vertex point sources of §8.3–8.4.
+   onto their tangent bases (§8.5). Points and unsigned curves (their vertices): per quad around the source
+   vertex the outward flux −|a_f|∇ψ_v of its hat function, shared by the other corners (App. A.1).
 8. **Steps**: (m + t L∇) X = X⁰ with ``t = t_coef · h²``, h the mean edge length; per quad
    ``Y_f = normalize((I − n_f n_fᵀ) Σ_{v∈f} X_v)``; ``b = Σ_f Dᵀ M_f V_f Y_f``; ``L φ = b`` with the level-set
    constraints of §7.1 (if Y = ∇φ then b = L φ exactly on planar faces).
@@ -296,6 +297,24 @@ class VoxelSurfaceDomain:
                 np.add.at(X0, v, z)
 
 
+    def point_source(self, ids: np.ndarray, X0: np.ndarray) -> None:
+        """Isolated vertex sources (App. A.1 on a vertex discretization): on every quad f around a source v the
+        outward flux vector ``−|a_f| ∇_f ψ_v`` of v's hat function ψ_v, shared by the quad's other three corners
+        (projected onto their tangent bases). It points away from v on each quad and sums to zero around v on a
+        flat umbrella (∮ ψ_v n ds = 0), so no net vector survives in the far field. (The Laplacian-row weights of
+        the polygon solver are unbalanced here: corrected quads at digital corners have positive off-diagonal
+        entries.)"""
+        if len(ids) == 0:
+            return
+        F, ops = self.faces, self.face_ops
+        f, k = np.nonzero(np.isin(F, ids))
+        vec = -ops.area[f, None] * ops.gradient[f, :, k] / 3.0
+        for o in (1, 2, 3):
+            j = F[f, (k + o) % 4]
+            z = np.einsum("kj,kj->k", vec, self.e1[j]) + 1j * np.einsum("kj,kj->k", vec, self.e2[j])
+            np.add.at(X0, j, z)
+
+
 class _DomainSteps(VertexSignedHeat):
     """The shared vertex-based steps I–III driven by a :class:`VoxelSurfaceDomain` (its curve source)."""
 
@@ -306,6 +325,9 @@ class _DomainSteps(VertexSignedHeat):
 
     def curve_source(self, curves, X0, normals=None):
         self.domain.curve_source(curves, X0)
+
+    def point_source(self, ids, X0):
+        self.domain.point_source(ids, X0)
 
 
 # --------------------------------------------------------------------------------------------- the solver
