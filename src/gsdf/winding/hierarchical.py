@@ -19,7 +19,7 @@ from numba import njit, prange
 from .._checks import as_mesh
 from ..spatial.bvh import build_bvh
 from ._query import map_queries
-from .exact import solid_angle_w
+from ._solid_angle import solid_angle_w
 
 
 @njit(cache=True)

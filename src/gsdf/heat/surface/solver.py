@@ -1,50 +1,24 @@
-"""The signed heat method on triangle meshes (Feng & Crane 2024, §3–7, Alg. 1–4)."""
+"""Front-end of the signed heat method on triangle meshes (Feng & Crane 2024, §3–7, Alg. 1–4).
+
+Operators and sources: :mod:`gsdf.heat.domains.triangle` (or :mod:`gsdf.heat.domains.intrinsic` with
+``intrinsic_delaunay=True``); steps I–III, constraints and shift: :mod:`gsdf.heat.core`. What stays here is the
+public class, L1 integration (§7.2), sharpening (§7.3) and curve splitting helpers.
+"""
 
 from __future__ import annotations
 
-import hashlib
-
 import numpy as np
-import scipy.sparse as sp
 
 from ... import _checks
-from ...linalg import Factorization, HermitianFactorization, cached_factorization, saddle_matrix
+from ..core import SignedHeatCore
+from ..domains.intrinsic import IntrinsicDomain
+from ..domains.triangle import TriangleDomain, raw_curves, raw_points
+from ..sources import as_curves, as_point_sources
 from .operators import TriangleMeshOperators
 from .sources import build_sources
 
 LEVEL_SETS = ("zero", "multiple", "none")
 CONNECTIONS = ("auto", "complex", "real")
-
-
-class _RealBlockFactorization:
-    """Factorization of the real 2|E|×2|E| vector heat operator ``M ⊗ I₂ + t L∇`` (2×2 blocks, any orientation);
-    ``solve`` takes and returns complex edge vectors (reference-face coordinates)."""
-
-    def __init__(self, A):
-        A = sp.csr_matrix(A)
-        A.sum_duplicates()
-        self.n = A.shape[0] // 2
-        self._chol = None
-        try:
-            from cholespy import CholeskySolverD, MatrixType
-        except ImportError:
-            self._lu = Factorization(A.tocsc())
-            self.backend = "superlu"
-        else:
-            self._chol = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32), A.indices.astype(np.int32),
-                                         np.ascontiguousarray(A.data, dtype=np.float64), MatrixType.CSR)
-            self.backend = "cholmod"
-
-    def solve(self, b):
-        b = np.asarray(b, np.complex128)
-        r = np.empty(2 * self.n)
-        r[0::2], r[1::2] = b.real, b.imag
-        if self._chol is not None:
-            x = np.zeros_like(r)
-            self._chol.solve(r, x)
-        else:
-            x = self._lu.solve(r)
-        return x[0::2] + 1j * x[1::2]
 
 
 class SurfaceSignedHeatSolver:
@@ -120,73 +94,34 @@ class SurfaceSignedHeatSolver:
         self.intrinsic_delaunay = bool(intrinsic_delaunay)
         self.input_ops = TriangleMeshOperators(V, F)
         self.t = self.t_coef * self.input_ops.h ** 2
-        self._states: dict = {}
-        self._state_key = None
-        if not self.intrinsic_delaunay:
-            self._set_ops(self.input_ops)
-        # with intrinsic_delaunay the triangulation is built on first use: by the first solve (with its curve
-        # edges kept unflippable), or without fixed edges when an operator is accessed before any solve
-
-    def __getattr__(self, name):
-        d = self.__dict__
-        if name in SurfaceSignedHeatSolver._STATE and d.get("intrinsic_delaunay") and d.get("_state_key") is None:
-            self._use_state(self._key(np.zeros((0, 2), np.int64)), None)
-            return getattr(self, name)
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-
-    _STATE = ("ops", "C", "_Mv", "_eps", "_vec", "_poisson", "_cache")
-
-    def _set_ops(self, ops):
-        self.ops = ops
-        self.C = self.ops.cotan_laplacian().tocsc()
-        Mv = self.ops.vertex_mass()
-        self._Mv = np.where(Mv > 0, Mv, Mv.mean())               # unreferenced vertices: keep the system regular
-        # tiny mass regularization fixes the constant of every mesh component (C is only semidefinite)
-        self._eps = 1e-10 * float(self.C.diagonal().mean()) / float(self._Mv.mean())
-        self._vec = None
-        self._poisson = None
-        self._cache: dict = {}
-
-    def _use_state(self, key, fixed_pairs):
-        """Switch to the intrinsic triangulation with the original edges ``fixed_pairs`` unflippable (built and
-        cached on first use, with its own factorizations)."""
-        if key == self._state_key:
-            return
-        if self._state_key is not None:
-            self._states[self._state_key] = tuple(getattr(self, a) for a in self._STATE)
-        if key in self._states:
-            for a, v in zip(self._STATE, self._states[key]):
-                setattr(self, a, v)
+        if self.intrinsic_delaunay:
+            # the triangulation is built on first use: by the first solve (with its curve edges kept
+            # unflippable), or without fixed edges when an operator is accessed before any solve
+            self.domain = IntrinsicDomain(V, F, t=self.t, connection=self.connection, input_ops=self.input_ops)
         else:
-            from .intrinsic import intrinsic_delaunay, layout
+            self.domain = TriangleDomain(t=self.t, connection=self.connection, ops=self.input_ops)
+        self.core = SignedHeatCore(self.domain)
 
-            Fi, L, nflips, log = intrinsic_delaunay(self.V, self.F, fixed_pairs, return_log=True)
-            ops = TriangleMeshOperators(self.V, Fi, P=layout(L))
-            ops.n_flips, ops.flip_log, ops.L_slots = nflips, log, L
-            self._set_ops(ops)
-            if len(self._states) >= 4:
-                self._states.pop(next(iter(self._states)))
-        self._state_key = key
+    @property
+    def ops(self) -> TriangleMeshOperators:
+        """Operators of the triangulation in use (the input one, or the current intrinsic one)."""
+        return self.domain.ops
+
+    @property
+    def C(self):
+        """The cotan Laplacian (Eq. 10) of the triangulation in use."""
+        return self.domain.laplacian()
+
+    @property
+    def _cache(self) -> dict:
+        return self.core.poisson._cache
 
     # ------------------------------------------------------------------ steps
     @property
     def vector_heat_factorization(self):
         """The factorization of ``M + t L∇`` (Eq. 12), built on first use (complex, or the real 2×2 block form
         on inconsistently oriented meshes)."""
-        if self._vec is None:
-            if self.connection == "real" or (self.connection == "auto" and not self.ops.consistent):
-                M = self.ops.cr_mass().diagonal()
-                A = sp.diags(np.repeat(M, 2)) + self.t * self.ops.cr_connection_laplacian_real()
-                self._vec = _RealBlockFactorization(A)
-            else:
-                A = self.ops.cr_mass() + self.t * self.ops.cr_connection_laplacian()
-                self._vec = HermitianFactorization(A)
-        return self._vec
-
-    def _poisson_fact(self) -> Factorization:
-        if self._poisson is None:
-            self._poisson = Factorization((self.C + sp.diags(self._eps * self._Mv)).tocsc())
-        return self._poisson
+        return self.core.vector_heat_factorization
 
     def diffuse(self, sources) -> np.ndarray:
         """Step I: X = (M + tL∇)⁻¹ X0, complex per edge (Alg. 2)."""
@@ -194,31 +129,26 @@ class SurfaceSignedHeatSolver:
 
     def unit_field(self, X: np.ndarray) -> np.ndarray:
         """Step II: face-averaged, normalized vectors Y (m, 3) (§6, Alg. 3); zero where X vanishes."""
-        Y = self.ops.edge_to_face_vectors(X)
-        nrm = np.linalg.norm(Y, axis=1)
-        out = np.zeros_like(Y)
-        # no relative threshold: far from the sources |X| decays like exp(-d/√t) (1e-20 is common) yet its
-        # direction is still meaningful (§3.1)
-        np.divide(Y, nrm[:, None], out=out, where=nrm[:, None] > 0)
-        return out
+        return self.core.unit_field(X)
 
     # ------------------------------------------------------------------ public
-    def compute_distance(self, curves, points=(), curve_signs=None, level_set_constraint: str = "zero",
-                         soft_weight=None, curve_normals=None) -> np.ndarray:
+    def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
+                         soft_weight=None, curve_normals=None, progress=None) -> np.ndarray:
         """Generalized signed distance at the vertices, negative inside.
 
         Parameters
         ----------
         curves : list
-            Each curve either an int array of vertex indices (a polyline along edges) or a list of surface
-            points ``(face_index, barycentric (3,))`` (``(vertex, ())`` also means a vertex). A curve oriented
-            counter-clockwise (seen from the side the face normals point to) encloses the negative region.
+            Each curve a :class:`gsdf.Curve`, an int array of vertex indices (a polyline along edges), an (k, 2)
+            edge set inside a :class:`gsdf.Curve`, or a list of surface points ``(face_index, barycentric
+            (3,))`` (``(vertex, ())`` also means a vertex). A curve oriented counter-clockwise (seen from the
+            side the face normals point to) encloses the negative region. Keyword-only from here on.
         points : sequence
             Isolated point sources (App. A.1): vertex indices or ``(face, barycentric)`` tuples (split over the
             face's vertices). Distance to points is unsigned.
         curve_signs : list of bool, optional
             Per curve: True = oriented (signed, default), False = unoriented (unsigned distance, App. A.2; must
-            run along edges).
+            run along edges). Bools only; must agree with ``Curve.signed``.
         level_set_constraint : {"zero", "multiple", "none"}
             ``"zero"``: φ = 0 on all sources (saddle system Eq. 14; vertex sources are eliminated directly);
             ``"multiple"``: φ constant along every connected curve component (curves sharing a vertex are one
@@ -232,6 +162,8 @@ class SurfaceSignedHeatSolver:
             vector, or one (3,) per curve point), used instead of the face normals in N = T × n (Eq. 11) — the
             way to orient curves on nonorientable domains (§9.4), where face normals flip across the seam.
             Negating them negates φ. Not available with ``intrinsic_delaunay=True``.
+        progress : callable, optional
+            ``progress(stage, fraction)`` (:mod:`gsdf.heat.core`).
 
         Notes
         -----
@@ -254,184 +186,11 @@ class SurfaceSignedHeatSolver:
         >>> solver.compute_distance([np.array([6, 7, 12, 6])], level_set_constraint="none").shape
         (25,)
         """
-        mode = _checks.choice(level_set_constraint, "level_set_constraint", LEVEL_SETS)
-        lam = None
-        if soft_weight is not None:
-            lam = _checks.positive(soft_weight, "soft_weight")
-        if self.intrinsic_delaunay:
-            if curve_normals is not None:
-                raise ValueError("curve_normals: not available with intrinsic_delaunay=True")
-            curves, points = self._to_intrinsic(curves, points, curve_signs)
-        S = build_sources(self.ops, curves, points, curve_signs, curve_normals)
-        return self._solve_sources(S, mode, lam)
+        return self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
+                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
+                                          progress=progress, curve_normals=curve_normals)
 
-    def _to_intrinsic(self, curves, points, curve_signs):
-        """Re-express the sources on an intrinsic Delaunay triangulation (§9.4): vertex polylines and curve
-        segments along input edges stay on those edges (kept unflippable); segments inside input faces are
-        carried through the flips (their midpoints and directions, :func:`~gsdf.heat.surface.intrinsic.
-        locate_points`) and re-split along the intrinsic edges by tracing (:func:`~gsdf.heat.surface.intrinsic.
-        trace_paths`); point sources inside faces are carried through the flips. Switches to the triangulation
-        that keeps the needed edges and returns (curves, points) for :func:`build_sources` on it."""
-        from .intrinsic import face_coords, locate_points, trace_paths
-        from .sources import _bary_curve_segments, _faces_of_node, _parse_curve, _to_face
-
-        ops0 = self.input_ops
-        F0, V0 = ops0.F, ops0.V
-        if curves is None:
-            curves = []
-        if isinstance(curves, np.ndarray) and curves.ndim == 1 and np.issubdtype(curves.dtype, np.integer):
-            curves = [curves]
-        curves = list(curves)
-        signs = [True] * len(curves) if curve_signs is None else [bool(x) for x in curve_signs]
-        specs, pairs = [], []
-        mids_f, mids_b, mids_v = [], [], []                  # face-segment midpoints to carry through the flips
-        for k, c in enumerate(curves):
-            parsed = _parse_curve(c, ops0, k)
-            vs = None
-            if parsed[0] == "v":
-                vs = parsed[1]
-            elif ((parsed[2] > 0).sum(1) == 1).all():          # surface points that are all vertices
-                vs = F0[parsed[1], np.argmax(parsed[2], axis=1)]
-            if vs is not None:
-                keep = np.concatenate([[True], vs[1:] != vs[:-1]])
-                vs = vs[keep]
-                e = ops0.edge_lookup(vs[:-1], vs[1:])
-                if np.any(e < 0):
-                    q = int(np.flatnonzero(e < 0)[0])
-                    raise ValueError(f"curves[{k}]: vertices {vs[q]} and {vs[q + 1]} (points {q}, {q + 1}) are not "
-                                     "joined by a mesh edge (give the curve as (face, barycentric) points)")
-                if k < len(signs) and not signs[k] and vs[0] != vs[-1]:
-                    raise ValueError(f"curves[{k}]: open unsigned curves are not supported with "
-                                     "intrinsic_delaunay=True (close the curve or use the input triangulation)")
-                specs.append(("v", vs))
-                pairs.append(np.stack([vs[:-1], vs[1:]], 1))
-                continue
-            if k < len(signs) and not signs[k]:
-                raise ValueError(f"curves[{k}]: unsigned curves must run along mesh edges (give vertex indices)")
-            nf, nb, *_ = _bary_curve_segments(ops0, parsed[1], parsed[2], f"curves[{k}]", return_faces=True)
-            segs = []
-            for q in range(len(nf) - 1):
-                fa, ba, fb, bb = nf[q], nb[q], nf[q + 1], nb[q + 1]
-                va, vb = set(F0[fa, ba > 0].tolist()), set(F0[fb, bb > 0].tolist())
-                both = va | vb
-                if len(both) <= 2:                             # on one input edge (or one vertex)
-                    if len(both) == 2 and ops0.edge_lookup(*sorted(both)) >= 0:
-                        pairs.append(np.array([sorted(both)]))
-                        segs.append(("e", (fa, ba), (fb, bb)))
-                        continue
-                    if len(both) == 1:
-                        continue                               # zero length
-                g = min(_faces_of_node(ops0, fa, ba) & _faces_of_node(ops0, fb, bb))
-                wa, wb = _to_face(F0, fa, ba, g), _to_face(F0, fb, bb, g)
-                if np.abs(wa - wb).max() == 0:
-                    continue
-                mids_f.append(g)
-                mids_b.append(0.5 * (wa + wb))
-                mids_v.append(0.5 * (wb - wa) @ V0[F0[g]])
-                segs.append(("f", len(mids_f) - 1))
-            if not segs:
-                raise ValueError(f"curves[{k}]: the curve has zero length")
-            specs.append(("b", segs))
-        # point sources: vertices stay, points inside faces / on edges are carried through the flips
-        pts_v, pts_track = [], []
-        if points is not None:
-            items = list(np.asarray(points).reshape(-1)) if isinstance(points, np.ndarray) else list(points)
-            for q, it in enumerate(items):
-                if np.isscalar(it):
-                    v = int(it)
-                    if v != it or not 0 <= v < ops0.n_vertices:
-                        raise ValueError(f"points[{q}]: vertex index {it!r} out of range for {ops0.n_vertices} "
-                                         "vertices")
-                    pts_v.append(v)
-                    continue
-                _, f, bq = _parse_curve([it, it], ops0, 0)
-                if (bq[0] > 0).sum() == 1:
-                    pts_v.append(int(F0[f[0], np.argmax(bq[0])]))
-                else:
-                    pts_track.append((int(f[0]), bq[0]))
-        P = np.concatenate(pairs) if pairs else np.zeros((0, 2), np.int64)
-        P = np.unique(np.sort(P, axis=1), axis=0)
-        if self._state_key is None:
-            self._use_state(self._key(P), P)
-        else:
-            # are all curve edges (same vertex pair, same length) present in the current triangulation?
-            e = self.ops.edge_lookup(P[:, 0], P[:, 1])
-            ok = np.all(e >= 0) and np.allclose(self.ops.edge_len[e],
-                                                ops0.edge_len[ops0.edge_lookup(P[:, 0], P[:, 1])], rtol=1e-9, atol=0)
-            if not ok:
-                self._use_state(self._key(P), P)
-        ops = self.ops
-        # carry midpoints (with half-segment vectors) and point sources through the flips
-        nm = len(mids_f)
-        tf = np.array(mids_f + [f for f, _ in pts_track], np.int64)
-        tb = np.array(mids_b + [b for _, b in pts_track]).reshape(-1, 3)
-        tv = np.zeros((len(tf), 2))
-        if nm:
-            tv[:nm] = face_coords(V0, F0, tf[:nm], np.array(mids_v))
-        if len(tf):
-            tf, tb, tv = locate_points(V0, F0, ops.flip_log, tf, tb, tv)
-        paths = []
-        if nm:
-            paths = trace_paths(ops.F, ops.L_slots, np.concatenate([tf[:nm], tf[:nm]]),
-                                np.concatenate([tb[:nm], tb[:nm]]), np.concatenate([tv[:nm], -tv[:nm]]))
-
-        def on_edge(node):
-            """An input node on an input edge / vertex as an intrinsic (face, barycentric)."""
-            f, b = node
-            vs = F0[f, b > 0]
-            ws = b[b > 0]
-            if len(vs) == 2:
-                e = int(ops.edge_lookup(vs[0], vs[1]))
-            else:                                              # a vertex: any intrinsic face around it
-                vf = ops.vertex_faces()
-                g = int(vf.indices[vf.indptr[vs[0]]])
-                out = np.zeros(3)
-                out[vf.data[vf.indptr[vs[0]]] - 1] = 1.0
-                return g, out
-            g = int(ops.edge_ref_slot[e] // 3)
-            out = np.zeros(3)
-            for v, w in zip(vs, ws):
-                out[np.flatnonzero(ops.F[g] == v)[0]] += w
-            return g, out
-
-        out = []
-        for spec in specs:
-            if spec[0] == "v":
-                out.append(spec[1])
-                continue
-            nodes = []
-            for sg in spec[1]:
-                if sg[0] == "e":
-                    chain = [on_edge(sg[1]), on_edge(sg[2])]
-                else:
-                    i = sg[1]
-                    bf, bb = paths[nm + i]                      # backward: crossings ..., start point
-                    ff, fb = paths[i]                          # forward: crossings ..., end point
-                    chain = [(int(f), b) for f, b in zip(bf[::-1], bb[::-1])] + \
-                            [(int(f), b) for f, b in zip(ff, fb)]
-                nodes.extend(chain if not nodes else chain[1:])
-            out.append(nodes)
-        pts = pts_v + [(int(f), b) for f, b in zip(tf[nm:], tb[nm:])]
-        return out, (pts if pts else None)
-
-    def _solve_sources(self, S, mode, lam):
-        """Steps I–III for parsed sources (Alg. 1), with the level-set handling of §7.1."""
-        if not np.any(S.X0):
-            raise ValueError("curves: the sources have zero total length / weight")
-        X = self.diffuse(S)
-        Y = self.unit_field(X)
-        b = self.ops.divergence(Y)
-        if mode == "none":
-            phi = self._poisson_fact().solve(b)
-        elif lam is not None:
-            phi = self._soft(S, b, mode, lam)
-        elif mode == "zero":
-            phi = self._zero(S, b)
-        else:
-            phi = self._multiple(S, b)
-        return self._shift(S, phi)
-
-    def compute_distance_l1(self, curves, points=(), curve_signs=None) -> np.ndarray:
+    def compute_distance_l1(self, curves, *, points=(), curve_signs=None) -> np.ndarray:
         """Piecewise-continuous generalized signed distance (§7.2): per-corner values, shape (m, 3).
 
         For curves that do not bound a region (or are inconsistently oriented) the unit field cannot be
@@ -449,7 +208,9 @@ class SurfaceSignedHeatSolver:
 
         if self.intrinsic_delaunay:
             raise NotImplementedError("compute_distance_l1 is not available with intrinsic_delaunay=True")
-        S = build_sources(self.ops, curves, points, curve_signs)
+        cs = as_curves(curves, curve_signs)
+        raw, signs, _ = raw_curves(cs)
+        S = build_sources(self.ops, raw, raw_points(as_point_sources(points)), signs)
         Y = self.unit_field(self.diffuse(S))
         Phi = integrate_l1(self.ops, Y)
         # shift: mean over the curve segments of the value in a face containing the segment midpoint
@@ -466,7 +227,7 @@ class SurfaceSignedHeatSolver:
                 return Phi - float((vals * L).sum() / L.sum())
         return Phi - float(Phi.min())
 
-    def sharpen(self, phi0: np.ndarray, curves, points=(), iterations: int = 3000) -> np.ndarray:
+    def sharpen(self, phi0: np.ndarray, curves, *, points=(), iterations: int = 3000) -> np.ndarray:
         """Distance sharpening (§7.3, Eq. 18): the largest |∇φ| ≤ 1 function with the sign pattern of ``phi0``
         that vanishes on the sources, by PDHG warm-started from ``phi0`` (a signed heat result).
 
@@ -483,9 +244,11 @@ class SurfaceSignedHeatSolver:
         phi0 = np.asarray(phi0, dtype=np.float64)
         if phi0.shape != (self.ops.n_vertices,) or not np.isfinite(phi0).all():
             raise ValueError(f"phi0: expected {self.ops.n_vertices} finite values, got shape {phi0.shape}")
+        raw, signs, _ = raw_curves(as_curves(curves))
+        pts = raw_points(as_point_sources(points))
         if self.intrinsic_delaunay:
-            curves, points = self._to_intrinsic(curves, points, None)
-        S = build_sources(self.ops, curves, points, None)
+            raw, pts = self.domain.transfer(raw, pts, signs)
+        S = build_sources(self.ops, raw, pts, None)
         ids, w, isv = self._all_nodes(S)
         fixed = np.zeros(self.ops.n_vertices, bool)
         fixed[ids[isv < 0][w[isv < 0] > 0]] = True
@@ -529,7 +292,6 @@ class SurfaceSignedHeatSolver:
             out.append([(f, _bary_in_face(self.input_ops, pa, f)), (f, _bary_in_face(self.input_ops, pb, f))])
         return out
 
-    # ------------------------------------------------------------------ constraints (§7.1)
     def _all_nodes(self, S):
         rows = list(S.node_rows)
         isv = list(S.node_is_vertex)
@@ -539,136 +301,3 @@ class SurfaceSignedHeatSolver:
         ids = np.concatenate([r[0] for r in rows])
         w = np.concatenate([r[1] for r in rows])
         return ids, w, np.concatenate(isv)
-
-    def _interp(self, ids, w):
-        k = len(ids)
-        return sp.csr_matrix((w.ravel(), (np.repeat(np.arange(k), ids.shape[1]), ids.ravel())),
-                             shape=(k, self.ops.n_vertices))
-
-    @staticmethod
-    def _key(*arrays):
-        h = hashlib.sha1()
-        for a in arrays:
-            a = np.ascontiguousarray(a)
-            h.update(str(a.shape).encode())
-            h.update(a.tobytes())
-        return h.hexdigest()
-
-    def _cached(self, key, build):
-        return cached_factorization(self._cache, key, build)
-
-    def _zero(self, S, b):
-        ids, w, isv = self._all_nodes(S)
-        n = self.ops.n_vertices
-        if np.all(isv >= 0):
-            # all sources at vertices: eliminate them (Dirichlet φ = 0), as geometry-central does
-            fixed = np.zeros(n, bool)
-            fixed[isv] = True
-            free = np.flatnonzero(~fixed)
-            key = self._key(np.array([0]), np.flatnonzero(fixed))
-
-            def build():
-                Cf = self.C[free][:, free] + sp.diags(self._eps * self._Mv[free])
-                return Factorization(Cf.tocsc())
-
-            fact = self._cached(key, build)
-            phi = np.zeros(n)
-            phi[free] = fact.solve(b[free])
-            return phi
-        # general points: φ(p) = 0 at every node (equivalent to Eq. 14 followed by the exact shift to zero)
-        A = self._interp(ids, w)
-        A = _unique_rows(A)
-        return self._saddle_solve(A, b, tag=1)
-
-    def _multiple(self, S, b):
-        A = self._difference_rows(S)
-        if A.shape[0] == 0:
-            return self._poisson_fact().solve(b)
-        return self._saddle_solve(A, b, tag=2)
-
-    def _saddle_solve(self, A, b, tag):
-        n = self.ops.n_vertices
-        A = A.tocsr()
-        key = self._key(np.array([tag]), A.indptr, A.indices, A.data)
-        delta = 1e-12 * float(self.C.diagonal().mean())
-
-        def build():
-            C = self.C + sp.diags(self._eps * self._Mv)
-            return Factorization(saddle_matrix(C, A, delta))
-
-        fact = self._cached(key, build)
-        rhs = np.concatenate([b, np.zeros(A.shape[0])])
-        return fact.solve(rhs)[:n]
-
-    def _difference_rows(self, S, single=False):
-        """Rows φ(p_i) - φ(p_0) = 0 per connected curve component (all nodes together when ``single``)."""
-        groups = _curve_components(S, self.ops.n_vertices) if not single else np.zeros(len(S.node_rows), int)
-        mats = []
-        for g in np.unique(groups):
-            sel = np.flatnonzero(groups == g)
-            ids = np.concatenate([S.node_rows[c][0] for c in sel])
-            w = np.concatenate([S.node_rows[c][1] for c in sel])
-            if single and S.point_rows is not None:
-                ids = np.concatenate([ids, S.point_rows[0]])
-                w = np.concatenate([w, S.point_rows[1]])
-            P = _unique_rows(self._interp(ids, w))
-            if P.shape[0] > 1:
-                mats.append(P[1:] - sp.csr_matrix(np.ones((P.shape[0] - 1, 1))) @ P[:1])
-        if not mats:
-            return sp.csr_matrix((0, self.ops.n_vertices))
-        return sp.vstack(mats).tocsr()
-
-    def _soft(self, S, b, mode, lam):
-        A = self._difference_rows(S, single=(mode != "multiple"))
-        key = self._key(np.array([3]), np.array([lam]), A.indptr, A.indices, A.data)
-
-        def build():
-            K = self.C + lam * (A.T @ A) + sp.diags(self._eps * self._Mv)
-            return Factorization(K.tocsc())
-
-        return self._cached(key, build).solve(b)
-
-    def _shift(self, S, phi):
-        """Alg. 13: subtract the length-weighted mean of φ along the curves (min over points if no curves)."""
-        if S.node_rows:
-            ids = np.concatenate([m[0] for m in S.seg_mid])
-            w = np.concatenate([m[1] for m in S.seg_mid])
-            L = np.concatenate(S.seg_len)
-            vals = (phi[ids] * w).sum(1)
-            if L.sum() > 0:
-                return phi - float((vals * L).sum() / L.sum())
-        return phi - float(phi.min())
-
-
-def _unique_rows(A):
-    """Drop duplicate rows of a sparse matrix (repeated nodes would make the saddle system singular)."""
-    A = sp.csr_matrix(A)
-    A.sum_duplicates()
-    A.eliminate_zeros()
-    A.sort_indices()
-    k = A.shape[0]
-    nnz = np.diff(A.indptr)
-    width = int(nnz.max()) if k else 0
-    key = np.full((k, 2 * width), -1.0)
-    pos = np.arange(A.nnz) - np.repeat(A.indptr[:-1], nnz)
-    row = np.repeat(np.arange(k), nnz)
-    key[row, pos] = A.indices
-    key[row, width + pos] = np.round(A.data, 12)
-    _, idx = np.unique(key, axis=0, return_index=True)
-    return A[np.sort(idx)]
-
-
-def _curve_components(S, n):
-    """Connected components of curves: curves sharing a vertex node belong together."""
-    from scipy.sparse.csgraph import connected_components
-
-    k = len(S.node_rows)
-    r, c = [], []
-    for i, isv in enumerate(S.node_is_vertex):
-        v = isv[isv >= 0]
-        r.append(np.full(len(v), i))
-        c.append(v)
-    r, c = np.concatenate(r), np.concatenate(c)
-    G = sp.csr_matrix((np.ones(len(r)), (r, k + c)), shape=(k + n, k + n))
-    lab = connected_components(G, directed=False)[1]
-    return lab[:k]

@@ -25,7 +25,6 @@ multiplier update; larger grids use the preconditioned CG per update, which is s
 
 from __future__ import annotations
 
-import os
 import time
 
 import numpy as np
@@ -34,34 +33,9 @@ import scipy.sparse as sp
 from ..._checks import positive
 from ...field import GridField, grid_points
 from .sources import Sources
+from .memory import available_memory, check_memory  # noqa: F401  (re-exported)
 from .yukawa import YukawaTree, grid_nearest_distance
 
-BYTES_PER_NODE = 400  # positions, X, Y, d*, DCT work arrays (≈ 250 B/node measured); the constrained CG more
-
-
-def available_memory() -> int:
-    """Bytes of available physical memory (MemAvailable), or 8 GiB when it cannot be read."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    try:
-        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return 8 << 30
-
-
-def check_memory(n_nodes: int, max_memory=None) -> int:
-    """Estimate the memory of a grid solve with ``n_nodes`` nodes and refuse (ValueError) when too large."""
-    need = int(n_nodes) * BYTES_PER_NODE
-    limit = int(0.8 * available_memory()) if max_memory is None else int(max_memory)
-    if need > limit:
-        raise ValueError(f"resolution too large: a grid of {n_nodes:,} nodes needs about {need / 2**30:.1f} GiB, "
-                         f"more than the {limit / 2**30:.1f} GiB allowed; lower the resolution")
-    return need
 
 
 def neumann_laplacian(shape, spacing) -> sp.csr_matrix:
@@ -246,7 +220,7 @@ def solve_constrained(rhs, shape, spacing, C, w, rho: float, tol: float, max_out
     direct = None
     if n <= direct_below:
         try:  # factorize once (CHOLMOD), every outer step is then two triangular solves
-            from .tet import SPDSolver
+            from ...linalg import SPDSolver
 
             direct = SPDSolver(A, direct_max=direct_below)  # many outer steps: factorize, never CG
         except Exception:  # pragma: no cover - fall back to the iterative inner solver

@@ -48,6 +48,7 @@ import scipy.sparse as sp
 from scipy.spatial import Delaunay, cKDTree
 
 from ...field import TetField
+from ...linalg import SPDSolver
 from .sources import Sources
 
 BYTES_PER_TET_VERTEX = 3000  # ~6.5 tets per vertex, sparse P1 matrix and its Cholesky factor
@@ -235,76 +236,6 @@ def weak_divergence(T, vol, G, Y, n):
     return b
 
 
-class SPDSolver:
-    """Solve with a sparse symmetric positive definite matrix, set up once for many right-hand sides.
-
-    Small systems (n ≤ ``direct_max``) are factorized: CHOLMOD via cholespy (SuperLU if it is missing). Larger
-    ones use preconditioned conjugate gradients: the graded tet Laplacians are well conditioned (Jacobi-CG to
-    1e-10 takes 0.06 s on the 23k-unknown mech-holes-shark system, CHOLMOD 1.3 s, SuperLU 65 s;
-    bench/bench_solver_choices.py) — pyamg's
-    smoothed aggregation preconditions when installed, Jacobi otherwise. If CG does not converge the matrix
-    is factorized after all.
-    """
-
-    def __init__(self, A, direct_max: int = 5000, rtol: float = 1e-10):
-        A = sp.csr_matrix(A)
-        A.sum_duplicates()
-        self.A, self.n, self.rtol = A, A.shape[0], rtol
-        self._chol = self._lu = self._M = None
-        if self.n <= direct_max:
-            self._factorize()
-            return
-        try:
-            import pyamg
-
-            self._M = pyamg.smoothed_aggregation_solver(A, symmetry="symmetric").aspreconditioner()
-        except ImportError:
-            d = A.diagonal()
-            self._M = sp.diags(1.0 / np.where(d > 0, d, 1.0))
-
-    def _factorize(self):
-        try:
-            from cholespy import CholeskySolverD, MatrixType
-
-            C = self.A.tocoo()
-            self._chol = CholeskySolverD(self.n, C.row.astype(np.int32), C.col.astype(np.int32),
-                                         C.data.astype(np.float64), MatrixType.COO)
-        except (ImportError, ValueError):  # no cholespy, or numerically not positive definite: LU
-            from scipy.sparse.linalg import splu
-
-            self._lu = splu(sp.csc_matrix(self.A), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
-
-    @property
-    def direct(self) -> bool:
-        return self._chol is not None or self._lu is not None
-
-    def _direct_solve(self, b):
-        if self._chol is not None:
-            x = np.zeros_like(b)
-            self._chol.solve(b, x)
-            return x
-        return self._lu.solve(b)
-
-    def _solve_vector(self, b):
-        from scipy.sparse.linalg import cg
-
-        if self.direct:  # a previous right-hand side defeated CG
-            return self._direct_solve(np.ascontiguousarray(b))
-        x, info = cg(self.A, b, rtol=self.rtol, atol=0.0, maxiter=20 * int(np.sqrt(self.n)) + 500, M=self._M)
-        if info == 0:
-            return x
-        self._factorize()
-        return self._direct_solve(np.ascontiguousarray(b))
-
-    def solve(self, b):
-        b = np.ascontiguousarray(b, dtype=np.float64)
-        if self.direct:
-            return self._direct_solve(b)
-        if b.ndim == 1:
-            return self._solve_vector(b)
-        return np.column_stack([self._solve_vector(b[:, j]) for j in range(b.shape[1])])
-
-
 # ----------------------------------------------------------------------------------------------- meshing
 def delaunay_mesh(Z, lo, hi, h, levels: int = 8, grading: float = 2.0):
     """Vertices (Z first), tets and the scipy Delaunay locator of Z + the graded lattice."""
@@ -373,7 +304,7 @@ def solve_tet(src: Sources, X, lo, hi, shape, t_coef: float = 1.0, level_set_con
     ``faces`` are the input triangles (indices into ``X``) for meshes, None for clouds.
     """
     from ..._checks import choice, positive
-    from .grid import available_memory
+    from .memory import available_memory
     from .yukawa import YukawaTree
 
     step1 = choice(step1, "step1", {"yukawa", "heat"})

@@ -1,0 +1,351 @@
+"""The signed heat method, written once (Feng & Crane 2024, §3 Alg. 1, §7.1, Alg. 13), for every domain.
+
+A *domain* (:mod:`gsdf.heat.domains`: triangle mesh, intrinsic Delaunay, polygon mesh, point cloud, grid, tet
+mesh, voxel surface) supplies operators and assembled sources (:class:`~gsdf.heat.domains.base.HeatDomain`);
+:class:`SignedHeatCore` does the rest:
+
+Step I    X = (M + t L∇)⁻¹ X⁰ (Eq. 12) — factorized once per domain (complex Hermitian, or the real 2×2-block
+          form), or computed by the domain (Yukawa sums in volumes);
+Step II   Y = X / |X| on the domain's divergence elements (zero where X vanishes: far from the sources |X|
+          decays like exp(-d/√t) yet its direction still counts, so there is no relative threshold, §3.1);
+Step III  L φ = ∇·Y with the level-set constraint (§7.1):
+
+          * ``"zero"`` — hard: φ = 0 at every source node. Sources all at vertices are eliminated (Dirichlet
+            rows, as geometry-central does); otherwise the saddle system of Eq. 14 (a tiny −δI block keeps it
+            nonsingular). The result is not shifted (it already vanishes on the sources);
+          * ``"multiple"`` — hard: φ constant along each connected curve component (curves sharing a vertex
+            are one component), then shifted;
+          * ``"none"`` — no constraint, then shifted;
+          * ``soft_weight=λ`` (with "zero" or "multiple") — the penalty λ Σ (φ(p_i) − φ(p_0))² instead of the
+            hard rows (domains may define their own penalty rows: the grid penalizes φ(b_f)²), then shifted.
+
+Shift (Alg. 13): subtract the length-weighted mean of φ along the curves (``Sources.shift_rows``), or the
+minimum when there are only point sources.
+
+Every factorization is kept: the Poisson operator per domain, constrained systems per constraint set (a
+repeated call with the same sources costs only solves).
+
+Progress: every heat path reports through one callback signature, ``progress(stage: str, fraction: float)``
+with ``fraction`` in [0, 1]; stages are ``"sources"``, ``"heat (step I)"``, ``"poisson (step III)"`` (and
+``"tet mesh"`` on tets). :func:`adapt_progress` accepts the older ``progress(stage, done, total)`` form too.
+
+Example
+-------
+>>> import numpy as np
+>>> from gsdf.heat.surface.meshes import grid_mesh
+>>> from gsdf.heat.surface.curves import level_set_curves
+>>> from gsdf.heat.domains.triangle import TriangleDomain
+>>> V, F = grid_mesh(32)
+>>> core = SignedHeatCore(TriangleDomain(V, F))
+>>> circle = level_set_curves(V, F, np.linalg.norm(V, axis=1) - 0.5)
+>>> phi = core.compute_distance(circle)
+>>> round(float(phi[np.argmin(np.linalg.norm(V, axis=1))]), 1)
+-0.5
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+
+import numpy as np
+import scipy.sparse as sp
+
+from .. import _checks
+from ..linalg import (BlockHermitianFactorization, Factorization, HermitianFactorization, cached_factorization,
+                      saddle_matrix)
+from .domains.base import PoissonSolver
+from .sources import Sources, as_curves, as_point_sources
+
+__all__ = ["SignedHeatCore", "FactorizedPoisson", "LEVEL_SETS", "unique_rows", "adapt_progress", "normalize"]
+
+LEVEL_SETS = ("zero", "multiple", "none")
+
+
+def adapt_progress(progress):
+    """``progress(stage, fraction)`` from a user callback taking ``(stage, fraction)`` or the older
+    ``(stage, done, total)``; a no-op for None."""
+    if progress is None:
+        return lambda stage, fraction: None
+    try:
+        nparams = len([p for p in inspect.signature(progress).parameters.values()
+                       if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) and p.default is p.empty])
+    except (TypeError, ValueError):
+        nparams = 2
+    if nparams >= 3:
+        return lambda stage, fraction: progress(stage, int(round(1000 * fraction)), 1000)
+    return progress
+
+
+def hash_key(*arrays) -> str:
+    """A cache key for constraint sets: sha1 over shapes and bytes."""
+    h = hashlib.sha1()
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def normalize(Y: np.ndarray) -> np.ndarray:
+    """Step II: Y / |Y| per row; rows with |Y| = 0 stay 0."""
+    nrm = np.linalg.norm(Y, axis=1)
+    out = np.zeros_like(Y)
+    np.divide(Y, nrm[:, None], out=out, where=nrm[:, None] > 0)
+    return out
+
+
+def unique_rows(A, order: str = "first"):
+    """Drop duplicate rows of a sparse matrix (repeated nodes would make the saddle system singular).
+
+    ``order="first"`` keeps the rows in the order of their first occurrence, ``"sorted"`` in lexicographic
+    order of (column indices, values) — for one-hot rows, ascending vertex index."""
+    A = sp.csr_matrix(A)
+    A.sum_duplicates()
+    A.eliminate_zeros()
+    A.sort_indices()
+    k = A.shape[0]
+    nnz = np.diff(A.indptr)
+    width = int(nnz.max()) if k else 0
+    key = np.full((k, 2 * width), -1.0)
+    pos = np.arange(A.nnz) - np.repeat(A.indptr[:-1], nnz)
+    row = np.repeat(np.arange(k), nnz)
+    key[row, pos] = A.indices
+    key[row, width + pos] = np.round(A.data, 12)
+    _, idx = np.unique(key, axis=0, return_index=True)
+    return A[np.sort(idx) if order == "first" else idx]
+
+
+def curve_components(S: Sources, n: int) -> np.ndarray:
+    """Connected component of every curve: curves sharing a vertex node belong together."""
+    from scipy.sparse.csgraph import connected_components
+
+    k = int(S.node_curve.max()) + 1 if len(S.node_curve) else 0
+    isv = S.node_vertex >= 0
+    r, c = S.node_curve[isv], S.node_vertex[isv]
+    G = sp.csr_matrix((np.ones(len(r)), (r, k + c)), shape=(k + n, k + n))
+    return connected_components(G, directed=False)[1][:k]
+
+
+class FactorizedPoisson(PoissonSolver):
+    """Step III by sparse factorizations of ``L + ε M`` (ε fixes the constant of every component: L is only
+    semidefinite), kept per constraint set.
+
+    ``spd``: the factory of SPD solves (default :class:`gsdf.linalg.Factorization`; tets use
+    :class:`gsdf.linalg.SPDSolver`, CG/AMG above a size)."""
+
+    def __init__(self, L, Mv, spd=None):
+        self.L = sp.csr_matrix(L).tocsc()
+        self.Mv = np.asarray(Mv, np.float64)
+        self.n = self.L.shape[0]
+        self._eps = 1e-10 * float(np.abs(self.L.diagonal()).mean()) / float(self.Mv.mean())
+        self._spd = spd or (lambda A: Factorization(sp.csc_matrix(A)))
+        self._free = None
+        self._cache: dict = {}
+
+    def _cached(self, key, build):
+        return cached_factorization(self._cache, key, build)
+
+    def free(self, b):
+        if self._free is None:
+            self._free = self._spd((self.L + sp.diags(self._eps * self.Mv)).tocsc())
+        return self._free.solve(b)
+
+    def dirichlet(self, fixed, b):
+        fixed = np.unique(np.asarray(fixed, np.int64))
+        mask = np.zeros(self.n, bool)
+        mask[fixed] = True
+        free = np.flatnonzero(~mask)
+        key = hash_key(np.array([0]), fixed)
+
+        def build():
+            return self._spd((self.L[free][:, free] + sp.diags(self._eps * self.Mv[free])).tocsc())
+
+        phi = np.zeros(self.n)
+        if len(free):
+            phi[free] = self._cached(key, build).solve(b[free])
+        return phi
+
+    def constrained(self, A, b, tag):
+        A = sp.csr_matrix(A)
+        key = hash_key(np.array([hash(tag) % 2**31]), A.indptr, A.indices, A.data)
+        delta = 1e-12 * float(self.L.diagonal().mean())
+
+        def build():
+            return Factorization(saddle_matrix(self.L + sp.diags(self._eps * self.Mv), A, delta))
+
+        rhs = np.concatenate([b, np.zeros(A.shape[0])])
+        return self._cached(key, build).solve(rhs)[: self.n]
+
+    def penalized(self, A, w, b):
+        A = sp.csr_matrix(A)
+        w = np.broadcast_to(np.asarray(w, np.float64), (A.shape[0],))
+        key = hash_key(np.array([3]), w, A.indptr, A.indices, A.data)
+
+        def build():
+            if np.all(w == w[0]):
+                K = self.L + w[0] * (A.T @ A) + sp.diags(self._eps * self.Mv)
+            else:
+                K = self.L + A.T @ sp.diags(w) @ A + sp.diags(self._eps * self.Mv)
+            return self._spd(K.tocsc())
+
+        return self._cached(key, build).solve(b)
+
+
+class SignedHeatCore:
+    """Steps I–III, the level-set constraints and the shift for one domain (module docs).
+
+    Parameters
+    ----------
+    domain : HeatDomain
+        The operators (``gsdf.heat.domains``).
+
+    Attributes
+    ----------
+    poisson : PoissonSolver — the domain's own, or :class:`FactorizedPoisson` of its Laplacian.
+    """
+
+    MAX_STATES = 4
+
+    def __init__(self, domain):
+        self.domain = domain
+        self._states: dict = {}
+
+    def _state(self) -> dict:
+        """Factorizations of the domain's current operators (domains that switch triangulations, like the
+        intrinsic one, expose ``state_key``; a few states are kept)."""
+        key = getattr(self.domain, "state_key", None)
+        st = self._states.get(key)
+        if st is None:
+            if len(self._states) >= self.MAX_STATES:
+                self._states.pop(next(iter(self._states)))
+            st = self._states[key] = {"vec": None, "poisson": None}
+        return st
+
+    # ------------------------------------------------------------------ steps
+    @property
+    def vector_heat_factorization(self):
+        """The factorization of ``M + t L∇`` (Eq. 12), built on first use."""
+        st = self._state()
+        if st["vec"] is None:
+            form = self.domain.heat_form
+            if form == "complex":
+                st["vec"] = HermitianFactorization(self.domain.vector_heat_matrix())
+            elif form == "real2":
+                st["vec"] = BlockHermitianFactorization(self.domain.vector_heat_matrix())
+            else:
+                raise ValueError(f"domain: heat_form {form!r} has no vector heat operator")
+        return st["vec"]
+
+    @property
+    def poisson(self) -> PoissonSolver:
+        """The domain's Step III solver (its own, or :class:`FactorizedPoisson` of its Laplacian)."""
+        st = self._state()
+        if st["poisson"] is None:
+            st["poisson"] = self.domain.poisson_solver() or FactorizedPoisson(self.domain.laplacian(),
+                                                                              self.domain.mass())
+        return st["poisson"]
+
+    def diffuse(self, S: Sources) -> np.ndarray:
+        """Step I."""
+        if self.domain.heat_form == "direct":
+            return self.domain.diffuse(S)
+        return self.vector_heat_factorization.solve(S.X0)
+
+    def unit_field(self, X) -> np.ndarray:
+        """Step II: the normalized vectors on the domain's divergence elements."""
+        return normalize(self.domain.gather(X))
+
+    # ------------------------------------------------------------------ public
+    def sources(self, curves, points=(), curve_signs=None, **options) -> Sources:
+        """Type-check curves and points (:func:`~gsdf.heat.sources.as_curves`) and assemble them on the domain."""
+        cs = as_curves(curves, curve_signs)
+        ps = as_point_sources(points)
+        return self.domain.assemble_sources(cs, ps, **options)
+
+    def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
+                         soft_weight=None, progress=None, **options) -> np.ndarray:
+        """Validate, assemble and solve (Alg. 1 with §7.1); returns φ (n,) on the domain's nodes."""
+        mode = _checks.choice(level_set_constraint, "level_set_constraint", LEVEL_SETS)
+        lam = None if soft_weight is None else _checks.positive(soft_weight, "soft_weight")
+        report = adapt_progress(progress)
+        report("sources", 0.0)
+        S = self.sources(curves, points, curve_signs, **options)
+        return self.solve(S, mode, lam, report)
+
+    def solve(self, S: Sources, mode: str = "zero", lam=None, report=None) -> np.ndarray:
+        """Steps I–III for assembled sources; ``mode`` a level-set constraint, ``lam`` the soft weight or None."""
+        report = report or (lambda stage, fraction: None)
+        if S.X0 is not None and not np.any(S.X0):
+            raise ValueError("curves: the sources have zero total length / weight")
+        report("heat (step I)", 0.0)
+        X = self.diffuse(S)
+        report("heat (step I)", 1.0)
+        report("poisson (step III)", 0.0)
+        b = self.domain.divergence(self.unit_field(X))
+        phi, shift = self.poisson_step(S, b, mode, lam)
+        if shift:
+            phi = self.shift(S, phi)
+        report("poisson (step III)", 1.0)
+        return phi
+
+    def poisson_step(self, S: Sources, b, mode: str, lam):
+        """Step III with the level-set constraint; returns (φ, whether to shift)."""
+        P = self.poisson
+        if mode == "none":
+            return P.free(b), True
+        if lam is not None:
+            custom = self.domain.soft_rows(S, mode)
+            if custom is None:
+                A = self.difference_rows(S, single=(mode != "multiple"))
+                w = lam
+            else:
+                A, w = custom
+                w = lam * np.asarray(w, np.float64)
+            if A.shape[0] == 0:
+                return P.free(b), True
+            return P.penalized(A, w, b), True
+        if mode == "zero":
+            A, vert = self.domain.zero_rows(S)
+            again = getattr(self.domain, "shift_hard_zero", True)
+            if len(vert) and np.all(vert >= 0):
+                return P.dirichlet(vert, b), again
+            return P.constrained(unique_rows(A), b, "zero"), again
+        A = self.difference_rows(S, single=False)
+        if A.shape[0] == 0:
+            return P.free(b), True
+        return P.constrained(A, b, "multiple"), True
+
+    def difference_rows(self, S: Sources, single: bool = False):
+        """Rows φ(p_i) − φ(p_0) = 0 per connected curve component (over all nodes and points when ``single``)."""
+        n = self.domain.n_nodes
+        order = self.domain.difference_order
+        if S.components is not None and not single:
+            groups = S.components
+        elif single:
+            groups = np.zeros(len(S.node_curve), np.int64)
+        else:
+            groups = curve_components(S, n)[S.node_curve] if len(S.node_curve) else np.zeros(0, np.int64)
+        mats = []
+        gs = np.unique(groups)
+        if single and len(gs) == 0 and S.point_rows is not None:
+            gs = np.array([0])
+        for g in gs:
+            R = S.node_rows[np.flatnonzero(groups == g)]
+            if single and S.point_rows is not None:
+                R = sp.vstack([R, S.point_rows])
+            Pm = unique_rows(R, order)
+            if Pm.shape[0] > 1:
+                mats.append(Pm[1:] - sp.csr_matrix(np.ones((Pm.shape[0] - 1, 1))) @ Pm[:1])
+        if not mats:
+            return sp.csr_matrix((0, n))
+        return sp.vstack(mats).tocsr()
+
+    @staticmethod
+    def shift(S: Sources, phi):
+        """Alg. 13: subtract the weighted mean of φ along the curves (the minimum with only point sources)."""
+        if S.shift_rows is not None and S.shift_rows.shape[0]:
+            w = S.shift_weights
+            if w.sum() > 0:
+                return phi - float(((S.shift_rows @ phi) * w).sum() / w.sum())
+        return phi - float(phi.min())

@@ -1,0 +1,292 @@
+"""The signed heat method on polygon meshes (Feng & Crane 2024, §8.3) with the polygon Laplacian of Bunge,
+Herholz, Kazhdan & Botsch 2020 ("Polygon Laplacian made simple").
+
+Operators (Bunge et al. §3–4):
+
+* every polygon f with more than three corners gets a virtual vertex ``x_f = Σ_i w_i x_i`` whose affine weights
+  w minimize the sum of squared areas of the fan triangles (x_f, x_i, x_{i+1}) (the minimizer x_f is unique; of
+  the weights reproducing it the minimum-norm ones are taken, as geometry-central does);
+* the polygon is split into that fan; on the refined triangle mesh the cotan stiffness C_fan, the lumped mass and
+  the gradient/divergence of piecewise-linear functions are the usual ones (:mod:`.operators`);
+* the prolongation P ((n + #virtual) × n) is the identity on original vertices and the weights w on virtual ones;
+  ``L = Pᵀ C_fan P`` and ``M = lump(Pᵀ M_fan P)`` (row sums; Bunge et al. §4.2 use the lumped mass), i.e.
+  ``M = Pᵀ A_fan`` with A_fan the barycentric areas of the refined mesh, since the rows of P sum to one.
+
+  Triangles are left unrefined: for a triangle the optimal virtual vertex is the centroid, and the prolonged fan
+  operators equal the triangle's cotan stiffness and barycentric mass exactly (linear precision), so on a
+  triangle mesh L is the cotan Laplacian.
+
+Signed heat method on top (§8.3): tangent planes at the vertices from the area-weighted sum of the fine triangle
+normals (an arbitrary basis in each plane); the vertex connection Laplacian multiplies the off-diagonal entries of
+L by the rotation between the tangent bases of the two vertices (the smallest rotation aligning their normals,
+as in Eq. 9 and Sharp et al. 2019 §6.2.2); X⁰ at a curve vertex accumulates the in-plane curve normals of its
+incident edges times half their lengths (the "average edge normal times half the sum of incident edge lengths"
+of §8.3, averaged by length); step I solves ``(M + t L∇) X = X⁰``; for step II X is prolonged to the fine
+vertices (virtual vertex = Σ w_i X_i as 3D vectors), averaged onto the fine triangles, projected into them and
+normalized; step III applies the fine divergence and restricts by Pᵀ (Bunge et al. §4.5, D = -Pᵀ Gᵀ M_T), then
+solves ``L φ = b`` with the level-set constraints of §7.1. The diffusion time is ``t = t_coef · ℓ̄²`` with ℓ̄
+the mean polygon edge length (geometry-central's choice for polygon meshes).
+
+Curves run along polygon edges (vertex-index polylines). Sign convention as everywhere in gsdf: the left of a
+curve (the inside of a counter-clockwise loop seen from the normal side) is negative, the opposite of
+potpourri3d.
+
+:class:`PolygonDomain` supplies these operators to :class:`gsdf.heat.core.SignedHeatCore` (sources: the
+vertex-based ones of :class:`~gsdf.heat.domains.base.VertexSurfaceDomain`);
+:class:`gsdf.PolygonMeshSignedHeatSolver` (:mod:`gsdf.heat.surface.polygon`) is the front-end.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ... import _checks
+from ..surface.operators import TriangleMeshOperators
+from .base import VertexSurfaceDomain, tangent_frames
+
+
+# --------------------------------------------------------------------------------------------- geometry helpers
+def _parse_polygons(polygons, n: int) -> dict:
+    """Validate polygons; return {degree: (q, degree) int64 array} (vectorized per degree)."""
+    import itertools
+
+    if isinstance(polygons, np.ndarray) and polygons.ndim == 2 and polygons.dtype != object:
+        arr = polygons
+        if not np.issubdtype(arr.dtype, np.integer):
+            if not (np.issubdtype(arr.dtype, np.floating) and np.all(arr == np.round(arr))):
+                raise ValueError(f"polygons: vertex indices must be integers, got dtype {arr.dtype}")
+        sizes = np.full(len(arr), arr.shape[1], np.int64)
+        flat = arr.astype(np.int64).ravel()
+    else:
+        try:
+            polygons = [np.asarray(p).ravel() if isinstance(p, np.ndarray) else p for p in polygons]
+            sizes = np.fromiter(map(len, polygons), np.int64, count=len(polygons))
+            flat = np.asarray(list(itertools.chain.from_iterable(polygons)))
+        except TypeError as exc:
+            raise ValueError("polygons: expected a list of vertex-index sequences or an (m, k) int array") from exc
+        if flat.size and not np.issubdtype(flat.dtype, np.integer):
+            if not (np.issubdtype(flat.dtype, np.number) and np.all(flat == np.round(flat))):
+                raise ValueError(f"polygons: vertex indices must be integers, got dtype {flat.dtype}")
+        flat = flat.astype(np.int64)
+    if len(sizes) == 0:
+        raise ValueError("polygons: is empty (0 faces)")
+    if (sizes < 3).any():
+        k = int(np.flatnonzero(sizes < 3)[0])
+        raise ValueError(f"polygons[{k}]: a polygon needs at least 3 vertices, got {int(sizes[k])}")
+    start = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    bad = (flat < 0) | (flat >= n)
+    if bad.any():
+        k = int(np.searchsorted(start, np.flatnonzero(bad)[0], side="right") - 1)
+        raise ValueError(f"polygons[{k}]: vertex index out of range for {n} vertices")
+    out = {}
+    for s in np.unique(sizes):
+        sel = np.flatnonzero(sizes == s)
+        Q = flat[start[sel][:, None] + np.arange(s)]
+        S = np.sort(Q, axis=1)
+        rep = (S[:, 1:] == S[:, :-1]).any(1)
+        if rep.any():
+            k = int(sel[np.flatnonzero(rep)[0]])
+            raise ValueError(f"polygons[{k}]: repeats a vertex ({Q[np.flatnonzero(rep)[0]].tolist()})")
+        out[int(s)] = Q
+    return out
+
+
+def virtual_vertex_weights(X: np.ndarray) -> np.ndarray:
+    """Affine weights (q, s) of the virtual vertices of q polygons with s corners ``X`` (q, s, 3).
+
+    The virtual vertex minimizes Σ_i |(x_i - x) × (x_{i+1} - x)|² (twice the squared fan-triangle areas, Bunge et
+    al. 2020 §3): a 3×3 linear least-squares problem per polygon. Its weights are the minimum-norm affine ones
+    reproducing it (``Σ w = 1``, ``Σ w_i x_i = x``); degenerate polygons get uniform weights.
+
+    Example
+    -------
+    >>> X = np.array([[[0., 0, 0], [2, 0, 0], [2, 1, 0], [0, 1, 0]]])
+    >>> virtual_vertex_weights(X).round(6).tolist()
+    [[0.25, 0.25, 0.25, 0.25]]
+    """
+    q, s, _ = X.shape
+    c = X.mean(axis=1, keepdims=True)
+    A = X - c                                                   # centred corners (translation invariance)
+    B = np.roll(A, -1, axis=1)
+    D = B - A
+    # (a - x) × (b - x) = a × b - x × (b - a) = a × b + [d]_× x   (d = b - a)
+    Dx = np.zeros((q, s, 3, 3))
+    Dx[..., 0, 1], Dx[..., 0, 2] = -D[..., 2], D[..., 1]
+    Dx[..., 1, 0], Dx[..., 1, 2] = D[..., 2], -D[..., 0]
+    Dx[..., 2, 0], Dx[..., 2, 1] = -D[..., 1], D[..., 0]
+    H = np.einsum("qsij,qsik->qjk", Dx, Dx)
+    rhs = -np.einsum("qsij,qsi->qj", Dx, np.cross(A, B))
+    scale = np.trace(H, axis1=1, axis2=2)
+    ok = scale > 0
+    lam, U = np.linalg.eigh(H)                                   # H is symmetric PSD: a safe pseudo-inverse
+    keep = lam > 1e-10 * np.maximum(scale, 1e-300)[:, None]
+    inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
+    x = np.einsum("qij,qj,qkj,qk->qi", U, inv, U, rhs)
+    ok &= keep.sum(1) == 3                                       # collinear corners: no unique minimizer
+    # minimum-norm affine weights: w = K⁺ r with K = [Aᵀ; 1ᵀ] (4 × s), r = [x; 1]
+    K = np.concatenate([np.transpose(A, (0, 2, 1)), np.ones((q, 1, s))], axis=1)
+    r = np.concatenate([x, np.ones((q, 1))], axis=1)
+    w = np.einsum("qij,qj->qi", np.linalg.pinv(K, rcond=1e-10), r)
+    ok &= np.isfinite(w).all(1) & (np.abs(w.sum(1) - 1) < 1e-6)
+    w[~ok] = 1.0 / s
+    return w
+
+
+def virtual_vertex_refinement(V: np.ndarray, polygons):
+    """Refine polygons by virtual-vertex fans (Bunge et al. 2020).
+
+    Returns ``(V_refined, F_refined, P)``: the first ``len(V)`` refined vertices are the input ones, the others the
+    virtual vertices of the polygons with more than three corners; triangles are kept as they are. ``P`` is the
+    sparse prolongation (len(V_refined), len(V)): identity rows for original vertices, affine weights for virtual
+    ones.
+
+    Example
+    -------
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    >>> Vr, Fr, P = virtual_vertex_refinement(V, [[0, 1, 2, 3]])
+    >>> (Vr[4].round(3) + 0.0).tolist(), len(Fr), P.shape
+    ([0.5, 0.5, 0.0], 4, (5, 4))
+    """
+    V = np.asarray(V, dtype=np.float64)
+    groups = polygons if isinstance(polygons, dict) else _parse_polygons(polygons, len(V))
+    n = len(V)
+    tris = [groups[3]] if 3 in groups else []
+    newV, fans, prow, pcol, pval = [], [], [np.arange(n)], [np.arange(n)], [np.ones(n)]
+    nv = n
+    for s, Q in groups.items():
+        if s == 3:
+            continue
+        w = virtual_vertex_weights(V[Q])                                # (q, s) polygons of this degree
+        ids = nv + np.arange(len(Q))
+        nv += len(Q)
+        newV.append(np.einsum("qs,qsj->qj", w, V[Q]))
+        fans.append(np.stack([np.repeat(ids, s), Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1))
+        prow.append(np.repeat(ids, s))
+        pcol.append(Q.ravel())
+        pval.append(w.ravel())
+    Vr = np.concatenate([V] + newV) if newV else V.copy()
+    Fr = np.concatenate(tris + fans) if (tris or fans) else np.zeros((0, 3), np.int64)
+    P = sp.csr_matrix((np.concatenate(pval), (np.concatenate(prow), np.concatenate(pcol))), shape=(nv, n))
+    return Vr, Fr, P
+
+
+def frame_transport(N, e1, e2, i, j) -> np.ndarray:
+    """Unit complex r_ij expressing the basis vector e1_j in the basis of i after the smallest rotation taking
+    N_j to N_i (Sharp et al. 2019 §6.2.2; geometry-central ``transportBetween(j, i)``): a tangent vector z_j in
+    frame j is ``r_ij z_j`` in frame i; r_ji = conj(r_ij)."""
+    a, b, v = N[j], N[i], e1[j]
+    c = np.einsum("kj,kj->k", a, b)
+    w = np.cross(a, b)
+    # R v = v + w × v + w × (w × v) / (1 + c)  (Rodrigues, rotation taking a to b); antiparallel: skip
+    den = np.where(1 + c > 1e-12, 1 + c, np.inf)
+    wv = np.cross(w, v)
+    Rv = v + wv + np.cross(w, wv) / den[:, None]
+    z = np.einsum("kj,kj->k", Rv, e1[i]) + 1j * np.einsum("kj,kj->k", Rv, e2[i])
+    mag = np.abs(z)
+    return np.where(mag > 0, z / np.where(mag > 0, mag, 1.0), 1.0)
+
+
+def connection_laplacian(L: sp.spmatrix, N, e1, e2) -> sp.csr_matrix:
+    """Vertex connection Laplacian: off-diagonal entries of the real Laplacian L times the frame rotations
+    r_ij (Eq. 9 / §8.3–8.4), the diagonal unchanged; Hermitian by construction (upper part, conjugated)."""
+    L = sp.coo_matrix(L)
+    up = L.row < L.col
+    i, j, v = L.row[up], L.col[up], L.data[up]
+    r = frame_transport(N, e1, e2, i, j)
+    d = L.diagonal()
+    n = L.shape[0]
+    rows = np.concatenate([i, j, np.arange(n)])
+    cols = np.concatenate([j, i, np.arange(n)])
+    vals = np.concatenate([v * r, v * np.conj(r), d.astype(np.complex128)])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+# --------------------------------------------------------------------------------------------- polygon solver
+class PolygonDomain(VertexSurfaceDomain):
+    """Polygon mesh (§8.3) with the Bunge et al. 2020 polygon Laplacian (module docs).
+
+    Parameters
+    ----------
+    V : (n, 3) float; polygons : list of int sequences (or an (m, k) array), any mix of degrees, planar or not;
+    t_coef : float, diffusion time ``t = t_coef · (mean polygon edge length)²``.
+
+    Attributes
+    ----------
+    L : (n, n) PSD polygon Laplacian ``Pᵀ C_fan P``; M : (n,) lumped mass; P : prolongation;
+    V_refined, F_refined : the virtual-vertex refinement; N, e1, e2 : vertex tangent frames.
+
+    Example
+    -------
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    >>> PolygonDomain(V, [[0, 1, 2, 3]]).L.shape
+    (4, 4)
+    """
+
+    def __init__(self, V, polygons, t_coef: float = 1.0):
+        V = _checks.as_points(V, "V")
+        t_coef = _checks.positive(t_coef, "t_coef")
+        self.n_vertices = n = len(V)
+        self.V = V
+        polys = _parse_polygons(polygons, n)
+        self.V_refined, F, self.P = virtual_vertex_refinement(V, polys)
+        # fan triangles of zero area (nonconvex / degenerate polygons) carry no stiffness or mass: drop them
+        dbl = np.linalg.norm(np.cross(self.V_refined[F[:, 1]] - self.V_refined[F[:, 0]],
+                                      self.V_refined[F[:, 2]] - self.V_refined[F[:, 0]]), axis=1)
+        E = self._edges(polys)
+        self._edge_keys, first = np.unique(np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1]),
+                                           return_index=True)
+        ell = np.linalg.norm(V[E[first, 1]] - V[E[first, 0]], axis=1)      # unique polygon edges
+        self.mean_edge = float(ell.mean())
+        good = dbl > 1e-12 * self.mean_edge ** 2
+        if not good.any():
+            raise ValueError("polygons: all polygons have zero area")
+        self.F_refined = F[good]
+        ops = TriangleMeshOperators(self.V_refined, self.F_refined)
+        self.fine_ops = ops
+        Pt = self.P.T.tocsr()
+        L = (Pt @ ops.cotan_laplacian() @ self.P).tocsr()               # Bunge et al. 2020 §4: L = Pᵀ L_fan P
+        L = (0.5 * (L + L.T)).tocsr()
+        self.M = Pt @ ops.vertex_mass()                                  # lumped Pᵀ M_fan P (rows of P sum to 1)
+        # vertex normals: area-weighted fine triangle normals (§8.3)
+        An = np.zeros((len(self.V_refined), 3))
+        for k in range(3):
+            np.add.at(An, self.F_refined[:, k], ops.normals * ops.areas[:, None])
+        An = An[:n]
+        nrm = np.linalg.norm(An, axis=1)
+        An[nrm == 0] = [0, 0, 1.0]
+        N = An / np.maximum(nrm, 1e-300)[:, None]
+        e1, e2 = tangent_frames(N)
+        Lconn = connection_laplacian(L, N, e1, e2)
+        super().__init__(V, L, self.M, Lconn, N, e1, e2, t_coef * self.mean_edge ** 2)
+
+    @staticmethod
+    def _edges(groups) -> np.ndarray:
+        return np.concatenate([np.stack([Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1) for Q in groups.values()])
+
+    def gather(self, X) -> np.ndarray:
+        """§8.3: prolong the vertex vectors to the fine vertices (virtual vertex = Σ w_i X_i as 3D vectors), sum
+        them over every fine triangle and project into its plane (normalized by the core)."""
+        ops = self.fine_ops
+        Xf = self.P @ self.to_3d(X)                                      # (n + #virtual, 3)
+        Y = Xf[ops.F].sum(axis=1)
+        Y -= ops.normals * np.einsum("fj,fj->f", Y, ops.normals)[:, None]
+        return Y
+
+    def divergence(self, Y) -> np.ndarray:
+        """The fine divergence restricted by Pᵀ (Bunge et al. §4.5)."""
+        return self.P.T @ self.fine_ops.divergence(Y)
+
+    def check_curve_edges(self, a, k):
+        n = self.n_vertices
+        key = np.minimum(a[:-1], a[1:]) * n + np.maximum(a[:-1], a[1:])
+        pos = np.clip(np.searchsorted(self._edge_keys, key), 0, len(self._edge_keys) - 1)
+        bad = self._edge_keys[pos] != key
+        if bad.any():
+            q = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"curves[{k}]: vertices {a[q]} and {a[q + 1]} (points {q}, {q + 1}) are not joined by "
+                             "a polygon edge (curves must run along polygon edges)")
+
+
+__all__ = ["PolygonDomain", "virtual_vertex_refinement", "virtual_vertex_weights", "connection_laplacian",
+           "frame_transport", "tangent_frames"]

@@ -1,0 +1,197 @@
+"""Direct sparse solvers: factorize once, solve many (SuperLU in symmetric mode; CHOLMOD via cholespy).
+
+The only module of gsdf that wraps a sparse factorization (with :mod:`.iterative`, which falls back to it).
+
+* :class:`Factorization` — SuperLU LU of a square real or complex matrix (symmetric mode first);
+* :class:`HermitianFactorization` — complex Hermitian positive definite (SuperLU, or CHOLMOD on the 2n real form);
+* :class:`BlockHermitianFactorization` — a complex operator given as its real 2n×2n SPD block matrix
+  (``[[Re, -Im], [Im, Re]]`` per entry, or any real 2×2 blocks such as reflections): CHOLMOD, SuperLU fallback;
+  solves take and return complex vectors;
+* :func:`cholesky` — CHOLMOD of a real SPD matrix (None when cholespy is missing or the matrix is not PD);
+* :func:`cached_factorization` — a small keyed cache of factorizations (constraint sets).
+
+Example
+-------
+>>> import numpy as np, scipy.sparse as sp
+>>> Factorization(sp.diags([2.0, 4.0]).tocsc()).solve(np.array([2.0, 2.0]))
+array([1. , 0.5])
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+__all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
+           "cholesky", "cached_factorization"]
+
+
+class Factorization:
+    """A sparse LU factorization of a square (typically symmetric / Hermitian) matrix, reused across solves.
+
+    Parameters
+    ----------
+    A : scipy.sparse matrix, shape (n, n), real or complex
+    symmetric : bool
+        Use the symmetric mode of SuperLU (ordering of A + Aᵀ, diagonal pivots first): several times less fill
+        for the Laplacian-like matrices of the heat method.
+    """
+
+    def __init__(self, A, symmetric: bool = True):
+        A = sp.csc_matrix(A)
+        if A.shape[0] != A.shape[1]:
+            raise ValueError(f"matrix: expected a square matrix, got shape {A.shape}")
+        self.shape = A.shape
+        self.dtype = A.dtype
+        if symmetric:
+            try:
+                self._lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                                     options={"SymmetricMode": True})
+                return
+            except RuntimeError:                              # a zero pivot without pivoting (saddle systems)
+                pass
+        try:
+            self._lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+        except RuntimeError as exc:
+            raise ValueError(f"matrix: the sparse system is singular ({exc})") from exc
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """Solve ``A x = b`` for one right-hand side (n,) or several (n, k)."""
+        b = np.asarray(b)
+        if np.iscomplexobj(b) and not np.iscomplexobj(np.zeros(0, self.dtype)):
+            return self._lu.solve(np.ascontiguousarray(b.real)) + 1j * self._lu.solve(np.ascontiguousarray(b.imag))
+        return self._lu.solve(np.ascontiguousarray(b, dtype=np.result_type(b, self.dtype)))
+
+
+class HermitianFactorization:
+    """Factorization of a sparse Hermitian positive definite complex matrix, reused across solves.
+
+    ``backend="superlu"`` (the default, ``"auto"``): SciPy's SuperLU on the complex matrix in symmetric mode.
+    ``backend="cholmod"``: CHOLMOD through ``cholespy`` on the equivalent real symmetric system of size 2n (the
+    2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved). Measured on the vector heat operators (bunny00 CR edges,
+    113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2–3.5× faster (0.58 vs 1.14 s,
+    0.15 vs 0.53 s) and solves as fast (bench/bench_solver_choices.py), so the 2n embedding is not worth it.
+
+    Example
+    -------
+    >>> import numpy as np, scipy.sparse as sp
+    >>> A = sp.csr_matrix(np.array([[2.0, 1j], [-1j, 2.0]]))
+    >>> x = HermitianFactorization(A).solve(np.array([1.0, 0.0]))
+    >>> bool(np.allclose(A @ x, [1.0, 0.0]))
+    True
+    """
+
+    def __init__(self, A, backend: str = "auto"):
+        A = sp.coo_matrix(A)
+        n = A.shape[0]
+        self.n = n
+        self._chol = None
+        if backend not in ("auto", "superlu", "cholmod"):
+            raise ValueError(f"backend: expected 'auto', 'superlu' or 'cholmod', got {backend!r}")
+        if backend == "cholmod":
+            from cholespy import CholeskySolverD, MatrixType
+
+            r, c, v = A.row, A.col, A.data.astype(np.complex128)
+            rows = np.concatenate([2 * r, 2 * r, 2 * r + 1, 2 * r + 1])
+            cols = np.concatenate([2 * c, 2 * c + 1, 2 * c, 2 * c + 1])
+            vals = np.concatenate([v.real, -v.imag, v.imag, v.real])
+            R = sp.csr_matrix((vals, (rows, cols)), shape=(2 * n, 2 * n))
+            R.sum_duplicates()
+            self._chol = CholeskySolverD(2 * n, R.indptr.astype(np.int32), R.indices.astype(np.int32),
+                                         np.ascontiguousarray(R.data), MatrixType.CSR)
+            self.backend = "cholmod"
+            return
+        self._lu = Factorization(A.astype(np.complex128))
+        self.backend = "superlu"
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """Solve ``A x = b`` for a complex right-hand side (n,)."""
+        b = np.asarray(b, dtype=np.complex128)
+        if self._chol is None:
+            return self._lu.solve(b)
+        rb = np.empty(2 * self.n)
+        rb[0::2], rb[1::2] = b.real, b.imag
+        x = np.zeros_like(rb)
+        self._chol.solve(rb, x)
+        return x[0::2] + 1j * x[1::2]
+
+
+
+class CholeskyFactorization:
+    """CHOLMOD (cholespy) factorization of a real SPD matrix; ``solve`` for (n,) or (n, k) right-hand sides."""
+
+    def __init__(self, A):
+        from cholespy import CholeskySolverD, MatrixType
+
+        A = sp.csr_matrix(A)
+        A.sum_duplicates()
+        self.n = A.shape[0]
+        self._chol = CholeskySolverD(self.n, A.indptr.astype(np.int32), A.indices.astype(np.int32),
+                                     np.ascontiguousarray(A.data, dtype=np.float64), MatrixType.CSR)
+
+    def solve(self, b):
+        b = np.ascontiguousarray(b, dtype=np.float64)
+        x = np.zeros_like(b)
+        self._chol.solve(b, x)
+        return x
+
+
+def cholesky(A):
+    """A :class:`CholeskyFactorization` of the real SPD ``A``, or None when cholespy is not installed or CHOLMOD
+    finds ``A`` not positive definite (callers then use :class:`Factorization`)."""
+    try:
+        return CholeskyFactorization(A)
+    except (ImportError, ValueError, RuntimeError):
+        return None
+
+
+class BlockHermitianFactorization:
+    """Factorization of a complex linear operator given in real form: the 2n×2n SPD matrix whose 2×2 block
+    (i, j) maps (Re, Im) of unknown j to row i (e.g. the vector heat operator ``M ⊗ I₂ + t L∇`` on meshes whose
+    face orientations disagree, where transport is a reflection). CHOLMOD via cholespy, SuperLU without it.
+    ``solve`` takes and returns complex vectors (n,).
+
+    Example
+    -------
+    >>> import numpy as np, scipy.sparse as sp
+    >>> f = BlockHermitianFactorization(sp.diags([2.0, 2.0]))
+    >>> complex(f.solve(np.array([2.0 + 4.0j]))[0])
+    (1+2j)
+    """
+
+    def __init__(self, A):
+        A = sp.csr_matrix(A)
+        A.sum_duplicates()
+        self.n = A.shape[0] // 2
+        self._chol = None
+        try:
+            from cholespy import CholeskySolverD, MatrixType
+        except ImportError:
+            self._lu = Factorization(A.tocsc())
+            self.backend = "superlu"
+        else:
+            self._chol = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32), A.indices.astype(np.int32),
+                                         np.ascontiguousarray(A.data, dtype=np.float64), MatrixType.CSR)
+            self.backend = "cholmod"
+
+    def solve(self, b):
+        b = np.asarray(b, np.complex128)
+        r = np.empty(2 * self.n)
+        r[0::2], r[1::2] = b.real, b.imag
+        if self._chol is not None:
+            x = np.zeros_like(r)
+            self._chol.solve(r, x)
+        else:
+            x = self._lu.solve(r)
+        return x[0::2] + 1j * x[1::2]
+
+
+def cached_factorization(cache: dict, key, build, most: int = 8):
+    """``cache[key]``, building it with ``build()`` on a miss; the oldest entry is dropped beyond ``most``."""
+    fact = cache.get(key)
+    if fact is None:
+        if len(cache) >= most:
+            cache.pop(next(iter(cache)))
+        fact = cache[key] = build()
+    return fact
