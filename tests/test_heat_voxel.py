@@ -48,7 +48,7 @@ def sphere_run(N, normal_radius=3.0, broken=False, **kw):
     P = s.vertices - c
     theta = np.arccos(np.clip(-P[:, 2] / np.linalg.norm(P, axis=1), -1, 1))     # polar angle from the south pole
     ref = R * (theta - np.arccos(-0.3))
-    A = s.domain.mass
+    A = s.domain.mass()
     # the true sign is the digital region's: inside = all incident quads in the region (curve vertices excluded)
     nin = np.bincount(s.faces.ravel(), weights=np.repeat(region, 4).astype(float), minlength=len(P))
     nall = np.bincount(s.faces.ravel(), minlength=len(P))
@@ -67,7 +67,7 @@ def plane_run(N, nrm=(1, 1, 1), mdir=(1, -1, 0), **kw):
     phi = s.compute_distance(region_boundary_curves(s.faces, (s.face_centres - ctr) @ m < 0))
     P = s.vertices - ctr
     sel = (np.linalg.norm(P - np.outer(P @ nrm, nrm), axis=1) < 0.3 * N) & (np.abs(P @ nrm) < 1.0)
-    return eps(phi[sel], (P @ m)[sel], s.domain.mass[sel])
+    return eps(phi[sel], (P @ m)[sel], s.domain.mass()[sel])
 
 
 # ------------------------------------------------------------------------------------------------ the surface
@@ -176,7 +176,7 @@ def test_linear_precision_on_a_corrected_plane():
     assert np.all(d.face_ops.area[onf] <= 1 + 1e-12)
     Y = np.tile(g, (d.m, 1))
     Y[~onf] = d.gradient(phi)[~onf]
-    assert np.allclose(d.divergence_of_vectors(d.gradient(phi)), d.L @ phi)         # div ♭∇φ = Lφ
+    assert np.allclose(d.divergence(d.gradient(phi)), d.L @ phi)         # div ♭∇φ = Lφ
     assert np.allclose(d.L @ np.ones(d.n), 0)
 
 
@@ -279,11 +279,11 @@ def test_point_sources_and_unsigned_curves(sphere32):
         phi = s.compute_distance([], points=[src])
         Q = P[src] / np.linalg.norm(P[src])
         geo = 13 * np.arccos(np.clip(P @ Q / np.linalg.norm(P, axis=1), -1, 1))
-        assert phi[src] == 0 and eps(phi, geo, s.domain.mass) < 0.035
+        assert phi[src] == 0 and eps(phi, geo, s.domain.mass()) < 0.035
     uns = s.compute_distance(ring, curve_signs=[False] * len(ring))
     signed = s.compute_distance(ring)
     assert uns.min() > -1e-6
-    assert eps(uns, np.abs(signed), s.domain.mass) < 0.03
+    assert eps(uns, np.abs(signed), s.domain.mass()) < 0.03
 
 
 def test_curves_across_quad_diagonals(sphere32):
@@ -329,9 +329,9 @@ def test_bad_input():
         s.compute_distance([np.array([0, n])])
     with pytest.raises(ValueError, match=r"curves\[0\].*out of range"):
         s.compute_distance([np.array([-1, 0])])
-    with pytest.raises(ValueError, match=r"curves\[0\].*integers"):
+    with pytest.raises(ValueError, match=r"curves\[0\].*(booleans|integers)"):
         s.compute_distance([np.array([True, False])])
-    with pytest.raises(ValueError, match=r"curves\[0\].*integers"):
+    with pytest.raises(ValueError, match=r"curves.*integer"):
         s.compute_distance([np.array([0.5, 1.0])])
     far = int(np.argmax(np.linalg.norm(s.vertices - s.vertices[f[0]], axis=1)))
     with pytest.raises(ValueError, match=r"curves\[0\].*common quad"):

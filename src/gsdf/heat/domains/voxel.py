@@ -1,7 +1,8 @@
 """The signed heat method on digital surfaces — boundaries of binary volumes (Feng & Crane 2024, §8.5).
 
-The domain owns the operators and the sources; steps I–III, the constraints and the shift are the shared
-vertex-based signed heat steps.
+:class:`VoxelSurfaceDomain` owns the operators and the sources (a
+:class:`~gsdf.heat.domains.base.VertexSurfaceDomain`); steps I–III, the constraints and the shift are
+:class:`gsdf.heat.core.SignedHeatCore`'s. :class:`VoxelSurfaceSignedHeatSolver` is the front-end.
 
 Pipeline (notes wave2-swn-recon-voxel §3):
 
@@ -54,10 +55,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from ... import _checks
-from ..surface.polygon import (LEVEL_SETS, VertexSignedHeat, connection_laplacian, frame_transport,
-                               solve_vertex_sources, tangent_frames)
+from ..core import SignedHeatCore
 from ._degoes import face_operators
 from ._digital import digital_surface, integral_invariant_normals
+from .base import VertexSurfaceDomain, tangent_frames
+from .polygon import connection_laplacian, frame_transport
 
 CONNECTIONS = ("A", "B")
 
@@ -106,7 +108,7 @@ def as_spacing(spacing) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------------------------- the domain
-class VoxelSurfaceDomain:
+class VoxelSurfaceDomain(VertexSurfaceDomain):
     """Operators and sources of the signed heat method on the digital surface of a binary volume (module docs).
 
     Parameters
@@ -124,15 +126,30 @@ class VoxelSurfaceDomain:
     connection : {"A", "B"}
         Connection Laplacian: "A" the de Goes/DGtal operator (default), "B" the scalar Laplacian with rotated
         off-diagonals (cross-check).
+    t_coef : float
+        Diffusion time ``t = t_coef · h²``, h the mean edge length.
 
     Attributes
     ----------
     vertices : (n, 3); faces : (m, 4) outward quads; face_centres : (m, 3); normals : (m, 3) corrected u_f;
-    L : (n, n) PSD Laplacian; mass : (n,) lumped mass; Lconn : (n, n) complex connection Laplacian;
-    vertex_normals, e1, e2 : (n, 3) vertex frames; h : mean edge length; face_ops : the per-face operators.
+    L : (n, n) PSD Laplacian; Mv : (n,) lumped mass (``mass()``); Lconn : (n, n) complex connection Laplacian;
+    vertex_normals (= N), e1, e2 : (n, 3) vertex frames; h : mean edge length; t : diffusion time;
+    face_ops : the per-face operators (:class:`~gsdf.heat.domains._degoes.FaceOperators`).
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> from gsdf.heat.core import SignedHeatCore
+    >>> x = np.indices((16, 16, 16)) - 7.5
+    >>> d = VoxelSurfaceDomain((x ** 2).sum(0) < 6 ** 2)
+    >>> phi = SignedHeatCore(d).compute_distance([], points=[0])
+    >>> phi.shape == (d.n,) and bool(phi.min() == 0)
+    True
     """
 
-    def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, normals=None, connection: str = "A"):
+    def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, normals=None, connection: str = "A",
+                 t_coef: float = 1.0):
+        t_coef = _checks.positive(t_coef, "t_coef")
         occ = as_occupancy(occupancy)
         s = as_spacing(spacing)
         self.connection = _checks.choice(connection, "connection", CONNECTIONS)
@@ -150,7 +167,8 @@ class VoxelSurfaceDomain:
         self.vertices, self.faces, self.face_centres = S.vertices, S.faces, S.centres
         self.n, self.m = len(S.vertices), len(S.faces)
         self.normals = self._normals(normals, occ, s, r)
-        self._assemble()
+        L, M, Lconn = self._assemble()
+        super().__init__(self.vertices, L, M, Lconn, self.vertex_normals, self.e1, self.e2, t_coef * self.h ** 2)
 
     # ---------------------------------------------------------------- normals and operators
     def _normals(self, normals, occ, s, r) -> np.ndarray:
@@ -184,8 +202,8 @@ class VoxelSurfaceDomain:
         rows = np.broadcast_to(F[:, :, None], (m, 4, 4)).ravel()
         cols = np.broadcast_to(F[:, None, :], (m, 4, 4)).ravel()
         L = sp.csr_matrix((ops.laplacian.ravel(), (rows, cols)), shape=(n, n))
-        self.L = (0.5 * (L + L.T)).tocsr()
-        self.mass = np.bincount(F.ravel(), weights=np.repeat(ops.area / 4.0, 4), minlength=n)
+        L = (0.5 * (L + L.T)).tocsr()
+        M = np.bincount(F.ravel(), weights=np.repeat(ops.area / 4.0, 4), minlength=n)
         # vertex normals: normalized mean of the incident corrected normals (§8.5)
         Nv = np.zeros((n, 3))
         for a in range(3):
@@ -202,10 +220,9 @@ class VoxelSurfaceDomain:
         self.face_e1, self.face_e2 = f1, np.cross(nf, f1)
         E = np.stack([F.ravel(), np.roll(F, -1, axis=1).ravel()], 1)
         self.h = float(np.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=1).mean())
-        if self.connection == "A":
-            self.Lconn = self.connection_laplacian_a()
-        else:
-            self.Lconn = connection_laplacian(self.L, Nv, self.e1, self.e2)
+        Lconn = self.connection_laplacian_a() if self.connection == "A" else connection_laplacian(L, Nv, self.e1,
+                                                                                                  self.e2)
+        return L, M, Lconn
 
     def vertex_face_transport(self) -> np.ndarray:
         """r_vf (m, 4) complex: a tangent vector z in the frame of corner vertex v of face f is ``r_vf z`` in the
@@ -228,19 +245,15 @@ class VoxelSurfaceDomain:
         A = sp.csr_matrix((vals.ravel(), (rows, cols)), shape=(n, n))
         return (0.5 * (A + A.conj().T)).tocsr()
 
-    def divergence(self, Xv: np.ndarray) -> np.ndarray:
-        """Step II and the right-hand side of step III: per quad Y_f = normalize((I − n nᵀ) Σ_{v∈f} X_v) from
-        vertex vectors Xv (n, 3); returns ``b = Σ_f Dᵀ M_f V_f Y_f`` (n,), so that ``L φ = b`` when Y = ∇φ."""
-        ops, F = self.face_ops, self.faces
-        nf = ops.normal
-        Y = Xv[F].sum(axis=1)
-        Y -= nf * np.einsum("ij,ij->i", Y, nf)[:, None]
-        nrm = np.linalg.norm(Y, axis=1)
-        Yn = np.zeros_like(Y)
-        np.divide(Y, nrm[:, None], out=Yn, where=nrm[:, None] > 0)
-        return self.divergence_of_vectors(Yn)
+    # ---------------------------------------------------------------- steps II and III (protocol)
+    def gather(self, X) -> np.ndarray:
+        """Step II before normalization: per quad ``(I − n_f n_fᵀ) Σ_{v∈f} X_v`` (m, 3) from the complex vertex
+        vectors X (n,) (§8.5; the core normalizes)."""
+        nf = self.face_ops.normal
+        Y = self.to_3d(X)[self.faces].sum(axis=1)
+        return Y - nf * np.einsum("ij,ij->i", Y, nf)[:, None]
 
-    def divergence_of_vectors(self, Y: np.ndarray) -> np.ndarray:
+    def divergence(self, Y: np.ndarray) -> np.ndarray:
         """``Σ_f Dᵀ M_f V_f Y_f`` (n,) for face vectors Y (m, 3) (the integrated divergence, gsdf's sign: it equals
         L φ for Y = ∇φ of a linear φ)."""
         ops = self.face_ops
@@ -281,13 +294,13 @@ class VoxelSurfaceDomain:
         s = cum[hi] - cum[lo]
         return s / np.linalg.norm(s, axis=1, keepdims=True)
 
-    def check_segments(self, a: np.ndarray, k: int) -> None:
+    def check_curve_edges(self, a: np.ndarray, k: int) -> None:
         """Validate that consecutive vertices of curve k share a quad."""
         self.segment_normals(a[:-1], a[1:], f"curves[{k}]")
 
-    def curve_source(self, curves, X0: np.ndarray) -> None:
+    def curve_source(self, curves, X0: np.ndarray, normals=None) -> None:
         """Add ``(ℓ_s / 2) t̂_s × n_s`` of every segment to X⁰ at both end vertices, projected onto their tangent
-        bases (§8.5; module docs item 7)."""
+        bases (§8.5; module docs item 7). ``normals`` is not used (the segment normals are the quads')."""
         for g in curves:
             a, b = g[:-1], g[1:]
             T = self.vertices[b] - self.vertices[a]                # = ℓ_s t̂_s
@@ -313,21 +326,6 @@ class VoxelSurfaceDomain:
             j = F[f, (k + o) % 4]
             z = np.einsum("kj,kj->k", vec, self.e1[j]) + 1j * np.einsum("kj,kj->k", vec, self.e2[j])
             np.add.at(X0, j, z)
-
-
-class _DomainSteps(VertexSignedHeat):
-    """The shared vertex-based steps I–III driven by a :class:`VoxelSurfaceDomain` (its curve source)."""
-
-    def __init__(self, domain: VoxelSurfaceDomain, t: float):
-        d = domain
-        super().__init__(d.vertices, d.L, d.mass, d.Lconn, t, d.vertex_normals, d.e1, d.e2, d.divergence)
-        self.domain = d
-
-    def curve_source(self, curves, X0, normals=None):
-        self.domain.curve_source(curves, X0)
-
-    def point_source(self, ids, X0):
-        self.domain.point_source(ids, X0)
 
 
 # --------------------------------------------------------------------------------------------- the solver
@@ -371,15 +369,14 @@ class VoxelSurfaceSignedHeatSolver:
 
     def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, *, t_coef: float = 1.0, normals=None,
                  connection: str = "A"):
-        t_coef = _checks.positive(t_coef, "t_coef")
         self.domain = d = VoxelSurfaceDomain(occupancy, spacing, normal_radius, normals=normals,
-                                             connection=connection)
+                                             connection=connection, t_coef=t_coef)
         self.vertices, self.faces, self.face_centres, self.normals = d.vertices, d.faces, d.face_centres, d.normals
-        self.t = t_coef * d.h ** 2
-        self.core = _DomainSteps(d, self.t)
+        self.t = d.t
+        self.core = SignedHeatCore(d)
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
-                         soft_weight=None) -> np.ndarray:
+                         soft_weight=None, progress=None) -> np.ndarray:
         """Generalized signed geodesic distance (n,) at the vertices, negative inside.
 
         Parameters
@@ -396,9 +393,16 @@ class VoxelSurfaceSignedHeatSolver:
             finally shifted to mean zero along the curves (Alg. 13).
         soft_weight : float, optional
             Replace the hard constraint by the penalty λ Σ (φ(v) − φ(v₀))² (§7.1).
+        progress : callable, optional
+            ``progress(stage, fraction)`` (:mod:`gsdf.heat.core`).
+
+        Returns
+        -------
+        phi : (n,) float64
         """
-        return solve_vertex_sources(self.core, curves, points, curve_signs, level_set_constraint, soft_weight,
-                                    edge_check=self.domain.check_segments)
+        return self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
+                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
+                                          progress=progress)
 
 
-__all__ = ["VoxelSurfaceSignedHeatSolver", "VoxelSurfaceDomain", "as_occupancy", "as_spacing", "LEVEL_SETS"]
+__all__ = ["VoxelSurfaceSignedHeatSolver", "VoxelSurfaceDomain", "as_occupancy", "as_spacing"]
