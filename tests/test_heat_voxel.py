@@ -364,3 +364,34 @@ def test_entry_point_and_spacing():
     c = gsdf.VoxelSurfaceSignedHeatSolver(occ, spacing=[1.0, 1.0, 2.0])
     assert np.ptp(c.vertices[:, 2]) == pytest.approx(2 * np.ptp(a.vertices[:, 2]))
     assert isinstance(a.domain.L, sp.csr_matrix)
+
+
+# ------------------------------------------------------------------------------------------------ CLI
+def test_cli_heat_surface_voxels(tmp_path):
+    from click.testing import CliRunner
+
+    from gsdf.cli.main import main
+    from gsdf.io import read_mesh
+
+    occ = ball(20, 7)
+    np.save(tmp_path / "ball.npy", occ)
+    out = tmp_path / "ball.ply"
+    r = CliRunner().invoke(main, ["heat-surface", str(tmp_path / "ball.npy"), "--voxels", "--cut", "z<5",
+                                  "--spacing", "0.5", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    s = VoxelSurfaceSignedHeatSolver(occ, spacing=0.5)
+    phi = s.compute_distance(region_boundary_curves(s.faces, s.face_centres[:, 2] < 5))
+    from plyfile import PlyData
+
+    d = PlyData.read(str(out))["vertex"]["distance"]
+    assert np.allclose(d, phi)
+    V, _ = read_mesh(str(out))
+    assert np.allclose(V[:, 2].max(), s.vertices[:, 2].max())
+    for args, msg in ((["--cut", "q<1"], "--cut"), ([], "exactly one of"), (["--cut", "z<99"], "no curve")):
+        r = CliRunner().invoke(main, ["heat-surface", str(tmp_path / "ball.npy"), "--voxels", *args, "-o",
+                                      str(out)])
+        assert r.exit_code != 0 and msg in r.output
+    np.save(tmp_path / "bad.npy", np.zeros((3, 3), bool))
+    r = CliRunner().invoke(main, ["heat-surface", str(tmp_path / "bad.npy"), "--voxels", "--cut", "z<1", "-o",
+                                  str(out)])
+    assert r.exit_code != 0 and "occupancy" in r.output
