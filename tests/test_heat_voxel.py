@@ -36,7 +36,10 @@ def sphere_run(N, normal_radius=3.0, broken=False, **kw):
     R = N / 2 - 2
     s = VoxelSurfaceSignedHeatSolver(ball(N, R), normal_radius=normal_radius, **kw)
     c = N / 2
-    region = s.face_centres[:, 2] < c + 0.3 * R
+    # the curve at the grid plane z = zc nearest to c + 0.3 R (quads with centres below zc + ¼: the region's
+    # boundary edges then lie on that plane, not up to half a voxel off it)
+    zc = c + np.round(0.3 * R)
+    region = s.face_centres[:, 2] < zc + 0.25
     curves = region_boundary_curves(s.faces, region)
     if broken:                                                  # delete every other run of 4 segments (50 %)
         pieces = []
@@ -47,7 +50,7 @@ def sphere_run(N, normal_radius=3.0, broken=False, **kw):
     phi = s.compute_distance(curves)
     P = s.vertices - c
     theta = np.arccos(np.clip(-P[:, 2] / np.linalg.norm(P, axis=1), -1, 1))     # polar angle from the south pole
-    ref = R * (theta - np.arccos(-0.3))
+    ref = R * (theta - np.arccos(-(zc - c) / R))
     A = s.domain.mass()
     # the true sign is the digital region's: inside = all incident quads in the region (curve vertices excluded)
     nin = np.bincount(s.faces.ravel(), weights=np.repeat(region, 4).astype(float), minlength=len(P))
@@ -240,6 +243,9 @@ def test_digital_sphere_converges_with_resolution():
     assert runs[2][1] >= 0.99
     triv = sphere_run(64, normal_radius=0)[0]
     assert triv > 4 * e[2]
+    # a radius growing like r ∝ h^(1/3) in world units (½ N^(2/3) voxels) removes the fixed-radius bias
+    s32, s64 = (sphere_run(N, normal_radius=0.5 * N ** (2 / 3))[0] for N in (32, 64))
+    assert s64 < 0.6 * s32 and s64 < 0.5 * e[2]
 
 
 def test_broken_sphere_curve():

@@ -358,7 +358,10 @@ class VoxelSurfaceSignedHeatSolver:
         Voxel size (world units per voxel along x, y, z).
     normal_radius : float
         Integral-invariant radius of the corrected normals, in voxels (of the smallest spacing); 0 = trivial
-        normals. Default 3.
+        normals. Default 3 (DGtal's). A fixed radius in voxels leaves a normal bias that stops the convergence
+        under refinement (digital sphere: ε ≈ 0.005 from N = 64 on); for convergence studies let it grow like
+        ``0.5 · N^(2/3)`` voxels for an object N voxels across (r ∝ h^(1/3) in world units, Coeurjolly et al.
+        2014; bench/RESULTS.md "heat-voxel").
     t_coef : float
         Diffusion time ``t = t_coef · h²``, h the mean edge length (≈ the voxel size).
     normals : None, "trivial" or (m, 3) array
