@@ -409,3 +409,13 @@ def test_cli_heat_surface_voxels(tmp_path):
     r = CliRunner().invoke(main, ["heat-surface", str(tmp_path / "bad.npy"), "--voxels", "--cut", "z<1", "-o",
                                   str(out)])
     assert r.exit_code != 0 and "occupancy" in r.output
+
+
+def test_typed_curves_edge_sets(sphere32):
+    from gsdf.heat.sources import Curve
+
+    s, ring = sphere32
+    E = np.stack([ring[0][:-1], ring[0][1:]], 1)[np.random.default_rng(0).permutation(len(ring[0]) - 1)]
+    assert np.allclose(s.compute_distance([Curve(E)]), s.compute_distance(ring))             # chained edges
+    assert np.allclose(s.compute_distance([Curve(ring[0], signed=False)]),
+                       s.compute_distance(ring, curve_signs=[False]))
