@@ -32,6 +32,8 @@ _EXPORTS = {
     # the signed heat method on surfaces (Feng & Crane 2024)
     "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
     "level_set_curves": "heat", "region_boundary_curves": "heat", "Curve": "heat.sources",
+    "level_set_curves": "heat", "region_boundary_curves": "heat",
+    "VoxelSurfaceSignedHeatSolver": "heat.domains.voxel",
     "read_curves": "io.curves", "write_curves": "io.curves",
     # the signed heat method in volumes (grids, tets) and morphology
     "signed_heat_volume": "heat.volume", "YukawaTree": "heat.volume",
