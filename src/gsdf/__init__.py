@@ -36,6 +36,8 @@ _EXPORTS = {
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
     "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
     "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "tori",
+    # dataset batches (issue 16)
+    "run_batch": "batch", "sdf_samples": "batch",
 }
 
 __all__ = sorted(_EXPORTS)
