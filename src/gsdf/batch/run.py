@@ -290,11 +290,11 @@ def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
     window = max(2, 2 * ex.n_slots)
     inflight = {}  # future -> job
 
-    def finish(rec):
+    def finish(rec, report=True):
         rec.setdefault("time", _now())
         writer.write(rec)
         result.records.append(rec)
-        if progress is not None:
+        if report and progress is not None:
             progress(rec, _tally(result.records, total))
 
     try:
@@ -340,7 +340,8 @@ def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
         ex.cancel(list(inflight))
         for job in inflight.values():
             finish({**{k: job[k] for k in ("task", "input", "output", "options", "params_sha256", "attempts",
-                                           "run")}, "status": "cancelled", "error": "interrupted (Ctrl-C)"})
+                                           "run")}, "status": "cancelled", "error": "interrupted (Ctrl-C)"},
+                   report=False)
         for job in todo:
             result.records.append({**{k: job[k] for k in ("task", "input", "output", "run")},
                                    "status": "pending"})
