@@ -278,6 +278,7 @@ def test_local_worker_killed_loses_no_item(dataset, tmp_path):
     finally:
         ex.close()
     assert killed
+    assert all(x["threads"] == max(1, os.cpu_count() // 2) for x in r.records if x["status"] == "done")
     assert {x["output"] for x in r.records} == GOOD | {"corrupt.npz"}
     assert all(x["status"] in ("done", "failed") for x in r.records)
     assert _outputs(tmp_path / "out") == {x["output"] for x in r.records if x["status"] == "done"}
@@ -305,8 +306,21 @@ def test_dask_matches_single_process_bit_for_bit(dask2, local_run, dataset, tmp_
         assert a.files == b.files
         for k in a.files:
             assert a[k].tobytes() == b[k].tobytes(), (p, k)
+    assert all(x["threads"] == max(1, os.cpu_count() // 2) for x in r.records if x["status"] == "done")
     again = run_batch(str(dataset), "sdf-samples", str(tmp_path / "d"), {"n_samples": N}, executor=dask2)
     assert again.counts["skipped"] == 5
+
+
+def test_dask_connect_shares_host_cores(dask2, dataset, tmp_path):
+    ex = DaskExecutor.connect(dask2.client.scheduler.address, timeout=5)
+    try:
+        assert set(ex.threads_by_worker.values()) == {max(1, os.cpu_count() // 2)}  # 2 workers on this host
+        r = run_batch([str(dataset / "sphere.obj")], "occupancy", str(tmp_path / "c"), {"n_points": 500},
+                      executor=ex)
+    finally:
+        ex.close()
+    assert r.counts["done"] == 1 and r.records[0]["threads"] == max(1, os.cpu_count() // 2)
+    assert np.load(tmp_path / "c" / "sphere.npz")["occupancy"].shape == (500,)
 
 
 def test_dask_worker_killed_loses_no_item(dask2, dataset, tmp_path):

@@ -105,6 +105,22 @@ def _import_distributed():
     return distributed
 
 
+def _share_hosts(client) -> dict:
+    """Worker address -> BLAS/numba threads, so that the Dask threads of all workers on one host share its cores
+    (a host with 16 cores and 4 one-thread workers gives each item 4 threads). Workers that join later
+    fall back to their own cores / their own Dask threads."""
+    try:
+        cores = client.run(_threads.available_cpus, wait=True)
+        workers = client.scheduler_info().get("workers", {})
+    except Exception:  # pragma: no cover - a scheduler without workers yet, or a refused run()
+        return {}
+    per_host: dict = {}
+    for addr, w in workers.items():
+        per_host[w.get("host")] = per_host.get(w.get("host"), 0) + int(w.get("nthreads", 1))
+    return {addr: _threads.threads_per_worker(per_host[w.get("host")], cores.get(addr))
+            for addr, w in workers.items() if addr in cores}
+
+
 class DaskExecutor:
     """Items as Dask futures on ``client``; one thread of each Dask worker runs one item.
 
@@ -120,6 +136,7 @@ class DaskExecutor:
 
     def __init__(self, client, cluster=None, threads: int | None = None):
         self.client, self.cluster, self.threads = client, cluster, threads
+        self.threads_by_worker = None
         self._distributed = _import_distributed()
 
     @classmethod
@@ -149,7 +166,10 @@ class DaskExecutor:
         except (OSError, TimeoutError, ValueError) as exc:
             raise ValueError(f"scheduler: cannot reach the Dask scheduler at {address} "
                              f"(gave up after {time.monotonic() - t0:.1f} s: {exc})") from None
-        return cls(client, None, threads)
+        ex = cls(client, None, threads)
+        if threads is None:
+            ex.threads_by_worker = _share_hosts(client)
+        return ex
 
     @property
     def n_slots(self) -> int:

@@ -301,6 +301,8 @@ def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
         while todo or inflight:
             while todo and len(inflight) < window:
                 job = todo.popleft()
+                if job["threads"] is None:  # the executor's share of the cores (or, remote, per worker)
+                    job = {**job, "threads": ex.threads, "threads_by_worker": getattr(ex, "threads_by_worker", None)}
                 inflight[ex.submit(process_item, job)] = job
             done = ex.wait(inflight, timeout=poll)
             deaths = []

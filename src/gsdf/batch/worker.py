@@ -47,22 +47,25 @@ def write_npz_atomic(path, arrays: dict) -> None:
         raise
 
 
-def worker_threads(requested) -> int:
-    """Threads of this item: ``requested``, or (None) this machine's cores shared by the worker processes'
-    threads (a Dask worker with k threads runs k items at once)."""
+def worker_threads(requested, by_worker=None) -> int:
+    """Threads of this item: ``requested``; else, on a Dask worker, its entry in ``by_worker`` (worker address ->
+    threads, measured by the driver when it connected) or its host's cores divided by its own Dask threads;
+    else all cores of this machine."""
     if requested:
         return int(requested)
-    per_process = 1
     import sys
 
     if "distributed" in sys.modules:
         try:
             from distributed import get_worker
 
-            per_process = get_worker().state.nthreads
+            w = get_worker()
+            if by_worker and w.address in by_worker:
+                return int(by_worker[w.address])
+            return _threads.threads_per_worker(w.state.nthreads)
         except (ValueError, AttributeError):
             pass
-    return _threads.threads_per_worker(per_process)
+    return _threads.available_cpus()
 
 
 def process_item(job: dict) -> dict:
@@ -77,7 +80,7 @@ def process_item(job: dict) -> dict:
     rec["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     seconds = {}
     try:
-        rec["threads"] = _threads.limit_threads(worker_threads(job.get("threads")))
+        rec["threads"] = _threads.limit_threads(worker_threads(job.get("threads"), job.get("threads_by_worker")))
         rec["input_sha256"] = file_sha256(job["input"])
         geo = load_input(job["input"], job["options"].get("estimate_normals", False))
         rec["counts"] = geo.counts()
