@@ -123,6 +123,29 @@ def test_task_bad_options():
         sdf_samples(Geometry(np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.]]), F=np.array([[0, 1, 2]])), n_samples=10)
     with pytest.raises(ValueError, match="source"):
         sdf_samples(42)
+    with pytest.raises(ValueError, match="out-of-memory estimate"):
+        sdf_grid(g, resolution=4000)
+
+
+def test_point_cloud_inputs(tmp_path):
+    from gsdf.io import write_points
+
+    from .shapes import fibonacci_sphere
+
+    P = fibonacci_sphere(1500)
+    out = sdf_samples(Geometry(P, N=P), n_samples=N, seed=4)
+    r = np.linalg.norm(out["points"], axis=1)
+    far = np.abs(r - 1) > 0.1
+    assert np.all((out["sdf"][far] < 0) == (r[far] < 1))
+    grid = sdf_grid(Geometry(P, N=P), resolution=9, method="pat")
+    assert grid["sdf"][4, 4, 4] == pytest.approx(-1.0, abs=0.1)  # the centre node, 1 from the sphere
+    write_points(str(tmp_path / "bare.xyz"), P)
+    with pytest.raises(ValueError, match="no normals"):
+        occupancy(str(tmp_path / "bare.xyz"))
+    occ = occupancy(str(tmp_path / "bare.xyz"), n_points=2000, estimate_normals=True)
+    rr = np.linalg.norm(occ["points"], axis=1)
+    ok = np.abs(rr - 1) > 0.1
+    assert np.mean(occ["occupancy"][ok] == (rr[ok] < 1)) > 0.99
 
 
 # ---------------------------------------------------------------------------------- inputs and manifests

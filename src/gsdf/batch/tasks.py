@@ -311,6 +311,23 @@ def occupancy(source, n_points: int = 100_000, normalize: str = "none", uniform_
                    c0, s0, dt)
 
 
+GRID_BYTES_PER_NODE = 96  # node positions (24), distance + winding + sign (24), outputs and temporaries
+
+
+def check_grid_memory(resolution: int, max_memory=None) -> None:
+    """Refuse a dense grid whose estimated working memory (``GRID_BYTES_PER_NODE`` × R³) exceeds ``max_memory``
+    (default 80 % of the available memory), before allocating anything: a clear per-item error, not an OOM kill."""
+    need = GRID_BYTES_PER_NODE * int(resolution) ** 3
+    if max_memory is None:
+        try:
+            max_memory = 0.8 * os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        except (ValueError, OSError, AttributeError):  # pragma: no cover - platforms without sysconf
+            return
+    if need > max_memory:
+        raise ValueError(f"resolution: a {resolution}^3 grid needs about {need / 2**30:.1f} GiB, more than the "
+                         f"{max_memory / 2**30:.1f} GiB available (out-of-memory estimate)")
+
+
 def _grid_box(X, normalize, pad):
     c, s, c0, s0 = frame(X, normalize)
     half = (1.0 + pad) * (s if normalize != "none" else 0.5 * float((X.max(axis=0) - X.min(axis=0)).max()))
@@ -346,6 +363,7 @@ def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str
                          'use "fast" or "heat"')
     from ..field import grid_points
 
+    check_grid_memory(o["resolution"])
     c, half, c0, s0 = _grid_box(geo.X, o["normalize"], o["pad"])
     R = o["resolution"]
     lo, hi = c - half, c + half
@@ -388,6 +406,7 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
     """
     o = check_options("surface", locals_without_source(locals()))
     geo = _geometry(source, o["estimate_normals"])
+    check_grid_memory(o["resolution"])
     c, half, c0, s0 = _grid_box(geo.X, o["normalize"], o["pad"])
     lo, hi = c - half, c + half
     R = o["resolution"]
