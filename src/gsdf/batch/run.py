@@ -287,7 +287,6 @@ def _hint(ex) -> str:
 
 
 def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
-    window = max(2, 2 * ex.n_slots)
     inflight = {}  # future -> job
 
     def finish(rec, report=True):
@@ -299,6 +298,7 @@ def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
 
     try:
         while todo or inflight:
+            window = max(2, 2 * ex.n_slots)  # a Dask cluster may grow or shrink during the run
             while todo and len(inflight) < window:
                 job = todo.popleft()
                 if job["threads"] is None:  # the executor's share of the cores (or, remote, per worker)
