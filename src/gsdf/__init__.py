@@ -44,6 +44,8 @@ _EXPORTS = {
     "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "tori",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
     "reconstruct_simply_connected": "recon", "mesh_topology": "recon",
+    # dataset batches (issue 16)
+    "run_batch": "batch", "sdf_samples": "batch",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -37,6 +37,7 @@ def main():
 
 for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn, reconstruct):
     main.add_command(command)
+main.add_command(__import__("gsdf.cli.batch", fromlist=["batch"]).batch)  # gsdf batch (issue 16)
 
 if __name__ == "__main__":  # pragma: no cover
     main()

@@ -1,0 +1,32 @@
+"""Dataset batches: SDF samples, occupancy, SDF grids and surfaces for thousands of (broken) meshes and clouds.
+
+Modules (one job each):
+
+- :mod:`~gsdf.batch.tasks` — the per-item tasks, plain functions of one input (``sdf_samples``, ``occupancy``,
+  ``sdf_grid``, ``surface``), their options and array names;
+- :mod:`~gsdf.batch.inputs` — INPUTS (folder, glob, manifest file, list) to items with mirrored output paths;
+- :mod:`~gsdf.batch.manifest` — the JSON-lines manifest and the content hashes that make runs resumable;
+- :mod:`~gsdf.batch.worker` — one item on a worker: threads, hash, read, compute, atomic ``.npz`` write;
+- :mod:`~gsdf.batch.executors` — local processes or a Dask cluster behind one submit / wait interface;
+- :mod:`~gsdf.batch.run` — the driver :func:`run_batch`: resume, retries, Ctrl-C, the manifest.
+
+Example
+-------
+>>> from gsdf.batch import run_batch, sdf_samples
+>>> out = sdf_samples("bunny.off", n_samples=250_000)                         # doctest: +SKIP
+>>> r = run_batch("meshes/", "sdf-samples", "out/", workers=2)                 # doctest: +SKIP
+>>> r = run_batch("meshes/", "sdf-grid", "grids/", {"resolution": 128},
+...               scheduler="tcp://scheduler:8786")                             # doctest: +SKIP
+"""
+
+from .executors import DaskExecutor, LocalExecutor
+from .inputs import Item, collect_inputs
+from .manifest import file_sha256, read_manifest
+from .run import BatchInterrupted, BatchResult, run_batch
+from .tasks import TASKS, Geometry, check_options, load_input, occupancy, run_task, sdf_grid, sdf_samples, surface
+from .worker import process_item, write_npz_atomic
+
+__all__ = ["run_batch", "BatchResult", "BatchInterrupted", "collect_inputs", "Item", "read_manifest",
+           "file_sha256", "TASKS", "Geometry", "load_input", "check_options", "run_task", "sdf_samples",
+           "occupancy", "sdf_grid", "surface", "process_item", "write_npz_atomic", "LocalExecutor",
+           "DaskExecutor"]
