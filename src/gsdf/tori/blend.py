@@ -128,7 +128,10 @@ def _nearest_walk(x0, x1, x2, Ps, lo, hi, right, start, end, k, wb, shrink, bd, 
     while sp > 0:
         sp -= 1
         node = stack[sp]
-        if _box_d2(lo, hi, node, x0, x1, x2) * shrink > min(bd[k - 1], wb):
+        bx = _box_d2(lo, hi, node, x0, x1, x2)
+        # the (1 + eps)² shrink relaxes only the k-th distance test: the warm-start bound wb is a hard limit
+        # on accepted points, so shrinking it too could leave fewer than k points (inf rows, NaN sums)
+        if bx > wb or bx * shrink > bd[k - 1]:
             continue
         rr = right[node]
         if rr < 0:
