@@ -104,3 +104,32 @@ def test_pat_kd_eps_never_gives_nan():
         v = gsdf.PointsAsTori(P, P, k=20, kd_eps=eps).signed_distance(Qr)
         assert np.isfinite(v).all()
         assert np.abs(v - (np.linalg.norm(Qr, axis=1) - 1)).max() < 0.1
+
+
+# ---- memory guard (gsdf._memory) ---------------------------------------------------------------------
+
+
+def test_grid_allocations_are_refused_with_size_and_limit(monkeypatch):
+    from gsdf._memory import available_bytes, check_bytes
+    from gsdf.contour import extract_isosurface
+    from gsdf.ops import voxelize, voxels_to_mesh
+
+    with pytest.raises(ValueError, match=r"100000x100000x100000 cells: needs about 8\.0 PB, more than the"):
+        voxelize(mesh=(V, F), resolution=100000)
+    with pytest.raises(ValueError, match="extract_isosurface: resolution=100000.*needs about"):
+        extract_isosurface(lambda q: q[:, 0], [0, 0, 0], [1, 1, 1], resolution=100000)
+    monkeypatch.setenv("GSDF_MEMORY_LIMIT", "1M")
+    assert available_bytes() == 1 << 20
+    with pytest.raises(ValueError, match=r"more than the 1\.0 MB allowed"):
+        voxelize(mesh=(V, F), resolution=64)
+    with pytest.raises(ValueError, match="voxels_to_mesh"):
+        voxels_to_mesh(np.ones((64, 64, 64), bool), [0, 0, 0], [1, 1, 1])
+    with pytest.raises(ValueError, match="queries x"):
+        gsdf.PointsAsTori(fibonacci_sphere(5000), fibonacci_sphere(5000), k=64)
+    check_bytes(1000, "small")  # under the limit: no error
+    monkeypatch.setenv("GSDF_MEMORY_LIMIT", "lots")
+    with pytest.raises(ValueError, match="GSDF_MEMORY_LIMIT"):
+        available_bytes()
+    monkeypatch.delenv("GSDF_MEMORY_LIMIT")
+    occ, lo, hi = voxelize(mesh=(V, F), resolution=16)  # the normal path still works
+    assert occ.any()

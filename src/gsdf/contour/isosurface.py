@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import as_points, choice, integer
+from .._memory import check_bytes, grid_bytes
 from ..field import grid_shape
 
 __all__ = ["extract_isosurface", "refine_on_edges"]
@@ -263,6 +264,10 @@ def extract_isosurface(
     choice(inside, "inside", {"above", "below"})
 
     shape = grid_shape(lo, hi, resolution)
+    # values (8 B/node) and scikit-image's marching cubes (a float32 copy, edge caches: ~24 B/node measured
+    # loosely), plus one chunk of query points
+    check_bytes(grid_bytes(shape, 32) + 48 * min(chunk, grid_bytes(shape, 1)),
+                f"extract_isosurface: resolution={resolution} gives a {shape[0]}x{shape[1]}x{shape[2]} grid")
     axes = [np.linspace(lo[d], hi[d], shape[d]) for d in range(3)]  # same nodes as field.grid_points
     spacing = (hi - lo) / (np.asarray(shape) - 1)
     total = int(np.prod(shape))

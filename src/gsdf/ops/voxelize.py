@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import as_mesh, as_normals, as_points, as_weights, integer, positive
+from .._memory import check_bytes, grid_bytes
 
 __all__ = [
     "voxel_grid",
@@ -212,6 +213,9 @@ def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max
     hi = dhi if bbox_max is None else bbox_max
     shape, gmin, gmax = voxel_grid(lo, hi, r)
 
+    # the grid (8 B/cell, +1 B for voxelize's occupancy) plus one chunk of centres, indices and values
+    check_bytes(grid_bytes(shape, 9) + 64 * min(chunk, grid_bytes(shape, 1)),
+                f"winding grid: resolution={r} gives {shape[0]}x{shape[1]}x{shape[2]} cells")
     total = int(np.prod(shape))
     W = np.empty(total, dtype=np.float64)
     for s in range(0, total, chunk):
@@ -339,6 +343,10 @@ def voxels_to_mesh(occ, bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
     """
     A = _occupancy(occ)
     lo, hi = _bbox(bbox_min, bbox_max)
+    # padded copy and masks (~4 B/cell), plus ~300 B per exposed cell face (at most 6 per occupied cell:
+    # indices, quads, triangles, the unique of the node ids)
+    check_bytes(grid_bytes(np.array(A.shape) + 2, 4) + 300 * 6 * int(np.count_nonzero(A)),
+                f"voxels_to_mesh: a {A.shape[0]}x{A.shape[1]}x{A.shape[2]} occupancy grid")
     shape = np.array(A.shape, dtype=np.int64)
     h = (hi - lo) / shape
     nn = shape + 1  # nodes per axis

@@ -473,6 +473,10 @@ def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) ->
     P = frame.geometry(P, "P")
     if c is not None:
         c = frame.queries(c[None, :], "orient_towards")[0]
+    from .._memory import check_bytes
+
+    check_bytes(8 * n * (kk + 1) + 24 * min(n, chunk) * (kk + 1) * 2,
+                f"estimate_normals: {n} points x {kk} neighbours")
     idx = _knn(P, kk)
     out = np.empty((n, 3))
     for s in range(0, n, chunk):
