@@ -76,8 +76,12 @@ def test_areas_normals_and_pat_at_scale(s, o):
 
 
 def test_unit_scale_input_keeps_the_identity_frame():
-    fr = Frame.of(V)
+    fr = Frame.of(V * 0.75)  # centred, half-extent in [0.5, 1)
     assert fr.identity and fr.geometry(V) is V
+    X = np.random.default_rng(0).normal(size=(50, 3)) + 3.0
+    for k in (-900, -40, 0, 7, 900):  # power-of-two scalings map to bitwise the same frame coordinates
+        Y = Frame.of(np.ldexp(X, k)).geometry(np.ldexp(X, k))
+        assert np.array_equal(Y, Frame.of(X).geometry(X))
     fr = Frame.of(V * 1e150)
     assert not fr.identity and np.abs(fr.geometry(V * 1e150)).max() <= 1.0
 

@@ -137,8 +137,12 @@ def finite(x, name: str) -> float:
     return v
 
 
-def integer(x, name: str, lo: int = 1) -> int:
-    """Validate an integer (not a bool, no fractional part) that is at least ``lo``."""
+#: Largest integer option accepted (beyond 2**53 floats cannot hold it, and numba kernels take int64).
+MAX_INT = 2 ** 53
+
+
+def integer(x, name: str, lo: int = 1, hi: int = MAX_INT) -> int:
+    """Validate an integer (not a bool, no fractional part) in ``[lo, hi]``."""
     if isinstance(x, (bool, np.bool_, str, bytes)) or np.ndim(x) != 0:
         raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}")
     try:
@@ -147,6 +151,8 @@ def integer(x, name: str, lo: int = 1) -> int:
         raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}") from exc
     if v != x or v < lo:
         raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}")
+    if v > hi:
+        raise ValueError(f"{name}: expected an integer <= {hi}, got {x!r}")
     return v
 
 

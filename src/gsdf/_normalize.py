@@ -7,9 +7,10 @@ squares about the origin. Every entry point therefore maps its geometry *and* it
 where the geometry's bounding box is centred at the origin with half-extent in [0.5, 1), runs the kernels
 there and maps lengths back on output.
 
-* The scale is a power of two (``2**k``), so scaling is exact in binary floating point: for input that
-  already sits in a comfortable range (half-extent in [2^-30, 2^30], centre within 16 half-extents of the
-  origin) the frame is the identity and results are bitwise the same as without it.
+* The scale is a power of two (``2**k``), so scaling is exact in binary floating point, and the centre scales
+  with the input: two inputs that differ by a power-of-two factor map to bitwise the same frame
+  coordinates, so every result is bitwise scale-covariant. Only input already centred at the origin with
+  half-extent in [0.5, 1) skips the mapping (the identity frame, no copy).
 * Queries farther than :data:`FAR` (2^64 frame units, i.e. 2^64 times the geometry's size) are moved
   radially onto that sphere: a winding number there is below 1e-38 and a distance grows exactly by the
   moved length up to a relative 2^-64 (:meth:`Frame.queries` returns that excess).
@@ -31,8 +32,6 @@ import numpy as np
 
 #: Queries farther than this (frame units) from the geometry's centre are clamped radially onto it.
 FAR = 2.0 ** 64
-_IDENTITY_EXP = 30  # half-extents in [2^-30, 2^30] need no scaling
-_IDENTITY_OFFSET = 16.0  # centres within 16 half-extents of the origin need no centring
 
 
 class Frame:
@@ -68,8 +67,7 @@ class Frame:
         if half == 0.0:  # a single point: scale by the centre's magnitude so the frame stays O(1)
             cm = float(np.max(np.abs(c)))
             e = int(np.frexp(cm)[1]) if cm > 0 else 0
-        identity = abs(e) <= _IDENTITY_EXP and float(np.max(np.abs(c))) <= _IDENTITY_OFFSET * max(half, 2.0 ** e)
-        if identity:
+        if e == 0 and not np.any(c):
             return cls(np.zeros_like(c), 0, True)
         return cls(c, e, False)
 

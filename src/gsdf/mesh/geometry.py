@@ -16,6 +16,9 @@ def scaled_edges(V: np.ndarray, F: np.ndarray):
     ``2**e`` is the power of two just above the largest |component| (e = 0 for a point-like face), so the
     scaled edges lie in [-1, 1] and their products are well inside float64.
     """
+    from .._checks import as_mesh
+
+    V, F = as_mesh(V, F, allow_empty_faces=True)
     a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     u, v = b - a, c - a
     big = np.maximum(np.abs(u).max(axis=1), np.abs(v).max(axis=1))

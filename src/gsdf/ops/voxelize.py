@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_mesh, as_normals, as_points, as_weights, integer, positive
+from .._checks import as_mesh, as_normals, as_points, as_weights, integer, nonnegative, positive
 from .._memory import check_bytes, grid_bytes
 
 __all__ = [
@@ -186,18 +186,8 @@ def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max
     """
     wn, X = _winding_object(mesh, points, beta)
     r = integer(resolution, "resolution", 1)
-    try:
-        pad = float(pad)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"pad: expected a number, got {pad!r}") from exc
-    if not np.isfinite(pad) or pad < 0:
-        raise ValueError(f"pad: must be a finite number >= 0, got {pad!r}")
-    try:
-        chunk = int(chunk)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"chunk: expected a positive integer, got {chunk!r}") from exc
-    if chunk < 1:
-        raise ValueError(f"chunk: expected a positive integer, got {chunk!r}")
+    pad = nonnegative(pad, "pad", most=1e6)
+    chunk = integer(chunk, "chunk", 1)
     if progress is not None and not callable(progress):
         raise ValueError("progress: expected a callable(done, total) or None")
 
