@@ -189,11 +189,11 @@ def test_chunks_and_repeat_queries_agree():
     Q = np.random.default_rng(3).uniform(-2, 2, (1000, 3))
     d, f, c, b = td._query(Q)
     d7, f7, c7, b7 = td._query(Q, chunk=7)
-    np.testing.assert_allclose(np.sqrt(d7), np.sqrt(d), atol=1e-15)
+    np.testing.assert_allclose(d7, d, atol=1e-15)
     np.testing.assert_allclose(c7, c, atol=1e-15)
     # a single query, and a 1-D query point
     d1, f1, c1 = td.query(Q[5])
-    assert d1.shape == (1,) and abs(d1[0] - np.sqrt(d[5])) < 1e-15
+    assert d1.shape == (1,) and abs(d1[0] - d[5]) < 1e-15
 
 
 def test_closest_point_triangle_regions_and_barycentrics():

@@ -136,7 +136,7 @@ def test_chunked_queries_match(monkeypatch):
     full = gsdf.fast_winding_number(V, F, Q)
     monkeypatch.setattr(_query, "CHUNK", 77)
     fwn = gsdf.FastWindingNumber(V, F)
-    out = _query.map_queries(fwn._kernel, Q, chunk=77, coherent=True)
+    out = _query.map_queries(fwn._kernel, Q, chunk=77, coherent=True, frame=fwn._frame)
     np.testing.assert_allclose(out, full, atol=1e-14)
     # float32 queries accepted
     np.testing.assert_allclose(fwn(Q.astype(np.float32)), fwn(Q.astype(np.float32).astype(np.float64)))

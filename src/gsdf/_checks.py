@@ -102,29 +102,62 @@ def as_weights(a, n: int, name: str = "areas") -> np.ndarray:
     return A
 
 
-def positive(x, name: str) -> float:
-    """Validate a finite positive scalar."""
+def _real(x, name: str) -> float:
+    if isinstance(x, (bool, np.bool_)) or np.ndim(x) != 0 or isinstance(x, (str, bytes)):
+        raise ValueError(f"{name}: expected a number, got {x!r}")
     try:
-        v = float(x)
-    except (TypeError, ValueError) as exc:
+        return float(x)
+    except (TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"{name}: expected a number, got {x!r}") from exc
-    if not np.isfinite(v) or v <= 0:
-        raise ValueError(f"{name}: must be a finite positive number, got {x!r}")
+
+
+def positive(x, name: str, most: float = np.inf) -> float:
+    """Validate a finite positive scalar (at most ``most``); bools, strings and arrays are refused."""
+    v = _real(x, name)
+    if not np.isfinite(v) or v <= 0 or v > most:
+        rng = "" if most == np.inf else f" <= {most:g}"
+        raise ValueError(f"{name}: must be a finite positive number{rng}, got {x!r}")
     return v
 
 
-def integer(x, name: str, lo: int = 1) -> int:
-    """Validate an integer (not a bool, no fractional part) that is at least ``lo``."""
+def nonnegative(x, name: str, most: float = np.inf) -> float:
+    """Validate a finite scalar >= 0 (at most ``most``)."""
+    v = _real(x, name)
+    if not np.isfinite(v) or v < 0 or v > most:
+        rng = "" if most == np.inf else f" and <= {most:g}"
+        raise ValueError(f"{name}: must be a finite number >= 0{rng}, got {x!r}")
+    return v
+
+
+def finite(x, name: str) -> float:
+    """Validate a finite real scalar."""
+    v = _real(x, name)
+    if not np.isfinite(v):
+        raise ValueError(f"{name}: must be a finite number, got {x!r}")
+    return v
+
+
+#: Largest integer option accepted (beyond 2**53 floats cannot hold it, and numba kernels take int64).
+MAX_INT = 2 ** 53
+
+
+def integer(x, name: str, lo: int = 1, hi: int = MAX_INT) -> int:
+    """Validate an integer (not a bool, no fractional part) in ``[lo, hi]``."""
+    if isinstance(x, (bool, np.bool_, str, bytes)) or np.ndim(x) != 0:
+        raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}")
     try:
         v = int(x)
     except (TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}") from exc
-    if isinstance(x, bool) or v != x or v < lo:
+    if v != x or v < lo:
         raise ValueError(f"{name}: expected an integer >= {lo}, got {x!r}")
+    if v > hi:
+        raise ValueError(f"{name}: expected an integer <= {hi}, got {x!r}")
     return v
 
 
 def choice(x, name: str, options) -> str:
-    if x not in options:
+    """Validate one of a set of (hashable, usually string) options."""
+    if not isinstance(x, (str, int)) or isinstance(x, bool) or x not in options:
         raise ValueError(f"{name}: must be one of {sorted(options)}, got {x!r}")
     return x

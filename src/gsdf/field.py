@@ -122,7 +122,9 @@ class GridField(Field):
         """
         from skimage.measure import marching_cubes
 
-        level = float(level)
+        from ._checks import finite
+
+        level = finite(level, "level")
         vmin, vmax = float(self.values.min()), float(self.values.max())
         if not (vmin < level < vmax):
             raise ValueError(f"level {level} is outside the field's range [{vmin:.6g}, {vmax:.6g}]: no surface")

@@ -15,8 +15,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_points, choice, integer
+from .._checks import as_points, choice, finite, integer
+from .._memory import check_bytes, grid_bytes
 from ..field import grid_shape
+
+#: More bisection steps than this cannot improve a float64 root (the bracket reaches one ulp well before).
+MAX_BISECTION = 200
 
 __all__ = ["extract_isosurface", "refine_on_edges"]
 
@@ -32,14 +36,7 @@ def _check_func(func):
     return func
 
 
-def _finite(x, name: str) -> float:
-    try:
-        v = float(x)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: expected a number, got {x!r}") from exc
-    if not np.isfinite(v):
-        raise ValueError(f"{name}: must be finite, got {x!r}")
-    return v
+_finite = finite  # one spelling: gsdf._checks.finite
 
 
 def _check_bbox(bbox_min, bbox_max, axes=(0, 1, 2)) -> tuple[np.ndarray, np.ndarray]:
@@ -151,7 +148,7 @@ def refine_on_edges(func, A, B, fa, fb, level: float = 0.5, steps: int = 10, chu
     if B.shape[0] != k:
         raise ValueError(f"A and B: expected the same number of rows, got {k} and {B.shape[0]}")
     level = _finite(level, "level")
-    steps = integer(steps, "steps", 0)
+    steps = integer(steps, "steps", 0, hi=MAX_BISECTION)
     chunk = integer(chunk, "chunk", 1)
     fa = np.asarray(fa, dtype=np.float64).copy()
     fb = np.asarray(fb, dtype=np.float64).copy()
@@ -258,11 +255,15 @@ def extract_isosurface(
     lo, hi = _check_bbox(bbox_min, bbox_max)
     resolution = integer(resolution, "resolution", 2)
     level = _finite(level, "level")
-    bisection_steps = integer(bisection_steps, "bisection_steps", 0)
+    bisection_steps = integer(bisection_steps, "bisection_steps", 0, hi=MAX_BISECTION)
     chunk = integer(chunk, "chunk", 1)
     choice(inside, "inside", {"above", "below"})
 
     shape = grid_shape(lo, hi, resolution)
+    # values (8 B/node) and scikit-image's marching cubes (a float32 copy, edge caches: ~24 B/node measured
+    # loosely), plus one chunk of query points
+    check_bytes(grid_bytes(shape, 32) + 48 * min(chunk, grid_bytes(shape, 1)),
+                f"extract_isosurface: resolution={resolution} gives a {shape[0]}x{shape[1]}x{shape[2]} grid")
     axes = [np.linspace(lo[d], hi[d], shape[d]) for d in range(3)]  # same nodes as field.grid_points
     spacing = (hi - lo) / (np.asarray(shape) - 1)
     total = int(np.prod(shape))

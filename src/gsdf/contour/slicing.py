@@ -191,7 +191,7 @@ def slice_contours(
         raise ValueError("z_values: contains NaN or infinite values")
     resolution = integer(resolution, "resolution", 2)
     level = _finite(level, "level")
-    bisection_steps = integer(bisection_steps, "bisection_steps", 0)
+    bisection_steps = integer(bisection_steps, "bisection_steps", 0, hi=200)
     chunk = integer(chunk, "chunk", 1)
     choice(inside, "inside", {"above", "below"})
 

@@ -9,6 +9,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .._checks import as_points
+from .._normalize import Frame
 
 __all__ = ["PointCloudDistance", "point_cloud_distance"]
 
@@ -18,14 +19,16 @@ class PointCloudDistance:
 
     def __init__(self, P):
         self.P = as_points(P, "P")
-        self.tree = cKDTree(self.P)
+        self._frame = Frame.of(self.P)  # the tree lives in the normalised frame (gsdf._normalize)
+        self.tree = cKDTree(self._frame.geometry(self.P, "P"))
 
     def query(self, Q):
         """Returns ``(d (q,), index (q,) int64, closest (q, 3))`` for the query points ``Q`` (q, 3)."""
         Q = as_points(Q, "Q")
-        d, idx = self.tree.query(Q, k=1, workers=-1)
+        Qf, excess = self._frame.queries(Q, want_excess=True)
+        d, idx = self.tree.query(Qf, k=1, workers=-1)
         idx = np.asarray(idx, dtype=np.int64)
-        return np.asarray(d, dtype=np.float64), idx, self.P[idx]
+        return self._frame.length(np.asarray(d, dtype=np.float64) + excess), idx, self.P[idx]
 
 
 def point_cloud_distance(P, Q, return_closest: bool = False):

@@ -45,7 +45,9 @@ def _pseudonormal_sign(V, F, Q, closest, face, bary) -> np.ndarray:
     if on_vertex.any():
         k = np.argmax(bary[on_vertex], axis=1)
         n[on_vertex] = pn.vertex[F[face[on_vertex], k]]
-    s = np.einsum("ij,ij->i", Q - closest, n)
+    D = Q - closest
+    D /= np.maximum(np.max(np.abs(D), axis=1, keepdims=True), np.finfo(float).tiny)  # no under/overflow
+    s = np.einsum("ij,ij->i", D, n)
     return np.where(s < 0, -1.0, 1.0)
 
 

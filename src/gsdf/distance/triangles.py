@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit, prange
 
 from .._checks import as_mesh, as_points, integer
+from .._normalize import Frame
 from ..spatial.morton import morton_order
 from ..spatial.bvh import build_triangle_bvh
 
@@ -195,11 +196,14 @@ def closest_point_triangle(P, A, B, C):
         P, A, B, C = (np.ascontiguousarray(np.broadcast_to(X, (n, 3))) for X in (P, A, B, C))
     except ValueError as exc:
         raise ValueError(f"P, A, B, C: row counts do not broadcast ({exc})") from exc
+    frame = Frame.of(np.concatenate([A, B, C]))  # scale invariance (gsdf._normalize)
+    A, B, C = (frame.geometry(X, name) for X, name in ((A, "A"), (B, "B"), (C, "C")))
+    P, excess = frame.queries(P, "P", want_excess=True)
     d2 = np.empty(n)
     Q = np.empty((n, 3))
     bary = np.empty((n, 3))
     _closest_point_triangles_kernel(P, A, B, C, d2, Q, bary)
-    return np.sqrt(d2), Q, bary
+    return frame.length(np.sqrt(d2) + excess), frame.point(Q), bary
 
 
 # ----------------------------------------------------------------------------------------------------
@@ -447,16 +451,27 @@ class TriangleDistance:
         leaf = integer(leaf_size, "leaf_size", 1)
         self.V = V
         self.F = F
-        self.bvh = build_triangle_bvh(V, F, leaf)
+        # the tree and the kernels work in the normalised frame of the mesh (scale invariance, gsdf._normalize)
+        self._frame = Frame.of_mesh(V, F)
+        Vf = self._frame.geometry(V)
+        self.bvh = build_triangle_bvh(Vf, F, leaf)
         # triangle corners in tree order, contiguous per leaf
-        self._D = _pack(np.ascontiguousarray(V[F[self.bvh.order]].reshape(-1, 9)), _DEGENERATE)
+        self._D = _pack(np.ascontiguousarray(Vf[F[self.bvh.order]].reshape(-1, 9)), _DEGENERATE)
 
     @property
     def n_faces(self) -> int:
         return int(self.F.shape[0])
 
     def _query(self, Q, chunk: int = CHUNK, want_bary: bool = True):
-        """Validated queries -> (d2, face, closest, bary); ``bary`` is None unless ``want_bary``."""
+        """Validated queries -> (d, face, closest, bary) in input units; ``bary`` is None unless ``want_bary``."""
+        fr = self._frame
+        Q, excess = fr.queries(Q, want_excess=True)
+        d2, face, closest, bary = self._query_frame(Q, chunk, want_bary)
+        d = np.sqrt(d2, out=d2)
+        d += excess
+        return fr.length(d), face, fr.point(closest), bary
+
+    def _query_frame(self, Q, chunk: int, want_bary: bool):
         nq = Q.shape[0]
         d2 = np.empty(nq)
         face = np.empty(nq, np.int64)
@@ -486,15 +501,14 @@ class TriangleDistance:
             The closest point on that triangle.
         """
         Q = as_points(Q, "Q")
-        d2, face, closest, _ = self._query(Q, want_bary=False)
-        return np.sqrt(d2, out=d2), face, closest
+        d, face, closest, _ = self._query(Q, want_bary=False)
+        return d, face, closest
 
     def query_barycentric(self, Q):
         """Like :meth:`query` but also returns the barycentric coordinates (q, 3) of the closest point in
         its triangle ``F[face]`` (exact zeros on edges, exact one at vertices)."""
         Q = as_points(Q, "Q")
-        d2, face, closest, bary = self._query(Q)
-        return np.sqrt(d2, out=d2), face, closest, bary
+        return self._query(Q)
 
 
 def unsigned_distance(V, F, Q, return_closest: bool = False):
@@ -532,8 +546,10 @@ def brute_force_distance(V, F, Q):
     """O(q m) reference: distance from every query to every triangle. Returns ``(d, face)``. For testing."""
     V, F = as_mesh(V, F)
     Q = as_points(Q, "Q")
-    T = np.ascontiguousarray(V[F].reshape(-1, 9))
+    frame = Frame.of_mesh(V, F)
+    T = np.ascontiguousarray(frame.geometry(V)[F].reshape(-1, 9))
+    Q, excess = frame.queries(Q, want_excess=True)
     d2 = np.empty(Q.shape[0])
     face = np.empty(Q.shape[0], np.int64)
     _brute_kernel(Q, T, d2, face)
-    return np.sqrt(d2), face
+    return frame.length(np.sqrt(d2) + excess), face

@@ -60,6 +60,12 @@ def corner_angles(V, F) -> np.ndarray:
     P = V[F]  # (m, 3, 3)
     u = np.roll(P, -1, axis=1) - P  # corner k -> k+1
     v = np.roll(P, -2, axis=1) - P  # corner k -> k+2
+    # angles are scale-invariant: divide each corner's sides by a power of two near their size first, so
+    # |u x v| and u . v neither underflow (1e-200 triangles) nor overflow (1e200)
+    big = np.maximum(np.abs(u).max(axis=2), np.abs(v).max(axis=2))
+    if np.isfinite(big).all():
+        ex = np.where(big > 0, np.frexp(big)[1], 0)[:, :, None]
+        u, v = np.ldexp(u, -ex), np.ldexp(v, -ex)
     s = np.linalg.norm(np.cross(u, v), axis=-1)
     c = np.einsum("mkd,mkd->mk", u, v)
     return np.arctan2(s, c)

@@ -203,8 +203,10 @@ def trim_mesh(V, F, winding, keep="outside", bisection_steps=12):
 
 def _steps(bisection_steps):
     try:
+        if isinstance(bisection_steps, (bool, np.bool_, str)) or np.ndim(bisection_steps) != 0:
+            raise TypeError
         s = int(bisection_steps)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"bisection_steps: expected a non-negative integer, got {bisection_steps!r}") from exc
     if s != bisection_steps or s < 0 or s > 60:
         raise ValueError(f"bisection_steps: expected an integer in [0, 60], got {bisection_steps!r}")
@@ -413,8 +415,16 @@ def mesh_boolean(VA, FA, VB, FB, op, beta=2.0, exact=False, bisection_steps=12, 
     VB, FB = as_mesh(VB, FB)
     beta = positive(beta, "beta")
     steps = _steps(bisection_steps)
+    # scale invariance: trim and stitch in the normalised frame of both operands (gsdf._normalize)
+    from .._normalize import Frame
+
+    frame = Frame.of(np.concatenate((VA, VB)))
+    VA, VB = frame.geometry(VA, "VA"), frame.geometry(VB, "VB")
     fA = _checked_field(winding_a, "winding_a") if winding_a is not None else _default_field(VA, FA, beta, exact)
     fB = _checked_field(winding_b, "winding_b") if winding_b is not None else _default_field(VB, FB, beta, exact)
+    if not frame.identity:  # user winding fields take input coordinates
+        fA = (lambda f: lambda Q: f(frame.point(Q)))(fA) if winding_a is not None else fA
+        fB = (lambda f: lambda Q: f(frame.point(Q)))(fB) if winding_b is not None else fB
     refine = _refine_on_edges()
 
     keepA_inside = op == "intersection"
@@ -434,4 +444,4 @@ def mesh_boolean(VA, FA, VB, FB, op, beta=2.0, exact=False, bisection_steps=12, 
     used, Fc = np.unique(F, return_inverse=True)
     if used.shape[0] != V.shape[0]:
         V, F = V[used], Fc.reshape(-1, 3)
-    return np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
+    return np.ascontiguousarray(frame.point(V), dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)

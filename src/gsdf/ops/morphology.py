@@ -44,9 +44,9 @@ def offset_surface(field, distance: float):
     0.7
     """
     _check_field(field)
-    d = float(distance)
-    if not np.isfinite(d):
-        raise ValueError(f"distance: must be finite, got {distance!r}")
+    from .._checks import finite
+
+    d = finite(distance, "distance")
     return field.isosurface(d)
 
 

@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_mesh, as_normals, as_points, as_weights, integer, positive
+from .._checks import as_mesh, as_normals, as_points, as_weights, integer, nonnegative, positive
+from .._memory import check_bytes, grid_bytes
 
 __all__ = [
     "voxel_grid",
@@ -185,18 +186,8 @@ def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max
     """
     wn, X = _winding_object(mesh, points, beta)
     r = integer(resolution, "resolution", 1)
-    try:
-        pad = float(pad)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"pad: expected a number, got {pad!r}") from exc
-    if not np.isfinite(pad) or pad < 0:
-        raise ValueError(f"pad: must be a finite number >= 0, got {pad!r}")
-    try:
-        chunk = int(chunk)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"chunk: expected a positive integer, got {chunk!r}") from exc
-    if chunk < 1:
-        raise ValueError(f"chunk: expected a positive integer, got {chunk!r}")
+    pad = nonnegative(pad, "pad", most=1e6)
+    chunk = integer(chunk, "chunk", 1)
     if progress is not None and not callable(progress):
         raise ValueError("progress: expected a callable(done, total) or None")
 
@@ -212,6 +203,9 @@ def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max
     hi = dhi if bbox_max is None else bbox_max
     shape, gmin, gmax = voxel_grid(lo, hi, r)
 
+    # the grid (8 B/cell, +1 B for voxelize's occupancy) plus one chunk of centres, indices and values
+    check_bytes(grid_bytes(shape, 9) + 64 * min(chunk, grid_bytes(shape, 1)),
+                f"winding grid: resolution={r} gives {shape[0]}x{shape[1]}x{shape[2]} cells")
     total = int(np.prod(shape))
     W = np.empty(total, dtype=np.float64)
     for s in range(0, total, chunk):
@@ -339,6 +333,10 @@ def voxels_to_mesh(occ, bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
     """
     A = _occupancy(occ)
     lo, hi = _bbox(bbox_min, bbox_max)
+    # padded copy and masks (~4 B/cell), plus ~300 B per exposed cell face (at most 6 per occupied cell:
+    # indices, quads, triangles, the unique of the node ids)
+    check_bytes(grid_bytes(np.array(A.shape) + 2, 4) + 300 * 6 * int(np.count_nonzero(A)),
+                f"voxels_to_mesh: a {A.shape[0]}x{A.shape[1]}x{A.shape[2]} occupancy grid")
     shape = np.array(A.shape, dtype=np.int64)
     h = (hi - lo) / shape
     nn = shape + 1  # nodes per axis

@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from .._checks import as_points
+from .._memory import check_bytes
 from ..spatial.bvh import build_bvh
 from ..spatial.radius_grid import build_radius_grid, gather_within
 
@@ -128,7 +129,10 @@ def _nearest_walk(x0, x1, x2, Ps, lo, hi, right, start, end, k, wb, shrink, bd, 
     while sp > 0:
         sp -= 1
         node = stack[sp]
-        if _box_d2(lo, hi, node, x0, x1, x2) * shrink > min(bd[k - 1], wb):
+        bx = _box_d2(lo, hi, node, x0, x1, x2)
+        # the (1 + eps)² shrink relaxes only the k-th distance test: the warm-start bound wb is a hard limit
+        # on accepted points, so shrinking it too could leave fewer than k points (inf rows, NaN sums)
+        if bx > wb or bx * shrink > bd[k - 1]:
             continue
         rr = right[node]
         if rr < 0:
@@ -237,6 +241,7 @@ class PointKNN:
         k = int(min(k, len(self.P)))
         k_min = k if k_min is None else int(min(max(k_min, 1), k))
         Q = np.ascontiguousarray(Q, dtype=np.float64)
+        check_bytes(16 * len(Q) * k, f"{len(Q)} queries x {k} nearest neighbours")
         d, i = np.empty((len(Q), k)), np.empty((len(Q), k), np.int64)
         t = self.t
         r2 = float(radius) ** 2 if k_min < k else np.inf
@@ -333,8 +338,10 @@ class NeighbourBlend:
 
         Q = as_points(Q, name)
         out = np.empty((len(Q), width) if width else len(Q))
-        for s in range(0, len(Q), CHUNK):
-            q = Q[s: s + CHUNK]
+        # neighbour blocks are (chunk, k_eval) distances and indices: keep one block within ~64 MB
+        chunk = max(1, min(CHUNK, (64 << 20) // (16 * self.k_eval + 64)))
+        for s in range(0, len(Q), chunk):
+            q = Q[s: s + chunk]
             if len(q) > 4096:  # Z-order: neighbouring queries share tree nodes and tori in cache
                 o = morton_order(q)
                 q = np.ascontiguousarray(q[o])
@@ -344,5 +351,5 @@ class NeighbourBlend:
                 out[s: s + len(q)][o] = tmp
             else:
                 d, i = self.neighbours(q)
-                fn(q, d, i, out[s: s + CHUNK])
+                fn(q, d, i, out[s: s + chunk])
         return out

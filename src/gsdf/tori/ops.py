@@ -51,9 +51,9 @@ def difference(a, b):
 
 def offset(field, r: float):
     """Dilation (r > 0) or erosion (r < 0) by |r|: the level set φ = r, i.e. φ − r."""
-    r = float(r)
-    if not np.isfinite(r):
-        raise ValueError(f"r: must be finite, got {r!r}")
+    from .._checks import finite
+
+    r = finite(r, "r")
     return lambda Q: _call(field, Q) - r
 
 

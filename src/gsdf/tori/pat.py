@@ -20,7 +20,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .._checks import as_points, choice, integer, positive
+from .._checks import as_points, choice, integer, nonnegative, positive
+from .._normalize import Frame
 from .blend import NeighbourBlend
 from .fit import jet_coefficients
 from .torus import TORUS_WIDTH, coefficients_to_tori, torus_eval
@@ -171,51 +172,83 @@ class PointsAsTori:
                  curvature_cap: float = 4.0, kd_eps: float = 0.0, _state=None):
         self.estimator = choice(estimator, "estimator", {"jet", "learned"})
         self.k = integer(k, "k", lo=6)
-        self.C = positive(C, "C")
+        self.C = positive(C, "C", most=1e300)
         self.k_eval = integer(k_eval, "k_eval", lo=1)
         self.k_fallback = integer(k_fallback, "k_fallback", lo=1)
-        self.options = dict(normal_weight=float(normal_weight), ridge=float(ridge),
+        self.options = dict(normal_weight=nonnegative(normal_weight, "normal_weight"),
+                            ridge=nonnegative(ridge, "ridge"),
                             curvature_cap=positive(curvature_cap, "curvature_cap"))
         if r_eval is not None:
             r_eval = positive(r_eval, "r_eval")
-        kd_eps = float(kd_eps)
-        if not kd_eps >= 0:
-            raise ValueError(f"kd_eps: must be >= 0, got {kd_eps!r}")
+        # (1 + kd_eps)² scales squared box distances in the neighbour walk: keep it a modest finite factor
+        kd_eps = nonnegative(kd_eps, "kd_eps", most=1e3)
         if _state is not None:
-            self.P, self.N, self.coefficients, self.tori = _state
-            self._blend = NeighbourBlend(self.P, self.C, r_eval, self.k_eval, self.k_fallback, kd_eps=kd_eps)
+            self.P, self.N, coefficients, tori, framed = _state
+        else:
+            self.P, self.N = _clean_cloud(P, N, self.k)
+        # scale invariance: tori, neighbour search and kernel work in the cloud's normalised frame
+        self._frame = fr = Frame.of(self.P)
+        self._Pf = fr.geometry(self.P, "P")
+        if r_eval is not None:
+            r_eval = float(fr.inverse_length(r_eval))
+            if not (np.isfinite(r_eval) and r_eval > 0):
+                raise ValueError("r_eval: not representable relative to the cloud's size")
+        self._blend = NeighbourBlend(self._Pf, self.C, r_eval, self.k_eval, self.k_fallback, kd_eps=kd_eps)
+        if _state is not None:
+            if framed is not None:
+                self._coefficients, self._tori = framed
+            else:  # format 1: tori in input units only
+                self._coefficients = _coefficients_units(coefficients, -fr.exponent)
+                self._tori = _tori_to_frame(tori, fr)
             return
-        self.P, self.N = _clean_cloud(P, N, self.k)
-        self._blend = NeighbourBlend(self.P, self.C, r_eval, self.k_eval, self.k_fallback, kd_eps=kd_eps)
-        d, idx = self._blend.knn.query(self.P, self.k)
+        d, idx = self._blend.knn.query(self._Pf, self.k)
         if self.estimator == "learned":
             from .learned import learned_coefficients
 
-            self.coefficients = learned_coefficients(self.P, self.N, idx, d)
+            self._coefficients = learned_coefficients(self._Pf, self.N, idx, d)
         else:
-            self.coefficients = jet_coefficients(self.P, self.N, idx, d, normal_weight, ridge)
-        scale = float(np.linalg.norm(self.P.max(0) - self.P.min(0))) or 1.0
+            self._coefficients = jet_coefficients(self._Pf, self.N, idx, d, self.options["normal_weight"],
+                                                 self.options["ridge"])
+        scale = float(np.linalg.norm(self._Pf.max(0) - self._Pf.min(0))) or 1.0
         h = np.median(d[:, -1])
-        self.tori = coefficients_to_tori(self.P, self.N, self.coefficients, k_floor=1e-6 / scale,
-                                         k_cap=self.options["curvature_cap"] / max(h, 1e-300))
+        self._tori = coefficients_to_tori(self._Pf, self.N, self._coefficients, k_floor=1e-6 / scale,
+                                          k_cap=self.options["curvature_cap"] / max(h, 1e-300))
+
+    @property
+    def tori(self) -> np.ndarray:
+        """Fitted tori (n, TORUS_WIDTH) in input units (the kernels use a copy in the normalised frame)."""
+        return _tori_from_frame(self._tori, self._frame)
+
+    @property
+    def coefficients(self) -> np.ndarray:
+        """Height-field coefficients (a00, a10, a01, a20, a11, a02) per point (n, 6), in input units."""
+        return _coefficients_units(self._coefficients, self._frame.exponent)
 
     @property
     def r_eval(self) -> float:
-        return self._blend.r_eval
+        """Summation radius R_eval in input units."""
+        return float(self._frame.length(self._blend.r_eval))
 
     def _eval(self, Q, want_grad):
         b = self._blend
+        fr = self._frame
+        Q = as_points(Q, "Q")
+        Qf, excess = fr.queries(Q, want_excess=True)
 
         def fn(q, d, i, out):
             g = np.empty((len(q), 3)) if want_grad else np.empty((1, 3))
             o = np.empty(len(q))
-            _pat_kernel(q, d, i, self.tori, self.P, b.hull, self.C, b.r_eval, b.k_fallback, want_grad, o, g)
+            _pat_kernel(q, d, i, self._tori, self._Pf, b.hull, self.C, b.r_eval, b.k_fallback, want_grad, o, g)
             if want_grad:
                 out[:] = g
             else:
                 out[:] = o
 
-        return b.map(Q, fn, width=3 if want_grad else 0)
+        out = b.map(Qf, fn, width=3 if want_grad else 0)
+        if want_grad:
+            return out
+        # a clamped far query (gsdf._normalize.FAR) is farther by ``excess``; there φ grows like the distance
+        return fr.length(out + excess)
 
     def signed_distance(self, Q) -> np.ndarray:
         """Generalized signed distance φ(Q) of Eq. 5.6, (q,) float64; negative inside."""
@@ -237,24 +270,104 @@ class PointsAsTori:
 
     def save(self, path) -> None:
         """Write the fitted tori (and the cloud) to an ``.npz`` file; reload with :meth:`load`."""
+        # coefficients and tori in input units (the normalised frame is recomputed from P on load)
+        # and, for a bitwise round trip, the frame copies the kernels use (format 2)
         np.savez_compressed(path, P=self.P, N=self.N, coefficients=self.coefficients, tori=self.tori,
+                            coefficients_frame=self._coefficients, tori_frame=self._tori,
                             estimator=self.estimator, k=self.k, C=self.C, r_eval=self.r_eval,
-                            k_eval=self.k_eval, k_fallback=self.k_fallback, format=np.int64(1))
+                            k_eval=self.k_eval, k_fallback=self.k_fallback, format=np.int64(2))
 
     @classmethod
     def load(cls, path) -> "PointsAsTori":
-        """Read a file written by :meth:`save`."""
+        """Read a file written by :meth:`save`; every array is checked against the points (shape, length,
+        finiteness) before any kernel reads it."""
         try:
             z = np.load(path, allow_pickle=False)
+            files = set(z.files)
         except Exception as exc:
-            raise ValueError(f"{path}: not a saved PointsAsTori file ({exc})") from exc
+            raise ValueError(f"{path}: not a saved PointsAsTori file ({type(exc).__name__}: {exc})") from exc
         need = {"P", "N", "coefficients", "tori", "C", "r_eval", "k_eval", "k_fallback", "k", "estimator"}
-        if not need <= set(z.files):
-            raise ValueError(f"{path}: missing arrays {sorted(need - set(z.files))}")
-        tori = np.ascontiguousarray(z["tori"], dtype=np.float64)
-        if tori.ndim != 2 or tori.shape[1] != TORUS_WIDTH or not np.isfinite(tori).all():
-            raise ValueError(f"{path}: tori array is malformed")
-        state = (as_points(z["P"], "P"), as_points(z["N"], "N"), np.asarray(z["coefficients"]), tori)
-        return cls(None, None, estimator=str(z["estimator"]), k=int(z["k"]), C=float(z["C"]),
-                   r_eval=float(z["r_eval"]), k_eval=int(z["k_eval"]), k_fallback=int(z["k_fallback"]),
-                   _state=state)
+        if not need <= files:
+            raise ValueError(f"{path}: missing arrays {sorted(need - files)}")
+        try:
+            fmt = 1 if "format" not in files else _scalar(z["format"], path, "format")
+        except ValueError:
+            raise
+        except Exception as exc:
+            raise ValueError(f"{path}: unreadable array ({type(exc).__name__}: {exc})") from exc
+        if fmt not in (1, 2):
+            raise ValueError(f"{path}: unknown PointsAsTori file format {fmt!r}")
+        try:
+            arrays = {name: z[name] for name in need | ({"format", "tori_frame", "coefficients_frame"} & files)}
+        except Exception as exc:
+            raise ValueError(f"{path}: unreadable array ({type(exc).__name__}: {exc})") from exc
+        P = as_points(arrays["P"], f"{path}: P")
+        n = P.shape[0]
+        N = as_points(arrays["N"], f"{path}: N")
+        if N.shape[0] != n:
+            raise ValueError(f"{path}: N has {N.shape[0]} rows but P has {n}")
+        for name, width in (("coefficients", 6), ("tori", TORUS_WIDTH), ("coefficients_frame", 6),
+                            ("tori_frame", TORUS_WIDTH)):
+            if name not in arrays:
+                continue
+            A = arrays[name]
+            if A.dtype.kind not in "fiu" or A.shape != (n, width):
+                raise ValueError(f"{path}: {name} must be a ({n}, {width}) numeric array, got {A.shape} {A.dtype}")
+            if not np.isfinite(A).all():
+                raise ValueError(f"{path}: {name} contains NaN or infinite values")
+
+        frame_copies = "tori_frame" in arrays and "coefficients_frame" in arrays and fmt == 2
+        state = (P, N, np.ascontiguousarray(arrays["coefficients"], dtype=np.float64),
+                 np.ascontiguousarray(arrays["tori"], dtype=np.float64),
+                 (np.ascontiguousarray(arrays["coefficients_frame"], dtype=np.float64),
+                  np.ascontiguousarray(arrays["tori_frame"], dtype=np.float64)) if frame_copies else None)
+        if n < 1:
+            raise ValueError(f"{path}: no points")
+        return cls(None, None, estimator=str(_scalar(arrays["estimator"], path, "estimator")),
+                   k=_scalar(arrays["k"], path, "k"), C=_scalar(arrays["C"], path, "C"),
+                   r_eval=_scalar(arrays["r_eval"], path, "r_eval"), k_eval=_scalar(arrays["k_eval"], path, "k_eval"),
+                   k_fallback=_scalar(arrays["k_fallback"], path, "k_fallback"), _state=state)
+
+
+def _coefficients_units(A, exponent):
+    """Coefficients scaled by 2**exponent lengths: a00 is a length, a10/a01 slopes, a20/a11/a02 curvatures."""
+    if exponent == 0:
+        return A
+    A = np.array(A, dtype=np.float64, copy=True)
+    A[:, 0] = np.ldexp(A[:, 0], exponent)
+    A[:, 3:6] = np.ldexp(A[:, 3:6], -exponent)
+    return A
+
+
+def _tori_from_frame(T, frame):
+    """Tori of the normalised frame in input units: positions mapped back, curvatures k1, k2 divided by s."""
+    if frame.identity:
+        return T
+    from .torus import T_K1, T_K2, T_P
+
+    T = np.array(T, copy=True)
+    T[:, T_P:T_P + 3] = frame.point(T[:, T_P:T_P + 3])
+    with np.errstate(over="ignore"):
+        T[:, T_K1:T_K2 + 1] = np.ldexp(T[:, T_K1:T_K2 + 1], -frame.exponent)
+    return T
+
+
+def _tori_to_frame(T, frame):
+    if frame.identity:
+        return np.ascontiguousarray(T)
+    from .torus import T_K1, T_K2, T_P
+
+    T = np.array(T, dtype=np.float64, copy=True)
+    T[:, T_P:T_P + 3] = frame.geometry(T[:, T_P:T_P + 3], "tori")
+    T[:, T_K1:T_K2 + 1] = np.ldexp(T[:, T_K1:T_K2 + 1], frame.exponent)
+    if not np.isfinite(T).all():
+        raise ValueError("tori: not representable at the cloud's scale")
+    return np.ascontiguousarray(T)
+
+
+def _scalar(a, path, name):
+    """The Python scalar stored in a 0-d array of a saved file, or ValueError."""
+    a = np.asarray(a)
+    if a.shape != () or a.dtype.kind not in "biufU":
+        raise ValueError(f"{path}: {name} must be a scalar, got shape {a.shape} dtype {a.dtype}")
+    return a.item()

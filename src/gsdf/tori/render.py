@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_points, integer
+from .._checks import as_points, finite, integer, positive
+from .._memory import check_bytes
 
 __all__ = ["sphere_trace", "render_png"]
 
@@ -25,6 +26,40 @@ def _gradient(sdf, X, h):
         e[a] = h
         G[:, a] = (sdf(X + e) - sdf(X - e)) / (2 * h)
     return G
+
+
+def _box(bbox_min, bbox_max):
+    lo, hi = as_points(bbox_min, "bbox_min"), as_points(bbox_max, "bbox_max")
+    if lo.shape[0] != 1 or hi.shape[0] != 1:
+        raise ValueError(f"bbox_min/bbox_max: expected 3 numbers each, got shapes {lo.shape} and {hi.shape}")
+    lo, hi = lo[0], hi[0]
+    if np.any(hi <= lo) or not np.isfinite(hi - lo).all():
+        raise ValueError(f"bbox_min/bbox_max: the box {lo.tolist()}..{hi.tolist()} is empty, flat or too large "
+                         "to view (need bbox_max > bbox_min on every axis)")
+    return lo, hi
+
+
+def _direction(x, name):
+    v = as_points(x, name)
+    if v.shape[0] != 1:
+        raise ValueError(f"{name}: expected a (3,) direction, got shape {np.shape(x)}")
+    v = v[0] / max(float(np.abs(v[0]).max()), 1e-300)
+    n = float(np.linalg.norm(v))
+    if not n > 0:
+        raise ValueError(f"{name}: the zero vector is not a direction")
+    return v / n
+
+
+def _values(sdf, X):
+    try:
+        v = np.asarray(sdf(X), dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"sdf: did not return numbers for {len(X)} points ({exc})") from exc
+    if v.shape != (len(X),):
+        raise ValueError(f"sdf: expected shape ({len(X)},) from {len(X)} points, got {v.shape}")
+    if not np.isfinite(v).all():
+        raise ValueError("sdf: returned NaN or infinite values")
+    return v
 
 
 def sphere_trace(sdf, bbox_min, bbox_max, width: int = 256, height: int = 256, level: float = 0.0,
@@ -59,11 +94,20 @@ def sphere_trace(sdf, bbox_min, bbox_max, width: int = 256, height: int = 256, l
     >>> img.shape, bool((img[16, 16] < 255).any()), bool((img[0, 0] == 255).all())
     ((32, 32, 3), True, True)
     """
-    lo, hi = as_points(bbox_min, "bbox_min")[0], as_points(bbox_max, "bbox_max")[0]
-    width, height = integer(width, "width"), integer(height, "height")
+    if not callable(sdf):
+        raise ValueError(f"sdf: expected a callable sdf(Q (q, 3)) -> (q,), got {type(sdf).__name__}")
+    lo, hi = _box(bbox_min, bbox_max)
+    width, height = integer(width, "width", hi=1 << 15), integer(height, "height", hi=1 << 15)
+    check_bytes(120 * width * height, f"sphere_trace: a {width}x{height} image")
+    level = finite(level, "level")
+    fov = positive(fov, "fov", most=179.0)
+    max_steps = integer(max_steps, "max_steps", hi=1 << 20)
+    step_scale = positive(step_scale, "step_scale", most=1.0)
+    f, up = _direction(view, "view"), _direction(up, "up")
+    # the image frame needs up not parallel to the viewing direction
+    if np.linalg.norm(np.cross(f, up)) < 1e-9:
+        raise ValueError(f"up: {tuple(up)} is parallel to the view direction {tuple(f)}; the view is degenerate")
     c, diag = 0.5 * (lo + hi), float(np.linalg.norm(hi - lo))
-    f = np.asarray(view, float)
-    f = f / np.linalg.norm(f)
     eye = c + f * diag * 0.5 / np.tan(np.radians(fov) / 2) * 1.1
     fwd = -f
     right = np.cross(fwd, up)
@@ -89,7 +133,7 @@ def sphere_trace(sdf, bbox_min, bbox_max, width: int = 256, height: int = 256, l
         if idx.size == 0:
             break
         X = eye + t[idx, None] * D[idx]
-        v = np.asarray(sdf(X), float) - level
+        v = _values(sdf, X) - level
         done = np.abs(v) < tol
         hit[idx[done]] = True
         t[idx] += step_scale * np.where(done, 0.0, v)  # v < 0 (overshoot) steps back
@@ -124,11 +168,15 @@ def render_png(sdf, path, width: int = 256, height: int = 256, level: float = 0.
     """
     from PIL import Image
 
+    level = finite(level, "level")
     if bbox_min is None or bbox_max is None:
         if not hasattr(sdf, "P"):
             raise ValueError("bbox_min/bbox_max: required when sdf is not a PointsAsTori")
         lo, hi = sdf.P.min(0), sdf.P.max(0)
-        m = 0.1 * np.linalg.norm(hi - lo) + abs(float(level))
+        m = 0.1 * np.linalg.norm(hi - lo) + abs(level)
         bbox_min, bbox_max = lo - m, hi + m
     img = sphere_trace(sdf, bbox_min, bbox_max, width, height, level, **kw)
+    if (img == 255).all():
+        raise ValueError(f"no ray hit the level set {float(level):g} inside the box (nothing to render): wrong "
+                         "level, box or view?")
     Image.fromarray(img).save(path)

@@ -9,13 +9,15 @@ from ..spatial.morton import morton_order
 CHUNK = 1 << 20
 
 
-def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, coherent: bool = False) -> np.ndarray:
+def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, coherent: bool = False,
+                frame=None) -> np.ndarray:
     """Validate ``Q`` chunk by chunk and call ``kernel(q_chunk, out_chunk)`` on each.
 
     Only one float64 copy of one chunk exists at a time, so 10^8 float32 queries need ~chunk×24 bytes of
     scratch beyond the output. ``progress(done, total)`` is called after each chunk when given.
     ``coherent=True`` evaluates each chunk in Morton order (tree walks of neighbouring queries then share
-    cached nodes) and scatters the results back.
+    cached nodes) and scatters the results back. ``frame`` (a :class:`gsdf._normalize.Frame`) maps each
+    validated chunk into the geometry's normalised frame first (the kernel's geometry lives there).
     """
     A = np.asarray(Q)
     if A.ndim == 1 and A.shape[0] == dim:
@@ -32,6 +34,8 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         if not np.isfinite(q).all():
             bad = s + int(np.argmax(~np.isfinite(q).all(axis=1)))
             raise ValueError(f"Q: contains NaN or infinite coordinates (first at row {bad})")
+        if frame is not None:
+            q = frame.queries(q)
         if coherent and e - s > 4096 and not _already_coherent(q):
             o = morton_order(q)
             tmp = np.empty(e - s)

@@ -15,6 +15,7 @@ import numpy as np
 from numba import njit, prange
 
 from .._checks import as_faces, as_mesh, as_normals, as_points, as_weights
+from .._normalize import Frame
 from ._query import map_queries
 from ._solid_angle import solid_angle_w
 
@@ -112,8 +113,9 @@ def winding_number(V, F, Q, method: str = "auto") -> np.ndarray:
         from .hierarchical import ExactWindingNumber
 
         return ExactWindingNumber(V, F)(Q)
-    T = triangle_corners(V, F)
-    return map_queries(lambda q, out: _wn_triangles(T, q, out), Q)
+    frame = Frame.of_mesh(V, F)  # scale invariance: kernels run on O(1) coordinates (gsdf._normalize)
+    T = triangle_corners(frame.geometry(V), F)
+    return map_queries(lambda q, out: _wn_triangles(T, q, out), Q, frame=frame)
 
 
 def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
@@ -128,8 +130,8 @@ def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
     areas : (m,) float, optional
         Area a_i of each point; estimated with :func:`gsdf.point_areas` when omitted.
     """
-    P, NA = oriented_area_normals(P, N, areas)
-    return map_queries(lambda q, out: _wn_points(P, NA, q, out), Q)
+    frame, P, NA = oriented_area_normals(P, N, areas)
+    return map_queries(lambda q, out: _wn_points(P, NA, q, out), Q, frame=frame)
 
 
 def winding_number_2d(V, E, Q) -> np.ndarray:
@@ -145,21 +147,27 @@ def winding_number_2d(V, E, Q) -> np.ndarray:
     """
     V = as_points(V, "V", dim=2)
     E = as_faces(E, V.shape[0], "E", corners=2)
-    S = np.ascontiguousarray(V[E].reshape(-1, 4))
-    return map_queries(lambda q, out: _wn_polyline(S, q, out), Q, dim=2)
+    frame = Frame.of_mesh(V, E)
+    S = np.ascontiguousarray(frame.geometry(V)[E].reshape(-1, 4))
+    return map_queries(lambda q, out: _wn_polyline(S, q, out), Q, dim=2, frame=frame)
 
 
-def oriented_area_normals(P, N, areas=None) -> tuple[np.ndarray, np.ndarray]:
-    """Validate a cloud and return ``(P, a_i n_i)`` with unit normals scaled by the point areas."""
+def oriented_area_normals(P, N, areas=None):
+    """Validate a cloud; return ``(frame, P', a'_i n_i)`` in the cloud's normalised frame
+    (:class:`gsdf._normalize.Frame`): points P' = (P − c)/s, unit normals scaled by the point areas a' = a/s²."""
     P = as_points(P, "P")
     N = as_normals(N, P.shape[0], "N")
-    L = np.linalg.norm(N, axis=1, keepdims=True)
+    frame = Frame.of(P)
+    Pf = frame.geometry(P, "P")
+    L = np.max(np.abs(N), axis=1, keepdims=True)  # normalise in two steps: |N| of tiny or huge rows stays finite
     U = np.zeros_like(N)
     np.divide(N, L, out=U, where=L > 0)
+    L = np.linalg.norm(U, axis=1, keepdims=True)
+    np.divide(U, L, out=U, where=L > 0)
     if areas is None:
         from .point_areas import point_areas
 
-        a = point_areas(P, N)
+        a = point_areas(Pf, U)
     else:
-        a = as_weights(areas, P.shape[0], "areas")
-    return P, np.ascontiguousarray(U * a[:, None])
+        a = frame.inverse_area(as_weights(areas, P.shape[0], "areas"))
+    return frame, Pf, np.ascontiguousarray(U * a[:, None])

@@ -34,7 +34,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .._checks import as_mesh, as_points
+from .._checks import as_mesh, as_points, integer
+from .._normalize import Frame
 from ..spatial.bvh import BVH, build_bvh
 from ._query import map_queries
 from .exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w, triangle_corners
@@ -266,13 +267,16 @@ def _eval_points(Q, P, NA, N, C, beta2, order, out):
 
 
 def _check_params(beta, order):
+    if isinstance(beta, (bool, np.bool_)) or np.ndim(beta) != 0:
+        raise ValueError(f"beta: expected a number, got {beta!r}")
     try:
         beta = float(beta)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"beta: expected a number, got {beta!r}") from exc
-    if not np.isfinite(beta) or beta <= 0:
-        raise ValueError(f"beta: must be a finite positive number, got {beta!r}")
-    if order not in (0, 1, 2):
+    # β² multiplies node radii² in the walk: beyond 1e150 it overflows (every node would be opened anyway)
+    if not np.isfinite(beta) or beta <= 0 or beta > 1e150:
+        raise ValueError(f"beta: must be a finite positive number <= 1e150, got {beta!r}")
+    if isinstance(order, (bool, np.bool_)) or np.ndim(order) != 0 or order not in (0, 1, 2):
         raise ValueError(f"order: must be 0, 1 or 2, got {order!r}")
     return beta, int(order)
 
@@ -283,7 +287,7 @@ class _FastWindingBase:
 
     def __call__(self, Q, progress=None) -> np.ndarray:
         """Winding numbers at query points ``Q`` (q, 3); evaluated in parallel chunks."""
-        return map_queries(self._kernel, Q, progress=progress, coherent=True)
+        return map_queries(self._kernel, Q, progress=progress, coherent=True, frame=self._frame)
 
     query = __call__
 
@@ -322,7 +326,9 @@ class FastWindingNumber(_FastWindingBase):
     def __init__(self, V, F, beta: float = 2.0, order: int = 2, leaf_size: int = 8):
         V, F = as_mesh(V, F)
         self.beta, self.order = _check_params(beta, order)
-        T = triangle_corners(V, F)
+        leaf_size = integer(leaf_size, "leaf_size", 1)
+        self._frame = Frame.of_mesh(V, F)  # scale invariance: the tree lives in the normalised frame
+        T = triangle_corners(self._frame.geometry(V), F)
         Tv = T.reshape(-1, 3, 3)
         X = Tv.mean(axis=1)
         self.tree = build_bvh(X, Tv.min(axis=1), Tv.max(axis=1), leaf_size, split="volume")
@@ -380,8 +386,9 @@ class FastWindingNumberPoints(_FastWindingBase):
     """
 
     def __init__(self, P, N, areas=None, beta: float = 2.3, order: int = 2, leaf_size: int = 8):
-        P, NA = oriented_area_normals(P, N, areas)
+        self._frame, P, NA = oriented_area_normals(P, N, areas)  # normalised frame (gsdf._normalize)
         self.beta, self.order = _check_params(beta, order)
+        leaf_size = integer(leaf_size, "leaf_size", 1)
         self.tree = build_bvh(P, P, P, leaf_size)
         o = self.tree.order
         self._P = np.ascontiguousarray(P[o])

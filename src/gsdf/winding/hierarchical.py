@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .._checks import as_mesh
+from .._checks import as_mesh, integer
+from .._normalize import Frame
 from ..spatial.bvh import build_bvh
 from ._query import map_queries
 from ._solid_angle import solid_angle_w
@@ -130,6 +131,9 @@ class ExactWindingNumber:
 
     def __init__(self, V, F, leaf_size: int = 8):
         V, F = as_mesh(V, F)
+        leaf_size = integer(leaf_size, "leaf_size", 1)
+        self._frame = Frame.of_mesh(V, F)  # scale invariance (gsdf._normalize)
+        V = self._frame.geometry(V)
         Tv = V[F]
         self.tree = t = build_bvh(Tv.mean(axis=1), Tv.min(axis=1), Tv.max(axis=1), leaf_size)
         self._T = np.ascontiguousarray(Tv[t.order].reshape(-1, 9))
@@ -140,7 +144,7 @@ class ExactWindingNumber:
         self._use_cap = np.diff(self._ptr) < (t.end - t.start)
 
     def __call__(self, Q, progress=None) -> np.ndarray:
-        return map_queries(self._kernel, Q, progress=progress, coherent=True)
+        return map_queries(self._kernel, Q, progress=progress, coherent=True, frame=self._frame)
 
     def _kernel(self, q, out):
         t = self.tree

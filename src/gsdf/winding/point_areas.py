@@ -19,6 +19,7 @@ from numba import njit, prange
 from scipy.spatial import cKDTree
 
 from .._checks import as_normals, as_points, integer
+from .._normalize import Frame
 
 __all__ = ["point_areas", "estimate_normals"]
 
@@ -328,7 +329,11 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     if n < 2:
         raise ValueError(f"P: need at least 2 points to estimate point areas, got {n}")
     kk = min(k, n - 1)
-    kc = min(n - 1, kk * integer(candidates, "candidates", 1))
+    kc = min(n - 1, kk * min(integer(candidates, "candidates", 1), n))
+    # scale invariance: areas are computed in the cloud's normalised frame and scaled back (gsdf._normalize)
+    frame = Frame.of(P)
+    P = frame.geometry(P, "P")
+    N = N / np.maximum(np.abs(N).max(axis=1, keepdims=True), np.finfo(float).tiny)
     tree = cKDTree(P)
     out = np.zeros(n)
     chunk = max(1, (1 << 22) // (kc + 1))  # bounded memory: ~32 MB of neighbour indices at a time
@@ -340,7 +345,10 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
         plane = np.zeros((e - s, 3))
         _tangent_neighbours(P, N, cand, s, kk, sel, plane)
         _voronoi_areas(P, N, plane, sel, s, boundary == "hull", out[s:e])
-    return out
+    a = frame.area(out)
+    if not np.isfinite(a).all():
+        raise ValueError(f"P: point areas overflow float64 at this scale (cloud half-size 2^{frame.exponent})")
+    return a
 
 
 @njit(parallel=True, cache=True)
@@ -461,6 +469,14 @@ def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) ->
             raise ValueError(f"orient_towards: expected a single (3,) point, got shape {c.shape}")
         c = c[0]
     kk = min(k, n - 1)
+    frame = Frame.of(P)  # PCA of O(1) coordinates: no overflow of the covariance, no cancellation
+    P = frame.geometry(P, "P")
+    if c is not None:
+        c = frame.queries(c[None, :], "orient_towards")[0]
+    from .._memory import check_bytes
+
+    check_bytes(8 * n * (kk + 1) + 24 * min(n, chunk) * (kk + 1) * 2,
+                f"estimate_normals: {n} points x {kk} neighbours")
     idx = _knn(P, kk)
     out = np.empty((n, 3))
     for s in range(0, n, chunk):

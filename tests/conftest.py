@@ -1,0 +1,17 @@
+"""Shared pytest configuration: hypothesis profiles for tests/test_properties.py.
+
+``ci`` (default) is bounded so the property tests finish in a few minutes on 2 cores; ``long`` explores far
+more cases: ``python -m pytest tests/test_properties.py --hypothesis-profile=long``.
+"""
+
+try:
+    from hypothesis import HealthCheck, settings
+except ImportError:  # hypothesis is in the "test" extra; without it only test_properties.py is skipped
+    pass
+else:
+    _common = dict(deadline=None, derandomize=False, print_blob=True,
+                   suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                          HealthCheck.filter_too_much])
+    settings.register_profile("ci", max_examples=20, **_common)
+    settings.register_profile("long", max_examples=600, **_common)
+    settings.load_profile("ci")
