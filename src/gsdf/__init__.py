@@ -36,12 +36,17 @@ _EXPORTS = {
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
     "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
     "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "tori",
+    # one thread setting for numba kernels and BLAS (gsdf.threads)
+    "set_num_threads": "threads", "get_num_threads": "threads",
 }
+_SUBMODULES = {"threads"}
 
 __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name):
+    if name in _SUBMODULES:
+        return import_module(f".{name}", __name__)
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'gsdf' has no attribute {name!r}")
@@ -51,4 +56,4 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
+    return sorted(set(globals()) | set(_EXPORTS) | _SUBMODULES)
