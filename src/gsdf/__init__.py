@@ -6,7 +6,11 @@ Re-exports only; see ``docs/architecture.md`` for the layout. Names are resolved
 
 from importlib import import_module
 
+from ._jit import configure_cache as _configure_cache
+
 __version__ = "0.1.0"
+
+_configure_cache()  # numba's cache dir when the install dir and the user cache are read-only (cheap)
 
 _EXPORTS = {
     # I/O

@@ -15,6 +15,7 @@ from .slice import slice_cmd
 from .surface import surface
 from .tori import tori
 from .voxelize import voxelize
+from .warmup import warmup
 from .winding import winding
 
 
@@ -30,7 +31,24 @@ def _threads_option(ctx, param, value):
         raise click.BadParameter(str(exc), ctx=ctx, param=param) from None
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _Main(click.Group):
+    """The gsdf group: a numba compilation failure becomes one message naming the kernel (exit 1)."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort):
+            raise
+        except Exception as exc:
+            from .._jit import compile_error_message
+
+            message = compile_error_message(exc)
+            if message is None:
+                raise
+            raise click.ClickException(message) from exc
+
+
+@click.group(cls=_Main, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="gsdf")
 @click.option("--threads", type=str, default=None, callback=_threads_option, metavar="N",
               help="Threads for numba kernels and BLAS (one setting for both; default: GSDF_NUM_THREADS, "
@@ -41,13 +59,17 @@ def main(threads):
     Meshes: OBJ, OFF, PLY, STL. Point clouds: XYZ/PWN (3 or 6 columns), PLY, OBJ v/vn, PC, NPY.
     Start with `gsdf demo`.
     """
+    from .._jit import install_compile_notice
+
+    install_compile_notice()  # one line on stderr when a kernel compiles (first use after install)
     if threads is not None:
         from .. import threads as _threads
 
         _threads.set_num_threads(threads)
 
 
-for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render):
+for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render,
+                warmup):
     main.add_command(command)
 
 if __name__ == "__main__":  # pragma: no cover

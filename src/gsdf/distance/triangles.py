@@ -56,7 +56,7 @@ _STACK = 128
 # ----------------------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _segment(px, py, pz, ax, ay, az, bx, by, bz):
     """Closest point on segment ab to p: returns (squared distance, t) with the point a + t (b - a)."""
     ex, ey, ez = bx - ax, by - ay, bz - az
@@ -208,7 +208,7 @@ def closest_point_triangle(P, A, B, C):
 # ----------------------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _box_d2(px, py, pz, lo, hi, i):
     d = 0.0
     t = lo[i, 0] - px
@@ -235,7 +235,7 @@ def _box_d2(px, py, pz, lo, hi, i):
     return d
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tri_box_d2(px, py, pz, D, j):
     """Squared distance from p to the bounding box of packed triangle ``j`` (columns 13:19)."""
     d = 0.0
@@ -263,7 +263,7 @@ def _tri_box_d2(px, py, pz, D, j):
     return d
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tri_d2(px, py, pz, D, j):
     """Squared distance from p to triangle ``j`` of the packed array ``D`` (see :func:`_pack`).
 
