@@ -28,6 +28,7 @@ NOTICE = ("gsdf: compiling kernels, once per install (later runs start in about 
           "`gsdf warmup` compiles all of them at once)")
 
 _listener = None
+_first_compile_callbacks = []
 
 
 def _writable(path: str) -> bool:
@@ -92,6 +93,8 @@ def install_compile_notice(stream=None, message: str = NOTICE):
                 self.printed = True
                 out = stream if stream is not None else sys.stderr
                 print(message, file=out, flush=True)
+                while _first_compile_callbacks:
+                    _first_compile_callbacks.pop(0)()
 
         def on_end(self, ev):
             name = _kernel_name(ev.data.get("dispatcher"))
@@ -107,6 +110,15 @@ def install_compile_notice(stream=None, message: str = NOTICE):
     _listener = _Notice()
     event.register("numba:compile", _listener)
     return _listener
+
+
+def on_first_compile(callback) -> None:
+    """Call ``callback()`` when the first gsdf kernel compiles in this process (with the notice).
+
+    Needs :func:`install_compile_notice`; nothing happens on a warm cache. Used by ``gsdf demo`` to compile
+    the second half of its kernels in a background process while the first half compiles here.
+    """
+    _first_compile_callbacks.append(callback)
 
 
 def failed_kernel() -> str | None:

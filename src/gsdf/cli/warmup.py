@@ -31,6 +31,10 @@ JOBS = {
 }
 
 
+# jobs that other commands start in the background (not part of a full warm-up: a subset of "cloud")
+_PARTIAL = {"demo-cloud": "the point-cloud half of gsdf demo"}
+
+
 def _write_inputs(d: str) -> dict:
     """Tiny inputs in ``d``: the bundled soup and cloud, a manifold sphere with a curve, query points."""
     import numpy as np
@@ -62,6 +66,8 @@ def _job_commands(name: str, f: dict) -> list[list[str]]:
                 ["sdf", f["soup"], "-o", o("s.npz"), "--resolution", "12", "--surface", o("s.ply"), "-q"],
                 ["sdf", f["soup"], "-o", o("sp.npz"), "--resolution", "8", "--sign", "pseudonormal", "-q"],
                 ["slice", f["soup"], "-o", o("s.svg"), "--layers", "2", "--resolution", "16"]]
+    if name == "demo-cloud":
+        return [["surface", f["cloud"], "-o", o("c.ply"), "--resolution", "12"]]
     if name == "cloud":
         return [["surface", f["cloud"], "-o", o("c.ply"), "--resolution", "12"],
                 ["voxelize", f["cloud"], "-o", o("v.npz"), "--resolution", "8", "-q"],
@@ -126,7 +132,7 @@ def warm(jobs=None, processes=None, echo=None) -> list[tuple[str, float, str]]:
 
     names = list(JOBS) if jobs is None else list(jobs)
     for n in names:
-        if n not in JOBS:
+        if n not in JOBS and n not in _PARTIAL:
             raise ValueError(f"jobs: unknown warm-up job {n!r}; known: {', '.join(JOBS)}")
     processes = min(len(names), processes or get_num_threads()) or 1
     results = []
@@ -149,7 +155,60 @@ def warm(jobs=None, processes=None, echo=None) -> list[tuple[str, float, str]]:
 
 def _line(result) -> str:
     name, seconds, error = result
-    return f"  {name:<13} {seconds:6.1f} s  " + (f"FAILED: {error}" if error else JOBS[name])
+    return f"  {name:<13} {seconds:6.1f} s  " + (f"FAILED: {error}" if error else {**JOBS, **_PARTIAL}[name])
+
+
+class BackgroundWarmup:
+    """Compile ``jobs`` in one background process, started only if this process compiles a kernel.
+
+    On a cold cache and with >= 2 threads, the background process compiles (and caches) the kernels of
+    ``jobs`` while this process compiles its own; when this process reaches them they load from the cache.
+    On a warm cache nothing is started. :meth:`close` waits for the process (it is short-lived), or stops
+    it after ``timeout`` seconds.
+
+    Example
+    -------
+    >>> with BackgroundWarmup(["demo-cloud"]):           # doctest: +SKIP
+    ...     run_the_soup_part(); run_the_cloud_part()
+    """
+
+    def __init__(self, jobs):
+        from .._jit import install_compile_notice, on_first_compile
+        from ..threads import get_num_threads
+
+        self.jobs, self.proc = list(jobs), None
+        if get_num_threads() >= 2:
+            install_compile_notice()
+            on_first_compile(self._start)
+
+    def _start(self):
+        import subprocess
+
+        cmd = [sys.executable, "-m", "gsdf.cli.main", "--threads", "1", "warmup", "--only", ",".join(self.jobs),
+               "--jobs", "1"]
+        try:
+            self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                         stdin=subprocess.DEVNULL)
+        except OSError:  # pragma: no cover - no subprocesses here: compile in this process only
+            self.proc = None
+
+    def close(self, timeout: float = 120.0):
+        if self.proc is None:
+            return
+        import subprocess
+
+        try:
+            self.proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:  # pragma: no cover
+            self.proc.kill()
+            self.proc.wait()
+        self.proc = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close(timeout=0.0 if exc[0] is not None else 120.0)
 
 
 @click.command("warmup", help="""Compile all of gsdf's kernels now (once per install), in parallel.
