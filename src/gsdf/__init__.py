@@ -6,7 +6,11 @@ Re-exports only; see ``docs/architecture.md`` for the layout. Names are resolved
 
 from importlib import import_module
 
+from ._jit import configure_cache as _configure_cache
+
 __version__ = "0.1.0"
+
+_configure_cache()  # numba's cache dir when the install dir and the user cache are read-only (cheap)
 
 _EXPORTS = {
     # I/O
@@ -46,12 +50,17 @@ _EXPORTS = {
     "reconstruct_simply_connected": "recon", "mesh_topology": "recon",
     # dataset batches (issue 16)
     "run_batch": "batch", "sdf_samples": "batch",
+    # one thread setting for numba kernels and BLAS (gsdf.threads)
+    "set_num_threads": "threads", "get_num_threads": "threads",
 }
+_SUBMODULES = {"threads"}
 
 __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name):
+    if name in _SUBMODULES:
+        return import_module(f".{name}", __name__)
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'gsdf' has no attribute {name!r}")
@@ -61,4 +70,4 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
+    return sorted(set(globals()) | set(_EXPORTS) | _SUBMODULES)

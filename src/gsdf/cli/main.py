@@ -17,12 +17,45 @@ from .surface import surface
 from .swn import swn
 from .tori import tori
 from .voxelize import voxelize
+from .warmup import warmup
 from .winding import winding
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+def _threads_option(ctx, param, value):
+    """``--threads N`` (else ``GSDF_NUM_THREADS``): validated here, so bad values are usage errors."""
+    from .. import threads
+
+    try:
+        if value is not None:
+            return threads.parse_num_threads(value, name="--threads")
+        return threads._from_env()
+    except ValueError as exc:
+        raise click.BadParameter(str(exc), ctx=ctx, param=param) from None
+
+
+class _Main(click.Group):
+    """The gsdf group: a numba compilation failure becomes one message naming the kernel (exit 1)."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort):
+            raise
+        except Exception as exc:
+            from .._jit import compile_error_message
+
+            message = compile_error_message(exc)
+            if message is None:
+                raise
+            raise click.ClickException(message) from exc
+
+
+@click.group(cls=_Main, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="gsdf")
-def main():
+@click.option("--threads", type=str, default=None, callback=_threads_option, metavar="N",
+              help="Threads for numba kernels and BLAS (one setting for both; default: GSDF_NUM_THREADS, "
+                   "else all cores).")
+def main(threads):
     """gsdf: generalized winding numbers and signed distance for broken geometry.
 
     Meshes: OBJ, OFF, PLY, STL; also GLB/GLTF/3MF (trimesh) and VTK, VTU, MSH, MESH, INP, BDF, NAS, SU2
@@ -33,9 +66,17 @@ def main():
     refused, listing the ones it can), atomically (temporary file + rename), never onto an input of the
     command; an existing output file is replaced unless --no-clobber is given.
     """
+    from .._jit import install_compile_notice
+
+    install_compile_notice()  # one line on stderr when a kernel compiles (first use after install)
+    if threads is not None:
+        from .. import threads as _threads
+
+        _threads.set_num_threads(threads)
 
 
-for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn, reconstruct):
+for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn, reconstruct,
+                warmup):
     main.add_command(command)
 main.add_command(__import__("gsdf.cli.batch", fromlist=["batch"]).batch)  # gsdf batch (issue 16)
 

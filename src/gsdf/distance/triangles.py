@@ -31,6 +31,7 @@ from .._checks import as_mesh, as_points, integer
 from .._normalize import Frame
 from ..spatial.morton import morton_order
 from ..spatial.bvh import build_triangle_bvh
+from ..threads import apply_env
 
 __all__ = ["TriangleDistance", "unsigned_distance", "closest_point_triangle", "brute_force_distance"]
 
@@ -56,7 +57,7 @@ _STACK = 128
 # ----------------------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _segment(px, py, pz, ax, ay, az, bx, by, bz):
     """Closest point on segment ab to p: returns (squared distance, t) with the point a + t (b - a)."""
     ex, ey, ez = bx - ax, by - ay, bz - az
@@ -211,7 +212,7 @@ def closest_point_triangle(P, A, B, C):
 # ----------------------------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _box_d2(px, py, pz, lo, hi, i):
     d = 0.0
     t = lo[i, 0] - px
@@ -238,7 +239,7 @@ def _box_d2(px, py, pz, lo, hi, i):
     return d
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tri_box_d2(px, py, pz, D, j):
     """Squared distance from p to the bounding box of packed triangle ``j`` (columns 13:19)."""
     d = 0.0
@@ -266,7 +267,7 @@ def _tri_box_d2(px, py, pz, D, j):
     return d
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tri_d2(px, py, pz, D, j):
     """Squared distance from p to triangle ``j`` of the packed array ``D`` (see :func:`_pack`).
 
@@ -464,6 +465,7 @@ class TriangleDistance:
 
     def _query(self, Q, chunk: int = CHUNK, want_bary: bool = True):
         """Validated queries -> (d, face, closest, bary) in input units; ``bary`` is None unless ``want_bary``."""
+        apply_env()  # GSDF_NUM_THREADS
         fr = self._frame
         Q, excess = fr.queries(Q, want_excess=True)
         d2, face, closest, bary = self._query_frame(Q, chunk, want_bary)

@@ -21,6 +21,37 @@ from numba import njit, prange
 from .torus import local_frames
 
 
+@njit(cache=True)
+def _solve6(M, rhs):
+    """Solve the small dense system M c = rhs in place by Gaussian elimination with partial pivoting (the
+    algorithm of LAPACK's dgesv; hand-written because numba's np.linalg.solve costs ~7 s of compilation)."""
+    n = rhs.shape[0]
+    for col in range(n):
+        piv = col
+        for r in range(col + 1, n):
+            if abs(M[r, col]) > abs(M[piv, col]):
+                piv = r
+        if M[piv, col] == 0.0:
+            raise ValueError("jet fit: singular normal equations")
+        if piv != col:
+            for b in range(n):
+                M[col, b], M[piv, b] = M[piv, b], M[col, b]
+            rhs[col], rhs[piv] = rhs[piv], rhs[col]
+        inv = 1.0 / M[col, col]
+        for r in range(col + 1, n):
+            f = M[r, col] * inv
+            if f != 0.0:
+                for b in range(col, n):
+                    M[r, b] -= f * M[col, b]
+                rhs[r] -= f * rhs[col]
+    for r in range(n - 1, -1, -1):
+        acc = rhs[r]
+        for b in range(r + 1, n):
+            acc -= M[r, b] * rhs[b]
+        rhs[r] = acc / M[r, r]
+    return rhs
+
+
 @njit(parallel=True, cache=True)
 def _jet_kernel(P, N, S, T, idx, dist, normal_weight, ridge, out):
     n, k = idx.shape
@@ -70,7 +101,7 @@ def _jet_kernel(P, N, S, T, idx, dist, normal_weight, ridge, out):
         reg = ridge * (wsum + 1e-12)
         for a in range(6):
             M[a, a] += reg if a >= 3 else 1e-9 * (wsum + 1e-12)
-        c = np.linalg.solve(M, rhs)
+        c = _solve6(M, rhs)
         # back to unscaled coordinates: a00 = h b00, a10 = b10, a20 = b20 / h
         out[i, 0] = c[0] * h
         out[i, 1] = c[1]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..spatial.morton import morton_order
+from ..threads import apply_env
 
 CHUNK = 1 << 20
 
@@ -19,6 +20,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
     cached nodes) and scatters the results back. ``frame`` (a :class:`gsdf._normalize.Frame`) maps each
     validated chunk into the geometry's normalised frame first (the kernel's geometry lives there).
     """
+    apply_env()  # GSDF_NUM_THREADS
     A = np.asarray(Q)
     if A.ndim == 1 and A.shape[0] == dim:
         A = A.reshape(1, dim)

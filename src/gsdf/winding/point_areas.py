@@ -362,63 +362,84 @@ def _tangent_neighbours(P, N, cand, offset, k, sel, plane):
     """
     m = cand.shape[1]
     for row in prange(cand.shape[0]):
-        i = offset + row
-        nx, ny, nz = N[i, 0], N[i, 1], N[i, 2]
-        nn = np.sqrt(nx * nx + ny * ny + nz * nz)
-        if nn == 0.0:
+        _tangent_row(P, N, cand, offset, k, sel, plane, np.int64(row))
+
+
+@njit(cache=True)
+def _tangent_row(P, N, cand, offset, k, sel, plane, row):
+    """One row of :func:`_tangent_neighbours` (kept out of the parallel loop: shorter parfor compilation)."""
+    m = cand.shape[1]
+    i = offset + row
+    nx, ny, nz = N[i, 0], N[i, 1], N[i, 2]
+    nn = np.sqrt(nx * nx + ny * ny + nz * nz)
+    if nn == 0.0:
+        return
+    nx /= nn
+    ny /= nn
+    nz /= nn
+    keep = np.empty(m, np.int64)
+    c = 0
+    for s in range(m):
+        j = cand[row, s]
+        if j == i:
             continue
-        nx /= nn
-        ny /= nn
-        nz /= nn
-        keep = np.empty(m, np.int64)
-        c = 0
-        for s in range(m):
-            j = cand[row, s]
-            if j == i:
-                continue
-            if N[j, 0] * nx + N[j, 1] * ny + N[j, 2] * nz < 0.0:
-                continue  # opposite normal: the other side of a thin sheet (§3.1)
-            keep[c] = j
-            c += 1
-        vx, vy, vz = nx, ny, nz
-        if c >= 2:
-            mx, my, mz = P[i, 0], P[i, 1], P[i, 2]
-            for s in range(c):
-                j = keep[s]
-                mx += P[j, 0]
-                my += P[j, 1]
-                mz += P[j, 2]
-            mx /= c + 1
-            my /= c + 1
-            mz /= c + 1
-            C = np.zeros((3, 3))
-            for s in range(c + 1):
-                j = keep[s] if s < c else np.int64(i)
-                d0, d1, d2 = P[j, 0] - mx, P[j, 1] - my, P[j, 2] - mz
-                C[0, 0] += d0 * d0
-                C[0, 1] += d0 * d1
-                C[0, 2] += d0 * d2
-                C[1, 1] += d1 * d1
-                C[1, 2] += d1 * d2
-                C[2, 2] += d2 * d2
-            C[1, 0] = C[0, 1]
-            C[2, 0] = C[0, 2]
-            C[2, 1] = C[1, 2]
-            w, U = np.linalg.eigh(C)
-            if w[1] > 0.0:  # a real plane (not collinear or coincident points)
-                vx, vy, vz = U[0, 0], U[1, 0], U[2, 0]
-                if vx * nx + vy * ny + vz * nz < 0.0:
-                    vx, vy, vz = -vx, -vy, -vz
-        plane[row, 0], plane[row, 1], plane[row, 2] = vx, vy, vz
-        dist = np.empty(c)
+        if N[j, 0] * nx + N[j, 1] * ny + N[j, 2] * nz < 0.0:
+            continue  # opposite normal: the other side of a thin sheet (§3.1)
+        keep[c] = j
+        c += 1
+    vx, vy, vz = nx, ny, nz
+    if c >= 2:
+        mx, my, mz = P[i, 0], P[i, 1], P[i, 2]
         for s in range(c):
             j = keep[s]
-            d0, d1, d2 = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
-            h = d0 * vx + d1 * vy + d2 * vz
-            dist[s] = d0 * d0 + d1 * d1 + d2 * d2 - h * h
-        o = np.argsort(dist)
-        for s in range(min(k, c)):
-            sel[row, s] = keep[o[s]]
+            mx += P[j, 0]
+            my += P[j, 1]
+            mz += P[j, 2]
+        mx /= c + 1
+        my /= c + 1
+        mz /= c + 1
+        C = np.zeros((3, 3))
+        for s in range(c + 1):
+            j = keep[s] if s < c else np.int64(i)
+            d0, d1, d2 = P[j, 0] - mx, P[j, 1] - my, P[j, 2] - mz
+            C[0, 0] += d0 * d0
+            C[0, 1] += d0 * d1
+            C[0, 2] += d0 * d2
+            C[1, 1] += d1 * d1
+            C[1, 2] += d1 * d2
+            C[2, 2] += d2 * d2
+        C[1, 0] = C[0, 1]
+        C[2, 0] = C[0, 2]
+        C[2, 1] = C[1, 2]
+        w, U = np.linalg.eigh(C)
+        if w[1] > 0.0:  # a real plane (not collinear or coincident points)
+            vx, vy, vz = U[0, 0], U[1, 0], U[2, 0]
+            if vx * nx + vy * ny + vz * nz < 0.0:
+                vx, vy, vz = -vx, -vy, -vz
+    plane[row, 0], plane[row, 1], plane[row, 2] = vx, vy, vz
+    dist = np.empty(c)
+    for s in range(c):
+        j = keep[s]
+        d0, d1, d2 = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
+        h = d0 * vx + d1 * vy + d2 * vz
+        dist[s] = d0 * d0 + d1 * d1 + d2 * d2 - h * h
+    # the min(k, c) smallest by insertion (c is a few dozen; np.argsort would cost seconds of compilation)
+    kk = min(k, c)
+    for s in range(c):
+        d = dist[s]
+        j = keep[s]
+        t = s if s < kk else kk
+        if t == kk and (kk == 0 or d >= dist[kk - 1]):
+            continue  # not among the kk nearest so far
+        while t > 0 and dist[t - 1] > d:
+            if t < kk:
+                dist[t] = dist[t - 1]
+                keep[t] = keep[t - 1]
+            t -= 1
+        dist[t] = d
+        keep[t] = j
+    for s in range(kk):
+        sel[row, s] = keep[s]
 
 
 def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) -> np.ndarray:

@@ -1,0 +1,140 @@
+"""Cold start: the compile notice, clean compile-failure messages, the numba cache-dir fallback, gsdf warmup."""
+
+import io
+import os
+import subprocess
+import sys
+
+import click
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from numba import njit
+from numba.core import event
+
+from gsdf import _jit
+from gsdf.cli.main import main
+
+SRC = os.path.join(os.path.dirname(__file__), "..", "src")
+
+
+def _gsdf_function(source: str, name: str):
+    """A jitted function that numba sees as living in a gsdf module (the notice only watches gsdf kernels)."""
+    scope = {"__name__": "gsdf._test_kernels", "np": np}
+    exec(source, scope)
+    return njit(scope[name])
+
+
+@pytest.fixture
+def fresh_listener(monkeypatch):
+    monkeypatch.setattr(_jit, "_listener", None)
+    stream = io.StringIO()
+    listener = _jit.install_compile_notice(stream=stream)
+    yield stream
+    event.unregister("numba:compile", listener)
+
+
+def test_notice_printed_once_on_compile(fresh_listener):
+    f = _gsdf_function("def add_one(x):\n    return x + 1\n", "add_one")
+    assert fresh_listener.getvalue() == ""
+    assert f(1) == 2
+    assert fresh_listener.getvalue().count("compiling kernels, once per install") == 1
+    assert f(1.5) == 2.5  # a second specialisation compiles, no second line
+    assert fresh_listener.getvalue().count("\n") == 1
+
+
+def test_notice_ignores_other_kernels(fresh_listener):
+    g = njit(lambda x: x * 2)  # module is this test file, not gsdf
+    assert g(3) == 6
+    assert fresh_listener.getvalue() == ""
+
+
+def test_compile_failure_names_kernel(fresh_listener):
+    bad = _gsdf_function("def broken(x):\n    return x + undefined_name\n", "broken")
+    with pytest.raises(Exception) as info:
+        bad(1)
+    msg = _jit.compile_error_message(info.value)
+    assert msg is not None and "gsdf._test_kernels.broken" in msg and "failed on this platform" in msg
+    assert _jit.failed_kernel() == "gsdf._test_kernels.broken"
+
+
+def test_cli_compile_failure_is_clean_error(fresh_listener):
+    bad = _gsdf_function("def broken2(x):\n    return x + undefined_name\n", "broken2")
+
+    @click.command("broken-test")
+    def broken_cmd():
+        bad(1)
+
+    main.add_command(broken_cmd)
+    try:
+        res = CliRunner().invoke(main, ["broken-test"])
+    finally:
+        main.commands.pop("broken-test")
+    assert res.exit_code == 1
+    assert "compiling the numba kernel gsdf._test_kernels.broken2 failed" in res.output
+    assert "Traceback" not in res.output
+
+
+def test_other_errors_still_raise(fresh_listener):
+    @click.command("boom-test")
+    def boom():
+        raise RuntimeError("not a compile error")
+
+    main.add_command(boom)
+    try:
+        res = CliRunner().invoke(main, ["boom-test"])
+    finally:
+        main.commands.pop("boom-test")
+    assert isinstance(res.exception, RuntimeError)
+
+
+def test_cache_dir_fallback(monkeypatch, tmp_path):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.delitem(sys.modules, "numba")  # as before numba is imported (restored afterwards)
+    monkeypatch.setattr(_jit, "_writable", lambda path: False)  # read-only install and read-only home
+    path = _jit.configure_cache(str(tmp_path))
+    assert path is not None and os.environ["NUMBA_CACHE_DIR"] == path
+    assert os.path.basename(path).startswith("gsdf-numba-cache")
+
+
+def test_cache_dir_untouched_when_writable_or_set(monkeypatch, tmp_path):
+    monkeypatch.delitem(sys.modules, "numba")
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    assert _jit.configure_cache(str(tmp_path)) is None and "NUMBA_CACHE_DIR" not in os.environ
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "mine"))
+    monkeypatch.setattr(_jit, "_writable", lambda path: False)
+    assert _jit.configure_cache(str(tmp_path)) is None
+    assert os.environ["NUMBA_CACHE_DIR"] == str(tmp_path / "mine")
+
+
+def test_writable_checks_nearest_existing_parent(tmp_path):
+    assert _jit._writable(str(tmp_path / "not" / "yet" / "there"))
+
+
+def test_cli_prints_notice_on_cold_cache_only(tmp_path):
+    """A real `gsdf winding --exact` in a fresh process with an empty cache dir, then again (warm)."""
+    from gsdf.io import write_mesh
+
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    write_mesh(str(tmp_path / "t.obj"), V, F)
+    np.save(tmp_path / "q.npy", np.array([[0.1, 0.1, 0.1], [2.0, 2.0, 2.0]]))
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=os.path.abspath(SRC))
+    cmd = [sys.executable, "-m", "gsdf.cli.main", "winding", str(tmp_path / "t.obj"), str(tmp_path / "q.npy"),
+           "--exact", "-o", str(tmp_path / "w.npy"), "-q"]
+    first = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert first.returncode == 0, first.stderr
+    assert first.stderr.count("compiling kernels, once per install") == 1
+    w = np.load(tmp_path / "w.npy")
+    assert abs(w[0] - 1) < 1e-12 and abs(w[1]) < 1e-12
+    second = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert second.returncode == 0 and "compiling kernels" not in second.stderr
+
+
+def test_warmup_rejects_unknown_job():
+    res = CliRunner().invoke(main, ["warmup", "--only", "nonsense"])
+    assert res.exit_code == 1 and "unknown warm-up job 'nonsense'" in res.output
+    from gsdf.cli.warmup import warm
+
+    with pytest.raises(ValueError, match="unknown warm-up job"):
+        warm(["soup", "x"])
