@@ -211,7 +211,8 @@ error of 1/2 and either method may flip a voxel. "ratio" is (gsdf precompute + q
 
 {growth}
 """
-    write_section("winding", text)
+    # a partial run (--only) gets its own section, so the full tables of the last full run stay
+    write_section("winding" if not args.only else "winding-" + "-".join(sorted(parts)), text)
     print(text)
 
 

@@ -138,3 +138,11 @@ def test_warmup_rejects_unknown_job():
 
     with pytest.raises(ValueError, match="unknown warm-up job"):
         warm(["soup", "x"])
+
+
+def test_background_warmup_withdrawn_on_close(fresh_listener):
+    from gsdf.cli.warmup import BackgroundWarmup
+
+    bg = BackgroundWarmup(["demo-cloud"])
+    bg.close()  # nothing compiled in between: nothing started, and the callback is gone
+    assert bg.proc is None and bg._start not in _jit._first_compile_callbacks

@@ -120,3 +120,25 @@ def test_cli_threads_applies(clean, tmp_path):
     assert numba.get_num_threads() == 1 and threads.get_num_threads() == 1
     w = np.load(tmp_path / "w.npy")
     assert abs(w[0] - 1) < 1e-3 and abs(w[1]) < 1e-3
+
+
+def test_blas_solve_threads_default_one(clean, monkeypatch):
+    assert threads.blas_solve_threads() == 1  # no explicit setting: BLAS single-threaded around solves
+    np.linalg.svd(np.ones((3, 3)))
+    with threads.blas_region():
+        assert all(k == 1 for k in _blas_threads())
+    monkeypatch.setenv(threads.ENV_VAR, "2")
+    assert threads.blas_solve_threads() == 2
+    monkeypatch.delenv(threads.ENV_VAR)
+    threads.set_num_threads(3)
+    assert threads.blas_solve_threads() == 3
+
+
+def test_cli_default_blas_one_thread(clean):
+    import os
+
+    res = CliRunner().invoke(main, ["demo", "--help"])
+    assert res.exit_code == 0
+    assert os.environ["OPENBLAS_NUM_THREADS"] == "1"
+    assert all(k == 1 for k in _blas_threads())
+    assert threads._setting is None  # numba keeps its default

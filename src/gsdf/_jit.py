@@ -121,6 +121,12 @@ def on_first_compile(callback) -> None:
     _first_compile_callbacks.append(callback)
 
 
+def cancel_first_compile(callback) -> None:
+    """Withdraw a callback of :func:`on_first_compile` that has not run yet."""
+    if callback in _first_compile_callbacks:
+        _first_compile_callbacks.remove(callback)
+
+
 def failed_kernel() -> str | None:
     """The first gsdf kernel whose compilation raised and was not retried successfully (None if none)."""
     if _listener is None or not _listener.failed:

@@ -14,8 +14,14 @@ The rule this module enforces: **gsdf never runs BLAS threads and numba threads 
   the environment variable ``GSDF_NUM_THREADS``, or ``gsdf --threads N`` on the command line;
 - numba's parallel kernels use ``n`` threads (capped at numba's pool size, ``NUMBA_NUM_THREADS``, which is
   fixed when numba starts); while they run BLAS is idle, so nothing else needs limiting;
-- around sparse factorizations and solves (:func:`blas_region`) BLAS is limited to ``n`` threads by
-  threadpoolctl and restored afterwards.
+- around sparse factorizations and solves (:func:`blas_region`) BLAS is limited by threadpoolctl and
+  restored afterwards: to ``n`` threads when the setting was made explicitly, else to **one** thread
+  (:func:`blas_solve_threads`). Measured (issue 17, 2 cores, shared machine at load ~30):
+  ``gsdf heat-surface bunny00.off`` took 337 s wall / 19.8 s CPU with OpenBLAS's default 2 threads and
+  54 s / 1.65 s with one; three such runs at once took 390 s each with 2 BLAS threads and 43 s with
+  ``--threads 1``. The supernodes of gsdf's sparse factorizations are too small for BLAS threads to pay,
+  and OpenBLAS's spinning idle threads collapse under contention. The ``gsdf`` command applies this
+  default process-wide at start (:func:`apply_cli_default`).
 
 Which calls to wrap (for heat/ and linalg/; wired by the lead after the heat refactor):
 
@@ -242,6 +248,22 @@ def limit(n):
         numba.set_num_threads(previous_numba)
 
 
+def blas_solve_threads() -> int:
+    """BLAS threads for sparse solves: the explicit setting (set_num_threads / limit / GSDF_NUM_THREADS /
+    --threads), else 1 (see the module docstring for the measurement)."""
+    if _setting is not None:
+        return _setting
+    env = _from_env()
+    return env if env is not None else 1
+
+
+def apply_cli_default() -> None:
+    """The ``gsdf`` command without ``--threads`` / ``GSDF_NUM_THREADS``: BLAS on one thread process-wide
+    (numba keeps all cores). A library user's process is left alone: there only :func:`blas_region` limits."""
+    if _setting is None and _from_env() is None:
+        _apply_blas_process_wide(1)
+
+
 @contextmanager
 def blas_region(n=None):
     """Limit BLAS (OpenBLAS, MKL, BLIS: every loaded one, via threadpoolctl) to the setting in the block.
@@ -252,7 +274,7 @@ def blas_region(n=None):
     Parameters
     ----------
     n : int, optional
-        Thread count for this block; default :func:`get_num_threads`.
+        Thread count for this block; default :func:`blas_solve_threads` (the explicit setting, else 1).
 
     Example
     -------
@@ -262,7 +284,7 @@ def blas_region(n=None):
     """
     from threadpoolctl import threadpool_limits
 
-    n = get_num_threads() if n is None else parse_num_threads(n)
+    n = blas_solve_threads() if n is None else parse_num_threads(n)
     with threadpool_limits(limits=n, user_api="blas"):
         yield n
 

@@ -54,7 +54,7 @@ class _Main(click.Group):
 @click.version_option(__version__, prog_name="gsdf")
 @click.option("--threads", type=str, default=None, callback=_threads_option, metavar="N",
               help="Threads for numba kernels and BLAS (one setting for both; default: GSDF_NUM_THREADS, "
-                   "else all cores).")
+                   "else all cores for numba and one for BLAS).")
 def main(threads):
     """gsdf: generalized winding numbers and signed distance for broken geometry.
 
@@ -69,10 +69,12 @@ def main(threads):
     from .._jit import install_compile_notice
 
     install_compile_notice()  # one line on stderr when a kernel compiles (first use after install)
-    if threads is not None:
-        from .. import threads as _threads
+    from .. import threads as _threads
 
+    if threads is not None:
         _threads.set_num_threads(threads)
+    else:
+        _threads.apply_cli_default()  # BLAS on one thread (measured: its idle threads spin, see gsdf.threads)
 
 
 for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn, reconstruct,

@@ -193,6 +193,9 @@ class BackgroundWarmup:
             self.proc = None
 
     def close(self, timeout: float = 120.0):
+        from .._jit import cancel_first_compile
+
+        cancel_first_compile(self._start)  # warm cache: nothing was started, and nothing will be
         if self.proc is None:
             return
         import subprocess
