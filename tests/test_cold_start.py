@@ -141,7 +141,7 @@ def test_warmup_rejects_unknown_job():
 
 
 def test_background_warmup_withdrawn_on_close(fresh_listener):
-    from gsdf.cli.warmup import BackgroundWarmup
+    from gsdf.cli._background import BackgroundWarmup
 
     bg = BackgroundWarmup(["demo-cloud"])
     bg.close()  # nothing compiled in between: nothing started, and the callback is gone

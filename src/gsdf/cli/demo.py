@@ -34,7 +34,7 @@ def demo(output_dir, resolution):
     from ..winding.point_areas import point_areas
     from .sdf import signed_distance_grid
 
-    from .warmup import BackgroundWarmup
+    from ._background import BackgroundWarmup
 
     def save(name, writer):
         with output_file(os.path.join(output_dir, name)) as tmp:

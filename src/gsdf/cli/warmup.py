@@ -86,18 +86,18 @@ def _job_commands(name: str, f: dict) -> list[list[str]]:
 
 
 def _run_job(name: str) -> tuple[str, float, str]:
-    """Run one job's commands in this process; returns (name, seconds, error or '')."""
-    from click.testing import CliRunner
-
-    from .main import main
+    """Run one job's commands, each as ``python -m gsdf.cli.main ...`` in a child process (the kernels they
+    compile land in the on-disk cache); returns (name, seconds, error or '')."""
+    import subprocess
 
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="gsdf-warmup-") as d:
         f = _write_inputs(d)
         for args in _job_commands(name, f):
-            res = CliRunner().invoke(main, args, catch_exceptions=True)
-            if res.exit_code != 0:
-                err = res.output.strip().splitlines()[-1:] or [repr(res.exception)]
+            res = subprocess.run([sys.executable, "-m", "gsdf.cli.main", *args], capture_output=True, text=True,
+                                 stdin=subprocess.DEVNULL)
+            if res.returncode != 0:
+                err = (res.stderr or res.stdout).strip().splitlines()[-1:] or [f"exit {res.returncode}"]
                 return name, time.perf_counter() - t0, f"gsdf {' '.join(args[:1])}: {err[0]}"
     return name, time.perf_counter() - t0, ""
 
@@ -156,62 +156,6 @@ def warm(jobs=None, processes=None, echo=None) -> list[tuple[str, float, str]]:
 def _line(result) -> str:
     name, seconds, error = result
     return f"  {name:<13} {seconds:6.1f} s  " + (f"FAILED: {error}" if error else {**JOBS, **_PARTIAL}[name])
-
-
-class BackgroundWarmup:
-    """Compile ``jobs`` in one background process, started only if this process compiles a kernel.
-
-    On a cold cache and with >= 2 threads, the background process compiles (and caches) the kernels of
-    ``jobs`` while this process compiles its own; when this process reaches them they load from the cache.
-    On a warm cache nothing is started. :meth:`close` waits for the process (it is short-lived), or stops
-    it after ``timeout`` seconds.
-
-    Example
-    -------
-    >>> with BackgroundWarmup(["demo-cloud"]):           # doctest: +SKIP
-    ...     run_the_soup_part(); run_the_cloud_part()
-    """
-
-    def __init__(self, jobs):
-        from .._jit import install_compile_notice, on_first_compile
-        from ..threads import get_num_threads
-
-        self.jobs, self.proc = list(jobs), None
-        if get_num_threads() >= 2:
-            install_compile_notice()
-            on_first_compile(self._start)
-
-    def _start(self):
-        import subprocess
-
-        cmd = [sys.executable, "-m", "gsdf.cli.main", "--threads", "1", "warmup", "--only", ",".join(self.jobs),
-               "--jobs", "1"]
-        try:
-            self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                         stdin=subprocess.DEVNULL)
-        except OSError:  # pragma: no cover - no subprocesses here: compile in this process only
-            self.proc = None
-
-    def close(self, timeout: float = 120.0):
-        from .._jit import cancel_first_compile
-
-        cancel_first_compile(self._start)  # warm cache: nothing was started, and nothing will be
-        if self.proc is None:
-            return
-        import subprocess
-
-        try:
-            self.proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:  # pragma: no cover
-            self.proc.kill()
-            self.proc.wait()
-        self.proc = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close(timeout=0.0 if exc[0] is not None else 120.0)
 
 
 @click.command("warmup", help="""Compile all of gsdf's kernels now (once per install), in parallel.

@@ -1,0 +1,63 @@
+"""Background compilation for ``gsdf demo``: a second process compiles (and caches) one warm-up job's kernels
+while this process compiles its own. Kept apart from :mod:`gsdf.cli.warmup`, which imports the command group,
+so that subcommands can use it without an import cycle."""
+
+from __future__ import annotations
+
+import sys
+
+
+class BackgroundWarmup:
+    """Compile ``jobs`` in one background process, started only if this process compiles a kernel.
+
+    On a cold cache and with >= 2 threads, the background process compiles (and caches) the kernels of
+    ``jobs`` while this process compiles its own; when this process reaches them they load from the cache.
+    On a warm cache nothing is started. :meth:`close` waits for the process (it is short-lived), or stops
+    it after ``timeout`` seconds.
+
+    Example
+    -------
+    >>> with BackgroundWarmup(["demo-cloud"]):           # doctest: +SKIP
+    ...     run_the_soup_part(); run_the_cloud_part()
+    """
+
+    def __init__(self, jobs):
+        from .._jit import install_compile_notice, on_first_compile
+        from ..threads import get_num_threads
+
+        self.jobs, self.proc = list(jobs), None
+        if get_num_threads() >= 2:
+            install_compile_notice()
+            on_first_compile(self._start)
+
+    def _start(self):
+        import subprocess
+
+        cmd = [sys.executable, "-m", "gsdf.cli.main", "--threads", "1", "warmup", "--only", ",".join(self.jobs),
+               "--jobs", "1"]
+        try:
+            self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                         stdin=subprocess.DEVNULL)
+        except OSError:  # pragma: no cover - no subprocesses here: compile in this process only
+            self.proc = None
+
+    def close(self, timeout: float = 120.0):
+        from .._jit import cancel_first_compile
+
+        cancel_first_compile(self._start)  # warm cache: nothing was started, and nothing will be
+        if self.proc is None:
+            return
+        import subprocess
+
+        try:
+            self.proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:  # pragma: no cover
+            self.proc.kill()
+            self.proc.wait()
+        self.proc = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close(timeout=0.0 if exc[0] is not None else 120.0)
