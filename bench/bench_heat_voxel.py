@@ -10,7 +10,7 @@
 * Option A vs Option B connection Laplacian, timings (surface, normals, operators, first solve with the
   factorizations, repeated solve).
 
-Run: ``PYTHONPATH=src python3 bench/bench_heat_voxel.py`` (writes the "heat-voxel" section of RESULTS.md).
+Run: ``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python3 bench/bench_heat_voxel.py`` (writes the "heat-voxel" section of RESULTS.md).
 """
 
 from __future__ import annotations
@@ -91,6 +91,21 @@ def plane(N, nrm, mdir, radius=3.0, exact=False):
     return eps(phi[sel], (P @ m)[sel], s.domain.mass()[sel])
 
 
+def icosphere(subdivisions, R=1.0, z_rel=0.3):
+    """Baseline: the triangle-mesh (Crouzeix–Raviart) signed heat method on an icosphere, curve z = z_rel·R."""
+    from gsdf.heat import SurfaceSignedHeatSolver
+    from gsdf.heat.surface.curves import level_set_curves
+    from gsdf.heat.surface.meshes import sphere_mesh
+
+    V, F = sphere_mesh(subdivisions, R)
+    s = SurfaceSignedHeatSolver(V, F)
+    t0 = time.perf_counter()
+    phi = s.compute_distance(level_set_curves(V, F, V[:, 2] - z_rel * R))
+    dt = time.perf_counter() - t0
+    ref = R * (np.arccos(np.clip(-V[:, 2] / R, -1, 1)) - np.arccos(-z_rel))
+    return eps(phi, ref, s.ops.vertex_mass()), len(V), dt
+
+
 def order(errs):
     return [float("nan")] + [float(np.log2(a / b)) for a, b in zip(errs[:-1], errs[1:])]
 
@@ -100,7 +115,7 @@ def main():
     lines = ["## heat-voxel — signed heat method on digital surfaces (§8.5)", "",
              f"Machine: {machine()}.", f"Load at start: `{load0}` (the machine is shared with other helpers: "
              "timings are indicative).", "",
-             "Command: `PYTHONPATH=src python3 bench/bench_heat_voxel.py`.", "",
+             "Command: `OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python3 bench/bench_heat_voxel.py` (single-threaded BLAS: on the shared, oversubscribed machine threaded BLAS made the factorizations 10-70x slower).", "",
              "ε is the §9.1 error (mass-weighted L2 / range of φ⁰ / √area); 'order' = log2(ε_N/2 / ε_N).", ""]
     # ---------------------------------------------------------------- sphere
     lines += ["### Digital sphere R = N/2 − 2, curve on the grid plane z = c + round(0.3R), φ⁰ = R(θ − θ0)", "",
@@ -136,6 +151,15 @@ def main():
         for k, N in enumerate(SIZES):
             lines.append(f"| {nrm} | {N} | {ii[k]:.5f} | {oi[k]:.2f} | {tr[k]:.5f} | {ot_[k]:.2f} | {ex[k]:.5f} | "
                          f"{oe[k]:.2f} |")
+    # ---------------------------------------------------------------- smooth baseline
+    lines += ["", "Baseline, the same method on a smooth triangle mesh (Crouzeix–Raviart SHM, "
+              "`SurfaceSignedHeatSolver`) on icospheres of similar vertex counts, curve z = 0.3R:", "",
+              "| subdivisions | vertices | ε | order | 1st solve s |", "|---|---|---|---|---|"]
+    base = [icosphere(k) for k in (3, 4, 5)]            # 6 (41k vertices): minutes in the complex SuperLU
+    ob = order([b[0] for b in base])
+    for k, (e, nv, dt) in enumerate(base):
+        lines.append(f"| {k + 3} | {nv} | {e:.5f} | {ob[k]:.2f} | {dt:.2f} |")
+    print("icosphere", base, flush=True)
     # ---------------------------------------------------------------- option A vs B, component timings
     N = SIZES[-2] if len(SIZES) > 1 else SIZES[0]
     eA, _ = sphere(N)

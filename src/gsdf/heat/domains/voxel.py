@@ -147,11 +147,6 @@ class VoxelSurfaceDomain(VertexSurfaceDomain):
     True
     """
 
-    # Step I is factorized in the real 2n×2n form of the Hermitian M + t L∇ (CHOLMOD through cholespy, SuperLU
-    # without it): on the 72.6k-vertex digital sphere (N = 128) that took 4.5 s against 60 s for SuperLU on the
-    # complex matrix (bench/bench_heat_voxel.py, loaded machine). Same operator, same solution.
-    heat_form = "real2"
-
     def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, normals=None, connection: str = "A",
                  t_coef: float = 1.0):
         t_coef = _checks.positive(t_coef, "t_coef")
@@ -249,18 +244,6 @@ class VoxelSurfaceDomain(VertexSurfaceDomain):
         cols = np.broadcast_to(F[:, None, :], (m, 4, 4)).ravel()
         A = sp.csr_matrix((vals.ravel(), (rows, cols)), shape=(n, n))
         return (0.5 * (A + A.conj().T)).tocsr()
-
-    def vector_heat_matrix(self) -> sp.csr_matrix:
-        """Step I operator ``M + t L∇`` in real form (2n × 2n): block (i, j) = [[Re, −Im], [Im, Re]] of entry
-        (i, j), unknowns interleaved (Re, Im) per vertex (``heat_form = "real2"``)."""
-        A = sp.coo_matrix(sp.diags(self.Mv.astype(np.complex128)) + self.t * self.Lconn)
-        r, c, v = A.row, A.col, A.data
-        rows = np.concatenate([2 * r, 2 * r, 2 * r + 1, 2 * r + 1])
-        cols = np.concatenate([2 * c, 2 * c + 1, 2 * c, 2 * c + 1])
-        vals = np.concatenate([v.real, -v.imag, v.imag, v.real])
-        R = sp.csr_matrix((vals, (rows, cols)), shape=(2 * self.n, 2 * self.n))
-        R.sum_duplicates()
-        return R
 
     # ---------------------------------------------------------------- steps II and III (protocol)
     def gather(self, X) -> np.ndarray:
