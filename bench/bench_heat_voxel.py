@@ -41,11 +41,11 @@ def ball(N, R):
     return (x ** 2).sum(0) <= R ** 2
 
 
-def sphere(N, radius=3.0, broken=False, connection="A", timings=None):
+def sphere(N, radius=3.0, broken=False, connection="A", timings=None, t_coef=1.0):
     R = N / 2 - 2
     occ = ball(N, R)
     t0 = time.perf_counter()
-    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, connection=connection)
+    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, connection=connection, t_coef=t_coef)
     t_build = time.perf_counter() - t0
     c = N / 2
     # the curve at the grid plane z = zc nearest to c + 0.3 R (quads with centres below zc + ¼: the region's
@@ -73,7 +73,7 @@ def sphere(N, radius=3.0, broken=False, connection="A", timings=None):
     return eps(phi, ref, A), float(A[ok].sum() / A[inside | outside].sum())
 
 
-def plane(N, nrm, mdir, radius=3.0, exact=False):
+def plane(N, nrm, mdir, radius=3.0, exact=False, t_coef=1.0):
     nrm = np.asarray(nrm, float) / np.linalg.norm(nrm)
     m = np.asarray(mdir, float) / np.linalg.norm(mdir)
     x = np.indices((N,) * 3).transpose(1, 2, 3, 0) + 0.5
@@ -83,7 +83,7 @@ def plane(N, nrm, mdir, radius=3.0, exact=False):
         S = digital_surface(occ, np.ones(3))
         on = ((S.trivial_normals @ nrm) > 0) & (np.abs((S.centres - N / 2) @ nrm) < 1.0)
         normals = np.where(on[:, None], nrm, S.trivial_normals)
-    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, normals=normals)
+    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, normals=normals, t_coef=t_coef)
     ctr = np.full(3, N / 2)
     phi = s.compute_distance(region_boundary_curves(s.faces, (s.face_centres - ctr) @ m < 0))
     P = s.vertices - ctr
@@ -151,6 +151,15 @@ def main():
         for k, N in enumerate(SIZES):
             lines.append(f"| {nrm} | {N} | {ii[k]:.5f} | {oi[k]:.2f} | {tr[k]:.5f} | {ot_[k]:.2f} | {ex[k]:.5f} | "
                          f"{oe[k]:.2f} |")
+    # ---------------------------------------------------------------- diffusion time
+    lines += ["", "Diffusion time t = t_coef·h² (default t_coef = 1, the notes' t = h²): ε at the two finest N.", "",
+              "| case | N | t_coef = 1 | 2 | 4 | 16 |", "|---|---|---|---|---|---|"]
+    for N in SIZES[-2:]:
+        row = [sphere(N, 0.5 * N ** (2 / 3), t_coef=tc)[0] for tc in (1, 2, 4, 16)]
+        lines.append(f"| sphere, II r=½N^⅔ | {N} | " + " | ".join(f"{e:.5f}" for e in row) + " |")
+        row = [plane(N, (1, 2, 0), (2, -1, 0), exact=True, t_coef=tc) for tc in (1, 2, 4, 16)]
+        lines.append(f"| plane (1,2,0), exact normals | {N} | " + " | ".join(f"{e:.5f}" for e in row) + " |")
+        print("t_coef", N, lines[-2:], flush=True)
     # ---------------------------------------------------------------- smooth baseline
     lines += ["", "Baseline, the same method on a smooth triangle mesh (Crouzeix–Raviart SHM, "
               "`SurfaceSignedHeatSolver`) on icospheres of similar vertex counts, curve z = 0.3R:", "",
