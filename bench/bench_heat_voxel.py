@@ -1,6 +1,7 @@
 """Signed heat method on digital surfaces (Feng & Crane 2024 §8.5): convergence and timings.
 
-* Digital sphere R = N/2 − 2 at N = 16 … 128, curve = boundary of {quads with centre z < zc + ¼}, zc = c + round(0.3 R), reference
+* Digital sphere R = N/2 − 2 at N = 16 … 128, curve = boundary of {quads with centre z < zc + ¼},
+  zc = c + round(0.3 R), reference
   φ⁰ = R(θ − θ0) at the radial projection; §9.1 error ε, sign correct (fraction of area, against the digital
   region; curve vertices excluded); corrected normals (integral invariants, r = 3 voxels, and r = ½ N^{2/3}
   voxels, i.e. r ∝ h^{1/3} in world units), trivial normals, and the broken curve (50 % of segments deleted).
@@ -10,7 +11,8 @@
 * Option A vs Option B connection Laplacian, timings (surface, normals, operators, first solve with the
   factorizations, repeated solve).
 
-Run: ``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python3 bench/bench_heat_voxel.py`` (writes the "heat-voxel" section of RESULTS.md).
+Run: ``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python3 bench/bench_heat_voxel.py``
+(writes the "heat-voxel" section of RESULTS.md).
 """
 
 from __future__ import annotations
@@ -115,7 +117,9 @@ def main():
     lines = ["## heat-voxel — signed heat method on digital surfaces (§8.5)", "",
              f"Machine: {machine()}.", f"Load at start: `{load0}` (the machine is shared with other helpers: "
              "timings are indicative).", "",
-             "Command: `OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python3 bench/bench_heat_voxel.py` (single-threaded BLAS: on the shared, oversubscribed machine threaded BLAS made the factorizations 10-70x slower).", "",
+             "Command: `OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python3 bench/bench_heat_voxel.py` "
+             "(single-threaded BLAS: on the shared, oversubscribed machine threaded BLAS made the factorizations "
+             "10-70x slower).", "",
              "ε is the §9.1 error (mass-weighted L2 / range of φ⁰ / √area); 'order' = log2(ε_N/2 / ε_N).", ""]
     # ---------------------------------------------------------------- sphere
     lines += ["### Digital sphere R = N/2 − 2, curve on the grid plane z = c + round(0.3R), φ⁰ = R(θ − θ0)", "",

@@ -153,7 +153,9 @@ def test_face_operators_identities_on_random_planar_polygons():
     assert np.linalg.eigvalsh(ops.laplacian).min() > -1e-12                                 # PSD
     lhs = np.einsum("mkl,mlj,mj->mk", ops.divergence, ops.flat, g)
     assert np.allclose(lhs, np.einsum("mkl,ml->mk", ops.laplacian, phi))                   # div ♭∇φ = Lφ
-    assert np.allclose(ops.area, 0.5 * np.abs((P2[..., 0] * np.roll(P2, -1, 1)[..., 1] - P2[..., 1] * np.roll(P2, -1, 1)[..., 0]).sum(1)))
+    Q2 = np.roll(P2, -1, 1)
+    shoelace = 0.5 * np.abs((P2[..., 0] * Q2[..., 1] - P2[..., 1] * Q2[..., 0]).sum(1))
+    assert np.allclose(ops.area, shoelace)
 
 
 def _corrected_plane(N=16, nrm=(1, 2, 0)):
@@ -249,7 +251,7 @@ def test_broken_sphere_curve():
     assert e1 < 2.0 * e0 and s1 >= 0.95 and s0 >= 0.99
 
 
-# ------------------------------------------------------------------------------------------------ sources and constraints
+# ---------------------------------------------------------------------------------------- sources and constraints
 @pytest.fixture(scope="module")
 def sphere32():
     s = VoxelSurfaceSignedHeatSolver(ball(32, 13))
