@@ -52,17 +52,18 @@ def _median(f, n=3):
 
 
 def hermitian():
+    import gsdf.heat.core as CORE
     import gsdf.heat.surface.polygon as PM
     import gsdf.heat.surface.solver as SM
     from bench_heat_surface import _cube_sphere
 
     mats = []
-    got, undo = _grab(SM, "HermitianFactorization")
+    got, undo = _grab(CORE, "HermitianFactorization")  # the signed heat core factorizes for every domain
     V, F = gsdf.read_mesh(os.path.join(data_dir(), "meshes", "bunny00.off"))
     SM.SurfaceSignedHeatSolver(V, F).vector_heat_factorization
     undo()
     mats.append(("bunny00.off, CR edges", got["A"]))
-    got, undo = _grab(PM, "HermitianFactorization")
+    got, undo = _grab(CORE, "HermitianFactorization")
     V, Q = _cube_sphere(64)
     PM.PolygonMeshSignedHeatSolver(V, list(Q)).core.vector_heat_factorization
     undo()
@@ -86,9 +87,9 @@ def hermitian():
 
 
 def tet_step3():
-    import gsdf.heat.volume.tet as T
+    import gsdf.heat.domains.tet as T
 
-    got, undo = _grab(T, "SPDSolver")
+    got, undo = _grab(T, "SPDSolver")  # the tet domain's Poisson solves (through gsdf.heat.core)
     V, F = gsdf.read_mesh(os.path.join(data_dir(), "meshes", "mech-holes-shark.off"))
     signed_heat_volume(mesh=(V, F), resolution=32, domain="tet")
     undo()

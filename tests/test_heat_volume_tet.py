@@ -124,8 +124,8 @@ def test_tet_bad_options(sphere):
         signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, mesher="gmsh")
     with pytest.raises(ValueError, match="GiB"):
         signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, max_memory=1000)
-    with pytest.raises(ValueError, match="multiple"):
-        signed_heat_volume(mesh=(V, F), resolution=8, level_set_constraint="multiple")  # grids: not available
+    with pytest.raises(ValueError, match="soft_weight"):
+        signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, soft_weight=-1.0)
     try:
         import tetgen  # noqa: F401
     except ImportError:

@@ -16,6 +16,8 @@ _EXPORTS = {
     "FastWindingNumber": "winding", "ExactWindingNumber": "winding", "FastWindingNumberPoints": "winding",
     "fast_winding_number": "winding", "fast_winding_number_points": "winding",
     "point_areas": "winding.point_areas", "estimate_normals": "winding.point_areas",
+    # surface winding numbers (thesis ch. 6)
+    "SurfaceWindingNumbers": "winding.surface", "surface_winding_number": "winding.surface",
     # distance
     "TriangleDistance": "distance", "PointCloudDistance": "distance", "unsigned_distance": "distance",
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",
@@ -29,6 +31,7 @@ _EXPORTS = {
     "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
     "level_set_curves": "heat", "region_boundary_curves": "heat",
     "VoxelSurfaceSignedHeatSolver": "heat.domains.voxel",
+    "level_set_curves": "heat", "region_boundary_curves": "heat", "Curve": "heat.sources",
     "read_curves": "io.curves", "write_curves": "io.curves",
     # the signed heat method in volumes (grids, tets) and morphology
     "signed_heat_volume": "heat.volume", "YukawaTree": "heat.volume",

@@ -10,20 +10,19 @@ from ._common import ensure_parent, load_geometry, normals_option, parse_floats,
 
 
 def _stage_progress(enabled: bool):
-    """A ``progress(stage, done, total)`` callback drawing one tqdm bar per stage."""
+    """A ``progress(stage, fraction)`` callback (gsdf.heat.core) drawing one tqdm bar (percent) per stage."""
     from tqdm import tqdm
 
     state = {"stage": None, "bar": None}
 
-    def update(stage, done, total):
+    def update(stage, fraction):
         if stage != state["stage"]:
             if state["bar"] is not None:
                 state["bar"].close()
             state["stage"] = stage
-            state["bar"] = tqdm(total=total, desc=stage, unit="node" if total > 1 else "step", unit_scale=True,
-                                disable=not enabled, leave=False)
+            state["bar"] = tqdm(total=100, desc=stage, unit="%", disable=not enabled, leave=False)
         bar = state["bar"]
-        bar.update(done - bar.n)
+        bar.update(max(0, int(round(100 * fraction)) - bar.n))
 
     def close():
         if state["bar"] is not None:
@@ -56,14 +55,19 @@ Example:
               help="h of t = t_coef·h²: the grid spacing (robust to flipped/noisy normals) or the input's mean "
                    "edge length / point spacing (as signedheat3d; more accurate on clean input with holes).")
 @click.option("--constraint", type=click.Choice(["zero", "none", "multiple"]), default="zero", show_default=True,
-              help="Level set (§7.1): pull φ to 0 at the sources (zero; a soft penalty on grids), shift by the "
-                   "source mean only (none), or one constant per connected input component (multiple, --tet).")
+              help="Level set (§7.1): φ = 0 at the sources (zero), shift by the source mean only (none), or one "
+                   "constant per connected input component (multiple).")
+@click.option("--soft-weight", type=click.FloatRange(min=0), default=None,
+              help="Impose zero/multiple by a penalty of this weight instead of exactly. Default on grids: 10 "
+                   "(the exact grid constraint is an augmented Lagrangian, minutes at 64³); 0 = exact. Default on "
+                   "tets: exact.")
 @click.option("--surface-format", type=click.Choice(["ply", "obj", "off", "stl"]), default="ply",
               show_default=True)
 @normals_option
 @quiet_option
 @report_errors
-def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constraint, surface_format, estimate_normals, quiet):
+def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constraint, soft_weight, surface_format,
+         estimate_normals, quiet):
     import numpy as np
 
     from ..heat.volume import signed_heat_volume
@@ -71,10 +75,14 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
     levels = parse_floats(offsets, "--offsets")
     geo = load_geometry(input, estimate_normals)
     kw = dict(mesh=(geo.V, geo.F)) if geo.is_mesh else dict(points=(geo.P, geo.N))
+    if soft_weight is None and not tet:
+        soft_weight = 10.0
+    if soft_weight == 0 or constraint == "none":
+        soft_weight = None
     update, close = _stage_progress(not quiet)
     try:
         field = signed_heat_volume(domain="tet" if tet else "grid", resolution=grid, t_coef=t_coef, t_scale=t_scale,
-                                   level_set_constraint=constraint, progress=update, **kw)
+                                   level_set_constraint=constraint, soft_weight=soft_weight, progress=update, **kw)
     finally:
         close()
     ensure_parent(output)

@@ -13,6 +13,7 @@ from .render import render
 from .sdf import sdf
 from .slice import slice_cmd
 from .surface import surface
+from .swn import swn
 from .tori import tori
 from .voxelize import voxelize
 from .winding import winding
@@ -28,7 +29,7 @@ def main():
     """
 
 
-for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render):
+for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn):
     main.add_command(command)
 
 if __name__ == "__main__":  # pragma: no cover

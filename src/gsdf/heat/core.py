@@ -128,45 +128,86 @@ def curve_components(S: Sources, n: int) -> np.ndarray:
 
 
 class FactorizedPoisson(PoissonSolver):
-    """Step III by sparse factorizations of ``L + ε M`` (ε fixes the constant of every component: L is only
-    semidefinite), kept per constraint set.
+    """Step III by sparse factorizations, kept per constraint set.
+
+    By default ``L + ε M`` is factorized (ε = 1e-10 · mean diag(L) / mean(M) fixes the constant of every
+    component: L is only semidefinite). With ``exact_gauge=True`` (tets) there is no ε: nodes in no element
+    (zero rows of L) get φ = 0 and the constant is fixed by pinning the first unknown (then the core's shift).
 
     ``spd``: the factory of SPD solves (default :class:`gsdf.linalg.Factorization`; tets use
-    :class:`gsdf.linalg.SPDSolver`, CG/AMG above a size)."""
+    :class:`gsdf.linalg.SPDSolver`, CG/AMG above a size).
+    """
 
-    def __init__(self, L, Mv, spd=None):
+    def __init__(self, L, Mv, spd=None, exact_gauge: bool = False):
         self.L = sp.csr_matrix(L).tocsc()
         self.Mv = np.asarray(Mv, np.float64)
         self.n = self.L.shape[0]
-        self._eps = 1e-10 * float(np.abs(self.L.diagonal()).mean()) / float(self.Mv.mean())
+        self.exact_gauge = bool(exact_gauge)
+        self._eps = 0.0 if exact_gauge else 1e-10 * float(np.abs(self.L.diagonal()).mean()) / float(self.Mv.mean())
+        self._active = self.L.diagonal() != 0 if exact_gauge else np.ones(self.n, bool)
         self._spd = spd or (lambda A: Factorization(sp.csc_matrix(A)))
-        self._free = None
         self._cache: dict = {}
 
     def _cached(self, key, build):
         return cached_factorization(self._cache, key, build)
 
+    def _reduced(self, key, Pm, b):
+        """Solve ``Pmᵀ (L + εM) Pm u = Pmᵀ b`` (pinning u_0 with the exact gauge) and return ``Pm u``."""
+        def build():
+            A = (Pm.T @ (self.L + sp.diags(self._eps * self.Mv)) @ Pm).tocsc() if self._eps else \
+                (Pm.T @ self.L @ Pm).tocsc()
+            if self.exact_gauge:
+                A = A[1:][:, 1:]
+            return self._spd(A)
+
+        rhs = Pm.T @ b
+        u = np.zeros(Pm.shape[1])
+        if self.exact_gauge:
+            u[1:] = self._cached(key, build).solve(rhs[1:])
+        else:
+            u = self._cached(key, build).solve(rhs)
+        return Pm @ u
+
     def free(self, b):
-        if self._free is None:
-            self._free = self._spd((self.L + sp.diags(self._eps * self.Mv)).tocsc())
-        return self._free.solve(b)
+        if not self.exact_gauge:
+            fact = self._cached("free", lambda: self._spd((self.L + sp.diags(self._eps * self.Mv)).tocsc()))
+            return fact.solve(b)
+        idx = np.flatnonzero(self._active)
+        Pm = sp.csr_matrix((np.ones(len(idx)), (idx, np.arange(len(idx)))), shape=(self.n, len(idx)))
+        return self._reduced("free", Pm, b)
 
     def dirichlet(self, fixed, b):
         fixed = np.unique(np.asarray(fixed, np.int64))
         mask = np.zeros(self.n, bool)
         mask[fixed] = True
-        free = np.flatnonzero(~mask)
+        free = np.flatnonzero(~mask & self._active)
         key = hash_key(np.array([0]), fixed)
 
         def build():
-            return self._spd((self.L[free][:, free] + sp.diags(self._eps * self.Mv[free])).tocsc())
+            A = self.L[free][:, free]
+            return self._spd((A + sp.diags(self._eps * self.Mv[free])).tocsc() if self._eps else A.tocsc())
 
         phi = np.zeros(self.n)
         if len(free):
             phi[free] = self._cached(key, build).solve(b[free])
         return phi
 
-    def constrained(self, A, b, tag):
+    def merged(self, groups, b):
+        """Hard "multiple" for vertex sources: every group of vertices shares one unknown (substitution)."""
+        col = np.full(self.n, -1)
+        free = self._active.copy()
+        for g in groups:
+            free[g] = False
+        fidx = np.flatnonzero(free)
+        col[fidx] = np.arange(len(fidx))
+        for k, g in enumerate(groups):
+            col[g[self._active[g]]] = len(fidx) + k
+        rows = np.flatnonzero(col >= 0)
+        Pm = sp.csr_matrix((np.ones(len(rows)), (rows, col[rows])), shape=(self.n, len(fidx) + len(groups)))
+        key = hash_key(np.array([4]), col)
+        return self._reduced(key, Pm, b)
+
+    def constrained(self, A, b, tag, weights=None):
         A = sp.csr_matrix(A)
         key = hash_key(np.array([hash(tag) % 2**31]), A.indptr, A.indices, A.data)
         delta = 1e-12 * float(self.L.diagonal().mean())
@@ -295,26 +336,48 @@ class SignedHeatCore:
         if mode == "none":
             return P.free(b), True
         if lam is not None:
-            custom = self.domain.soft_rows(S, mode)
+            custom = self.domain.soft_rows(S, mode, lam)
             if custom is None:
-                A = self.difference_rows(S, single=(mode != "multiple"))
-                w = lam
+                A, w = self.difference_rows(S, single=(mode != "multiple")), lam
             else:
                 A, w = custom
-                w = lam * np.asarray(w, np.float64)
             if A.shape[0] == 0:
                 return P.free(b), True
             return P.penalized(A, w, b), True
         if mode == "zero":
-            A, vert = self.domain.zero_rows(S)
+            rows = self.domain.zero_rows(S)
             again = getattr(self.domain, "shift_hard_zero", True)
+            A, vert = rows[0], rows[1]
+            if len(rows) == 3:                                  # the domain's own (weighted) rows
+                return P.constrained(A, b, "zero", weights=rows[2]), again
             if len(vert) and np.all(vert >= 0):
                 return P.dirichlet(vert, b), again
             return P.constrained(unique_rows(A), b, "zero"), again
+        groups = self.vertex_groups(S)
+        if groups is not None and hasattr(P, "merged"):
+            if not groups:
+                return P.free(b), True
+            return P.merged(groups, b), True
         A = self.difference_rows(S, single=False)
         if A.shape[0] == 0:
             return P.free(b), True
         return P.constrained(A, b, "multiple"), True
+
+    def vertex_groups(self, S: Sources):
+        """For "multiple" with every curve node at a vertex: the vertex set of each connected component with
+        more than one vertex (None when some node lies inside an element)."""
+        if S.node_vertex is None or not len(S.node_vertex) or np.any(S.node_vertex < 0):
+            return None if S.node_vertex is None or np.any(S.node_vertex < 0) else []
+        if S.components is not None:
+            lab = S.components
+        else:
+            lab = curve_components(S, self.domain.n_nodes)[S.node_curve]
+        out = []
+        for g in np.unique(lab):
+            v = np.unique(S.node_vertex[lab == g])
+            if len(v) > 1:
+                out.append(v)
+        return out
 
     def difference_rows(self, S: Sources, single: bool = False):
         """Rows φ(p_i) − φ(p_0) = 0 per connected curve component (over all nodes and points when ``single``)."""

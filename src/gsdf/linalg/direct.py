@@ -35,10 +35,13 @@ class Factorization:
     A : scipy.sparse matrix, shape (n, n), real or complex
     symmetric : bool
         Use the symmetric mode of SuperLU (ordering of A + Aᵀ, diagonal pivots first): several times less fill
-        for the Laplacian-like matrices of the heat method.
+        for the Laplacian-like matrices of the heat method. Falls back to the general LU below when a pivot
+        vanishes.
+    ordering, pivot : str, float
+        Column ordering (``permc_spec``) and partial-pivoting threshold of the general LU.
     """
 
-    def __init__(self, A, symmetric: bool = True):
+    def __init__(self, A, symmetric: bool = True, ordering: str = "MMD_AT_PLUS_A", pivot: float = 0.1):
         A = sp.csc_matrix(A)
         if A.shape[0] != A.shape[1]:
             raise ValueError(f"matrix: expected a square matrix, got shape {A.shape}")
@@ -52,7 +55,7 @@ class Factorization:
             except RuntimeError:                              # a zero pivot without pivoting (saddle systems)
                 pass
         try:
-            self._lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1)
+            self._lu = spla.splu(A, permc_spec=ordering, diag_pivot_thresh=pivot)
         except RuntimeError as exc:
             raise ValueError(f"matrix: the sparse system is singular ({exc})") from exc
 

@@ -21,7 +21,7 @@ never normalizes vectors. The core calls, in order:
    :class:`PoissonSolver` from ``poisson_solver()``; otherwise None and the core factorizes.
 
 Optional hooks (defaults here): ``zero_rows(S)`` — the rows of the hard ``"zero"`` constraint (default: every
-source node); ``soft_rows(S, mode)`` — rows and weights of the ``soft_weight=`` penalty (default: differences
+source node); ``soft_rows(S, mode, lam)`` — rows and weights of the ``soft_weight=`` penalty (default: differences
 φ(p_i) − φ(p_0) over all nodes, or per connected curve for ``"multiple"``); ``difference_order`` — which node is
 p_0 (``"first"``: the first node given; ``"sorted"``: the lowest vertex index).
 
@@ -31,17 +31,30 @@ normals with tangent frames, a Hermitian connection Laplacian, and ``gather`` / 
 
 Example
 -------
-A minimal domain (a polyline of 3 vertices, "Laplacian" of a path) — see ``tests/test_heat_core.py`` for one
-that solves::
+A flat triangle mesh as a vertex domain (``test_a_new_vertex_domain_plugs_into_the_core`` in
+tests/test_heat_core.py runs it against the exact distance to a circle)::
 
-    class PathDomain(VertexSurfaceDomain):
-        def __init__(self, X, L, M, Lconn, N):
-            super().__init__(X, L, M, Lconn, N, t=1.0)
-        def gather(self, X): ...
-        def divergence(self, Y): ...
+    class FlatVertexDomain(VertexSurfaceDomain):
+        def __init__(self, V, F):
+            self.ops = TriangleMeshOperators(V, F)
+            L = self.ops.cotan_laplacian()
+            N = np.tile([0.0, 0, 1], (len(V), 1))
+            e1, e2 = tangent_frames(N)
+            h = self.ops.edge_len.mean()
+            super().__init__(V, L, self.ops.vertex_mass(), L.astype(complex), N, e1, e2, t=h * h)
+
+        def gather(self, X):                      # vertex vectors summed over every face (the core normalizes)
+            return self.to_3d(X)[self.ops.F].sum(axis=1)
+
+        def divergence(self, Y):
+            return self.ops.divergence(Y)
+
+    phi = SignedHeatCore(FlatVertexDomain(V, F)).compute_distance([loop])
 """
 
 from __future__ import annotations
+
+from abc import ABC, abstractmethod
 
 import numpy as np
 import scipy.sparse as sp
@@ -53,25 +66,31 @@ __all__ = ["HeatDomain", "PoissonSolver", "VertexSurfaceDomain", "tangent_frames
 HEAT_FORMS = ("complex", "real2", "direct")
 
 
-class PoissonSolver:
+class PoissonSolver(ABC):
     """Step III solves of one domain, each ``(n,) -> (n,)``; the core's default factorizes (see
-    :class:`gsdf.heat.core.FactorizedPoisson`). Methods a domain may leave out raise ValueError naming the
-    constraint the domain cannot impose."""
+    :class:`gsdf.heat.core.FactorizedPoisson`). A solver that cannot impose some constraint raises ValueError
+    naming it."""
 
+    @abstractmethod
     def free(self, b):                          # L φ = b, up to a constant (regularized by the mass)
-        raise NotImplementedError
+        ...
 
+    @abstractmethod
     def dirichlet(self, fixed, b):              # L φ = b on the other nodes, φ = 0 on the node indices ``fixed``
-        raise NotImplementedError
+        ...
 
-    def constrained(self, A, b, tag):           # min ½φᵀLφ − bᵀφ subject to A φ = 0 (Eq. 14)
-        raise NotImplementedError
+    @abstractmethod
+    def constrained(self, A, b, tag, weights=None):   # min ½φᵀLφ − bᵀφ subject to A φ = 0 (Eq. 14)
+        ...
 
+    # optional: merged(groups, b) — "multiple" for vertex sources by substitution (one unknown per group)
+
+    @abstractmethod
     def penalized(self, A, w, b):               # (L + Aᵀ diag(w) A) φ = b
-        raise NotImplementedError
+        ...
 
 
-class HeatDomain:
+class HeatDomain(ABC):
     """Base class of signed-heat domains (module docs). Subclasses set ``n_nodes``, ``t``, ``heat_form`` and
     implement the operators; everything a solve does beyond operators is :mod:`gsdf.heat.core`'s."""
 
@@ -82,30 +101,36 @@ class HeatDomain:
     shift_hard_zero: bool = True        # apply the shift of Alg. 13 after a hard "zero" constraint too
 
     # ---- sources
+    @abstractmethod
     def assemble_sources(self, curves: list, points: list, **options) -> Sources:
-        raise NotImplementedError
+        """Validate ranges / edges of typed curves and points and assemble :class:`Sources`."""
 
-    # ---- step I
+    # ---- step I (one of the two, by ``heat_form``)
     def vector_heat_matrix(self):
         """M + t L∇ (complex Hermitian, or its real 2n×2n block form for ``heat_form == "real2"``)."""
-        raise NotImplementedError
+        raise ValueError(f"domain: {type(self).__name__} has no vector heat operator (heat_form={self.heat_form!r})")
 
     def diffuse(self, sources: Sources) -> np.ndarray:
         """Step I computed by the domain (``heat_form == "direct"``)."""
-        raise NotImplementedError
+        raise ValueError(f"domain: {type(self).__name__} does not compute step I itself (heat_form="
+                         f"{self.heat_form!r})")
 
     # ---- step II / III
+    @abstractmethod
     def gather(self, X) -> np.ndarray:
-        raise NotImplementedError
+        """Step-I vectors onto the divergence elements (k, d), not normalized."""
 
+    @abstractmethod
     def divergence(self, Y) -> np.ndarray:
-        raise NotImplementedError
+        """Unit vectors (k, d) -> b (n,), with L φ = b ⇔ ∇φ ≈ Y."""
 
+    @abstractmethod
     def laplacian(self) -> sp.csr_matrix:
-        raise NotImplementedError
+        """(n, n) real PSD Laplacian of step III."""
 
+    @abstractmethod
     def mass(self) -> np.ndarray:
-        raise NotImplementedError
+        """(n,) positive lumped masses."""
 
     def poisson_solver(self):
         """A :class:`PoissonSolver` specific to the domain, or None (the core factorizes ``laplacian()``)."""
@@ -113,11 +138,13 @@ class HeatDomain:
 
     # ---- constraint rows (defaults)
     def zero_rows(self, S: Sources):
-        """Rows of the hard "zero" constraint and, for one-hot rows, their vertices (-1 otherwise)."""
+        """Rows of the hard "zero" constraint and, for one-hot rows, their vertices (-1 otherwise); a domain may
+        return a third entry, per-row weights, to have its rows used as they are (the grid's cell rows)."""
         return S.all_rows()
 
-    def soft_rows(self, S: Sources, mode: str):
-        """Rows A and weights w of the soft penalty Σ w (A φ)²; None: the core's difference rows."""
+    def soft_rows(self, S: Sources, mode: str, lam: float):
+        """Rows A and weights w (λ included) of the soft penalty Σ w (A φ)²; None: the core's difference rows
+        with weight λ."""
         return None
 
 

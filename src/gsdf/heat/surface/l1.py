@@ -8,16 +8,16 @@ Reduction to |F| unknowns (as the paper does, following Feng et al. 2023 §3.4):
 ``φ_f(x) = c_f + Y_f · (x - x_f)`` (x_f its first corner), so only the offsets c_f are free; the jump across an
 interior edge ij between faces f and g is measured at the edge midpoint m,
 ``J_ij = c_f - c_g + Y_f·(m - x_f) - Y_g·(m - x_g)``, and ``min Σ w_ij |J_ij|`` is the linear program
-``min Σ w (s⁺ + s⁻)  s.t.  c_f - c_g - s⁺ + s⁻ = -(Y_f·(m - x_f) - Y_g·(m - x_g)),  s± ≥ 0``, solved by HiGHS.
+``min Σ w (s⁺ + s⁻)  s.t.  c_f - c_g - s⁺ + s⁻ = -(Y_f·(m - x_f) - Y_g·(m - x_g)),  s± ≥ 0``, solved by HiGHS
+through the dual-graph LP of :mod:`gsdf.dec.lp`.
 Nonmanifold edges contribute every pair of their faces (consecutive in face order).
 """
 
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
-from ...linalg import solve_lp
+from ...dec.lp import dual_graph_l1
 
 
 def edge_face_pairs(ops):
@@ -44,16 +44,8 @@ def integrate_l1(ops, Y: np.ndarray) -> np.ndarray:
     off = np.einsum("kj,kj->k", Y[f], mid - base[f]) - np.einsum("kj,kj->k", Y[g], mid - base[g])
     curl = np.abs(np.einsum("kj,kj->k", Y[f] - Y[g], t))    # Eq. 15: difference of projections on the edge
     w = ops.edge_len[e] * np.exp(-curl)
-    k = len(e)
-    if k == 0:
+    if len(e) == 0:
         c = np.zeros(m)
     else:
-        rows = np.concatenate([np.arange(k)] * 4)
-        cols = np.concatenate([f, g, m + np.arange(k), m + k + np.arange(k)])
-        vals = np.concatenate([np.ones(k), -np.ones(k), -np.ones(k), np.ones(k)])
-        A = sp.csr_matrix((vals, (rows, cols)), shape=(k, m + 2 * k))
-        cost = np.concatenate([np.zeros(m), w, w])
-        bounds = [(None, None)] * m + [(0, None)] * (2 * k)
-        x = solve_lp(cost, A_eq=A, b_eq=-off, bounds=bounds)
-        c = x[:m]
+        c = dual_graph_l1(m, np.stack([f, g], axis=1), off, w, gauge="none").shifts
     return c[:, None] + np.einsum("fkj,fj->fk", V[F] - base[:, None, :], Y)

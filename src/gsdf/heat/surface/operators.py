@@ -25,6 +25,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ...mesh.connectivity import unique_edges
+
 NEXT = np.array([1, 2, 0])
 PREV = np.array([2, 0, 1])
 
@@ -64,15 +66,11 @@ class TriangleMeshOperators:
         self.intrinsic = P is not None
         n, m = len(V), len(F)
         self.n_vertices, self.n_faces = n, m
-        a, b = F, F[:, NEXT]                                   # slot a: edge (v_a, v_{a+1})
-        lo, hi = np.minimum(a, b), np.maximum(a, b)
-        key = (lo * n + hi).ravel()
-        uniq, inv = np.unique(key, return_inverse=True)
-        self.edges = np.stack([uniq // n, uniq % n], axis=1).astype(np.int64)
-        self.edge_keys = uniq
-        self.n_edges = len(uniq)
-        self.face_edges = inv.reshape(m, 3).astype(np.int64)
-        self.slot_sign = np.where(a < b, 1.0, -1.0)
+        # slot a: edge (v_a, v_{a+1}); unique edges lower -> higher index, as everywhere (gsdf.mesh.connectivity)
+        self.edges, self.face_edges, signs = unique_edges(F, n)
+        self.edge_keys = self.edges[:, 0] * n + self.edges[:, 1]
+        self.n_edges = len(self.edges)
+        self.slot_sign = signs.astype(np.float64)
 
         P = V[F] if P is None else P                           # (m, 3, 3) corner positions
         self.P = P

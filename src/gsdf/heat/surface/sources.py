@@ -28,8 +28,9 @@ from .operators import NEXT, TriangleMeshOperators
 BARY_TOL = 1e-6
 
 
-class Sources:
-    """Parsed sources: the right-hand side X0 of Eq. 12 and the data for constraints and the shift."""
+class ParsedSources:
+    """Sources parsed on a triangle mesh (per-curve node and segment data, X0 of Eq. 12); turned into the one
+    :class:`gsdf.heat.sources.Sources` of the core by :func:`gsdf.heat.domains.triangle.to_core_sources`."""
 
     def __init__(self):
         self.X0 = None
@@ -311,7 +312,7 @@ def _edge_vectors_to_basis(ops, e, N):
 
 
 def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve_normals=None):
-    """Parse and validate all sources; return a :class:`Sources` with X0 (Eq. 11, App. A).
+    """Parse and validate all sources; return :class:`ParsedSources` with X0 (Eq. 11, App. A).
 
     ``curve_normals`` (optional, one entry per curve: None, a (3,) vector, or (k, 3) per curve point) replaces
     the face normals n in N = T × n (Eq. 11) for signed curves, e.g. on nonorientable domains; segment normals
@@ -338,7 +339,7 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve
     if not curves and pts is None:
         raise ValueError("curves: no sources given (empty curve list and no points)")
 
-    S = Sources()
+    S = ParsedSources()
     S.signed = signs
     nE = ops.n_edges
     X0 = np.zeros(nE, np.complex128)

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..._checks import as_points, choice, integer, positive
 from ...field import grid_shape
-from .grid import check_memory, solve_grid
+from .memory import check_memory
 from .sources import Sources, mesh_sources, point_sources
 from .yukawa import YukawaTree
 
@@ -96,8 +96,8 @@ def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = 0.
 
 
 def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=64, bbox_min=None, bbox_max=None,
-                       t_coef: float = 1.0, level_set_constraint: str = "zero", theta: float = 1.5,
-                       max_memory=None, progress=None, t_scale: str = "grid", **kwargs):
+                       t_coef: float = 1.0, level_set_constraint: str = "zero", soft_weight=None,
+                       theta: float = 1.5, max_memory=None, progress=None, t_scale: str = "grid", **kwargs):
     """Generalized signed distance in a volume by the signed heat method (Feng & Crane 2024, §8).
 
     Parameters
@@ -125,16 +125,23 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
         noisy normals (the Points-as-Tori corruption landscape).
     level_set_constraint : {"zero", "multiple", "none"}
         "zero" (default; measured more accurate than "none" on every benchmark input, bench/RESULTS.md): the
-        zero level set goes through the input — on grids a penalty on the trilinear values at the sources
-        (``constraint="exact"``: the exact per-cell constraint by an augmented Lagrangian, slow above 32³), on
-        tets φ = 0 exactly on every input vertex (and Steiner point). "multiple" (tets only): φ constant on
-        each connected component of the input. "none": φ shifted so its area-weighted mean over the sources is 0.
+        zero level set goes through the input, exactly — on grids the per-cell rows (the area-weighted mean of
+        the trilinear rows of the cell's sources) by an augmented Lagrangian (a factorization up to 50k nodes,
+        CG above: slow above ~40³; pass ``soft_weight`` for the fast penalty), on tets φ = 0 on every input
+        vertex (and Steiner point). "multiple": φ constant on each connected component of the input (faces
+        sharing vertices; clouds: near-neighbour graph). "none": φ shifted so its area-weighted mean over the
+        sources is 0.
+    soft_weight : float, optional
+        Replace the hard constraint by a penalty: on grids c Σ_f a_f φ(b_f)² / h⁴ (c = ``soft_weight``; 10 is
+        what ``gsdf heat`` uses), CG-solved in about the time of the unconstrained solve; on tets
+        λ Σ (φ(z_i) − φ(z_0))² over the input points. Then the same shift as "none". The older spelling
+        ``constraint="soft"`` (with ``constraint_weight=10``) / ``constraint="exact"`` is still accepted on grids.
     theta : float
         Cluster error tolerance of the tree-accelerated Yukawa sum (see :class:`YukawaTree`).
     max_memory : int, optional
         Byte limit of the solve (default 80 % of available memory); larger grids are refused before any work.
     progress : callable, optional
-        ``progress(stage, done, total)``.
+        ``progress(stage, fraction)`` (:mod:`gsdf.heat.core`; the older ``(stage, done, total)`` also works).
 
     Returns
     -------
@@ -162,12 +169,13 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     if t_scale == "input" and "t" not in kwargs:
         kwargs["t"] = t_coef * input_spacing(X, F) ** 2
     if domain == "tet":
-        from .tet import solve_tet
+        from .solve import solve_tet
 
         return solve_tet(src, X, lo, hi, shape, t_coef=t_coef, level_set_constraint=level_set_constraint,
-                         max_memory=max_memory, progress=progress, theta=theta, faces=F, **kwargs)
-    if level_set_constraint == "multiple":
-        raise ValueError('level_set_constraint "multiple" is only available on tet domains; use "none" or "zero"')
+                         soft_weight=soft_weight, max_memory=max_memory, progress=progress, theta=theta, faces=F,
+                         **kwargs)
+    from .solve import solve_grid
+
     check_memory(int(np.prod(shape)), max_memory)
-    return solve_grid(src, lo, hi, shape, t_coef=t_coef, level_set_constraint=level_set_constraint, theta=theta,
-                      progress=progress, **kwargs)
+    return solve_grid(src, lo, hi, shape, t_coef=t_coef, level_set_constraint=level_set_constraint,
+                      soft_weight=soft_weight, theta=theta, progress=progress, **kwargs)

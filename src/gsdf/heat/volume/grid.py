@@ -1,4 +1,5 @@
-"""The signed heat method on a regular grid (Feng & Crane 2024, §8.2).
+"""Operators and Poisson solvers of the grid signed-heat domain (Feng & Crane 2024, §8.2). The steps run in
+:mod:`gsdf.heat.core` over :class:`gsdf.heat.domains.grid.GridDomain`; ``solve_grid`` is in :mod:`.solve`.
 
 Step I   X_t(x) = Σ_f |f| N_f G_t(x, b_f), the Yukawa potential of the sources (the fundamental solution of
          id − tΔ, λ = 1/√t), by a tree walk (:mod:`.yukawa`) instead of the anchor's O(nodes × faces) sum.
@@ -8,11 +9,12 @@ Step III Δφ = ∇·Y with the seven-point Laplacian, Neumann boundary and forw
          edge's two nodes. Its normal equations are the 7-point graph Laplacian (natural Neumann boundary) against
          the forward-difference divergence of Y (the transpose of the forward-difference gradient).
 Level set: "none": φ is shifted so that its area-weighted mean over the source points is 0 (as the anchor
-         does). "zero" with ``constraint="soft"`` (default): the zero level set is pulled through the sources by a
-         penalty on the trilinear values φ(b_f), then the same shift. "zero" with ``constraint="exact"``: the
-         seed's constrained solve with trilinear rows (§8.2), one row per grid cell holding sources (the
-         area-weighted mean of their trilinear rows — one row per source would force φ ≡ 0 on every cell
-         crossed by a dense input), imposed exactly by the augmented Lagrangian (:func:`solve_constrained`).
+         does). ``soft_weight=c``: the zero level set is pulled through the sources by a penalty on the
+         trilinear values φ(b_f), then the same shift. "zero" (hard): the seed's constrained solve with
+         trilinear rows (§8.2), one row per grid cell holding sources (the area-weighted mean of their trilinear
+         rows — one row per source would force φ ≡ 0 on every cell crossed by a dense input), imposed exactly by
+         the augmented Lagrangian (:func:`solve_constrained`); "multiple": the same rows made equal per input
+         component.
 
 Linear algebra: the Neumann 7-point Laplacian on a box is diagonal in the DCT-II basis, so Step III is solved
 *exactly* by two fast cosine transforms, O(N log N) at every size (128³ in well under a second) — faster than
@@ -25,16 +27,11 @@ multiplier update; larger grids use the preconditioned CG per update, which is s
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import scipy.sparse as sp
 
-from ..._checks import positive
-from ...field import GridField, grid_points
-from .sources import Sources
+from ...linalg import Factorization, pcg
 from .memory import available_memory, check_memory  # noqa: F401  (re-exported)
-from .yukawa import YukawaTree, grid_nearest_distance
 
 
 
@@ -150,7 +147,7 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     shape = tuple(shape)
     if penalty is None:
         return dct_poisson(rhs, shape, spacing)
-    from scipy.sparse.linalg import LinearOperator, cg, splu, spsolve_triangular
+    from scipy.sparse.linalg import LinearOperator, spsolve_triangular
 
     n = int(np.prod(shape))
     L = neumann_laplacian(shape, spacing)
@@ -163,7 +160,7 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     upper = sp.triu(A_bb, format="csr")
     block = max(2, int(np.ceil((n / coarse_size) ** (1.0 / 3.0))))
     R = _aggregation(shape, block)
-    coarse = splu((R @ A @ R.T).tocsc())  # SPD: P > 0 pins the constant
+    coarse = Factorization((R @ A @ R.T).tocsc(), symmetric=False, ordering="COLAMD", pivot=1.0)  # SPD: P > 0
 
     def precondition(r):
         x = R.T @ coarse.solve(R @ r)
@@ -176,11 +173,7 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     M = LinearOperator((n, n), matvec=precondition)
     x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
     x0 += (rhs.sum() - (A @ x0).sum()) / penalty.sum()  # best constant shift (L annihilates constants)
-    x, info = cg(A, rhs, x0=x0, M=M, rtol=tol, maxiter=maxiter)
-    if info > 0:
-        import warnings
-
-        warnings.warn(f"step III: conjugate gradients stopped after {maxiter} iterations above rtol={tol:g}")
+    x, _ = pcg(A, rhs, M=M, x0=x0, rtol=tol, maxiter=maxiter, warn="step III")
     return x
 
 
@@ -203,20 +196,23 @@ def cell_constraint_matrix(B, a, bbox_min, spacing, shape):
 
 
 def solve_constrained(rhs, shape, spacing, C, w, rho: float, tol: float, max_outer: int = 200,
-                      inner_tol: float = 1e-8, direct_below: int = 50_000):
+                      inner_tol: float = 1e-8, direct_below: int = 50_000, regularize: bool = False):
     """min ½φᵀLφ − rhsᵀφ subject to Cφ = 0, by the augmented Lagrangian (method of multipliers).
 
     Each outer step solves (L + ρ CᵀWC) φ = rhs − Cᵀμ by CG preconditioned with the exact DCT solve of
     L + δI (warm-started), then updates μ ← μ + ρ W Cφ; stops when max |Cφ| ≤ ``tol``. W = diag(w).
-    Returns φ, the final max |Cφ| and the number of outer steps.
+    ``regularize``: add 1e-10 · mean diag to the matrix, for constraints that leave the constant free
+    (differences, "multiple"). Returns φ, the final max |Cφ| and the number of outer steps.
     """
-    from scipy.sparse.linalg import LinearOperator, cg
+    from scipy.sparse.linalg import LinearOperator
 
     shape = tuple(shape)
     n = int(np.prod(shape))
     L = neumann_laplacian(shape, spacing)
     Wd = rho * w
     A = (L + C.T @ sp.diags(Wd) @ C).tocsr()
+    if regularize:
+        A = (A + sp.identity(n) * (1e-10 * float(A.diagonal().mean()))).tocsr()
     direct = None
     if n <= direct_below:
         try:  # factorize once (CHOLMOD), every outer step is then two triangular solves
@@ -237,85 +233,10 @@ def solve_constrained(rhs, shape, spacing, C, w, rho: float, tol: float, max_out
         if direct is not None:
             phi = direct.solve(rhs - C.T @ mu)
         else:
-            phi, _ = cg(A, rhs - C.T @ mu, x0=phi, M=M, rtol=inner_tol, maxiter=500)
+            phi, _ = pcg(A, rhs - C.T @ mu, M=M, x0=phi, rtol=inner_tol, maxiter=500)
         r = C @ phi
         res = float(np.abs(r).max())
         if res <= tol:
             break
         mu += Wd * r
     return phi, res, k
-
-
-def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=None,
-               level_set_constraint: str = "none", constraint_weight: float = 10.0, theta: float = 1.5,
-               eps: float = 1e-4, progress=None, constraint: str = "soft", constraint_tol: float = 1e-4,
-               exact_rho: float = 1e5) -> GridField:
-    """Run Steps I–III on the grid ``shape`` spanning ``[bbox_min, bbox_max]``; returns a :class:`GridField`.
-
-    ``t`` defaults to ``t_coef · h²``, h the largest grid spacing (the seed's t = h², §10). ``progress`` is an
-    optional callable ``progress(stage: str, done: int, total: int)``. ``eps`` prunes sources weighing less than
-    ``eps`` × the nearest one (Step I, :class:`YukawaTree`); 1e-4 instead of 1e-6 moves φ by < 3e-6 of the box
-    diagonal on the broken bunny at 64³ and saves ~25 % of Step I.
-    """
-    timings = {}
-    lo = np.asarray(bbox_min, float)
-    hi = np.asarray(bbox_max, float)
-    shape = tuple(int(s) for s in shape)
-    spacing = (hi - lo) / (np.array(shape) - 1)
-    h = float(spacing.max())
-    t = float(t_coef) * h * h if t is None else positive(t, "t")
-    n = int(np.prod(shape))
-    report = progress or (lambda *a: None)
-
-    # Step I: Yukawa potential by the tree walk, d* from a distance transform of the sources' nodes
-    t0 = time.perf_counter()
-    tree = YukawaTree(src.B, src.W, t, theta=theta, eps=eps)
-    dref, slack = grid_nearest_distance(src.B, lo, spacing, shape)
-    Q = grid_points(lo, hi, shape)
-    done = [0]
-
-    def step(k):
-        done[0] += k
-        report("heat (step I)", done[0], n)
-
-    X = tree(Q, dref, slack, progress=step)
-    del Q, dref
-    timings["step1"] = time.perf_counter() - t0
-
-    # Step II: normalise (nodes where X vanishes, e.g. exact cancellation, get Y = 0)
-    t0 = time.perf_counter()
-    nrm = np.linalg.norm(X, axis=1)
-    ok = nrm > 0
-    X[ok] /= nrm[ok, None]
-    X[~ok] = 0.0
-    Y = X.reshape(shape + (3,))
-
-    # Step III: Poisson with the 7-point Laplacian and the forward-difference divergence
-    report("poisson (step III)", 0, 1)
-    rhs = divergence_rhs(Y, spacing)
-    del X, Y
-    penalty = None
-    info = {}
-    if level_set_constraint == "zero" and constraint == "exact":
-        # exact: the trilinear interpolant's area-weighted mean over the sources of every cell is 0
-        C, w = cell_constraint_matrix(src.B, src.a, lo, spacing, shape)
-        phi, res, outer = solve_constrained(rhs, shape, spacing, C, w / h ** 4, exact_rho, constraint_tol * h)
-        info = {"constraint_residual": res, "constraint_rows": C.shape[0], "outer_iterations": outer}
-    else:
-        if level_set_constraint == "zero":
-            # soft level-set constraint: + (c / h) Σ_f a_f φ(b_f)² / h³ in the energy
-            A = trilinear_matrix(src.B, lo, spacing, shape)
-            w = constraint_weight * src.a / h ** 4
-            penalty = (A.T @ sp.diags(w) @ A).tocsr()
-        phi = solve_poisson(rhs, shape, spacing, penalty)
-    del rhs, penalty
-    field = GridField(phi.reshape(shape), lo, hi)
-    if not (level_set_constraint == "zero" and constraint == "exact"):
-        # shift so that the mean over the sources is zero (the anchor's evaluateAverageAlongSourceGeometry)
-        shift = float(np.sum(src.a * field(src.B)) / np.sum(src.a))
-        field.values -= shift
-    report("poisson (step III)", 1, 1)
-    timings["step3"] = time.perf_counter() - t0
-    field.meta = {"method": "signed heat (grid)", "t": t, "theta": theta, "eps": eps, "timings": timings,
-                  "level_set_constraint": level_set_constraint, "n_sources": len(src.B), **info}
-    return field

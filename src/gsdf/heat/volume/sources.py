@@ -2,31 +2,19 @@
 
 A source is a set of points b_i with vector charges w_i = a_i N_i: triangle barycenters with area-weighted
 normals (triangle meshes, soups, fan-triangulated polygon meshes — the midpoint quadrature of §8.2), or cloud
-points with unit normals times point areas (the tangent-plane Voronoi areas of :func:`gsdf.point_areas`).
+points with unit normals times point areas (the tangent-plane Voronoi areas of :func:`gsdf.point_areas`). They
+are :class:`gsdf.heat.sources.Sources` (fields ``B``, ``W``, ``a``), the one sources type of every domain.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+import scipy.sparse as sp
 
 from ..._checks import as_mesh, as_normals, as_points, as_weights
+from ..sources import Sources
 
-
-@dataclass(frozen=True)
-class Sources:
-    """Source points ``B`` (m, 3), charges ``W = a N`` (m, 3), weights ``a`` (m,), and the input geometry."""
-
-    B: np.ndarray
-    W: np.ndarray
-    a: np.ndarray
-    kind: str
-    mean_spacing: float
-
-    @property
-    def bbox(self):
-        return self.B.min(axis=0), self.B.max(axis=0)
+__all__ = ["Sources", "mesh_sources", "point_sources", "cloud_components", "source_components"]
 
 
 def mesh_sources(V, F) -> Sources:
@@ -39,8 +27,8 @@ def mesh_sources(V, F) -> Sources:
     if not keep.any():
         raise ValueError("mesh: every face has zero area, so every normal is zero (no source to diffuse)")
     E = np.linalg.norm(T - T[:, [1, 2, 0]], axis=2)
-    return Sources(np.ascontiguousarray(T[keep].mean(axis=1)), np.ascontiguousarray(W[keep]), a[keep], "mesh",
-                   float(E.mean()))
+    return Sources(B=np.ascontiguousarray(T[keep].mean(axis=1)), W=np.ascontiguousarray(W[keep]), a=a[keep],
+                   kind="mesh", mean_spacing=float(E.mean()), extra={"faces": F[keep]})
 
 
 def point_sources(P, N, areas=None, k: int = 20) -> Sources:
@@ -65,5 +53,38 @@ def point_sources(P, N, areas=None, k: int = 20) -> Sources:
     if not keep.any():
         raise ValueError("points: every point has a zero normal or zero area (no source to diffuse)")
     spacing = float(np.sqrt(a[keep].mean()))
-    return Sources(np.ascontiguousarray(P[keep]), np.ascontiguousarray(U[keep] * a[keep, None]), a[keep], "points",
-                   spacing)
+    return Sources(B=np.ascontiguousarray(P[keep]), W=np.ascontiguousarray(U[keep] * a[keep, None]), a=a[keep],
+                   kind="points", mean_spacing=spacing)
+
+
+def cloud_components(Z: np.ndarray) -> np.ndarray:
+    """Connected components of a point set: each point joined to its 8 nearest neighbours closer than 3 × the
+    median nearest-neighbour distance. Returns labels (n,)."""
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    Z = np.asarray(Z, float)
+    k = min(9, len(Z))
+    d, nb = cKDTree(Z).query(Z, k=k, workers=-1)
+    if k == 1:
+        d, nb = d[:, None], nb[:, None]
+    med = np.median(d[:, 1]) if k > 1 else 0.0
+    ok = (d <= 3.0 * med) & (np.arange(k)[None, :] > 0)
+    r = np.repeat(np.arange(len(Z)), k)[ok.ravel()]
+    G = sp.coo_matrix((np.ones(len(r)), (r, nb.ravel()[ok.ravel()])), shape=(len(Z), len(Z)))
+    return connected_components(G, directed=False)[1]
+
+
+def source_components(src: Sources) -> np.ndarray:
+    """Connected component of every source point: faces sharing a vertex (meshes), or
+    :func:`cloud_components` (clouds). Returns labels (m,)."""
+    from scipy.sparse.csgraph import connected_components
+
+    F = src.extra.get("faces")
+    if F is None:
+        return cloud_components(src.B)
+    m = len(F)
+    n = int(F.max()) + 1
+    r = np.repeat(np.arange(m), 3)
+    G = sp.csr_matrix((np.ones(3 * m), (r, m + F.ravel())), shape=(m + n, m + n))
+    return connected_components(G, directed=False)[1][:m]

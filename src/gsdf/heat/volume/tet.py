@@ -1,4 +1,5 @@
-"""The signed heat method on tetrahedral meshes (Feng & Crane 2024, §8.1 and App. B).
+"""Meshing and operators of the tetrahedral signed-heat domain (Feng & Crane 2024, §8.1 and App. B). The steps
+run in :mod:`gsdf.heat.core` over :class:`gsdf.heat.domains.tet.TetDomain`; ``solve_tet`` is in :mod:`.solve`.
 
 Mesh (``mesher="delaunay"``, default, no extra dependency). The vertex set is
 
@@ -41,15 +42,11 @@ vertex) and is factorized once by CHOLMOD (``cholespy``, when installed) or Supe
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import Delaunay, cKDTree
 
-from ...field import TetField
 from ...linalg import SPDSolver
-from .sources import Sources
 
 BYTES_PER_TET_VERTEX = 3000  # ~6.5 tets per vertex, sparse P1 matrix and its Cholesky factor
 
@@ -161,14 +158,11 @@ def input_points(kind: str, X, F, h: float, surface_spacing: float = 0.5):
         Z = np.concatenate([V, S])
         comp = np.concatenate([lab, lab[Fu[owner, 0]]])
     else:
+        from .sources import cloud_components
+
         Z = np.asarray(X, float)
-        k = min(9, len(Z))
-        d, nb = cKDTree(Z).query(Z, k=k, workers=-1)
-        med = np.median(d[:, 1]) if k > 1 else 0.0
-        ok = (d <= 3.0 * med) & (np.arange(k)[None, :] > 0)
-        r = np.repeat(np.arange(len(Z)), k)[ok.ravel()]
-        G = sp.coo_matrix((np.ones(len(r)), (r, nb.ravel()[ok.ravel()])), shape=(len(Z), len(Z)))
-        ncomp, comp = connected_components(G, directed=False)
+        comp = cloud_components(Z)
+        ncomp = int(comp.max()) + 1
     # merge coincident points (duplicated vertices of soups, repeated cloud points)
     key = np.round(Z / max(1e-12 * float(np.abs(Z).max()), 1e-300))
     _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
@@ -293,130 +287,7 @@ def tetgen_mesh(Z, F_in, lo, hi, h, quality: float = 1.5):
     return nodes, np.asarray(elem, np.int64)[:, :4], None
 
 
-# ----------------------------------------------------------------------------------------------- solver
-def solve_tet(src: Sources, X, lo, hi, shape, t_coef: float = 1.0, level_set_constraint: str = "zero",
-              max_memory=None, progress=None, levels: int = 2, step1: str = "yukawa", mesher: str = "delaunay",
-              min_quality: float = 0.02, theta: float = 1.5, faces=None, amg_above: int = 400_000,
-              grading: float = 2.0, surface_spacing: float = 1.0, t=None) -> TetField:
-    """Steps I–III on a tet mesh of the box graded toward the input; returns a :class:`TetField`.
-
-    ``t`` defaults to ``t_coef · h²``, h the grid spacing the resolution gives (the lattice spacing near the input).
-    ``faces`` are the input triangles (indices into ``X``) for meshes, None for clouds.
-    """
-    from ..._checks import choice, positive
-    from .memory import available_memory
-    from .yukawa import YukawaTree
-
-    step1 = choice(step1, "step1", {"yukawa", "heat"})
-    mesher = choice(mesher, "mesher", {"delaunay", "tetgen"})
-    report = progress or (lambda *a: None)
-    timings = {}
-    t0 = time.perf_counter()
-    h = float((hi - lo).max()) / (max(shape) - 1)
-    kind = "mesh" if faces is not None else "points"
-    # TetGen conforms to the input triangles, so φ = 0 on their vertices is φ = 0 on the whole input
-    ss = np.inf if mesher == "tetgen" else surface_spacing
-    Z, comp = input_points(kind, np.asarray(X, float), faces, h, ss)
-    nZ = len(Z)
-    est = (nZ + 2 * int(np.prod(np.asarray(shape)) ** (2 / 3) * 8)) * BYTES_PER_TET_VERTEX
-    limit = int(0.8 * available_memory()) if max_memory is None else int(max_memory)
-    if est > limit:
-        raise ValueError(f"resolution too large: the tet mesh would need about {est / 2**30:.1f} GiB, more than "
-                         f"the {limit / 2**30:.1f} GiB allowed")
-    report("tet mesh", 0, 1)
-    if mesher == "tetgen":
-        Fz = None
-        if faces is not None:  # faces of the deduplicated vertices: match by position
-            kd = cKDTree(Z)
-            Fz = kd.query(np.asarray(X, float)[faces].reshape(-1, 3))[1].reshape(-1, 3)
-        P, T, D = tetgen_mesh(Z, Fz, lo, hi, h)
-    else:
-        P, T, D = delaunay_mesh(Z, lo, hi, h, levels=levels, grading=grading)
-    nV = len(P)
-    if nV * BYTES_PER_TET_VERTEX > limit:
-        raise ValueError(f"resolution too large: the tet mesh has {nV:,} vertices and needs about "
-                         f"{nV * BYTES_PER_TET_VERTEX / 2**30:.1f} GiB, more than the {limit / 2**30:.1f} GiB allowed")
-    vol, G, q = tet_geometry(P, T)
-    keep = q >= min_quality
-    Tk, volk, Gk = T[keep], vol[keep], G[keep]
-    timings["mesh"] = time.perf_counter() - t0
-    report("tet mesh", 1, 1)
-
-    # Step I and II: unit vector per (kept) tet
-    t0 = time.perf_counter()
-    tt = float(t_coef) * h * h if t is None else positive(t, "t")
-    report("heat (step I)", 0, 1)
-    if step1 == "yukawa":
-        C = P[Tk].mean(axis=1)
-        XT = YukawaTree(src.B, src.W, tt, theta=theta)(C)
-    else:
-        XT = _cr_heat(src, P, T, D, keep, vol, G, tt, amg_above)
-    nrm = np.linalg.norm(XT, axis=1)
-    YT = np.where(nrm[:, None] > 0, XT / np.where(nrm > 0, nrm, 1.0)[:, None], 0.0)
-    report("heat (step I)", 1, 1)
-    timings["step1"] = time.perf_counter() - t0
-
-    # Step III: P1 Poisson with the level-set constraint
-    t0 = time.perf_counter()
-    report("poisson (step III)", 0, 1)
-    b = weak_divergence(Tk, volk, Gk, YT, nV)
-    K = p1_laplacian(Tk, volk, Gk, nV)
-    used = np.zeros(nV, bool)
-    used[Tk.ravel()] = True
-    phi = np.zeros(nV)
-    if level_set_constraint == "zero":
-        free = used.copy()
-        free[:nZ] = False
-        idx = np.flatnonzero(free)
-        if len(idx):
-            phi[idx] = SPDSolver(K[idx][:, idx]).solve(b[idx])
-    else:
-        # unknowns: the free vertices, then one per component ("multiple") or per input point ("none")
-        ncomp = int(comp.max()) + 1 if level_set_constraint == "multiple" else nZ
-        lab = comp if level_set_constraint == "multiple" else np.arange(nZ)
-        free = used.copy()
-        free[:nZ] = False
-        fidx = np.flatnonzero(free)
-        col = np.full(nV, -1)
-        col[fidx] = np.arange(len(fidx))
-        col[:nZ] = len(fidx) + lab
-        col[:nZ][~used[:nZ]] = -1
-        rows = np.flatnonzero(col >= 0)
-        nU = len(fidx) + ncomp
-        Pm = sp.csr_matrix((np.ones(len(rows)), (rows, col[rows])), shape=(nV, nU))
-        A = (Pm.T @ K @ Pm).tocsr()
-        rhs = Pm.T @ b
-        # pin the first unknown (the constant mode), shift afterwards
-        sol = np.zeros(nU)
-        sol[1:] = SPDSolver(A[1:][:, 1:]).solve(rhs[1:])
-        phi = Pm @ sol
-        field_tmp = TetField(P, T, phi, D) if D is not None else None
-        phi_b = _eval(P, T, D, phi, src.B, field_tmp)
-        phi -= float(np.sum(src.a * phi_b) / np.sum(src.a))
-    if (~used).any():  # vertices in no kept tet: interpolate from the rest
-        phi[~used] = _eval(P, Tk, None, phi, P[~used], None, exclude=~used)
-    report("poisson (step III)", 1, 1)
-    timings["step3"] = time.perf_counter() - t0
-    field = TetField(P, T, phi, D)
-    field.meta = {"method": "signed heat (tet)", "t": tt, "h": h, "timings": timings, "n_vertices": nV,
-                  "n_tets": len(T), "n_input_points": nZ, "n_dropped_tets": int((~keep).sum()),
-                  "level_set_constraint": level_set_constraint, "step1": step1, "mesher": mesher,
-                  "n_components": int(comp.max()) + 1}
-    return field
-
-
-def _eval(P, T, D, phi, Q, field=None, exclude=None):
-    if field is not None:
-        return field(Q)
-    if exclude is not None:  # nearest used vertices, inverse-distance weighted
-        idx = np.flatnonzero(~exclude)
-        d, nb = cKDTree(P[idx]).query(Q, k=4)
-        w = 1.0 / np.maximum(d, 1e-300)
-        return (w * phi[idx][nb]).sum(axis=1) / w.sum(axis=1)
-    return TetField(P, T, phi)(Q)
-
-
-def _cr_heat(src, P, T, D, keep, vol, G, tt, amg_above):
+def cr_heat(src, P, T, D, keep, vol, G, tt, amg_above):
     """Step I of the seed on Crouzeix–Raviart faces; returns X per kept tet (mean of its face values)."""
     ok = keep  # the same tets as Step III (slivers make M + tL numerically indefinite)
     faces, TF, Lcr, Mcr = cr_operators(T[ok], vol[ok], G[ok])
