@@ -409,8 +409,7 @@ def test_cli_heat_surface_voxels(tmp_path):
 
 
 def test_typed_curves_edge_sets(sphere32):
-    from gsdf.heat.sources import Curve
-
+    Curve = gsdf.Curve
     s, ring = sphere32
     E = np.stack([ring[0][:-1], ring[0][1:]], 1)[np.random.default_rng(0).permutation(len(ring[0]) - 1)]
     assert np.allclose(s.compute_distance([Curve(E)]), s.compute_distance(ring))             # chained edges
