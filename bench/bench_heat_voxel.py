@@ -1,6 +1,7 @@
 """Signed heat method on digital surfaces (Feng & Crane 2024 §8.5): convergence and timings.
 
-* Digital sphere R = N/2 − 2 at N = 16 … 128, curve = boundary of {quads with centre z < zc + ¼}, zc = c + round(0.3 R), reference
+* Digital sphere R = N/2 − 2 at N = 16 … 128, curve = boundary of {quads with centre z < zc + ¼},
+  zc = c + round(0.3 R), reference
   φ⁰ = R(θ − θ0) at the radial projection; §9.1 error ε, sign correct (fraction of area, against the digital
   region; curve vertices excluded); corrected normals (integral invariants, r = 3 voxels, and r = ½ N^{2/3}
   voxels, i.e. r ∝ h^{1/3} in world units), trivial normals, and the broken curve (50 % of segments deleted).
@@ -10,7 +11,8 @@
 * Option A vs Option B connection Laplacian, timings (surface, normals, operators, first solve with the
   factorizations, repeated solve).
 
-Run: ``PYTHONPATH=src python3 bench/bench_heat_voxel.py`` (writes the "heat-voxel" section of RESULTS.md).
+Run: ``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python3 bench/bench_heat_voxel.py``
+(writes the "heat-voxel" section of RESULTS.md).
 """
 
 from __future__ import annotations
@@ -41,11 +43,11 @@ def ball(N, R):
     return (x ** 2).sum(0) <= R ** 2
 
 
-def sphere(N, radius=3.0, broken=False, connection="A", timings=None):
+def sphere(N, radius=3.0, broken=False, connection="A", timings=None, t_coef=1.0):
     R = N / 2 - 2
     occ = ball(N, R)
     t0 = time.perf_counter()
-    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, connection=connection)
+    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, connection=connection, t_coef=t_coef)
     t_build = time.perf_counter() - t0
     c = N / 2
     # the curve at the grid plane z = zc nearest to c + 0.3 R (quads with centres below zc + ¼: the region's
@@ -73,7 +75,7 @@ def sphere(N, radius=3.0, broken=False, connection="A", timings=None):
     return eps(phi, ref, A), float(A[ok].sum() / A[inside | outside].sum())
 
 
-def plane(N, nrm, mdir, radius=3.0, exact=False):
+def plane(N, nrm, mdir, radius=3.0, exact=False, t_coef=1.0):
     nrm = np.asarray(nrm, float) / np.linalg.norm(nrm)
     m = np.asarray(mdir, float) / np.linalg.norm(mdir)
     x = np.indices((N,) * 3).transpose(1, 2, 3, 0) + 0.5
@@ -83,12 +85,27 @@ def plane(N, nrm, mdir, radius=3.0, exact=False):
         S = digital_surface(occ, np.ones(3))
         on = ((S.trivial_normals @ nrm) > 0) & (np.abs((S.centres - N / 2) @ nrm) < 1.0)
         normals = np.where(on[:, None], nrm, S.trivial_normals)
-    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, normals=normals)
+    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, normals=normals, t_coef=t_coef)
     ctr = np.full(3, N / 2)
     phi = s.compute_distance(region_boundary_curves(s.faces, (s.face_centres - ctr) @ m < 0))
     P = s.vertices - ctr
     sel = (np.linalg.norm(P - np.outer(P @ nrm, nrm), axis=1) < 0.3 * N) & (np.abs(P @ nrm) < 1.0)
     return eps(phi[sel], (P @ m)[sel], s.domain.mass()[sel])
+
+
+def icosphere(subdivisions, R=1.0, z_rel=0.3):
+    """Baseline: the triangle-mesh (Crouzeix–Raviart) signed heat method on an icosphere, curve z = z_rel·R."""
+    from gsdf.heat import SurfaceSignedHeatSolver
+    from gsdf.heat.surface.curves import level_set_curves
+    from gsdf.heat.surface.meshes import sphere_mesh
+
+    V, F = sphere_mesh(subdivisions, R)
+    s = SurfaceSignedHeatSolver(V, F)
+    t0 = time.perf_counter()
+    phi = s.compute_distance(level_set_curves(V, F, V[:, 2] - z_rel * R))
+    dt = time.perf_counter() - t0
+    ref = R * (np.arccos(np.clip(-V[:, 2] / R, -1, 1)) - np.arccos(-z_rel))
+    return eps(phi, ref, s.ops.vertex_mass()), len(V), dt
 
 
 def order(errs):
@@ -100,7 +117,9 @@ def main():
     lines = ["## heat-voxel — signed heat method on digital surfaces (§8.5)", "",
              f"Machine: {machine()}.", f"Load at start: `{load0}` (the machine is shared with other helpers: "
              "timings are indicative).", "",
-             "Command: `PYTHONPATH=src python3 bench/bench_heat_voxel.py`.", "",
+             "Command: `OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python3 bench/bench_heat_voxel.py` "
+             "(single-threaded BLAS: on the shared, oversubscribed machine threaded BLAS made the factorizations "
+             "10-70x slower).", "",
              "ε is the §9.1 error (mass-weighted L2 / range of φ⁰ / √area); 'order' = log2(ε_N/2 / ε_N).", ""]
     # ---------------------------------------------------------------- sphere
     lines += ["### Digital sphere R = N/2 − 2, curve on the grid plane z = c + round(0.3R), φ⁰ = R(θ − θ0)", "",
@@ -136,6 +155,24 @@ def main():
         for k, N in enumerate(SIZES):
             lines.append(f"| {nrm} | {N} | {ii[k]:.5f} | {oi[k]:.2f} | {tr[k]:.5f} | {ot_[k]:.2f} | {ex[k]:.5f} | "
                          f"{oe[k]:.2f} |")
+    # ---------------------------------------------------------------- diffusion time
+    lines += ["", "Diffusion time t = t_coef·h² (default t_coef = 1, the notes' t = h²): ε at the two finest N.", "",
+              "| case | N | t_coef = 1 | 2 | 4 | 16 |", "|---|---|---|---|---|---|"]
+    for N in SIZES[-2:]:
+        row = [sphere(N, 0.5 * N ** (2 / 3), t_coef=tc)[0] for tc in (1, 2, 4, 16)]
+        lines.append(f"| sphere, II r=½N^⅔ | {N} | " + " | ".join(f"{e:.5f}" for e in row) + " |")
+        row = [plane(N, (1, 2, 0), (2, -1, 0), exact=True, t_coef=tc) for tc in (1, 2, 4, 16)]
+        lines.append(f"| plane (1,2,0), exact normals | {N} | " + " | ".join(f"{e:.5f}" for e in row) + " |")
+        print("t_coef", N, lines[-2:], flush=True)
+    # ---------------------------------------------------------------- smooth baseline
+    lines += ["", "Baseline, the same method on a smooth triangle mesh (Crouzeix–Raviart SHM, "
+              "`SurfaceSignedHeatSolver`) on icospheres of similar vertex counts, curve z = 0.3R:", "",
+              "| subdivisions | vertices | ε | order | 1st solve s |", "|---|---|---|---|---|"]
+    base = [icosphere(k) for k in (3, 4, 5)]            # 6 (41k vertices): minutes in the complex SuperLU
+    ob = order([b[0] for b in base])
+    for k, (e, nv, dt) in enumerate(base):
+        lines.append(f"| {k + 3} | {nv} | {e:.5f} | {ob[k]:.2f} | {dt:.2f} |")
+    print("icosphere", base, flush=True)
     # ---------------------------------------------------------------- option A vs B, component timings
     N = SIZES[-2] if len(SIZES) > 1 else SIZES[0]
     eA, _ = sphere(N)

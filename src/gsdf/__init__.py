@@ -35,9 +35,9 @@ _EXPORTS = {
     "mesh_boolean": "ops",
     # the signed heat method on surfaces (Feng & Crane 2024)
     "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
-    "level_set_curves": "heat", "region_boundary_curves": "heat", "Curve": "heat.sources",
     "level_set_curves": "heat", "region_boundary_curves": "heat",
     "VoxelSurfaceSignedHeatSolver": "heat.domains.voxel",
+    "level_set_curves": "heat", "region_boundary_curves": "heat", "Curve": "heat.sources",
     "read_curves": "io.curves", "write_curves": "io.curves",
     # the signed heat method in volumes (grids, tets) and morphology
     "signed_heat_volume": "heat.volume", "YukawaTree": "heat.volume",

@@ -161,7 +161,6 @@ def _ball_covariance(occ, centres, spacing, r):
     """Covariance (m, 3, 3) of the occupied voxel centres within distance r of each centre (world units)."""
     m = centres.shape[0]
     out = np.zeros((m, 3, 3))
-    nx, ny, nz = occ.shape
     r2 = r * r
     for f in prange(m):
         p = centres[f]
@@ -199,7 +198,6 @@ def _ball_covariance(occ, centres, spacing, r):
                     v = ss[a, b] - s[a] * s[b] / cnt
                     out[f, a, b] = v
                     out[f, b, a] = v
-    _ = nx + ny + nz
     return out
 
 

@@ -13,15 +13,15 @@ Pipeline (notes wave2-swn-recon-voxel §3):
    of radius ``normal_radius`` voxels around the quad centre, Coeurjolly et al. 2014); or trivial (the axis
    normals), or given.
 3. **Corrected embedding** (Coeurjolly & Lachaud 2022): every quad is projected, on its own, onto the plane
-   through the origin orthogonal to its u_f, ``x̃ = x − (u_f · x) u_f``; a quad's area becomes |u_f · n_f| (the
-   area of the smooth surface it stands for) and lengths shrink accordingly.
+   through the origin orthogonal to its u_f, ``x̃ = x − (u_f · x) u_f``; a quad's area is scaled by |u_f · n_f| (to
+   the area of the smooth surface it stands for) and lengths shrink accordingly.
 4. **Operators** (:mod:`._degoes`): de Goes et al. 2020 per-face gradient, flat, sharp, projection and inner
    product (λ = 1) on the corrected quads; Laplacian ``L = Σ_f Dᵀ M_f D`` (PSD), 1-form divergence, lumped
    mass ``m_v = Σ_f |a_f| / 4``.
 5. **Frames and transport**: vertex normals n_v = normalized mean of the incident u_f (§8.5), an arbitrary
    tangent basis per vertex and per face; r_vf the unit complex number of the smallest rotation n_v → n_f
    expressed in the two bases.
-6. **Connection Laplacian**, Option A (DGtal, de Goes et al. §5): per face, the covariant gradient of the
+6. **Connection Laplacian**, Option A (DGtal's, after de Goes et al. 2020): per face, the covariant gradient of the
    transported vertex vectors plus the λ-weighted projection term. Because ``U_f D = G_f`` it reduces to the
    scalar face Laplacian conjugated by the transports, ``L∇_ij = Σ_f conj(r_if) (Dᵀ M_f D)_ij r_jf``: a complex
    Hermitian PSD matrix, equal to L on a flat plane with aligned frames. Option B (§8.3/§8.4 style, for
@@ -147,11 +147,6 @@ class VoxelSurfaceDomain(VertexSurfaceDomain):
     True
     """
 
-    # Step I is factorized in the real 2n×2n form of the Hermitian M + t L∇ (CHOLMOD through cholespy, SuperLU
-    # without it): on the 72.6k-vertex digital sphere (N = 128) that took 4.5 s against 60 s for SuperLU on the
-    # complex matrix (bench/bench_heat_voxel.py, loaded machine). Same operator, same solution.
-    heat_form = "real2"
-
     def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, normals=None, connection: str = "A",
                  t_coef: float = 1.0):
         t_coef = _checks.positive(t_coef, "t_coef")
@@ -249,18 +244,6 @@ class VoxelSurfaceDomain(VertexSurfaceDomain):
         cols = np.broadcast_to(F[:, None, :], (m, 4, 4)).ravel()
         A = sp.csr_matrix((vals.ravel(), (rows, cols)), shape=(n, n))
         return (0.5 * (A + A.conj().T)).tocsr()
-
-    def vector_heat_matrix(self) -> sp.csr_matrix:
-        """Step I operator ``M + t L∇`` in real form (2n × 2n): block (i, j) = [[Re, −Im], [Im, Re]] of entry
-        (i, j), unknowns interleaved (Re, Im) per vertex (``heat_form = "real2"``)."""
-        A = sp.coo_matrix(sp.diags(self.Mv.astype(np.complex128)) + self.t * self.Lconn)
-        r, c, v = A.row, A.col, A.data
-        rows = np.concatenate([2 * r, 2 * r, 2 * r + 1, 2 * r + 1])
-        cols = np.concatenate([2 * c, 2 * c + 1, 2 * c, 2 * c + 1])
-        vals = np.concatenate([v.real, -v.imag, v.imag, v.real])
-        R = sp.csr_matrix((vals, (rows, cols)), shape=(2 * self.n, 2 * self.n))
-        R.sum_duplicates()
-        return R
 
     # ---------------------------------------------------------------- steps II and III (protocol)
     def gather(self, X) -> np.ndarray:
