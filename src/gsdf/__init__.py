@@ -38,12 +38,17 @@ _EXPORTS = {
     "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "tori",
     # dataset batches (issue 16)
     "run_batch": "batch", "sdf_samples": "batch",
+    # one thread setting for numba kernels and BLAS (gsdf.threads)
+    "set_num_threads": "threads", "get_num_threads": "threads",
 }
+_SUBMODULES = {"threads"}
 
 __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name):
+    if name in _SUBMODULES:
+        return import_module(f".{name}", __name__)
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'gsdf' has no attribute {name!r}")
@@ -53,4 +58,4 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
+    return sorted(set(globals()) | set(_EXPORTS) | _SUBMODULES)

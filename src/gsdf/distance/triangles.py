@@ -30,6 +30,7 @@ from numba import njit, prange
 from .._checks import as_mesh, as_points, integer
 from ..spatial.morton import morton_order
 from ..spatial.bvh import build_triangle_bvh
+from ..threads import apply_env
 
 __all__ = ["TriangleDistance", "unsigned_distance", "closest_point_triangle", "brute_force_distance"]
 
@@ -457,6 +458,7 @@ class TriangleDistance:
 
     def _query(self, Q, chunk: int = CHUNK, want_bary: bool = True):
         """Validated queries -> (d2, face, closest, bary); ``bary`` is None unless ``want_bary``."""
+        apply_env()  # GSDF_NUM_THREADS
         nq = Q.shape[0]
         d2 = np.empty(nq)
         face = np.empty(nq, np.int64)

@@ -21,6 +21,7 @@ import numpy as np
 from numba import njit, prange
 
 from .._checks import as_points, choice, integer, positive
+from ..threads import apply_env
 from .blend import NeighbourBlend
 from .fit import jet_coefficients
 from .torus import TORUS_WIDTH, coefficients_to_tori, torus_eval
@@ -169,6 +170,7 @@ class PointsAsTori:
     def __init__(self, P, N, estimator: str = "jet", k: int = 64, C: float = 64.0, r_eval=None,
                  k_eval: int = 64, k_fallback: int = 32, normal_weight: float = 1.0, ridge: float = 1e-3,
                  curvature_cap: float = 4.0, kd_eps: float = 0.0, _state=None):
+        apply_env()  # GSDF_NUM_THREADS
         self.estimator = choice(estimator, "estimator", {"jet", "learned"})
         self.k = integer(k, "k", lo=6)
         self.C = positive(C, "C")

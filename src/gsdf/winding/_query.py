@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..spatial.morton import morton_order
+from ..threads import apply_env
 
 CHUNK = 1 << 20
 
@@ -17,6 +18,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
     ``coherent=True`` evaluates each chunk in Morton order (tree walks of neighbouring queries then share
     cached nodes) and scatters the results back.
     """
+    apply_env()  # GSDF_NUM_THREADS
     A = np.asarray(Q)
     if A.ndim == 1 and A.shape[0] == dim:
         A = A.reshape(1, dim)

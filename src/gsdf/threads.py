@@ -1,0 +1,275 @@
+"""One thread setting for the whole package: numba's parallel kernels and the BLAS under sparse solves.
+
+gsdf runs two kinds of threaded code: numba ``parallel=True`` kernels (threading layer: OpenMP, TBB or
+numba's workqueue) and the BLAS that sparse factorizations call (SuperLU/CHOLMOD supernodes, dense
+updates). Both default to one thread per core. Run together, or in several gsdf processes at once, they
+oversubscribe the cores: OpenBLAS's idle threads spin for a while after each call, OpenMP's likewise, so
+a numba kernel right after a solve (or three processes side by side) fights threads that do no work. On
+a 2-core machine three concurrent ``gsdf heat-surface`` runs took 62 s with default threads and 3.5 s
+with BLAS limited to one thread (issue 17).
+
+The rule this module enforces: **gsdf never runs BLAS threads and numba threads against each other.**
+
+- one setting, ``n`` threads: :func:`set_num_threads` (process-wide), :func:`limit` (a ``with`` block),
+  the environment variable ``GSDF_NUM_THREADS``, or ``gsdf --threads N`` on the command line;
+- numba's parallel kernels use ``n`` threads (capped at numba's pool size, ``NUMBA_NUM_THREADS``, which is
+  fixed when numba starts); while they run BLAS is idle, so nothing else needs limiting;
+- around sparse factorizations and solves (:func:`blas_region`) BLAS is limited to ``n`` threads by
+  threadpoolctl and restored afterwards.
+
+Which calls to wrap (for heat/ and linalg/; wired by the lead after the heat refactor):
+
+- ``gsdf.linalg``: every ``splu`` / ``cholespy.CholeskySolverD`` / ``scipy.sparse.linalg.factorized`` call
+  and every ``solve`` of a stored factorization -> ``with threads.blas_region(): ...``. One wrapper inside
+  the factorization object's ``__init__`` and ``solve`` covers all heat users;
+- ``gsdf.heat.surface.solver`` / ``polygon`` / ``pointcloud``: nothing beyond the linalg wrappers (the
+  numba kernels there follow :func:`numba_threads` automatically once the setting is applied);
+- ``gsdf.heat.volume.grid``: the DCT Poisson solves (scipy.fft workers) -> pass
+  ``workers=threads.get_num_threads()``; the CG loops' sparse mat-vecs are single-threaded already;
+- ``gsdf.heat.volume.tet``: the P1 Poisson factorization / CG -> ``blas_region``;
+- ``gsdf.linalg`` LPs (HiGHS): ``blas_region``.
+
+Example
+-------
+>>> import gsdf
+>>> gsdf.set_num_threads(1)                      # every later kernel and solve on one thread
+>>> with gsdf.threads.limit(2):                  # ... or only inside a block
+...     pass
+>>> gsdf.threads.get_num_threads()
+1
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from contextlib import contextmanager
+
+ENV_VAR = "GSDF_NUM_THREADS"
+
+_setting: int | None = None   # set by set_num_threads / limit; None: the environment variable or all cores
+
+
+def parse_num_threads(value, name: str = "threads") -> int:
+    """Validate a thread count: a positive integer (or a string of one, as from the environment).
+
+    Parameters
+    ----------
+    value : int or str
+        The requested number of threads.
+    name : str
+        What to call the value in the error message.
+
+    Returns
+    -------
+    int
+        ``value`` as a positive ``int``.
+
+    Raises
+    ------
+    ValueError
+        ``value`` is a bool, not an integer, or < 1.
+
+    Example
+    -------
+    >>> parse_num_threads("4")
+    4
+    """
+    if isinstance(value, bool):
+        raise ValueError(f"{name} must be a positive integer, got the bool {value!r}")
+    if isinstance(value, str):
+        text = value.strip()
+        try:
+            n = int(text)
+        except ValueError:
+            raise ValueError(f"{name} must be a positive integer, got {value!r}") from None
+    else:
+        try:
+            import operator
+
+            n = operator.index(value)
+        except TypeError:
+            raise ValueError(f"{name} must be a positive integer, got {value!r} "
+                             f"({type(value).__name__})") from None
+    if n < 1:
+        raise ValueError(f"{name} must be a positive integer (>= 1), got {n}")
+    return int(n)
+
+
+def available_cpus() -> int:
+    """Cores this process may run on (the affinity mask where the platform has one)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # pragma: no cover - macOS / Windows
+        return max(1, os.cpu_count() or 1)
+
+
+def _from_env() -> int | None:
+    value = os.environ.get(ENV_VAR)
+    if value is None or value.strip() == "":
+        return None
+    return parse_num_threads(value, name=f"the environment variable {ENV_VAR}")
+
+
+def get_num_threads() -> int:
+    """The thread setting in force: :func:`set_num_threads` / :func:`limit`, else ``GSDF_NUM_THREADS``,
+    else the number of available cores.
+
+    Raises
+    ------
+    ValueError
+        ``GSDF_NUM_THREADS`` is set to something that is not a positive integer.
+    """
+    if _setting is not None:
+        return _setting
+    env = _from_env()
+    return env if env is not None else available_cpus()
+
+
+def _numba_loaded() -> bool:
+    return "numba" in sys.modules
+
+
+def _apply_numba(n: int) -> None:
+    """numba's kernels use min(n, pool size) threads (the pool is sized once, when numba starts)."""
+    import numba
+
+    numba.set_num_threads(max(1, min(n, numba.config.NUMBA_NUM_THREADS)))
+
+
+def numba_threads() -> int:
+    """Threads numba's parallel kernels get under the current setting (``min(setting, NUMBA_NUM_THREADS)``)."""
+    import numba
+
+    return max(1, min(get_num_threads(), numba.config.NUMBA_NUM_THREADS))
+
+
+def set_num_threads(n) -> None:
+    """Set the number of threads for every later numba kernel and sparse solve in this process.
+
+    Parameters
+    ----------
+    n : int
+        Positive number of threads. numba's share is capped at its pool size (``NUMBA_NUM_THREADS``,
+        the cores by default); every BLAS in the process (loaded now or later) gets ``n`` threads.
+
+    Raises
+    ------
+    ValueError
+        ``n`` is not a positive integer.
+
+    Example
+    -------
+    >>> import gsdf
+    >>> gsdf.set_num_threads(1)
+    """
+    global _setting
+    _setting = parse_num_threads(n)
+    _apply_numba(_setting)
+    _apply_blas_process_wide(_setting)
+
+
+_BLAS_ENV = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
+_process_limiter = None
+
+
+def _apply_blas_process_wide(n: int) -> None:
+    """BLAS libraries loaded now get ``n`` threads (threadpoolctl); ones loaded later read the env vars."""
+    global _process_limiter
+    for var in _BLAS_ENV:
+        os.environ[var] = str(n)
+    if not any(m in sys.modules for m in ("numpy", "scipy")):
+        return  # nothing loaded yet: the environment variables cover it
+    from threadpoolctl import threadpool_limits
+
+    _process_limiter = threadpool_limits(limits=n, user_api="blas")
+
+
+_env_applied = False
+
+
+def apply_env() -> int | None:
+    """Apply ``GSDF_NUM_THREADS`` (once per process) when no explicit setting was made; returns it.
+
+    Called by the entry points (CLI start; winding, distance and tori constructors), so that the
+    environment variable takes effect without a :func:`set_num_threads` call. Without the variable, or
+    after :func:`set_num_threads`, it does nothing (numba and BLAS keep their defaults: all cores).
+
+    Raises
+    ------
+    ValueError
+        ``GSDF_NUM_THREADS`` is set to something that is not a positive integer.
+    """
+    global _env_applied
+    if _setting is not None:
+        return _setting
+    n = _from_env()
+    if n is None or _env_applied:
+        return n
+    _env_applied = True
+    _apply_numba(n)
+    _apply_blas_process_wide(n)
+    return n
+
+
+@contextmanager
+def limit(n):
+    """Inside the block, numba kernels and sparse solves use at most ``n`` threads; restored afterwards.
+
+    Parameters
+    ----------
+    n : int
+        Positive number of threads.
+
+    Example
+    -------
+    >>> import gsdf, numpy as np
+    >>> with gsdf.threads.limit(1):
+    ...     w = gsdf.fast_winding_number(V, F, Q)       # doctest: +SKIP
+    """
+    global _setting
+    n = parse_num_threads(n)
+    import numba
+
+    previous_setting, previous_numba = _setting, numba.get_num_threads()
+    _setting = n
+    _apply_numba(n)
+    try:
+        with blas_region():
+            yield n
+    finally:
+        _setting = previous_setting
+        numba.set_num_threads(previous_numba)
+
+
+@contextmanager
+def blas_region(n=None):
+    """Limit BLAS (OpenBLAS, MKL, BLIS: every loaded one, via threadpoolctl) to the setting in the block.
+
+    Wrap sparse factorizations and solves in it (see the module docstring for which). Numba's threads are
+    idle while BLAS runs, and vice versa, so the two never compete.
+
+    Parameters
+    ----------
+    n : int, optional
+        Thread count for this block; default :func:`get_num_threads`.
+
+    Example
+    -------
+    >>> from gsdf import threads
+    >>> with threads.blas_region():
+    ...     lu = scipy.sparse.linalg.splu(A)             # doctest: +SKIP
+    """
+    from threadpoolctl import threadpool_limits
+
+    n = get_num_threads() if n is None else parse_num_threads(n)
+    with threadpool_limits(limits=n, user_api="blas"):
+        yield n
+
+
+def blas_threads() -> list[tuple[str, int]]:
+    """(library, threads) for every BLAS loaded in this process (threadpoolctl's view), for reports."""
+    from threadpoolctl import threadpool_info
+
+    return [(d.get("internal_api", "?"), int(d.get("num_threads", 0)))
+            for d in threadpool_info() if d.get("user_api") == "blas"]
