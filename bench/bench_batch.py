@@ -153,7 +153,11 @@ def main():
     ap.add_argument("--meshes", type=int, default=40)
     ap.add_argument("--grid-meshes", type=int, default=20)
     ap.add_argument("--anchor-meshes", type=int, default=8)
-    ap.add_argument("--skip-throughput", action="store_true")
+    ap.add_argument("--skip-samples", action="store_true", help="no sdf-samples throughput")
+    ap.add_argument("--skip-grid", action="store_true", help="no sdf-grid throughput")
+    ap.add_argument("--skip-anchors", action="store_true", help="no anchor comparison")
+    ap.add_argument("--rows-from", nargs="*", default=None,
+                    help="measure nothing: write the section from the printed rows of earlier runs' logs")
     args = ap.parse_args()
     load0 = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     paths = pick_meshes(args.meshes)
@@ -161,22 +165,41 @@ def main():
     n_broken = sum(s != "closed" for s in states.values())
     print(f"{len(paths)} meshes, {n_broken} not closed manifold", flush=True)
     configs = [("local-1", "local", 1), ("local-2", "local", 2), ("dask-1", "dask", 1), ("dask-2", "dask", 2)]
-    rows = []
-    with tempfile.TemporaryDirectory() as work:
-        if not args.skip_throughput:
-            rows += throughput(paths, "sdf-samples", {"n_samples": 250_000}, configs, work)
-            grid_paths = paths[:: max(1, len(paths) // args.grid_meshes)][: args.grid_meshes]
-            rows += throughput(grid_paths, "sdf-grid", {"resolution": 128}, configs, work)
-    rng = np.random.default_rng(0)
-    bad = [p for p in paths if states[p] != "closed" and not states[p].startswith("unreadable")]
-    big = sorted(bad, key=os.path.getsize)[-args.anchor_meshes:]
-    arows = anchors(big, rng)
+    rows, arows, loads = [], [], []
+    if args.rows_from is not None:  # compose: rows printed by earlier (possibly concurrent) phase runs
+        import ast
+
+        for log in args.rows_from:
+            for line in open(log):
+                if line.startswith("('sdf-"):
+                    rows.append(ast.literal_eval(line.strip()))
+                elif line.startswith("{'mesh'"):
+                    arows.append(ast.literal_eval(line.strip()))
+                elif line.startswith("load: "):
+                    loads.append(line[6:].strip())
+    else:
+        print("load: " + load0, flush=True)
+        with tempfile.TemporaryDirectory() as work:
+            if not args.skip_samples:
+                rows += throughput(paths, "sdf-samples", {"n_samples": 250_000}, configs, work)
+            if not args.skip_grid:
+                grid_paths = paths[:: max(1, len(paths) // args.grid_meshes)][: args.grid_meshes]
+                rows += throughput(grid_paths, "sdf-grid", {"resolution": 128}, configs, work)
+        if not args.skip_anchors:
+            bad = [p for p in paths if states[p] != "closed" and not states[p].startswith("unreadable")]
+            big = sorted(bad, key=os.path.getsize)[-args.anchor_meshes:]
+            arows = anchors(big, np.random.default_rng(0))
     load1 = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
 
+    if loads:
+        load0 = "; ".join(loads)
+    print("load: " + load1, flush=True)
     lines = [f"Machine: {machine()}. Load before: `{load0}`; after: `{load1}` (the 2 cores are shared with "
              "other helpers' jobs: absolute times are inflated, the ratios measured in the same run are what count).",
              "", f"Command: `PYOPENGL_PLATFORM=egl PYTHONPATH=src /work/anchors/bin/python bench/bench_batch.py "
-             f"--meshes {args.meshes} --grid-meshes {args.grid_meshes} --anchor-meshes {args.anchor_meshes}`", "",
+             f"--meshes {args.meshes} --grid-meshes {args.grid_meshes} --anchor-meshes {args.anchor_meshes}` "
+             "(this run: its phases separately — `--skip-grid --skip-anchors`, `--skip-samples --skip-anchors`, "
+             "`--skip-samples --skip-grid` — then `--rows-from LOGS` to write this section)", "",
              f"Mesh set: {len(paths)} CGAL meshes (`pick_meshes`: 2-400 KB files evenly over the sorted list, plus "
              f"ten named broken ones), {n_broken} of them not closed manifold (holes, borders, non-manifold edges); "
              "unreadable or degenerate files are recorded as failed and count in the throughput.", ""]
@@ -185,8 +208,8 @@ def main():
                   "| task | executor | meshes | done | failed | wall s | meshes/min |", "|---|---|---|---|---|---|---|"]
         lines += [f"| {t} | {e} | {n} | {d} | {f} | {w:.1f} | {m:.1f} |" for t, e, n, d, f, w, m in rows]
         lines += ["", "sdf-samples: 250k samples/mesh on every mesh; sdf-grid: 128^3 on "
-                  f"{args.grid_meshes} of them (every other mesh: the full set at 128^3 x 4 executors did not fit "
-                  "the time on this loaded machine).", ""]
+                  f"{args.grid_meshes} of them (evenly spaced in the sorted set: the full set at 128^3 x 4 executors did "
+                  "not fit the time left on this loaded machine).", ""]
     lines += [f"Against the anchors, one run on the {len(arows)} largest broken meshes of the set: seconds per mesh, "
               f"and sign agreement with the exact winding number at {CHECK // 1000}k of each tool's own query "
               "points (its samples / its grid nodes).", "",
@@ -206,6 +229,8 @@ def main():
         lines += [""] + [f"- {m}: {'mesh-to-sdf' if k == 'm2s_error' else 'mesh2sdf'} raised {e}" for m, k, e in errs]
     text = "\n".join(lines)
     print(text)
+    if args.rows_from is None and (args.skip_samples or args.skip_grid or args.skip_anchors):
+        return  # a partial phase: its rows are in the log for --rows-from
     write_section("batch", "## batch (issue 16: `gsdf batch`)\n\n" + text)
 
 

@@ -123,6 +123,15 @@ def test_task_bad_options():
         sdf_samples(Geometry(np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.]]), F=np.array([[0, 1, 2]])), n_samples=10)
     with pytest.raises(ValueError, match="source"):
         sdf_samples(42)
+    from gsdf.batch import check_options
+
+    for bad, match in [({"n_samples": True}, "n_samples"), ({"pad": float("nan")}, "pad"),
+                       ({"sigmas": "a,b"}, "sigmas: expected a number"), ({"beta": -1}, "beta"),
+                       ({"dtype": "int8"}, "dtype"), ({"uniform_fraction": "x"}, "uniform_fraction")]:
+        with pytest.raises(ValueError, match=match):
+            check_options("sdf-samples", bad)
+    with pytest.raises(ValueError, match="method"):
+        check_options("surface", {"method": "pat"})
     with pytest.raises(ValueError, match="out-of-memory estimate"):
         sdf_grid(g, resolution=4000)
 

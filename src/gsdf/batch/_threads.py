@@ -1,26 +1,20 @@
-"""Thread limits of one batch worker: BLAS (threadpoolctl) and numba share the worker's slice of the cores.
+"""Thread limits of one batch worker: BLAS and numba share the worker's slice of the cores (via gsdf.threads).
 
 N workers each running numba kernels and BLAS with one thread per core would put N × cores threads on the
-machine; every worker therefore gets ``cores // N`` threads (at least one) for both. This is the only place
-the batch package touches thread settings, so it can be switched to the package-wide setting
-(``gsdf.threads``) in one line.
+machine; every worker therefore gets ``cores // N`` threads (at least one) for both, set through the package's
+one thread setting, :mod:`gsdf.threads` (threadpoolctl for BLAS, ``numba.set_num_threads``).
 """
 
 from __future__ import annotations
 
 import os
 
+from .. import threads as _gsdf_threads
+
 _BLAS_ENV = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS")
-_limiter = None  # keeps threadpoolctl's process-wide limit alive
+             "VECLIB_MAXIMUM_THREADS", _gsdf_threads.ENV_VAR)
 
-
-def available_cpus() -> int:
-    """Cores this process may run on (its affinity mask where the platform has one)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):  # pragma: no cover - macOS / Windows
-        return max(1, os.cpu_count() or 1)
+available_cpus = _gsdf_threads.available_cpus
 
 
 def threads_per_worker(workers: int, cores: int | None = None) -> int:
@@ -30,7 +24,7 @@ def threads_per_worker(workers: int, cores: int | None = None) -> int:
 
 
 def set_environment(n: int) -> None:
-    """Thread variables read by BLAS/OpenMP libraries that load later (call before importing numpy)."""
+    """Thread variables read by BLAS/OpenMP libraries (and gsdf) that load later: call before importing numpy."""
     for var in _BLAS_ENV:
         os.environ[var] = str(n)
 
@@ -38,16 +32,8 @@ def set_environment(n: int) -> None:
 def limit_threads(n: int) -> int:
     """Limit this process's BLAS and the calling thread's numba kernels to ``n`` threads; returns ``n``.
 
-    numba's setting is per thread (it applies to kernels launched from the calling thread), so workers call
-    this at the start of every item, from the thread that runs it; threadpoolctl's BLAS limit is process-wide.
+    numba's setting applies to kernels launched from the calling thread, so workers call this at the start of
+    every item, from the thread that runs it; the BLAS limit is process-wide.
     """
-    global _limiter
-    set_environment(n)
-    import numba
-    from threadpoolctl import threadpool_limits
-
-    numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
-    if _limiter is None or getattr(_limiter, "_gsdf_n", None) != n:
-        _limiter = threadpool_limits(limits=int(n), user_api="blas")
-        _limiter._gsdf_n = n
+    _gsdf_threads.set_num_threads(int(n))
     return int(n)

@@ -433,20 +433,24 @@ def locals_without_source(values: dict) -> dict:
     return {k: v for k, v in values.items() if k != "source"}
 
 
+def _float(x, name) -> float:
+    if isinstance(x, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected a number, got the bool {x!r}")
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a number, got {x!r}") from None
+
+
 def _unit(x, name):
-    x = float(x)
+    x = _float(x, name)
     if not 0.0 <= x <= 1.0:
         raise ValueError(f"{name}: must lie in [0, 1], got {x}")
     return x
 
 
 def _nonneg(x, name):
-    if isinstance(x, bool):
-        raise ValueError(f"{name}: expected a number, got the bool {x!r}")
-    try:
-        x = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a number, got {x!r}") from None
+    x = _float(x, name)
     if not (np.isfinite(x) and x >= 0):
         raise ValueError(f"{name}: must be a finite number >= 0, got {x}")
     return x
@@ -455,11 +459,9 @@ def _nonneg(x, name):
 def _sigmas(x, name):
     if isinstance(x, str):
         x = [t for t in x.split(",") if t.strip()]
-    try:
-        vals = tuple(positive(float(v), name) for v in x)
-    except TypeError:
-        raise ValueError(f"{name}: expected a list of positive numbers, got {x!r}") from None
-    return vals
+    if np.ndim(x) != 1:
+        raise ValueError(f"{name}: expected a list of positive numbers, got {x!r}")
+    return tuple(positive(_float(v, name), name) for v in x)
 
 
 def _flag(x, name):
@@ -482,7 +484,7 @@ def _int(lo):
 
 
 def _optional_positive(x, name):
-    return None if x is None or x == "" else positive(float(x), name)
+    return None if x is None or x == "" else positive(_float(x, name), name)
 
 
 _CHECKS = {

@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from .. import __version__
+from .batch import batch
 from .boolean import boolean
 from .demo import demo
 from .heat import heat
@@ -77,10 +78,10 @@ def main(threads):
         _threads.apply_cli_default()  # BLAS on one thread (measured: its idle threads spin, see gsdf.threads)
 
 
-for command in (demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn, reconstruct,
+for command in (batch, demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render, swn, reconstruct,
                 warmup):
     main.add_command(command)
-main.add_command(__import__("gsdf.cli.batch", fromlist=["batch"]).batch)  # gsdf batch (issue 16)
+
 
 if __name__ == "__main__":  # pragma: no cover
     main()
