@@ -87,30 +87,46 @@ class GridField(Field):
                     out += wx * wy * wz * v[i0[:, 0] + dx, i0[:, 1] + dy, i0[:, 2] + dz]
         return out
 
-    def isosurface(self, level: float = 0.0, close: bool = False):
+    def isosurface(self, level: float = 0.0, close: bool = False, report: bool = False):
         """Marching cubes (scikit-image) at ``level``; returns ``(V, F)`` in world coordinates.
 
         With ``close=True`` a level set that reaches the box is capped on the box faces (the grid is padded
-        with one layer of nodes above the level and the cap vertices are projected back onto the box), so the
-        result is always a closed, edge-manifold surface. Raises ValueError if the level is outside the range
-        of the field.
+        with one layer of nodes above the level and the cap vertices are projected back onto the box); the
+        result is welded (cap and surface share their seam vertices) and checked: with ``report=True``
+        ``(V, F, report)`` is returned, ``report`` from :func:`gsdf.mesh.topology.manifold_report` (closed,
+        edge- and vertex-manifold, welded). Where the level set touches itself at a grid node (a pinch), that
+        vertex is split per fan, so the mesh stays vertex-manifold and the report says it is not welded.
+        Raises ValueError if the level is outside the range of the field.
         """
         from skimage.measure import marching_cubes
 
         from ._checks import finite
+        from .mesh.topology import manifold_report, split_nonmanifold_vertices, weld
 
         level = finite(level, "level")
         vmin, vmax = float(self.values.min()), float(self.values.max())
         if not (vmin < level < vmax):
             raise ValueError(f"level {level} is outside the field's range [{vmin:.6g}, {vmax:.6g}]: no surface")
+        # scikit-image works in float32: hand it values relative to the level scaled to [-1, 1] and a unit
+        # spacing, so fields and boxes of any magnitude (1e-150 or 1e150) keep their sign pattern
+        rel = self.values * 0.5 - level * 0.5
+        rel = rel / float(np.abs(rel).max())
+        h = self.spacing
+        if close:
+            rel = np.pad(rel, 1, mode="constant", constant_values=1.0)
+        verts, faces, _, _ = marching_cubes(rel, level=0.0)
+        verts = np.asarray(verts, dtype=np.float64)
+        F = faces.astype(np.int64)
         if not close:
-            verts, faces, _, _ = marching_cubes(self.values, level=level, spacing=tuple(self.spacing))
-            return verts + self.bbox_min, faces.astype(np.int64)
-        pad = level + max(vmax - level, 1e-12)
-        vals = np.pad(self.values, 1, mode="constant", constant_values=pad)
-        verts, faces, _, _ = marching_cubes(vals, level=level, spacing=tuple(self.spacing))
-        verts = np.clip(verts - self.spacing + self.bbox_min, self.bbox_min, self.bbox_max)
-        return verts, faces.astype(np.int64)
+            V = self.bbox_min + verts * h
+            return (V, F, manifold_report(V, F)) if report else (V, F)
+        V = np.clip((verts - 1.0) * h + self.bbox_min, self.bbox_min, self.bbox_max)
+        V, F = weld(V, F)
+        rep = manifold_report(V, F)
+        if not rep["vertex_manifold"]:
+            V, F = split_nonmanifold_vertices(V, F)
+            rep = manifold_report(V, F)
+        return (V, F, rep) if report else (V, F)
 
     def isosurfaces(self, levels, close: bool = False):
         """Several level sets at once: a list of ``(V, F)``, one per level (e.g. offsets ±1 %, ±3 %)."""
@@ -244,10 +260,11 @@ class TetField(Field):
             out[~inside] = self.values[cKDTree(self.vertices).query(Q[~inside])[1]]
         return out
 
-    def isosurface(self, level: float = 0.0):
-        """Marching tetrahedra at ``level``: a shared-vertex triangle mesh ``(V, F)``, oriented so that
-        normals point toward increasing values (outward for a signed distance)."""
-        return marching_tetrahedra(self.vertices, self.tets, self.values, level)
+    def isosurface(self, level: float = 0.0, report: bool = False):
+        """Marching tetrahedra at ``level``: a welded triangle mesh ``(V, F)``, oriented so that normals point
+        toward increasing values (outward for a signed distance); ``report=True`` adds its
+        :func:`gsdf.mesh.topology.manifold_report` (see :func:`marching_tetrahedra`)."""
+        return marching_tetrahedra(self.vertices, self.tets, self.values, level, report=report)
 
     def isosurfaces(self, levels):
         return [self.isosurface(float(v)) for v in np.atleast_1d(np.asarray(levels, dtype=float))]
@@ -310,16 +327,21 @@ def locate_in_tets(X, T, Q, k: int = 16, chunk: int = 1 << 15):
     return s, bary
 
 
-def marching_tetrahedra(X, T, values, level: float = 0.0):
+def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     """Level set of a piecewise-linear function on a tet mesh (vectorized marching tetrahedra).
 
     Each tet with vertices on both sides contributes one triangle (1 vertex apart) or a quad split in two
-    (2 and 2); crossing points are shared per mesh edge, so the result is closed and edge-manifold away from
-    the mesh boundary. Triangles are oriented along the gradient of ``values``.
+    (2 and 2); crossing points are shared per mesh edge. Where the level passes exactly through mesh nodes,
+    crossing points of different edges coincide: they are welded, zero-area triangles dropped, and a vertex
+    where separate sheets touch is split per fan, so the result is edge- and vertex-manifold (closed away from
+    the mesh boundary). Triangles are oriented along the gradient of ``values``. ``report=True`` returns
+    ``(V, F, report)`` with :func:`gsdf.mesh.topology.manifold_report`.
     """
+    from ._checks import finite
+
     X = np.asarray(X, float)
     T = np.asarray(T, np.int64)
-    s = np.asarray(values, float) - float(level)
+    s = np.asarray(values, float) - finite(level, "level")
     if not (s.min() < 0 < s.max()):
         raise ValueError(f"level {level} is outside the field's range [{s.min() + level:.6g}, {s.max() + level:.6g}]: no surface")
     pos = s[T] > 0
@@ -357,4 +379,11 @@ def marching_tetrahedra(X, T, values, level: float = 0.0):
     flip = (n * up).sum(axis=1) < 0
     F[flip] = F[flip][:, [0, 2, 1]]
     keep = np.linalg.norm(n, axis=1) > 0
-    return V, F[keep].astype(np.int64)
+    from .mesh.topology import manifold_report, split_nonmanifold_vertices, weld
+
+    V, F = weld(V, F[keep].astype(np.int64))
+    rep = manifold_report(V, F)
+    if not rep["vertex_manifold"]:
+        V, F = split_nonmanifold_vertices(V, F)
+        rep = manifold_report(V, F)
+    return (V, F, rep) if report else (V, F)
