@@ -334,7 +334,9 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     (2 and 2); crossing points are shared per mesh edge. Where the level passes exactly through mesh nodes,
     crossing points of different edges coincide: they are welded, zero-area triangles dropped, and a vertex
     where separate sheets touch is split per fan, so the result is edge- and vertex-manifold (closed away from
-    the mesh boundary). Triangles are oriented along the gradient of ``values``. ``report=True`` returns
+    the mesh boundary). Two cases stay open, and the report says so: flat (zero-volume) tets, which a
+    Delaunay of cospherical points such as a regular grid contains, and tet faces lying wholly on the level
+    (three nodes exactly at ``level``). Triangles are oriented along the gradient of ``values``. ``report=True`` returns
     ``(V, F, report)`` with :func:`gsdf.mesh.topology.manifold_report`.
     """
     from ._checks import finite
@@ -344,9 +346,12 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     s = np.asarray(values, float) - finite(level, "level")
     if not (s.min() < 0 < s.max()):
         raise ValueError(f"level {level} is outside the field's range [{s.min() + level:.6g}, {s.max() + level:.6g}]: no surface")
-    pos = s[T] > 0
+    # values within round-off of the level are put exactly on it, and a node on the level counts as above it
+    # (a symbolic +0 perturbation): crossings at such a node then coincide exactly and are welded below
+    s = np.where(np.abs(s) <= 1e-12 * float(np.abs(s).max()), 0.0, s)
+    pos = s[T] >= 0
     npos = pos.sum(axis=1)
-    tris = []
+    tris, tet_of = [], []
     # one vertex apart: lone vertex and the three others
     for k, lone_is_pos in ((1, True), (3, False)):
         sel = npos == k
@@ -357,6 +362,7 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
         Ts = np.take_along_axis(T[sel], order, axis=1)
         a = Ts[:, 0]
         tris.append(np.stack([np.stack([a, Ts[:, 1]], 1), np.stack([a, Ts[:, 2]], 1), np.stack([a, Ts[:, 3]], 1)], 1))
+        tet_of.append(np.flatnonzero(sel))
     sel = npos == 2
     if sel.any():
         order = np.argsort(~pos[sel], axis=1, kind="stable")  # two positive first
@@ -365,17 +371,24 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
         e_ac, e_ad, e_bd, e_bc = (np.stack(p, 1) for p in ((a, c), (a, d), (b, d), (b, c)))
         tris.append(np.stack([e_ac, e_ad, e_bd], 1))
         tris.append(np.stack([e_ac, e_bd, e_bc], 1))
+        tet_of += [np.flatnonzero(sel)] * 2
     E = np.concatenate(tris)  # (k, 3 corners, 2 endpoints)
+    tet_of = np.concatenate(tet_of)
     Es = np.sort(E.reshape(-1, 2), axis=1)
     uniq, inv = np.unique(Es, axis=0, return_inverse=True)
     sa, sb = s[uniq[:, 0]], s[uniq[:, 1]]
     t = sa / (sa - sb)
     V = X[uniq[:, 0]] + t[:, None] * (X[uniq[:, 1]] - X[uniq[:, 0]])
+    V[t == 1.0] = X[uniq[t == 1.0, 1]]  # a crossing at a node is that node, bitwise (so it welds)
     F = inv.reshape(-1, 3)
-    # orient along the gradient: the endpoint with the larger value of any corner edge shows the direction
+    # orient along the gradient of the linear interpolant of each triangle's tet
     n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    e = E[:, 0]
-    up = np.where((s[e[:, 1]] > s[e[:, 0]])[:, None], X[e[:, 1]] - X[e[:, 0]], X[e[:, 0]] - X[e[:, 1]])
+    Tt = T[tet_of]
+    M = X[Tt[:, 1:]] - X[Tt[:, :1]]  # (k, 3, 3) rows p_i - p_0
+    ds = s[Tt[:, 1:]] - s[Tt[:, :1]]
+    ok = np.abs(np.linalg.det(M)) > 0
+    up = np.zeros_like(n)
+    up[ok] = np.linalg.solve(M[ok], ds[ok][:, :, None])[:, :, 0]
     flip = (n * up).sum(axis=1) < 0
     F[flip] = F[flip][:, [0, 2, 1]]
     keep = np.linalg.norm(n, axis=1) > 0
