@@ -78,7 +78,7 @@ class Frame:
         used[F.ravel()] = True
         return cls.of(V[used])
 
-    def _map(self, X: np.ndarray, name: str) -> np.ndarray:
+    def _map(self, X: np.ndarray, name: str, row0: int = 0) -> np.ndarray:
         if self.identity:
             return X
         with np.errstate(over="ignore", invalid="ignore"):
@@ -88,7 +88,7 @@ class Frame:
                 Y = np.ldexp(X - self.centre, -self.exponent)
         if not np.isfinite(Y).all():
             bad = int(np.argmax(~np.isfinite(Y).all(axis=1)))
-            raise ValueError(f"{name}: row {bad} cannot be represented relative to the geometry (its distance "
+            raise ValueError(f"{name}: row {row0 + bad} cannot be represented relative to the geometry (its distance "
                              f"from the geometry is beyond float64 range at the geometry's scale 2^{self.exponent})")
         return Y
 
@@ -96,13 +96,13 @@ class Frame:
         """Geometry coordinates (n, d) in the frame."""
         return np.ascontiguousarray(self._map(X, name))
 
-    def queries(self, Q: np.ndarray, name: str = "Q", want_excess: bool = False):
+    def queries(self, Q: np.ndarray, name: str = "Q", want_excess: bool = False, row0: int = 0):
         """Query coordinates in the frame, far queries clamped onto the sphere of radius :data:`FAR`.
 
         Returns the (q, d) array, and with ``want_excess`` also the (q,) radial length removed by the
         clamp (frame units; zero for all but very far queries).
         """
-        Y = self._map(Q, name)
+        Y = self._map(Q, name, row0)
         r = np.max(np.abs(Y), axis=1) if Y.shape[0] else np.zeros(0)
         far = r > FAR
         excess = np.zeros(Y.shape[0]) if want_excess else None

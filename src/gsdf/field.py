@@ -104,6 +104,9 @@ class GridField(Field):
         from .mesh.topology import manifold_report, split_nonmanifold_vertices, weld
 
         level = finite(level, "level")
+        for name, flag in (("close", close), ("report", report)):
+            if not isinstance(flag, (bool, np.bool_)):
+                raise ValueError(f"{name}: expected True or False, got {flag!r}")
         vmin, vmax = float(self.values.min()), float(self.values.max())
         if not (vmin < level < vmax):
             raise ValueError(f"level {level} is outside the field's range [{vmin:.6g}, {vmax:.6g}]: no surface")
