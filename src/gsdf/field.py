@@ -112,30 +112,49 @@ class GridField(Field):
                     out += wx * wy * wz * v[i0[:, 0] + dx, i0[:, 1] + dy, i0[:, 2] + dz]
         return out
 
-    def isosurface(self, level: float = 0.0, close: bool = False):
+    def isosurface(self, level: float = 0.0, close: bool = False, report: bool = False):
         """Marching cubes (scikit-image) at ``level``; returns ``(V, F)`` in world coordinates.
 
         With ``close=True`` a level set that reaches the box is capped on the box faces (the grid is padded
-        with one layer of nodes above the level and the cap vertices are projected back onto the box), so the
-        result is always a closed, edge-manifold surface. Raises ValueError if the level is outside the range
-        of the field.
+        with one layer of nodes above the level and the cap vertices are projected back onto the box); the
+        result is welded (cap and surface share their seam vertices) and checked: with ``report=True``
+        ``(V, F, report)`` is returned, ``report`` from :func:`gsdf.mesh.topology.manifold_report` (closed,
+        edge- and vertex-manifold, welded). Where the level set touches itself at a grid node (a pinch), that
+        vertex is split per fan, so the mesh stays vertex-manifold and the report says it is not welded.
+        Raises ValueError if the level is outside the range of the field.
         """
         from skimage.measure import marching_cubes
 
         from ._checks import finite
+        from .mesh.topology import manifold_report, split_nonmanifold_vertices, weld
 
         level = finite(level, "level")
+        for name, flag in (("close", close), ("report", report)):
+            if not isinstance(flag, (bool, np.bool_)):
+                raise ValueError(f"{name}: expected True or False, got {flag!r}")
         vmin, vmax = float(self.values.min()), float(self.values.max())
         if not (vmin < level < vmax):
             raise ValueError(f"level {level} is outside the field's range [{vmin:.6g}, {vmax:.6g}]: no surface")
+        # scikit-image works in float32: hand it values relative to the level scaled to [-1, 1] and a unit
+        # spacing, so fields and boxes of any magnitude (1e-150 or 1e150) keep their sign pattern
+        rel = self.values * 0.5 - level * 0.5
+        rel = rel / float(np.abs(rel).max())
+        h = self.spacing
+        if close:
+            rel = np.pad(rel, 1, mode="constant", constant_values=1.0)
+        verts, faces, _, _ = marching_cubes(rel, level=0.0)
+        verts = np.asarray(verts, dtype=np.float64)
+        F = faces.astype(np.int64)
         if not close:
-            verts, faces, _, _ = marching_cubes(self.values, level=level, spacing=tuple(self.spacing))
-            return verts + self.bbox_min, faces.astype(np.int64)
-        pad = level + max(vmax - level, 1e-12)
-        vals = np.pad(self.values, 1, mode="constant", constant_values=pad)
-        verts, faces, _, _ = marching_cubes(vals, level=level, spacing=tuple(self.spacing))
-        verts = np.clip(verts - self.spacing + self.bbox_min, self.bbox_min, self.bbox_max)
-        return verts, faces.astype(np.int64)
+            V = self.bbox_min + verts * h
+            return (V, F, manifold_report(V, F)) if report else (V, F)
+        V = np.clip((verts - 1.0) * h + self.bbox_min, self.bbox_min, self.bbox_max)
+        V, F = weld(V, F)
+        rep = manifold_report(V, F)
+        if not rep["vertex_manifold"]:
+            V, F = split_nonmanifold_vertices(V, F)
+            rep = manifold_report(V, F)
+        return (V, F, rep) if report else (V, F)
 
     def isosurfaces(self, levels, close: bool = False):
         """Several level sets at once: a list of ``(V, F)``, one per level (e.g. offsets ±1 %, ±3 %)."""
@@ -347,10 +366,11 @@ class TetField(Field):
             out[~inside] = self.values[cKDTree(self.vertices).query(Q[~inside])[1]]
         return out
 
-    def isosurface(self, level: float = 0.0):
-        """Marching tetrahedra at ``level``: a shared-vertex triangle mesh ``(V, F)``, oriented so that
-        normals point toward increasing values (outward for a signed distance)."""
-        return marching_tetrahedra(self.vertices, self.tets, self.values, level)
+    def isosurface(self, level: float = 0.0, report: bool = False):
+        """Marching tetrahedra at ``level``: a welded triangle mesh ``(V, F)``, oriented so that normals point
+        toward increasing values (outward for a signed distance); ``report=True`` adds its
+        :func:`gsdf.mesh.topology.manifold_report` (see :func:`marching_tetrahedra`)."""
+        return marching_tetrahedra(self.vertices, self.tets, self.values, level, report=report)
 
     def isosurfaces(self, levels):
         return [self.isosurface(float(v)) for v in np.atleast_1d(np.asarray(levels, dtype=float))]
@@ -589,21 +609,31 @@ def locate_in_tets(X, T, Q, k: int = 16, chunk: int = 1 << 15):
     return s, bary
 
 
-def marching_tetrahedra(X, T, values, level: float = 0.0):
+def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     """Level set of a piecewise-linear function on a tet mesh (vectorized marching tetrahedra).
 
     Each tet with vertices on both sides contributes one triangle (1 vertex apart) or a quad split in two
-    (2 and 2); crossing points are shared per mesh edge, so the result is closed and edge-manifold away from
-    the mesh boundary. Triangles are oriented along the gradient of ``values``.
+    (2 and 2); crossing points are shared per mesh edge. Where the level passes exactly through mesh nodes,
+    crossing points of different edges coincide: they are welded, zero-area triangles dropped, and a vertex
+    where separate sheets touch is split per fan, so the result is edge- and vertex-manifold (closed away from
+    the mesh boundary). Two cases stay open, and the report says so: flat (zero-volume) tets, which a
+    Delaunay of cospherical points such as a regular grid contains, and tet faces lying wholly on the level
+    (three nodes exactly at ``level``). Triangles are oriented along the gradient of ``values``. ``report=True`` returns
+    ``(V, F, report)`` with :func:`gsdf.mesh.topology.manifold_report`.
     """
+    from ._checks import finite
+
     X = np.asarray(X, float)
     T = np.asarray(T, np.int64)
-    s = np.asarray(values, float) - float(level)
+    s = np.asarray(values, float) - finite(level, "level")
     if not (s.min() < 0 < s.max()):
         raise ValueError(f"level {level} is outside the field's range [{s.min() + level:.6g}, {s.max() + level:.6g}]: no surface")
-    pos = s[T] > 0
+    # values within round-off of the level are put exactly on it, and a node on the level counts as above it
+    # (a symbolic +0 perturbation): crossings at such a node then coincide exactly and are welded below
+    s = np.where(np.abs(s) <= 1e-12 * float(np.abs(s).max()), 0.0, s)
+    pos = s[T] >= 0
     npos = pos.sum(axis=1)
-    tris = []
+    tris, tet_of = [], []
     # one vertex apart: lone vertex and the three others
     for k, lone_is_pos in ((1, True), (3, False)):
         sel = npos == k
@@ -614,6 +644,7 @@ def marching_tetrahedra(X, T, values, level: float = 0.0):
         Ts = np.take_along_axis(T[sel], order, axis=1)
         a = Ts[:, 0]
         tris.append(np.stack([np.stack([a, Ts[:, 1]], 1), np.stack([a, Ts[:, 2]], 1), np.stack([a, Ts[:, 3]], 1)], 1))
+        tet_of.append(np.flatnonzero(sel))
     sel = npos == 2
     if sel.any():
         order = np.argsort(~pos[sel], axis=1, kind="stable")  # two positive first
@@ -622,18 +653,32 @@ def marching_tetrahedra(X, T, values, level: float = 0.0):
         e_ac, e_ad, e_bd, e_bc = (np.stack(p, 1) for p in ((a, c), (a, d), (b, d), (b, c)))
         tris.append(np.stack([e_ac, e_ad, e_bd], 1))
         tris.append(np.stack([e_ac, e_bd, e_bc], 1))
+        tet_of += [np.flatnonzero(sel)] * 2
     E = np.concatenate(tris)  # (k, 3 corners, 2 endpoints)
+    tet_of = np.concatenate(tet_of)
     Es = np.sort(E.reshape(-1, 2), axis=1)
     uniq, inv = np.unique(Es, axis=0, return_inverse=True)
     sa, sb = s[uniq[:, 0]], s[uniq[:, 1]]
     t = sa / (sa - sb)
     V = X[uniq[:, 0]] + t[:, None] * (X[uniq[:, 1]] - X[uniq[:, 0]])
+    V[t == 1.0] = X[uniq[t == 1.0, 1]]  # a crossing at a node is that node, bitwise (so it welds)
     F = inv.reshape(-1, 3)
-    # orient along the gradient: the endpoint with the larger value of any corner edge shows the direction
+    # orient along the gradient of the linear interpolant of each triangle's tet
     n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    e = E[:, 0]
-    up = np.where((s[e[:, 1]] > s[e[:, 0]])[:, None], X[e[:, 1]] - X[e[:, 0]], X[e[:, 0]] - X[e[:, 1]])
+    Tt = T[tet_of]
+    M = X[Tt[:, 1:]] - X[Tt[:, :1]]  # (k, 3, 3) rows p_i - p_0
+    ds = s[Tt[:, 1:]] - s[Tt[:, :1]]
+    ok = np.abs(np.linalg.det(M)) > 0
+    up = np.zeros_like(n)
+    up[ok] = np.linalg.solve(M[ok], ds[ok][:, :, None])[:, :, 0]
     flip = (n * up).sum(axis=1) < 0
     F[flip] = F[flip][:, [0, 2, 1]]
     keep = np.linalg.norm(n, axis=1) > 0
-    return V, F[keep].astype(np.int64)
+    from .mesh.topology import manifold_report, split_nonmanifold_vertices, weld
+
+    V, F = weld(V, F[keep].astype(np.int64))
+    rep = manifold_report(V, F)
+    if not rep["vertex_manifold"]:
+        V, F = split_nonmanifold_vertices(V, F)
+        rep = manifold_report(V, F)
+    return (V, F, rep) if report else (V, F)

@@ -280,8 +280,12 @@ def extract_isosurface(
             f"level {level} is not crossed: func ranges over [{vmin:.6g}, {vmax:.6g}] on the grid, so there is no "
             "surface in the box (wrong level, box, or resolution too coarse to see the shape?)"
         )
+    # scikit-image works in float32: give it the values relative to the level, scaled to [-1, 1], so fields of
+    # any magnitude (1e-150 or 1e150) keep their sign pattern (a float32 1e-151 would be 0)
+    rel = values * 0.5 - level * 0.5
+    rel /= float(np.abs(rel).max())
     verts, faces, _, _ = marching_cubes(
-        values, level=level, gradient_direction="ascent" if inside == "above" else "descent"
+        rel, level=0.0, gradient_direction="ascent" if inside == "above" else "descent"
     )
     X = np.asarray(verts, dtype=np.float64)
     F = np.ascontiguousarray(faces, dtype=np.int64)

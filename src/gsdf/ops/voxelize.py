@@ -17,6 +17,7 @@ import numpy as np
 
 from .._checks import as_mesh, as_normals, as_points, as_weights, integer, nonnegative, positive
 from .._memory import check_bytes, grid_bytes
+from ..mesh.topology import manifold_report, split_nonmanifold_vertices
 
 __all__ = [
     "voxel_grid",
@@ -302,12 +303,20 @@ def load_voxels(path):
         raise ValueError(f"{path}: not a gsdf voxel file ({exc})") from exc
 
 
-def voxels_to_mesh(occ, bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
+def voxels_to_mesh(occ, bbox_min, bbox_max, report: bool = False):
     """Boundary of the occupied voxels as a triangle mesh (two triangles per exposed cell face).
 
     Every face between an occupied and an empty cell (or the outside of the grid) becomes a quad split in
     two triangles, oriented with the normal pointing out of the occupied region. Grid nodes are shared, so
-    the result is closed (edge-manifold except where two occupied cells touch only along an edge).
+    the result is closed and welded — except where occupied cells touch only along an edge or at a corner,
+    which no welded surface can represent manifoldly. There the rule is: *cells that share only an edge or a
+    corner are separate*; the faces of each cell at such an edge are paired with each other, and a grid node
+    gets one copy per fan of faces around it. Isolated edge and corner contacts then become closed,
+    edge- and vertex-manifold surfaces with coincident (unwelded) vertex copies at those nodes. An edge
+    contact whose two cells are also connected around the edge's end nodes (through other occupied cells)
+    cannot be cut by copying vertices: such edges stay non-manifold (four faces). ``report=True`` returns
+    what the mesh is (:func:`gsdf.mesh.topology.manifold_report`: closed, edge_manifold, vertex_manifold,
+    welded and the counts of non-manifold edges and vertices).
 
     Parameters
     ----------
@@ -322,6 +331,8 @@ def voxels_to_mesh(occ, bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
         Used grid nodes.
     F : (m, 3) int64
         Outward-oriented triangles; ``(0, 3)`` arrays when nothing is occupied.
+    report : dict
+        Only with ``report=True``: closed / edge-manifold / vertex-manifold / welded and counts.
 
     Examples
     --------
@@ -343,6 +354,7 @@ def voxels_to_mesh(occ, bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
     strides = np.array([nn[1] * nn[2], nn[2], 1], dtype=np.int64)
     P = np.pad(A, 1, constant_values=False)
     tris = []
+    cells = []  # flat index of the occupied cell each triangle bounds (pairs faces at non-manifold edges)
     for d in range(3):
         e1, e2 = (d + 1) % 3, (d + 2) % 3
         sl_lo = [slice(1, -1)] * 3
@@ -362,11 +374,30 @@ def voxels_to_mesh(occ, bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
                 q = q[:, ::-1]
             tris.append(q[:, [0, 1, 2]])
             tris.append(q[:, [0, 2, 3]])
+            cell = idx.copy()
+            cell[:, d] -= sign < 0  # sign=+1: the occupied cell is on the high side of node plane i
+            cid = np.ravel_multi_index(cell.T, A.shape)
+            cells += [cid, cid]
     if not tris:
-        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+        empty = (np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64))
+        return (*empty, manifold_report(*empty)) if report else empty
     F = np.concatenate(tris)
+    C = np.concatenate(cells)
     used, F = np.unique(F, return_inverse=True)
     F = F.reshape(-1, 3).astype(np.int64)
     ijk = np.column_stack(np.unravel_index(used, tuple(nn))).astype(np.float64)
     V = lo + ijk * h
-    return V, F
+    rep = manifold_report(V, F)
+    if not (rep["edge_manifold"] and rep["vertex_manifold"]):
+        tri_cell = C
+
+        def same_cell(hs):
+            """At an edge with 4 faces (two cells touching along it) pair the two faces of each cell."""
+            cs = tri_cell[hs // 3]
+            o = np.argsort(cs, kind="stable")
+            hs, cs = hs[o], cs[o]
+            return [(hs[i], hs[i + 1]) for i in range(0, len(hs) - 1, 2) if cs[i] == cs[i + 1]]
+
+        V, F = split_nonmanifold_vertices(V, F, pair_ok=same_cell)
+        rep = manifold_report(V, F)
+    return (V, F, rep) if report else (V, F)

@@ -193,8 +193,9 @@ class PointsAsTori:
         self._Pf = fr.geometry(self.P, "P")
         if r_eval is not None:
             r_eval = float(fr.inverse_length(r_eval))
-            if not (np.isfinite(r_eval) and r_eval > 0):
-                raise ValueError("r_eval: not representable relative to the cloud's size")
+            if not r_eval > 0:
+                raise ValueError("r_eval: too small to represent relative to the cloud's size")
+            r_eval = min(r_eval, 1e150)  # the cloud spans ~2 frame units: any radius beyond covers all of it
         self._blend = NeighbourBlend(self._Pf, self.C, r_eval, self.k_eval, self.k_fallback, kd_eps=kd_eps)
         if _state is not None:
             if framed is not None:

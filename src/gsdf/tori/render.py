@@ -106,7 +106,7 @@ def sphere_trace(sdf, bbox_min, bbox_max, width: int = 256, height: int = 256, l
     f, up = _direction(view, "view"), _direction(up, "up")
     # the image frame needs up not parallel to the viewing direction
     if np.linalg.norm(np.cross(f, up)) < 1e-9:
-        raise ValueError(f"up: {tuple(up)} is parallel to the view direction {tuple(f)}; the view is degenerate")
+        raise ValueError(f"up: {up.round(6).tolist()} is parallel to the view direction {f.round(6).tolist()}; the view is degenerate")
     c, diag = 0.5 * (lo + hi), float(np.linalg.norm(hi - lo))
     eye = c + f * diag * 0.5 / np.tan(np.radians(fov) / 2) * 1.1
     fwd = -f

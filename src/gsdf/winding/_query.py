@@ -37,7 +37,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
             bad = s + int(np.argmax(~np.isfinite(q).all(axis=1)))
             raise ValueError(f"Q: contains NaN or infinite coordinates (first at row {bad})")
         if frame is not None:
-            q = frame.queries(q)
+            q = frame.queries(q, row0=s)
         if coherent and e - s > 4096 and not _already_coherent(q):
             o = morton_order(q)
             tmp = np.empty(e - s)
