@@ -241,6 +241,10 @@ def _load_npz(path, keys, what: str) -> dict:
 
 def grid_points(bbox_min, bbox_max, shape) -> np.ndarray:
     """Positions of the nodes of a regular grid, shape (prod(shape), 3), C order."""
+    from ._memory import check_bytes, grid_bytes
+
+    # the node positions (24 B) and, in every caller, at least one float per node and its meshgrid copies
+    check_bytes(grid_bytes(shape, 56), f"a {'x'.join(str(int(s)) for s in shape)} grid of nodes (lower the resolution)")
     axes = [np.linspace(bbox_min[d], bbox_max[d], int(shape[d])) for d in range(3)]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
     return np.column_stack((X.ravel(), Y.ravel(), Z.ravel()))
