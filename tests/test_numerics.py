@@ -235,3 +235,11 @@ def test_marching_tetrahedra_welds_node_crossings():
         assert rep["welded"] and rep["closed"] and rep["edge_manifold"] and rep["vertex_manifold"], rep
         vol = np.einsum("ij,ij->i", Vt[Ft[:, 0]], np.cross(Vt[Ft[:, 1]], Vt[Ft[:, 2]])).sum() / 6
         assert abs(vol - 4 / 3 * np.pi * level ** 3) < 0.15 * vol  # outward (gradient) orientation
+
+
+def test_grid_node_positions_are_guarded_by_the_memory_estimate():
+    from gsdf.field import grid_points
+
+    with pytest.raises(ValueError, match="grid of nodes.*needs about"):
+        grid_points([0, 0, 0], [1, 1, 1], (5000, 5000, 5000))
+    assert grid_points([0, 0, 0], [1, 1, 1], (2, 3, 4)).shape == (24, 3)
