@@ -206,6 +206,9 @@ def test_lp_bad_input_and_limits():
         dual_graph_l1(2, P, [np.nan], [1.0])
     with pytest.raises(ValueError, match="n_cells"):
         dual_graph_l1(True, P, [0.0], [1.0])
+    with pytest.raises(ValueError, match="algorithm"):
+        dual_graph_l1(2, P, [0.0], [1.0], algorithm="gurobi")
+    assert dual_graph_l1(2, P, [0.5], [1.0], algorithm="highs-ipm").objective == pytest.approx(0.0, abs=1e-9)
     with pytest.raises(ValueError, match="pairs"):
         dual_graph_l1(2, np.array([[True, False]]), [0.0], [1.0])
     with pytest.raises(ValueError, match="infeasible"):

@@ -69,7 +69,7 @@ def _check_1d(a, k, name, default=None):
 
 
 def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit: float = 300.0,
-                  gauge: str = "component") -> DualL1Result:
+                  gauge: str = "component", algorithm: str = "highs") -> DualL1Result:
     """Minimise ``Σ_k w_k |d_k + x_{A_k} - x_{B_k}|`` over per-cell shifts x with HiGHS.
 
     Parameters
@@ -87,6 +87,7 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
         Seconds HiGHS may use; reaching it raises ValueError.
     gauge : "component" | "none"
         Fix one shift per connected component of the dual graph at 0 (default), or leave all free.
+    algorithm : "highs" (HiGHS picks), "highs-ds" (dual simplex) or "highs-ipm" (interior point + crossover)
 
     Returns
     -------
@@ -127,6 +128,8 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
             raise ValueError("bounds: need lo <= hi without NaN")
     if gauge not in ("component", "none"):
         raise ValueError(f"gauge: expected 'component' or 'none', got {gauge!r}")
+    if algorithm not in ("highs", "highs-ds", "highs-ipm"):
+        raise ValueError(f"algorithm: expected 'highs', 'highs-ds' or 'highs-ipm', got {algorithm!r}")
     if not isinstance(time_limit, (int, float)) or isinstance(time_limit, bool) or not time_limit > 0:
         raise ValueError(f"time_limit: expected a positive number of seconds, got {time_limit!r}")
 
@@ -154,7 +157,8 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
     cost = np.concatenate([np.zeros(n), w, w])
     bnds = np.column_stack([np.concatenate([x_lo, sp_lo, sm_lo]), np.concatenate([x_hi, sp_hi, sm_hi])])
     try:
-        res = linprog(cost, A_eq=A, b_eq=-d, bounds=bnds, method="highs", options={"time_limit": float(time_limit)})
+        res = linprog(cost, A_eq=A, b_eq=-d, bounds=bnds, method=algorithm,
+                      options={"time_limit": float(time_limit)})
     except Exception as exc:  # pragma: no cover - HiGHS raising instead of reporting
         raise ValueError(f"linear program: HiGHS failed ({exc})") from exc
     secs = time.perf_counter() - t0
