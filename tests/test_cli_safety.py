@@ -30,6 +30,7 @@ COMMANDS = {
     "tori": (["{cloud}", "-k", "8"], "t.npz"),
     "render": (["{cloud}", "--size", "8"], "r.png"),
     "swn": (["{sphere}", "{swn_curves}", "-q"], "w.ply"),
+    "reconstruct": (["{cloud}", "--method", "winding", "--resolution", "8", "-q"], "r.ply"),
 }
 # subcommands with their own safety tests here or elsewhere
 EXEMPT = {"demo": "test_demo_output_folder_that_is_a_file", "warmup": "reads and writes no user files",

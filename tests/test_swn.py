@@ -339,7 +339,7 @@ def test_cli_swn(tmp_path):
     assert txt.count("\nvt ") == 3 * ply["face"].count and "f 1/" in txt or "/1 " in txt
     bad = CliRunner().invoke(main, ["swn", f"{DATA}/double-torus.obj", f"{DATA}/double-torus.txt", "-o",
                                     str(tmp_path / "x.vtk")])
-    assert bad.exit_code != 0 and ".ply or .obj" in bad.output
+    assert bad.exit_code != 0 and ".ply, .obj" in bad.output
     badc = CliRunner().invoke(main, ["swn", f"{DATA}/double-torus.obj", _write(tmp_path, "b.txt", "zz\n"),
                                      "-o", out])
     assert badc.exit_code != 0 and "unknown directive" in badc.output

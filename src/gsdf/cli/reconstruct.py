@@ -6,7 +6,7 @@ import os
 
 import click
 
-from ._common import ensure_parent, quiet_option, report_errors
+from ._common import check_output, no_clobber_option, output_file, quiet_option, report_errors
 
 _METHODS = ("simply-connected", "winding", "heat", "pat")
 
@@ -38,6 +38,7 @@ Examples:
               help="Grid resolution of the comparison methods (ignored by simply-connected).")
 @click.option("--png", "png", default=None, help="Also write a PNG preview of the result (shaded by height).")
 @quiet_option
+@no_clobber_option
 @report_errors
 def reconstruct(cloud, out, method, outliers, clusters, max_iterations, resolution, png, quiet):
     import numpy as np
@@ -45,12 +46,9 @@ def reconstruct(cloud, out, method, outliers, clusters, max_iterations, resoluti
     from ..io import read_points, write_mesh
     from ..recon.topology import mesh_topology
 
+    check_output(out, (".ply", ".obj", ".off", ".stl"))
+    check_output(png, (".png",), "--png")
     P, N = read_points(cloud)
-    ext = os.path.splitext(out)[1].lower()
-    if ext not in (".ply", ".obj", ".off", ".stl"):
-        raise ValueError(f"--output: unsupported mesh extension {ext!r} (use .ply, .obj, .off or .stl)")
-    if png is not None and not png.lower().endswith(".png"):
-        raise ValueError(f"--png: expected a .png path, got {png!r}")
 
     def say(stage):
         if not quiet:
@@ -74,11 +72,11 @@ def reconstruct(cloud, out, method, outliers, clusters, max_iterations, resoluti
     manifold = top["closed"] and top["edge_manifold"] and top["vertex_manifold"]
     click.echo(f"  {len(V)} vertices, {len(F)} faces; components {top['components']}, genus {top['genus']}, "
                f"{'closed manifold' if manifold else 'NOT a closed manifold'}")
-    ensure_parent(out)
-    write_mesh(out, V, F)
+    with output_file(out, (".ply", ".obj", ".off", ".stl")) as tmp:
+        write_mesh(tmp, V, F)
     click.echo(f"mesh -> {os.path.abspath(out)}")
     if png is not None:
         from ..heat.surface.render import render_function_png
-        ensure_parent(png)
-        render_function_png(png, V, F, np.asarray(V)[:, 1], view=(0.3, 0.2, 1.0))
+        with output_file(png, (".png",), what="--png") as tmp:
+            render_function_png(tmp, V, F, np.asarray(V)[:, 1], view=(0.3, 0.2, 1.0))
         click.echo(f"preview -> {os.path.abspath(png)}")

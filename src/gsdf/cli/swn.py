@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from ._common import ensure_parent, quiet_option, report_errors
+from ._common import check_output, no_clobber_option, output_file, quiet_option, report_errors
 
 
 def write_swn_obj(path, V, F, corner_values, face_labels) -> None:
@@ -66,6 +66,7 @@ Example:
 @click.option("--png", default=None, help="Also write a PNG preview of the winding number.")
 @click.option("--view", default="0,0,1", show_default=True, help="View direction for the PNG (x,y,z).")
 @quiet_option
+@no_clobber_option
 @report_errors
 def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     from ..io import read_mesh
@@ -73,9 +74,9 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     from ..winding.surface import SurfaceWindingNumbers
     from ..winding.surface_curves import insert_curves
 
+    check_output(output, (".ply", ".obj"))
+    check_output(png, (".png",), "--png")
     ext = os.path.splitext(output)[1].lower()
-    if ext not in (".ply", ".obj"):
-        raise ValueError(f"{output}: the output must be .ply or .obj (got {ext or 'no extension'!r})")
     say = (lambda s: None) if quiet else (lambda s: click.echo(f"  {s} ...", err=True))
     say("reading")
     V, F = read_mesh(mesh)
@@ -91,8 +92,8 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
         res = solver.solve(list(segs), method=method, epsilon=epsilon, time_limit=time_limit, progress=update)
     finally:
         bar.close()
-    ensure_parent(output)
-    (write_swn_ply if ext == ".ply" else write_swn_obj)(output, V2, F2, res.corner_values, res.face_labels)
+    with output_file(output, (".ply", ".obj")) as tmp:
+        (write_swn_ply if ext == ".ply" else write_swn_obj)(tmp, V2, F2, res.corner_values, res.face_labels)
     A = solver.dec.face_area
     labs = np.unique(res.face_labels)
     share = ", ".join(f"{int(k)}: {100 * A[res.face_labels == k].sum() / A.sum():.1f}%" for k in labs)
@@ -110,8 +111,8 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
                 raise ValueError
         except ValueError:
             raise click.BadParameter(f"expected x,y,z (not all zero), got {view!r}", param_hint="--view")
-        ensure_parent(png)
         m = len(F2)
-        render_function_png(png, V2[F2].reshape(-1, 3), np.arange(3 * m).reshape(m, 3),
-                            res.corner_values.ravel() - 0.5, view=d)
+        with output_file(png, (".png",), what="--png") as tmp:
+            render_function_png(tmp, V2[F2].reshape(-1, 3), np.arange(3 * m).reshape(m, 3),
+                                res.corner_values.ravel() - 0.5, view=d)
         click.echo(f"image -> {os.path.abspath(png)}")
