@@ -734,7 +734,7 @@ def main():
     if args.time_step:
         time_step_study([20, 40, 80] if args.quick else [28, 56, 112, 224])
         return
-    parts = [f"## Signed heat method on surfaces (issue 3)\n\nMachine: {machine()}\n\nCommand: "
+    parts = [f"## Signed heat method on surfaces (issue 3)\n\nMachine: {machine()}; load average at start {os.getloadavg()[0]:.1f} (shared machine)\n\nCommand: "
              "`/work/anchors/bin/python bench/bench_heat_surface.py`\n"]
     if pp3d is not None:
         parts.append(against_potpourri())

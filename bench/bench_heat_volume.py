@@ -112,7 +112,7 @@ def reference(ref, Q, is_mesh):
 
 def main():
     quick = "--quick" in sys.argv
-    lines = [f"Machine: {machine()}", "", "Command: `/work/anchors/bin/python bench/bench_heat_volume.py " + " ".join(sys.argv[1:]) + "`", ""]
+    lines = [f"Machine: {machine()}; load average at start {os.getloadavg()[0]:.1f} (shared machine)", "", "Command: `/work/anchors/bin/python bench/bench_heat_volume.py " + " ".join(sys.argv[1:]) + "`", ""]
     V0, Fi, V, Fb = broken_bunny()
     if "--anchor64-only" in sys.argv:
         lo, hi, shape = volume_grid_box(V, 64)

@@ -23,6 +23,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .threads import single_blas_thread
+
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
            "cholesky", "cached_factorization"]
 
@@ -47,24 +49,26 @@ class Factorization:
             raise ValueError(f"matrix: expected a square matrix, got shape {A.shape}")
         self.shape = A.shape
         self.dtype = A.dtype
-        if symmetric:
+        with single_blas_thread():                            # SuperLU's tiny BLAS calls: threads only cost
+            if symmetric:
+                try:
+                    self._lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                                         options={"SymmetricMode": True})
+                    return
+                except RuntimeError:                          # a zero pivot without pivoting (saddle systems)
+                    pass
             try:
-                self._lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                                     options={"SymmetricMode": True})
-                return
-            except RuntimeError:                              # a zero pivot without pivoting (saddle systems)
-                pass
-        try:
-            self._lu = spla.splu(A, permc_spec=ordering, diag_pivot_thresh=pivot)
-        except RuntimeError as exc:
-            raise ValueError(f"matrix: the sparse system is singular ({exc})") from exc
+                self._lu = spla.splu(A, permc_spec=ordering, diag_pivot_thresh=pivot)
+            except RuntimeError as exc:
+                raise ValueError(f"matrix: the sparse system is singular ({exc})") from exc
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solve ``A x = b`` for one right-hand side (n,) or several (n, k)."""
         b = np.asarray(b)
-        if np.iscomplexobj(b) and not np.iscomplexobj(np.zeros(0, self.dtype)):
-            return self._lu.solve(np.ascontiguousarray(b.real)) + 1j * self._lu.solve(np.ascontiguousarray(b.imag))
-        return self._lu.solve(np.ascontiguousarray(b, dtype=np.result_type(b, self.dtype)))
+        with single_blas_thread():
+            if np.iscomplexobj(b) and not np.iscomplexobj(np.zeros(0, self.dtype)):
+                return self._lu.solve(np.ascontiguousarray(b.real)) + 1j * self._lu.solve(np.ascontiguousarray(b.imag))
+            return self._lu.solve(np.ascontiguousarray(b, dtype=np.result_type(b, self.dtype)))
 
 
 class HermitianFactorization:
