@@ -282,11 +282,22 @@ def blas_region(n=None):
     >>> with threads.blas_region():
     ...     lu = scipy.sparse.linalg.splu(A)             # doctest: +SKIP
     """
-    from threadpoolctl import threadpool_limits
-
     n = blas_solve_threads() if n is None else parse_num_threads(n)
-    with threadpool_limits(limits=n, user_api="blas"):
+    with _blas_controller().limit(limits=n, user_api="blas"):
         yield n
+
+
+_CONTROLLER = None
+
+
+def _blas_controller():
+    """threadpoolctl's view of the loaded thread pools, built once (a fresh scan per solve costs ~ms)."""
+    global _CONTROLLER
+    if _CONTROLLER is None:
+        from threadpoolctl import ThreadpoolController
+
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER
 
 
 def blas_threads() -> list[tuple[str, int]]:

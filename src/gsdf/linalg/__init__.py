@@ -7,7 +7,7 @@
   :func:`amg_preconditioner`;
 * :mod:`.saddle` — :func:`saddle_matrix` of equality-constrained least squares (Eq. 14);
 * :mod:`.lp` — :func:`solve_lp` (HiGHS);
-* :mod:`.threads` — :func:`single_blas_thread` (SuperLU runs with one BLAS thread).
+* BLAS threads around factorizations and solves: :func:`gsdf.threads.blas_region` (one thread unless set).
 
 Example
 -------
@@ -23,8 +23,7 @@ from .direct import (BlockHermitianFactorization, CholeskyFactorization, Factori
 from .iterative import SPDSolver, amg_preconditioner, pcg
 from .lp import solve_lp
 from .saddle import saddle_matrix
-from .threads import single_blas_thread
 
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
            "cholesky", "cached_factorization", "saddle_matrix", "solve_lp", "SPDSolver", "pcg",
-           "amg_preconditioner", "single_blas_thread"]
+           "amg_preconditioner"]

@@ -19,11 +19,23 @@ array([1. , 0.5])
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .threads import single_blas_thread
+from ..threads import blas_region
+
+
+def _in_blas_region(method):
+    """Run a factorization's method with BLAS limited by :func:`gsdf.threads.blas_region` (CHOLMOD's supernodes
+    and SuperLU's blocks are small: BLAS threads only contend with numba's)."""
+    @functools.wraps(method)
+    def wrapper(*args, **kwargs):
+        with blas_region():
+            return method(*args, **kwargs)
+    return wrapper
 
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
            "cholesky", "cached_factorization"]
@@ -49,7 +61,7 @@ class Factorization:
             raise ValueError(f"matrix: expected a square matrix, got shape {A.shape}")
         self.shape = A.shape
         self.dtype = A.dtype
-        with single_blas_thread():                            # SuperLU's tiny BLAS calls: threads only cost
+        with blas_region():                            # SuperLU's tiny BLAS calls: threads only cost
             if symmetric:
                 try:
                     self._lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
@@ -65,7 +77,7 @@ class Factorization:
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solve ``A x = b`` for one right-hand side (n,) or several (n, k)."""
         b = np.asarray(b)
-        with single_blas_thread():
+        with blas_region():
             if np.iscomplexobj(b) and not np.iscomplexobj(np.zeros(0, self.dtype)):
                 return self._lu.solve(np.ascontiguousarray(b.real)) + 1j * self._lu.solve(np.ascontiguousarray(b.imag))
             return self._lu.solve(np.ascontiguousarray(b, dtype=np.result_type(b, self.dtype)))
@@ -89,6 +101,7 @@ class HermitianFactorization:
     True
     """
 
+    @_in_blas_region
     def __init__(self, A, backend: str = "auto"):
         A = sp.coo_matrix(A)
         n = A.shape[0]
@@ -112,6 +125,7 @@ class HermitianFactorization:
         self._lu = Factorization(A.astype(np.complex128))
         self.backend = "superlu"
 
+    @_in_blas_region
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solve ``A x = b`` for a complex right-hand side (n,)."""
         b = np.asarray(b, dtype=np.complex128)
@@ -128,6 +142,7 @@ class HermitianFactorization:
 class CholeskyFactorization:
     """CHOLMOD (cholespy) factorization of a real SPD matrix; ``solve`` for (n,) or (n, k) right-hand sides."""
 
+    @_in_blas_region
     def __init__(self, A):
         from cholespy import CholeskySolverD, MatrixType
 
@@ -137,6 +152,7 @@ class CholeskyFactorization:
         self._chol = CholeskySolverD(self.n, A.indptr.astype(np.int32), A.indices.astype(np.int32),
                                      np.ascontiguousarray(A.data, dtype=np.float64), MatrixType.CSR)
 
+    @_in_blas_region
     def solve(self, b):
         b = np.ascontiguousarray(b, dtype=np.float64)
         x = np.zeros_like(b)
@@ -167,6 +183,7 @@ class BlockHermitianFactorization:
     (1+2j)
     """
 
+    @_in_blas_region
     def __init__(self, A):
         A = sp.csr_matrix(A)
         A.sum_duplicates()
@@ -182,6 +199,7 @@ class BlockHermitianFactorization:
                                          np.ascontiguousarray(A.data, dtype=np.float64), MatrixType.CSR)
             self.backend = "cholmod"
 
+    @_in_blas_region
     def solve(self, b):
         b = np.asarray(b, np.complex128)
         r = np.empty(2 * self.n)
