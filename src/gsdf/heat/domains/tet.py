@@ -91,16 +91,18 @@ class TetDomain(HeatDomain):
     def assemble_sources(self, curves, points, **options):
         raise ValueError("curves: volume domains take mesh or point-cloud sources (see signed_heat_volume)")
 
-    def prepare(self, src: Sources) -> Sources:
-        """Nodes = the input points (with their components), shift rows = interpolation at the sources."""
+    def prepare(self, src: Sources, shift: bool = True) -> Sources:
+        """Nodes = the input points (with their components), shift rows = interpolation at the sources (point
+        location of every source: skipped with ``shift=False``, for the unshifted hard "zero")."""
         nZ = self.n_input
         S = Sources(B=src.B, W=src.W, a=src.a, kind=src.kind, mean_spacing=src.mean_spacing, extra=dict(src.extra))
         S.node_rows = sp.csr_matrix((np.ones(nZ), (np.arange(nZ), np.arange(nZ))), shape=(nZ, self.n_nodes))
         S.node_vertex = np.arange(nZ)
         S.node_curve = np.zeros(nZ, np.int64)
         S.components = self.comp
-        S.shift_rows = tet_interpolation_rows(self.P, self.T, self.D, S.B)
-        S.shift_weights = S.a
+        if shift:
+            S.shift_rows = tet_interpolation_rows(self.P, self.T, self.D, S.B)
+            S.shift_weights = S.a
         return S
 
     def diffuse(self, S: Sources):

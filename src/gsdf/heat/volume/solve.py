@@ -128,7 +128,7 @@ def solve_tet(src: Sources, X, lo, hi, shape, t_coef: float = 1.0, level_set_con
     tt = float(t_coef) * h * h if t is None else positive(t, "t")
     domain = TetDomain(P, T, D, keep, vol, G, nZ, comp, tt, step1=step1, theta=theta, amg_above=amg_above)
     core = SignedHeatCore(domain)
-    S = domain.prepare(src)
+    S = domain.prepare(src, shift=(mode != "zero" or lam is not None))     # hard "zero" is not shifted
     report("heat (step I)", 0.0)
     Y = core.unit_field(core.diffuse(S))
     report("heat (step I)", 1.0)
