@@ -122,9 +122,10 @@ def test_core_progress_signature():
 
 
 # ------------------------------------------------------------------------------------------ volumes
-# old default "zero" on grids was the soft penalty (weight 10); "zero" is now hard and soft_weight= the penalty
+# the old grid default, "zero" by the soft penalty (weight 10), is soft_weight="auto" (the default) and 10.0;
+# the old constraint="exact" is soft_weight=None (the hard constraint)
 _NEW_SPELLING = {"grid_mesh_soft": dict(soft_weight=10.0),
-                 "grid_mesh_exact": dict(level_set_constraint="zero")}
+                 "grid_mesh_exact": dict(level_set_constraint="zero", soft_weight=None)}
 VOLUME = volume_cases()
 
 
@@ -154,7 +155,7 @@ def test_grid_multiple_and_hard_zero():
     V2 = np.concatenate([V - [0.8, 0, 0], V + [0.8, 0, 0]])
     F2 = np.concatenate([F, F + len(V)])
     kw = dict(mesh=(V2, F2), resolution=(20, 12, 12), bbox_min=[-1.5, -0.7, -0.7], bbox_max=[1.5, 0.7, 0.7])
-    fields = {m: signed_heat_volume(level_set_constraint=m, **kw) for m in ("zero", "multiple")}
+    fields = {m: signed_heat_volume(level_set_constraint=m, soft_weight=None, **kw) for m in ("zero", "multiple")}
     fields["soft"] = signed_heat_volume(soft_weight=10.0, **kw)
     T = V2[F2]
     B = T.mean(axis=1)
@@ -231,3 +232,14 @@ def test_grid_multiple_on_a_cloud_uses_its_components():
     f = signed_heat_volume(points=(P2, N), resolution=(20, 12, 12), bbox_min=[-1.5, -0.7, -0.7],
                            bbox_max=[1.5, 0.7, 0.7], level_set_constraint="multiple")
     assert f([[-0.8, 0, 0]])[0] < -0.3 and f([[0.8, 0, 0]])[0] < -0.3 and f([[0, 0.65, 0]])[0] > 0.05
+
+
+def test_grid_default_is_the_fast_penalty_and_none_is_hard():
+    """soft_weight="auto": the penalty (c = 10) on grids, so the default call stays as fast as before the core."""
+    from gsdf.heat.volume import signed_heat_volume
+
+    kw = dict(volume_cases())["grid_mesh_soft"]
+    phi = np.asarray(signed_heat_volume(**kw).values).ravel()
+    assert np.abs(phi - REF["grid_mesh_soft"]).max() <= 1e-8 * max(1.0, float(np.abs(REF["grid_mesh_soft"]).max()))
+    with pytest.raises(ValueError, match="soft_weight"):
+        signed_heat_volume(**kw, soft_weight="bogus")

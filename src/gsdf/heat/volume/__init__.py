@@ -96,7 +96,7 @@ def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = 0.
 
 
 def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=64, bbox_min=None, bbox_max=None,
-                       t_coef: float = 1.0, level_set_constraint: str = "zero", soft_weight=None,
+                       t_coef: float = 1.0, level_set_constraint: str = "zero", soft_weight="auto",
                        theta: float = 1.5, max_memory=None, progress=None, t_scale: str = "grid", **kwargs):
     """Generalized signed distance in a volume by the signed heat method (Feng & Crane 2024, §8).
 
@@ -131,9 +131,12 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
         vertex (and Steiner point). "multiple": φ constant on each connected component of the input (faces
         sharing vertices; clouds: near-neighbour graph). "none": φ shifted so its area-weighted mean over the
         sources is 0.
-    soft_weight : float, optional
-        Replace the hard constraint by a penalty: on grids c Σ_f a_f φ(b_f)² / h⁴ (c = ``soft_weight``; 10 is
-        what ``gsdf heat`` uses), CG-solved in about the time of the unconstrained solve; on tets
+    soft_weight : float, None or "auto"
+        "auto" (default): for "zero" on grids the penalty below with c = 10 — the hard grid constraint costs
+        minutes at 64³ and was less accurate than the penalty in both cases measured (a holed sphere at 20³: mean error
+        0.0058 vs 0.0042; the broken bunny at 32³: 0.0170 vs 0.0153) — and the hard constraint on tets.
+        None: the hard constraint on both. A number c: replace the hard constraint by a penalty, on grids
+        c Σ_f a_f φ(b_f)² / h⁴, CG-solved in about the time of the unconstrained solve; on tets
         λ Σ (φ(z_i) − φ(z_0))² over the input points. Then the same shift as "none". The older spelling
         ``constraint="soft"`` (with ``constraint_weight=10``) / ``constraint="exact"`` is still accepted on grids.
     theta : float
@@ -164,6 +167,9 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     t_coef = positive(t_coef, "t_coef")
     level_set_constraint = choice(level_set_constraint, "level_set_constraint", {"none", "zero", "multiple"})
     t_scale = choice(t_scale, "t_scale", {"grid", "input"})
+    if isinstance(soft_weight, str) and soft_weight == "auto":
+        soft_weight = (10.0 if domain == "grid" and level_set_constraint == "zero" and "constraint" not in kwargs
+                       else None)
     src, X, F = _input_positions(mesh, points)
     lo, hi, shape = volume_grid_box(X, resolution, bbox_min, bbox_max)
     if t_scale == "input" and "t" not in kwargs:
