@@ -180,8 +180,8 @@ def load_field(path) -> Field:
     """Read any field written by ``field.save(path)`` to ``.npz``: a :class:`GridField`, :class:`TetField` or
     :class:`SurfaceField`, chosen by the arrays the file holds.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np, os, tempfile
     >>> p = os.path.join(tempfile.mkdtemp(), "f.npz")
     >>> GridField(np.zeros((2, 2, 2)), [0, 0, 0], [1, 1, 1]).save(p)

@@ -158,8 +158,8 @@ def set_num_threads(n) -> None:
     ValueError
         ``n`` is not a positive integer.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import gsdf
     >>> gsdf.set_num_threads(1)
     """

@@ -59,8 +59,8 @@ def read_curves(path: str, F=None) -> CurveSources:
     -------
     CurveSources
 
-    Example
-    -------
+    Examples
+    --------
     >>> import tempfile, os
     >>> p = os.path.join(tempfile.mkdtemp(), "c.txt")
     >>> _ = open(p, "w").write("signed_curve\\nv 0\\nv 1\\nv 2\\nunsigned_point\\nv 5\\n")
