@@ -112,3 +112,4 @@ def test_run_blocks_names_the_failing_block(tmp_path):
                        capture_output=True, text=True, timeout=60, env=_env())
     assert r.returncode == 1
     assert "block 2 (line 9" in r.stderr and "boom" in r.stderr
+

@@ -16,6 +16,13 @@ class Field:
     * ``field.save(path)`` — format by extension, one of ``type(field).SAVE_EXTENSIONS``; any other extension is a
       ``ValueError`` listing those (the requested name is never changed). The file is written atomically
       (:mod:`gsdf.io.safe_write`).
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> f = gsdf.GridField(np.zeros((2, 2, 2)), [0, 0, 0], [1, 1, 1])   # every result type is a Field
+    >>> isinstance(f, gsdf.Field), f([[0.5, 0.5, 0.5]]).shape
+    (True, (1,))
     """
 
     #: Extensions :meth:`save` can write (lower case, with the dot).
@@ -595,6 +602,15 @@ def marching_tetrahedra(X, T, values, level: float = 0.0):
     Each tet with vertices on both sides contributes one triangle (1 vertex apart) or a quad split in two
     (2 and 2); crossing points are shared per mesh edge, so the result is closed and edge-manifold away from
     the mesh boundary. Triangles are oriented along the gradient of ``values``.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> X = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> T = np.array([[0, 1, 2, 3]])
+    >>> V, F = gsdf.marching_tetrahedra(X, T, X[:, 0] - 0.5)     # the plane x = 1/2 cuts one triangle
+    >>> V.shape, F.shape, np.allclose(V[:, 0], 0.5)
+    ((3, 3), (1, 3), True)
     """
     X = np.asarray(X, float)
     T = np.asarray(T, np.int64)

@@ -119,6 +119,12 @@ def get_num_threads() -> int:
     ------
     ValueError
         ``GSDF_NUM_THREADS`` is set to something that is not a positive integer.
+
+    Examples
+    --------
+    >>> import gsdf
+    >>> gsdf.get_num_threads() >= 1
+    True
     """
     if _setting is not None:
         return _setting
