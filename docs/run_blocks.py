@@ -69,6 +69,9 @@ def main(argv=None) -> int:
     ap.add_argument("--cwd", default=None, help="folder to run in (created if missing)")
     a = ap.parse_args(argv)
     page = os.path.abspath(a.page)
+    sys.path[:] = [os.path.abspath(x) if x else x for x in sys.path]  # a relative PYTHONPATH survives the chdir
+    if os.environ.get("PYTHONPATH"):  # ... and reaches the gsdf commands run in subprocesses
+        os.environ["PYTHONPATH"] = os.pathsep.join(os.path.abspath(x) for x in os.environ["PYTHONPATH"].split(os.pathsep) if x)
     if a.cwd:
         os.makedirs(a.cwd, exist_ok=True)
         os.chdir(a.cwd)
