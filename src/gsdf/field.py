@@ -16,6 +16,13 @@ class Field:
     * ``field.save(path)`` — format by extension, one of ``type(field).SAVE_EXTENSIONS``; any other extension is a
       ``ValueError`` listing those (the requested name is never changed). The file is written atomically
       (:mod:`gsdf.io.safe_write`).
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> f = gsdf.GridField(np.zeros((2, 2, 2)), [0, 0, 0], [1, 1, 1])   # every result type is a Field
+    >>> isinstance(f, gsdf.Field), f([[0.5, 0.5, 0.5]]).shape
+    (True, (1,))
     """
 
     #: Extensions :meth:`save` can write (lower case, with the dot).
@@ -199,8 +206,8 @@ def load_field(path) -> Field:
     """Read any field written by ``field.save(path)`` to ``.npz``: a :class:`GridField`, :class:`TetField` or
     :class:`SurfaceField`, chosen by the arrays the file holds.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np, os, tempfile
     >>> p = os.path.join(tempfile.mkdtemp(), "f.npz")
     >>> GridField(np.zeros((2, 2, 2)), [0, 0, 0], [1, 1, 1]).save(p)
@@ -624,6 +631,15 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     Delaunay of cospherical points such as a regular grid contains, and tet faces lying wholly on the level
     (three nodes exactly at ``level``). Triangles are oriented along the gradient of ``values``. ``report=True`` returns
     ``(V, F, report)`` with :func:`gsdf.mesh.topology.manifold_report`.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> X = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> T = np.array([[0, 1, 2, 3]])
+    >>> V, F = gsdf.marching_tetrahedra(X, T, X[:, 0] - 0.5)     # the plane x = 1/2 cuts one triangle
+    >>> V.shape, F.shape, np.allclose(V[:, 0], 0.5)
+    ((3, 3), (1, 3), True)
     """
     from ._checks import finite
 

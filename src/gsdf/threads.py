@@ -125,6 +125,12 @@ def get_num_threads() -> int:
     ------
     ValueError
         ``GSDF_NUM_THREADS`` is set to something that is not a positive integer.
+
+    Examples
+    --------
+    >>> import gsdf
+    >>> gsdf.get_num_threads() >= 1
+    True
     """
     if _setting is not None:
         return _setting
@@ -164,8 +170,8 @@ def set_num_threads(n) -> None:
     ValueError
         ``n`` is not a positive integer.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import gsdf
     >>> gsdf.set_num_threads(1)
     """

@@ -202,8 +202,8 @@ def run_batch(inputs, task, out, options=None, *, workers=None, dask_local=None,
     BatchInterrupted
         On Ctrl-C, after cancelling and recording the items in flight (``.result`` holds the partial result).
 
-    Example
-    -------
+    Examples
+    --------
     >>> r = run_batch("meshes/", "sdf-samples", "out/", {"n_samples": 250000}, workers=2)   # doctest: +SKIP
     >>> print(r.summary())                                                                   # doctest: +SKIP
     """

@@ -256,8 +256,8 @@ def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normali
     dict
         ``points`` (n, 3), ``sdf`` (n,) in ``dtype``; ``center`` (3,), ``scale``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> out = sdf_samples("bunny.off", n_samples=10000, normalize="sphere")     # doctest: +SKIP
     >>> out["points"].shape, out["sdf"].dtype                                     # doctest: +SKIP
     ((10000, 3), dtype('float32'))

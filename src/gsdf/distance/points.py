@@ -15,7 +15,16 @@ __all__ = ["PointCloudDistance", "point_cloud_distance"]
 
 
 class PointCloudDistance:
-    """Nearest-point distance to the points ``P`` (p, 3), with the k-d tree built once."""
+    """Nearest-point distance to the points ``P`` (p, 3), with the k-d tree built once.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> tree = gsdf.PointCloudDistance(np.eye(3))          # build once
+    >>> d = tree.query([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])[0]   # query many times
+    >>> np.round(d, 3).tolist()
+    [1.0, 1.0]
+    """
 
     def __init__(self, P):
         self.P = as_points(P, "P")
@@ -35,6 +44,13 @@ def point_cloud_distance(P, Q, return_closest: bool = False):
     """Distance from every query ``Q`` (q, 3) to the nearest of the points ``P`` (p, 3).
 
     Returns ``d`` (q,), or ``(d, index, closest)`` when ``return_closest`` is true.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> d = gsdf.point_cloud_distance(np.eye(3), [[0.0, 0.0, 0.0]])
+    >>> np.round(d, 3).tolist()
+    [1.0]
     """
     d, idx, closest = PointCloudDistance(P).query(Q)
     if return_closest:

@@ -70,6 +70,15 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0):
     Returns
     -------
     (q,) float64
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    >>> d = gsdf.signed_distance(V, F, [[0.1, 0.1, 0.1], [-1.0, 0.0, 0.0]])
+    >>> np.round(d, 3).tolist()                 # negative inside
+    [-0.1, 1.0]
     """
     V, F = as_mesh(V, F)
     Q = as_points(Q, "Q")
@@ -92,6 +101,15 @@ def signed_distance_points(P, N, Q, areas=None, beta: float = 2.3):
     ``|d|`` is the distance to the nearest point of ``P`` (p, 3); the sign comes from the fast winding
     number of the oriented points (normals ``N`` (p, 3), optional per-point ``areas`` (p,)): inside where
     it exceeds 1/2 (Barill et al. 2018).
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> rng = np.random.default_rng(0)
+    >>> P = rng.normal(size=(2000, 3)); P /= np.linalg.norm(P, axis=1, keepdims=True)   # unit sphere
+    >>> d = gsdf.signed_distance_points(P, P, [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    >>> np.round(d, 1).tolist()                 # negative inside
+    [-1.0, 1.0]
     """
     P = as_points(P, "P")
     N = as_normals(N, P.shape[0], "N")

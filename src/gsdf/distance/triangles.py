@@ -518,6 +518,15 @@ def unsigned_distance(V, F, Q, return_closest: bool = False):
 
     Returns ``d`` (q,), or ``(d, face, closest)`` when ``return_closest`` is true. To query the same
     geometry repeatedly, build a :class:`TriangleDistance` once.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    >>> F = np.array([[0, 1, 2]])
+    >>> d = gsdf.unsigned_distance(V, F, [[0.2, 0.2, 0.5], [0.2, 0.2, -0.5]])
+    >>> np.round(d, 3).tolist()
+    [0.5, 0.5]
     """
     V, F = as_mesh(V, F)
     Q = as_points(Q, "Q")

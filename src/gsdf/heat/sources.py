@@ -99,8 +99,8 @@ class Curve:
     kind : {"vertices", "points", "edges"}
     nodes : the validated nodes (int64 array, or a list of (int, float64 array) pairs)
 
-    Example
-    -------
+    Examples
+    --------
     >>> Curve([[0, 1], [1, 2], [2, 0]]).polylines()
     [array([0, 1, 2, 0])]
     """

@@ -59,8 +59,8 @@ def read_curves(path: str, F=None) -> CurveSources:
     -------
     CurveSources
 
-    Example
-    -------
+    Examples
+    --------
     >>> import tempfile, os
     >>> p = os.path.join(tempfile.mkdtemp(), "c.txt")
     >>> _ = open(p, "w").write("signed_curve\\nv 0\\nv 1\\nv 2\\nunsigned_point\\nv 5\\n")
@@ -157,7 +157,20 @@ def _as_surface_point(node, F, where):
 
 def write_curves(path: str, curves, curve_signs=None, points=()) -> None:
     """Write sources in the demo format (vertex-index curves as ``v`` nodes, surface points as ``f`` nodes) to a
-    ``.txt`` file (atomically, :mod:`gsdf.io.safe_write`)."""
+    ``.txt`` file (atomically, :mod:`gsdf.io.safe_write`).
+
+    Examples
+    --------
+    >>> import os, tempfile, gsdf
+    >>> path = os.path.join(tempfile.mkdtemp(), "curves.txt")
+    >>> gsdf.write_curves(path, [[0, 1, 2, 0]])          # one closed signed curve through vertices 0, 1, 2
+    >>> print(open(path).read().strip())
+    signed_curve
+    v 0
+    v 1
+    v 2
+    v 0
+    """
     signs = [True] * len(curves) if curve_signs is None else list(curve_signs)
     from .safe_write import atomic_output
 

@@ -174,6 +174,17 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     ------
     ValueError : fewer than 4 distinct points; coplanar / collinear points; NaN / inf; normals of the wrong
         shape; an unknown option; a cloud in which no point has a surface-like (planar) neighbourhood.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> i = np.arange(800) + 0.5
+    >>> phi, th = np.arccos(1 - 2 * i / 800), np.pi * (1 + 5 ** 0.5) * i
+    >>> P = np.column_stack([np.cos(th) * np.sin(phi), np.sin(th) * np.sin(phi), np.cos(phi)])
+    >>> V, F = gsdf.reconstruct_simply_connected(P)     # unoriented cloud -> one closed genus-0 mesh
+    >>> t = gsdf.mesh_topology(V, F)
+    >>> t["closed"], t["genus"]
+    (True, [0])
     """
     outliers = choice(outliers, "outliers", ("auto", "none"))
     max_iterations = integer(max_iterations, "max_iterations", lo=1)

@@ -31,6 +31,15 @@ def mesh_topology(V, F) -> dict:
     ``oriented`` (every interior edge used once in each direction), ``components`` (face-connected through
     edges), ``euler`` (V − E + F over used vertices), ``genus`` (list, per component, ``(2 − χ_c) / 2`` when the
     mesh is closed and manifold, else None), ``degenerate_faces`` (faces repeating a vertex), ``n_faces``.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    >>> t = gsdf.mesh_topology(V, F)
+    >>> t["closed"], t["oriented"], t["genus"]
+    (True, True, [0])
     """
     F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
     nF = len(F)

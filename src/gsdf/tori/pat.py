@@ -264,7 +264,7 @@ class PointsAsTori:
         return self._eval(Q, True)
 
     def isosurface(self, level: float = 0.0, resolution: int = 64, pad: float = 0.1):
-        """Mesh of the level set φ = ``level`` on a grid around the cloud (padded by ``pad`` × diagonal + |level|)."""
+        """Mesh of the level set φ = ``level`` on a grid around the cloud (padded by ``pad`` × diagonal + ``|level|``)."""
         from ..contour import extract_isosurface
 
         lo, hi = self.P.min(0), self.P.max(0)

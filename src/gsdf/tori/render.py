@@ -156,7 +156,7 @@ def render_png(sdf, path, width: int = 256, height: int = 256, level: float = 0.
                bbox_max=None, **kw) -> None:
     """Sphere-trace ``sdf`` (a :class:`PointsAsTori` or any pointwise SDF) and write a PNG.
 
-    The box defaults to the cloud's bounding box (``sdf.P``) padded by 10 % of its diagonal plus |level|.
+    The box defaults to the cloud's bounding box (``sdf.P``) padded by 10 % of its diagonal plus ``|level|``.
 
     Examples
     --------

@@ -129,6 +129,15 @@ def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
         Query points.
     areas : (m,) float, optional
         Area a_i of each point; estimated with :func:`gsdf.point_areas` when omitted.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> rng = np.random.default_rng(0)
+    >>> P = rng.normal(size=(2000, 3)); P /= np.linalg.norm(P, axis=1, keepdims=True)   # unit sphere
+    >>> w = gsdf.winding_number_points(P, P, [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    >>> bool(abs(w[0] - 1) < 0.05 and abs(w[1]) < 0.05)
+    True
     """
     frame, P, NA = oriented_area_normals(P, N, areas)
     return map_queries(lambda q, out: _wn_points(P, NA, q, out), Q, frame=frame)

@@ -406,6 +406,15 @@ def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarra
     """Fast generalized winding number of a triangle soup at ``Q`` (one call: build the tree, query).
 
     See :class:`FastWindingNumber` to reuse the tree across calls.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])          # outward tetrahedron
+    >>> w = gsdf.fast_winding_number(V, F, [[0.1, 0.1, 0.1], [2.0, 2.0, 2.0]])
+    >>> (np.round(w, 6) + 0.0).tolist()
+    [1.0, 0.0]
     """
     return FastWindingNumber(V, F, beta=beta, order=order)(Q)
 
@@ -414,5 +423,14 @@ def fast_winding_number_points(P, N, Q, areas=None, beta: float = 2.3, order: in
     """Fast winding number of an oriented point cloud at ``Q``; ``areas=None`` estimates point areas.
 
     See :class:`FastWindingNumberPoints` to reuse the tree across calls.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> rng = np.random.default_rng(0)
+    >>> P = rng.normal(size=(2000, 3)); P /= np.linalg.norm(P, axis=1, keepdims=True)   # unit sphere
+    >>> w = gsdf.fast_winding_number_points(P, P, [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])   # normals = P
+    >>> bool(abs(w[0] - 1) < 0.05 and abs(w[1]) < 0.05)
+    True
     """
     return FastWindingNumberPoints(P, N, areas=areas, beta=beta, order=order)(Q)

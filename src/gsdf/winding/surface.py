@@ -112,8 +112,8 @@ class SurfaceWindingNumbers:
     dec : TriangleDEC
     betti_1 : int, first Betti number (0: simply connected, no LP needed)
 
-    Example
-    -------
+    Examples
+    --------
     A closed loop on a flat grid bounds the square it runs around (counter-clockwise: label 1 inside):
 
     >>> from gsdf.heat.surface.meshes import grid_mesh
@@ -480,8 +480,8 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float =
                            time_limit: float = 300.0) -> SWNResult:
     """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> res = surface_winding_number(V, F, [loop])                          # doctest: +SKIP
     >>> res.face_labels                                                     # doctest: +SKIP
     """

@@ -358,8 +358,8 @@ class VoxelSurfaceSignedHeatSolver:
     faces : (m, 4) int64 outward quads
     face_centres : (m, 3); normals : (m, 3) corrected normals; domain : the :class:`VoxelSurfaceDomain`
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> import gsdf
     >>> x = np.indices((20, 20, 20)) - 9.5

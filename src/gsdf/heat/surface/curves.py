@@ -24,8 +24,8 @@ def level_set_curves(V, F, f, value: float = 0.0) -> list:
         (counter-clockwise w.r.t. the face normals): ``SurfaceSignedHeatSolver`` then returns values that are
         negative where ``f < value``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]]); F = np.array([[0, 1, 2]])
     >>> len(level_set_curves(V, F, np.array([-1.0, 1.0, 1.0])))
@@ -100,8 +100,8 @@ def region_boundary_curves(F, face_mask) -> list:
     the region negative. Boundary edges of the mesh that bound the region are included. Where the region
     touches itself at a vertex the loops are split there arbitrarily.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> F = np.array([[0, 1, 2], [0, 2, 3]])
     >>> [c.tolist() for c in region_boundary_curves(F, np.array([True, True]))]

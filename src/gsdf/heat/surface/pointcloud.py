@@ -29,8 +29,8 @@ class PointCloudSignedHeatSolver:
     domain, core : the :class:`~gsdf.heat.domains.pointcloud.PointCloudDomain` and its
     :class:`~gsdf.heat.core.SignedHeatCore`.
 
-    Example
-    -------
+    Examples
+    --------
     >>> solver = PointCloudSignedHeatSolver(P, N)                       # doctest: +SKIP
     >>> phi = solver.compute_distance([np.array([3, 17, 42, 8, 3])])    # doctest: +SKIP
     """

@@ -26,8 +26,8 @@ class PolygonMeshSignedHeatSolver:
     domain : the :class:`~gsdf.heat.domains.polygon.PolygonDomain`; core : its
     :class:`~gsdf.heat.core.SignedHeatCore` (factorizations kept between calls).
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> x = np.linspace(-1, 1, 9)
     >>> V = np.array([[a, b, 0.0] for a in x for b in x])

@@ -55,7 +55,7 @@ class SurfaceSignedHeatSolver:
         available; ``compute_distance_l1`` raises NotImplementedError. On a mesh that is already Delaunay no
         edge flips and the results equal those on the input triangulation.
     connection : {"auto", "complex", "real"}
-        Form of the connection Laplacian of step I. ``"auto"``: complex |E|×|E| (Eq. 9) when all faces are
+        Form of the connection Laplacian of step I. ``"auto"``: complex ``|E|×|E|`` (Eq. 9) when all faces are
         consistently oriented, else the real 2|E|×2|E| block form that also represents the reflections across
         orientation flips. ``"real"`` forces the block form (same result on orientable meshes, ~2× slower);
         ``"complex"`` forces Eq. 9 (wrong transport across orientation flips; for comparisons only).
@@ -63,8 +63,8 @@ class SurfaceSignedHeatSolver:
     Components of the mesh without sources get an arbitrary (near-constant) value; unreferenced vertices
     get 0 before the final shift.
 
-    Example
-    -------
+    Examples
+    --------
     >>> import numpy as np
     >>> from gsdf.heat import SurfaceSignedHeatSolver
     >>> from gsdf.heat.surface.meshes import grid_mesh
