@@ -89,7 +89,7 @@ def tangent_signed_distance(P: np.ndarray, N: np.ndarray, Q: np.ndarray, k: int 
     return np.einsum("qkx,qkx->qk", N[I], Q[:, None, :] - P[I]).mean(axis=1)
 
 
-def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.0) -> np.ndarray:
+def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.0, sign: str = "tangent") -> np.ndarray:
     """(nF,) int8 oriented face chain F0 on the tet complex ``K`` (canonical orientation; 0 = not in F0).
 
     Tets are labelled inside / outside by the sign of the tangent-plane distance of the nearest inlier points
@@ -102,12 +102,17 @@ def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.
     Parameters
     ----------
     K : TetComplex; P, N : (n, 3) — inlier points and their oriented unit normals; spacing : float — median
-    nearest-neighbour spacing of P; band : float.
+    nearest-neighbour spacing of P; band : float; sign : {"tangent", "winding"} — inside test of the tet
+    centroids (tangent-plane distance < 0, or fast winding number of the oriented points > ½).
     """
     ft = K.face_tets
     tree = cKDTree(P)
     cen = K.V[K.T].mean(axis=1)
-    inside = tangent_signed_distance(P, N, cen, tree=tree) < 0
+    if sign == "winding":
+        from ..winding import fast_winding_number_points
+        inside = fast_winding_number_points(P, N, cen) > 0.5
+    else:
+        inside = tangent_signed_distance(P, N, cen, tree=tree) < 0
     dv, _ = tree.query(K.V)
     near = (dv <= band * spacing)[K.faces].all(axis=1)
     both = (ft >= 0).all(axis=1)

@@ -127,9 +127,34 @@ def _solver(A, b):
     return x
 
 
+def _seeds(K, w, allowed, n_regions):
+    """One seed tet per region: the tet of largest w in the largest-volume face-connected component of
+    {w > ½} among the tets the region may use (a bubble around an outlier can hold the global maximum)."""
+    import scipy.sparse as sp
+    ft = K.face_tets
+    inside = w > 0.5
+    both = (ft >= 0).all(axis=1)
+    a, b = ft[both, 0], ft[both, 1]
+    keep = inside[a] & inside[b] & (allowed[a] == allowed[b])
+    A = sp.csr_matrix((np.ones(int(keep.sum())), (a[keep], b[keep])), shape=(K.n_tets, K.n_tets))
+    _, comp = connected_components(A, directed=False)
+    seeds = []
+    for r in range(n_regions):
+        cand = np.flatnonzero((allowed == r) & inside)
+        if cand.size == 0:
+            cand = np.flatnonzero(allowed == r)
+            if cand.size:
+                seeds.append(int(cand[np.argmax(w[cand])]))
+            continue
+        vol = np.bincount(comp[cand], K.volumes[cand])
+        best = np.flatnonzero(comp[cand] == np.argmax(vol))
+        seeds.append(int(cand[best[np.argmax(w[cand[best]])]]))
+    return np.array(seeds, dtype=np.int64)
+
+
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
-                                 hodge: bool = False, project: bool = True, band: float = 4.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 sign: str = "tangent", hodge: bool = False, project: bool = True, band: float = 10.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -143,6 +168,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         §6.1) and output one sphere per cluster (vertex-disjoint); False: exactly one sphere.
     max_iterations : int ≥ 1 — alternation rounds (the paper reports 1–4).
     steiner : bool — add the octree Steiner points (recommended; without them the outside has few tets).
+    sign : {"tangent", "winding"} — how tets near the points are labelled inside to build the chain F0: the
+        sign of the tangent-plane distance of the nearest points (default; better on sparse clouds with many
+        outliers) or the fast winding number of the oriented points > ½ (better on dense clouds).
     hodge : bool — run the Hodge decomposition of the Darboux derivative and the IRLS L0 correction chain of
         §4.2 (costly: it factorizes the face Laplacian).  On the Delaunay tetrahedralisation used here (a ball)
         the harmonic part is zero up to solver tolerance (reported as ``gamma_ratio``), so the correction is the
@@ -176,6 +204,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         shape; an unknown option; a cloud in which no point has a surface-like (planar) neighbourhood.
     """
     outliers = choice(outliers, "outliers", ("auto", "none"))
+    sign = choice(sign, "sign", ("tangent", "winding"))
     max_iterations = integer(max_iterations, "max_iterations", lo=1)
     if not isinstance(clusters, (bool, np.bool_)):
         raise ValueError(f"clusters: expected a bool, got {type(clusters).__name__}")
@@ -263,7 +292,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         t = time.perf_counter()
         say(f"jump Laplace (round {it + 1})")
         inlier_counts.append(int(use.sum()))
-        G = face_chain(K, Xi[use], Ni[use], spacing, band=band)
+        G = face_chain(K, Xi[use], Ni[use], spacing, band=band, sign=sign)
         f0_sizes.append(int(np.count_nonzero(G)))
         if f0_sizes[-1] == 0:
             raise ValueError("P: no candidate surface faces (the cloud is too sparse or too noisy for a surface)")
@@ -282,12 +311,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         timings["core"] += time.perf_counter() - t
         t = time.perf_counter()
         say(f"growing the ball (round {it + 1})")
-        seeds = []
-        for r in range(n_regions):
-            cand = np.flatnonzero(allowed == r)
-            if cand.size:
-                seeds.append(cand[np.argmax(w[cand])])
-        label, rejected = grow_regions(K, w, 0.5, seeds=np.array(seeds), allowed=allowed)
+        seeds = _seeds(K, w, allowed, n_regions)
+        label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed)
         rejected_hist.append(int(rejected))
         timings["grow"] += time.perf_counter() - t
         t = time.perf_counter()
