@@ -127,6 +127,32 @@ def _solver(A, b):
     return x
 
 
+def _fill_cavities(K, w):
+    """Raise w to 1 in the tets of {w ≤ ½} that no face path within {w ≤ ½} links to the hull: cavities.
+
+    A cavity inside the shape (a field error) cannot be enclosed by a growing ball, so the growth would leave a
+    slit from it to the outside; filled first, it is simply part of the inside.
+    """
+    import scipy.sparse as sp
+    ft = K.face_tets
+    out = w <= 0.5
+    both = (ft >= 0).all(axis=1)
+    a, b = ft[both, 0], ft[both, 1]
+    keep = out[a] & out[b]
+    A = sp.csr_matrix((np.ones(int(keep.sum())), (a[keep], b[keep])), shape=(K.n_tets, K.n_tets))
+    _, comp = connected_components(A, directed=False)
+    hull_t = np.concatenate([ft[ft[:, 1] < 0, 0], ft[ft[:, 0] < 0, 1]])
+    hull_t = hull_t[(hull_t >= 0)]
+    hull_t = hull_t[out[hull_t]]
+    linked = np.zeros(K.n_tets, dtype=bool)
+    if hull_t.size:
+        linked = np.isin(comp, np.unique(comp[hull_t]))
+    w = w.copy()
+    cav = out & ~linked
+    w[cav] = 1.0
+    return w, int(cav.sum())
+
+
 def _seeds(K, w, allowed, n_regions):
     """One seed tet per region: the tet of largest w in the largest-volume face-connected component of
     {w > ½} among the tets the region may use (a bubble around an outlier can hold the global maximum)."""
@@ -268,6 +294,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         ncl, cl = connected_components(A, directed=False)
         sizes = np.bincount(cl, minlength=ncl)
         big = np.flatnonzero(sizes >= max(4, 0.01 * n_p))
+        if big.size == 0:  # only specks: treat the cloud as one cluster
+            big = np.array([int(np.argmax(sizes))])
+            cl[:] = big[0]
         remap = -np.ones(ncl, dtype=np.int64)
         remap[big] = np.arange(len(big))
         cl = remap[cl]
@@ -287,6 +316,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     timings["core"] = timings["grow"] = timings["alternation"] = 0.0
     label = G = best = H = None
     gamma_ratios = []
+    cavities = []
     rounds = max_iterations if outliers == "auto" else 1
     for it in range(rounds):
         t = time.perf_counter()
@@ -308,11 +338,21 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
                 Lam, _ = correction_chain(K, gamma)
                 u, info = K.jump_laplace(G + Lam, solver=_solver)
         w = u.mean(axis=1)
+        w, n_cav = _fill_cavities(K, w)
+        cavities.append(n_cav)
         timings["core"] += time.perf_counter() - t
         t = time.perf_counter()
         say(f"growing the ball (round {it + 1})")
         seeds = _seeds(K, w, allowed, n_regions)
-        label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed)
+        # order: w, clamped at 1 (inside the field is a plateau), minus a small distance to the region's seed,
+        # so the front grows concentrically instead of fractally (notes 2(b).6)
+        cen = K.V[K.T].mean(axis=1)
+        sd = np.full(K.n_tets, 0.0)
+        for r, sdt in enumerate(seeds):
+            m = allowed == r
+            sd[m] = np.linalg.norm(cen[m] - cen[sdt], axis=1)
+        prio = np.minimum(w, 1.0) - 0.05 * sd
+        label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed, priority=prio)
         rejected_hist.append(int(rejected))
         timings["grow"] += time.perf_counter() - t
         t = time.perf_counter()
@@ -360,7 +400,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     dup = np.ones(n_in, dtype=bool)
     dup[keep] = False
     report = {
-        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "rejected_non_simple": rejected_hist,
+        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "cavity_tets": cavities, "rejected_non_simple": rejected_hist,
         "outliers": outlier_mask & ~dup, "prefiltered": int((~inl).sum()), "duplicates": int(dup.sum()),
         "surface_fraction": float(inl.mean()), "n_steiner": int(len(S)), "n_tets": int(K.n_tets), "n_regions": int(n_regions),
         "region_tets": int((label >= 0).sum()), "timings": timings,
