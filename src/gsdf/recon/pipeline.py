@@ -9,8 +9,10 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
    (:meth:`gsdf.dec.tet.TetComplex.jump_laplace`), per-tet winding value = mean of its corner values.  On a
    tetrahedralised ball the harmonic part γ and hence the L0 correction chain Λ are zero (notes 2(b).4), so
    the correction step is the identity here;
-5. rounding by the guarantee layer (:mod:`.grow`): the region of tets with w > ½ grown by simple tets only,
-   whose boundary is one PL sphere — closed, edge- and vertex-manifold, genus 0 — by construction;
+5. rounding by the guarantee layer (:mod:`.grow`): cavities of {w ≤ ½} are filled, then the region of tets
+   with w > ½ is grown by simple tets only from a seed in the largest inside component, in the order of
+   min(w, 1) − 0.05 × distance to the seed (concentric inside the plateau w ≈ 1, so fronts do not meet and
+   leave slits); its boundary is one PL sphere — closed, edge- and vertex-manifold, genus 0 — by construction;
 6. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``).
 
 Example
