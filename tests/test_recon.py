@@ -127,9 +127,9 @@ def test_sphere_reconstruction_is_a_sphere_close_to_the_points():
 def test_outliers_sphere_cc1_chi2_and_cd_falls_with_inliers():
     rng = np.random.default_rng(5)
     cds = []
-    for n in (1000, 4000):
+    for n in (800, 2500):
         S = _sphere(n, seed=n)
-        O = _sphere(400, seed=7) * (1 + rng.uniform(-0.5, 0.5, (400, 1)))
+        O = _sphere(300, seed=7) * (1 + rng.uniform(-0.5, 0.5, (300, 1)))
         V, F, rep = gsdf.reconstruct_simply_connected(np.concatenate([S, O]), return_report=True)
         t = mesh_topology(V, F)
         assert t["components"] == 1 and t["euler"] == 2 and t["closed"] and t["vertex_manifold"]
@@ -142,14 +142,14 @@ def test_outliers_sphere_cc1_chi2_and_cd_falls_with_inliers():
 
 
 def test_torus_cloud_still_gives_one_genus0_sphere():
-    P = _torus(3000)
+    P = _torus(2000)
     V, F = gsdf.reconstruct_simply_connected(P)
     assert is_sphere(V, F)
     assert _chamfer(V, F, P) < 0.1
 
 
 def test_two_spheres_clusters():
-    P = np.concatenate([_sphere(1500, 1), _sphere(1500, 2, c=(3, 0, 0))])
+    P = np.concatenate([_sphere(800, 1), _sphere(800, 2, c=(3, 0, 0))])
     V, F = gsdf.reconstruct_simply_connected(P, clusters=True)
     assert is_sphere(V, F, components=2)
     V1, F1 = gsdf.reconstruct_simply_connected(P)
@@ -157,7 +157,7 @@ def test_two_spheres_clusters():
 
 
 def test_hodge_option_gamma_is_zero_on_the_hull_tetrahedralisation():
-    V, F, rep = gsdf.reconstruct_simply_connected(_sphere(500), hodge=True, outliers="none", return_report=True)
+    V, F, rep = gsdf.reconstruct_simply_connected(_sphere(300), hodge=True, outliers="none", return_report=True)
     assert is_sphere(V, F)
     assert rep["gamma_ratio"][0] < 1e-8
 
@@ -192,7 +192,7 @@ def test_bad_input(P, N, kw, msg):
 
 
 def test_all_outliers_is_a_documented_result():
-    V, F, rep = gsdf.reconstruct_simply_connected(np.random.default_rng(0).uniform(-1, 1, (3000, 3)),
+    V, F, rep = gsdf.reconstruct_simply_connected(np.random.default_rng(0).uniform(-1, 1, (1500, 3)),
                                                   return_report=True)
     assert is_sphere(V, F)
     assert rep["surface_fraction"] < 0.45

@@ -86,8 +86,8 @@ def _neighbour(tet_faces, tet_face_sign, face_tets, t, k):
 
 
 @nb.njit(cache=True)
-def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, w, allowed, seeds, threshold, n_vertices,
-          n_edges):
+def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, w, prio, allowed, seeds, threshold,
+          n_vertices, n_edges):
     m = T.shape[0]
     label = -np.ones(m, dtype=np.int64)
     vcount = np.zeros(n_vertices, dtype=np.int64)
@@ -115,7 +115,7 @@ def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, w, al
         for k in range(4):
             t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
             if t2 >= 0 and label[t2] < 0 and w[t2] > threshold and allowed[t2] == r:
-                size = _heap_push(keys, vals, size, w[t2], t2)
+                size = _heap_push(keys, vals, size, prio[t2], t2)
     while size > 0:
         t, size = _heap_pop(keys, vals, size)
         if label[t] >= 0:
@@ -163,12 +163,12 @@ def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, w, al
         for k in range(4):
             t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
             if t2 >= 0 and label[t2] < 0 and w[t2] > threshold and allowed[t2] == r:
-                size = _heap_push(keys, vals, size, w[t2], t2)
+                size = _heap_push(keys, vals, size, prio[t2], t2)
     return label, rejected
 
 
-def grow_regions(K, w, threshold: float = 0.5, seeds=None, allowed=None) -> tuple[np.ndarray, int]:
-    """Grow vertex-disjoint PL-ball regions of tets with ``w > threshold``, by decreasing ``w``.
+def grow_regions(K, w, threshold: float = 0.5, seeds=None, allowed=None, priority=None) -> tuple[np.ndarray, int]:
+    """Grow vertex-disjoint PL-ball regions of tets with ``w > threshold``, by decreasing ``priority``.
 
     Parameters
     ----------
@@ -178,6 +178,9 @@ def grow_regions(K, w, threshold: float = 0.5, seeds=None, allowed=None) -> tupl
     seeds : (r,) int tet ids, one per region; default: the tet of maximum ``w``.  A seed is always accepted
         (a single tet is a ball), even below the threshold, so every region is non-empty.
     allowed : (m,) int — the region each tet may join (-1: none); default: every tet may join region 0.
+    priority : (m,) float — the order of growth (largest first); default ``w``.  Where w is flat (the jump
+        Laplace field is ≈ 1 throughout the inside) ties should be broken geometrically, or the fronts grow
+        fractally, meet, and leave one-tet-thick slits that no simple tet can fill.
 
     Returns
     -------
@@ -190,8 +193,11 @@ def grow_regions(K, w, threshold: float = 0.5, seeds=None, allowed=None) -> tupl
     if allowed is None:
         allowed = np.zeros(K.n_tets, dtype=np.int64)
     allowed = np.ascontiguousarray(allowed, dtype=np.int64)
-    return _grow(K.T, K.tet_edges, K.tet_faces, K.tet_face_sign, K.face_tets, _PAIR_TO_EDGE, w, allowed, seeds,
-                 float(threshold), K.n_vertices, K.n_edges)
+    prio = w if priority is None else np.ascontiguousarray(priority, dtype=np.float64)
+    if prio.shape != (K.n_tets,) or not np.isfinite(prio).all():
+        raise ValueError(f"priority: expected a finite array of shape ({K.n_tets},), got {prio.shape}")
+    return _grow(K.T, K.tet_edges, K.tet_faces, K.tet_face_sign, K.face_tets, _PAIR_TO_EDGE, w, prio, allowed,
+                 seeds, float(threshold), K.n_vertices, K.n_edges)
 
 
 def region_boundary(K, label: np.ndarray) -> np.ndarray:

@@ -47,17 +47,36 @@ def _propagate(order, pred, rel, flip):
             flip[i] = flip[p] * rel[i]
 
 
-def orient_normals(P: np.ndarray, N: np.ndarray, k: int = 10) -> np.ndarray:
+def orient_normals(P: np.ndarray, N: np.ndarray, k: int = 10, link: float = 6.0) -> np.ndarray:
     """Consistently orient unit normals ``N`` (n, 3) of points ``P`` by MST propagation (Hoppe 1992).
 
-    Each connected component of the kNN graph is oriented separately; its global sign makes the normal of its
-    point of largest x (plus tiny y, z tie-breaks) point towards +x, i.e. out of the component.
+    Components of the kNN graph (weights ``1 - |n_i·n_j|``) closer than ``link`` × the median spacing are
+    linked through their nearest pair (Hoppe's Riemannian graph contains the Euclidean MST), so one tree
+    carries one orientation across sampling gaps; farther components are separate objects.  The sign of each
+    tree is a majority vote of its convex-hull points, whose outward normals point away from its centroid.
     """
+    from scipy.spatial import ConvexHull
     n = len(P)
     k = min(k, n - 1)
-    _, I = cKDTree(P).query(P, k=k + 1)
+    tree = cKDTree(P)
+    _, I = tree.query(P, k=k + 1)
     rows = np.repeat(np.arange(n), k)
     cols = I[:, 1:].ravel()
+    ncomp, comp = connected_components(sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n)),
+                                       directed=False)
+    spacing = float(np.median(tree.query(P, k=2)[0][:, 1]))
+    if ncomp > 1:
+        extra_r, extra_c = [], []
+        for c in range(ncomp):  # one link per component (few components: not a hot loop)
+            mem = np.flatnonzero(comp == c)
+            rest = np.flatnonzero(comp != c)
+            d, j = cKDTree(P[rest]).query(P[mem])
+            a = int(np.argmin(d))
+            if d[a] <= link * spacing:  # a sampling gap inside one surface, not a gap between objects
+                extra_r.append(mem[a])
+                extra_c.append(rest[j[a]])
+        rows = np.concatenate([rows, np.array(extra_r, dtype=np.int64)])
+        cols = np.concatenate([cols, np.array(extra_c, dtype=np.int64)])
     wgt = 1.0 - np.abs(np.einsum("ij,ij->i", N[rows], N[cols])) + 1e-6
     G = sp.csr_matrix((wgt, (rows, cols)), shape=(n, n))
     G = G.maximum(G.T)
@@ -65,18 +84,24 @@ def orient_normals(P: np.ndarray, N: np.ndarray, k: int = 10) -> np.ndarray:
     T = T + T.T
     ncomp, comp = connected_components(T, directed=False)
     flip = np.ones(n)
-    score = P @ np.array([1.0, 1e-3, 1e-6])
     for c in range(ncomp):
         members = np.flatnonzero(comp == c)
-        root = members[np.argmax(score[members])]
+        root = members[0]
         order, pred = breadth_first_order(T, root, directed=False, return_predecessors=True)
         pred = np.where(pred < 0, -1, pred).astype(np.int64)
         rel = np.ones(n)
-        ok = pred >= 0
-        idx = np.flatnonzero(ok)
+        idx = np.flatnonzero(pred >= 0)
         rel[idx] = np.sign(np.einsum("ij,ij->i", N[idx], N[pred[idx]]) + 1e-300)
-        flip[root] = 1.0 if N[root, 0] >= 0 else -1.0
         _propagate(order.astype(np.int64), pred, rel, flip)
+        # global sign of this tree: convex-hull points of its members vote
+        try:
+            hv = members[ConvexHull(P[members]).vertices] if len(members) >= 4 else members
+        except Exception:  # flat or degenerate member set
+            hv = members
+        out = P[hv] - P[members].mean(axis=0)
+        vote = np.sum(np.sign(np.einsum("ij,ij->i", N[hv] * flip[hv, None], out)))
+        if vote < 0:
+            flip[members] *= -1
     return N * flip[:, None]
 
 
@@ -89,7 +114,7 @@ def tangent_signed_distance(P: np.ndarray, N: np.ndarray, Q: np.ndarray, k: int 
     return np.einsum("qkx,qkx->qk", N[I], Q[:, None, :] - P[I]).mean(axis=1)
 
 
-def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.0) -> np.ndarray:
+def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.0, sign: str = "tangent") -> np.ndarray:
     """(nF,) int8 oriented face chain F0 on the tet complex ``K`` (canonical orientation; 0 = not in F0).
 
     Tets are labelled inside / outside by the sign of the tangent-plane distance of the nearest inlier points
@@ -102,12 +127,17 @@ def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.
     Parameters
     ----------
     K : TetComplex; P, N : (n, 3) — inlier points and their oriented unit normals; spacing : float — median
-    nearest-neighbour spacing of P; band : float.
+    nearest-neighbour spacing of P; band : float; sign : {"tangent", "winding"} — inside test of the tet
+    centroids (tangent-plane distance < 0, or fast winding number of the oriented points > ½).
     """
     ft = K.face_tets
     tree = cKDTree(P)
     cen = K.V[K.T].mean(axis=1)
-    inside = tangent_signed_distance(P, N, cen, tree=tree) < 0
+    if sign == "winding":
+        from ..winding import fast_winding_number_points
+        inside = fast_winding_number_points(P, N, cen) > 0.5
+    else:
+        inside = tangent_signed_distance(P, N, cen, tree=tree) < 0
     dv, _ = tree.query(K.V)
     near = (dv <= band * spacing)[K.faces].all(axis=1)
     both = (ft >= 0).all(axis=1)

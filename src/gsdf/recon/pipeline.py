@@ -9,8 +9,10 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
    (:meth:`gsdf.dec.tet.TetComplex.jump_laplace`), per-tet winding value = mean of its corner values.  On a
    tetrahedralised ball the harmonic part γ and hence the L0 correction chain Λ are zero (notes 2(b).4), so
    the correction step is the identity here;
-5. rounding by the guarantee layer (:mod:`.grow`): the region of tets with w > ½ grown by simple tets only,
-   whose boundary is one PL sphere — closed, edge- and vertex-manifold, genus 0 — by construction;
+5. rounding by the guarantee layer (:mod:`.grow`): cavities of {w ≤ ½} are filled, then the region of tets
+   with w > ½ is grown by simple tets only from a seed in the largest inside component, in the order of
+   min(w, 1) − 0.05 × distance to the seed (concentric inside the plateau w ≈ 1, so fronts do not meet and
+   leave slits); its boundary is one PL sphere — closed, edge- and vertex-manifold, genus 0 — by construction;
 6. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``).
 
 Example
@@ -127,9 +129,60 @@ def _solver(A, b):
     return x
 
 
+def _fill_cavities(K, w):
+    """Raise w to 1 in the tets of {w ≤ ½} that no face path within {w ≤ ½} links to the hull: cavities.
+
+    A cavity inside the shape (a field error) cannot be enclosed by a growing ball, so the growth would leave a
+    slit from it to the outside; filled first, it is simply part of the inside.
+    """
+    import scipy.sparse as sp
+    ft = K.face_tets
+    out = w <= 0.5
+    both = (ft >= 0).all(axis=1)
+    a, b = ft[both, 0], ft[both, 1]
+    keep = out[a] & out[b]
+    A = sp.csr_matrix((np.ones(int(keep.sum())), (a[keep], b[keep])), shape=(K.n_tets, K.n_tets))
+    _, comp = connected_components(A, directed=False)
+    hull_t = np.concatenate([ft[ft[:, 1] < 0, 0], ft[ft[:, 0] < 0, 1]])
+    hull_t = hull_t[(hull_t >= 0)]
+    hull_t = hull_t[out[hull_t]]
+    linked = np.zeros(K.n_tets, dtype=bool)
+    if hull_t.size:
+        linked = np.isin(comp, np.unique(comp[hull_t]))
+    w = w.copy()
+    cav = out & ~linked
+    w[cav] = 1.0
+    return w, int(cav.sum())
+
+
+def _seeds(K, w, allowed, n_regions):
+    """One seed tet per region: the tet of largest w in the largest-volume face-connected component of
+    {w > ½} among the tets the region may use (a bubble around an outlier can hold the global maximum)."""
+    import scipy.sparse as sp
+    ft = K.face_tets
+    inside = w > 0.5
+    both = (ft >= 0).all(axis=1)
+    a, b = ft[both, 0], ft[both, 1]
+    keep = inside[a] & inside[b] & (allowed[a] == allowed[b])
+    A = sp.csr_matrix((np.ones(int(keep.sum())), (a[keep], b[keep])), shape=(K.n_tets, K.n_tets))
+    _, comp = connected_components(A, directed=False)
+    seeds = []
+    for r in range(n_regions):
+        cand = np.flatnonzero((allowed == r) & inside)
+        if cand.size == 0:
+            cand = np.flatnonzero(allowed == r)
+            if cand.size:
+                seeds.append(int(cand[np.argmax(w[cand])]))
+            continue
+        vol = np.bincount(comp[cand], K.volumes[cand])
+        best = np.flatnonzero(comp[cand] == np.argmax(vol))
+        seeds.append(int(cand[best[np.argmax(w[cand[best]])]]))
+    return np.array(seeds, dtype=np.int64)
+
+
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
-                                 hodge: bool = False, project: bool = True, band: float = 4.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 sign: str = "tangent", hodge: bool = False, project: bool = True, band: float = 10.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -143,6 +196,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         §6.1) and output one sphere per cluster (vertex-disjoint); False: exactly one sphere.
     max_iterations : int ≥ 1 — alternation rounds (the paper reports 1–4).
     steiner : bool — add the octree Steiner points (recommended; without them the outside has few tets).
+    sign : {"tangent", "winding"} — how tets near the points are labelled inside to build the chain F0: the
+        sign of the tangent-plane distance of the nearest points (default; better on sparse clouds with many
+        outliers) or the fast winding number of the oriented points > ½ (better on dense clouds).
     hodge : bool — run the Hodge decomposition of the Darboux derivative and the IRLS L0 correction chain of
         §4.2 (costly: it factorizes the face Laplacian).  On the Delaunay tetrahedralisation used here (a ball)
         the harmonic part is zero up to solver tolerance (reported as ``gamma_ratio``), so the correction is the
@@ -187,6 +243,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     (True, [0])
     """
     outliers = choice(outliers, "outliers", ("auto", "none"))
+    sign = choice(sign, "sign", ("tangent", "winding"))
     max_iterations = integer(max_iterations, "max_iterations", lo=1)
     if not isinstance(clusters, (bool, np.bool_)):
         raise ValueError(f"clusters: expected a bool, got {type(clusters).__name__}")
@@ -250,6 +307,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         ncl, cl = connected_components(A, directed=False)
         sizes = np.bincount(cl, minlength=ncl)
         big = np.flatnonzero(sizes >= max(4, 0.01 * n_p))
+        if big.size == 0:  # only specks: treat the cloud as one cluster
+            big = np.array([int(np.argmax(sizes))])
+            cl[:] = big[0]
         remap = -np.ones(ncl, dtype=np.int64)
         remap[big] = np.arange(len(big))
         cl = remap[cl]
@@ -269,12 +329,13 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     timings["core"] = timings["grow"] = timings["alternation"] = 0.0
     label = G = best = H = None
     gamma_ratios = []
+    cavities = []
     rounds = max_iterations if outliers == "auto" else 1
     for it in range(rounds):
         t = time.perf_counter()
         say(f"jump Laplace (round {it + 1})")
         inlier_counts.append(int(use.sum()))
-        G = face_chain(K, Xi[use], Ni[use], spacing, band=band)
+        G = face_chain(K, Xi[use], Ni[use], spacing, band=band, sign=sign)
         f0_sizes.append(int(np.count_nonzero(G)))
         if f0_sizes[-1] == 0:
             raise ValueError("P: no candidate surface faces (the cloud is too sparse or too noisy for a surface)")
@@ -290,15 +351,21 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
                 Lam, _ = correction_chain(K, gamma)
                 u, info = K.jump_laplace(G + Lam, solver=_solver)
         w = u.mean(axis=1)
+        w, n_cav = _fill_cavities(K, w)
+        cavities.append(n_cav)
         timings["core"] += time.perf_counter() - t
         t = time.perf_counter()
         say(f"growing the ball (round {it + 1})")
-        seeds = []
-        for r in range(n_regions):
-            cand = np.flatnonzero(allowed == r)
-            if cand.size:
-                seeds.append(cand[np.argmax(w[cand])])
-        label, rejected = grow_regions(K, w, 0.5, seeds=np.array(seeds), allowed=allowed)
+        seeds = _seeds(K, w, allowed, n_regions)
+        # order: w, clamped at 1 (inside the field is a plateau), minus a small distance to the region's seed,
+        # so the front grows concentrically instead of fractally (notes 2(b).6)
+        cen = K.V[K.T].mean(axis=1)
+        sd = np.full(K.n_tets, 0.0)
+        for r, sdt in enumerate(seeds):
+            m = allowed == r
+            sd[m] = np.linalg.norm(cen[m] - cen[sdt], axis=1)
+        prio = np.minimum(w, 1.0) - 0.05 * sd
+        label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed, priority=prio)
         rejected_hist.append(int(rejected))
         timings["grow"] += time.perf_counter() - t
         t = time.perf_counter()
@@ -346,7 +413,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     dup = np.ones(n_in, dtype=bool)
     dup[keep] = False
     report = {
-        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "rejected_non_simple": rejected_hist,
+        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "cavity_tets": cavities, "rejected_non_simple": rejected_hist,
         "outliers": outlier_mask & ~dup, "prefiltered": int((~inl).sum()), "duplicates": int(dup.sum()),
         "surface_fraction": float(inl.mean()), "n_steiner": int(len(S)), "n_tets": int(K.n_tets), "n_regions": int(n_regions),
         "region_tets": int((label >= 0).sum()), "timings": timings,
