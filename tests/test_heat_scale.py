@@ -109,8 +109,12 @@ def test_point_cloud_scale(scale):
     else:
         W, s = P * scale, scale
         ref = gsdf.PointCloudSignedHeatSolver(P).compute_distance([loop])
-    phi = _quiet(lambda: gsdf.PointCloudSignedHeatSolver(W).compute_distance([loop]))
+    solver = _quiet(lambda: gsdf.PointCloudSignedHeatSolver(W))
+    phi = _quiet(lambda: solver.compute_distance([loop]))
     _close(phi / s, ref)
+    r = gsdf.PointCloudSignedHeatSolver(P if scale != "offset" else R)
+    _close(solver.M / s ** 2, r.M)  # attributes in input units
+    assert abs(solver.t / s ** 2 / r.t - 1) < 1e-12 and abs(solver.mean_edge / s / r.mean_edge - 1) < 1e-12
     assert phi[np.argmax(P[:, 2])] < 0 < phi[np.argmin(P[:, 2])]  # the ring splits the sphere (ccw from +z)
 
 

@@ -43,14 +43,16 @@ class PointCloudSignedHeatSolver:
         P = _checks.as_points(P, "P")
         _check_spread(P)
         # scale invariance: the cloud is solved in its frame (centred, power-of-two scale: exact), distances
-        # are mapped back on output (gsdf._normalize); P, t, L, M, mean_edge below are in frame units
+        # are mapped back on output (gsdf._normalize); the attributes below are in input units
         self.frame = Frame.of(P)
         self.P_world = P
         self.domain = d = PointCloudDomain(self.frame.geometry(P, "P"), N, k=k, t_coef=t_coef,
                                            mollify_factor=mollify_factor)
         self.core = SignedHeatCore(d)
-        self.P, self.N, self.L, self.M, self.Lconn = d.P, d.N, d.L, d.M, d.Lconn
-        self.e1, self.e2, self.t, self.n_edges, self.mean_edge = d.e1, d.e2, d.t, d.n_edges, d.mean_edge
+        fr = self.frame  # attributes in input units (L, Lconn and the frames are scale-free)
+        self.P, self.N, self.L, self.M, self.Lconn = P, d.N, d.L, fr.area(d.M), d.Lconn
+        self.e1, self.e2, self.n_edges = d.e1, d.e2, d.n_edges
+        self.t, self.mean_edge = float(fr.area(d.t)), float(fr.length(d.mean_edge))
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
                          soft_weight=None, progress=None):

@@ -43,16 +43,17 @@ class PolygonMeshSignedHeatSolver:
 
     def __init__(self, V, polygons, t_coef: float = 1.0):
         # scale invariance: solved in the geometry's frame (centred, power-of-two scale: exact), distances
-        # mapped back on output (gsdf._normalize); V, L, M, t, mean_edge below are in frame units
+        # mapped back on output (gsdf._normalize); the attributes below are in input units
         V = _checks.as_points(V, "V")
         self.frame = Frame.of(V)
         self.V_world = V
         self.domain = d = PolygonDomain(self.frame.geometry(V), polygons, t_coef=t_coef)
         self.core = SignedHeatCore(d)
-        self.n_vertices, self.V, self.P = d.n_vertices, d.V, d.P
-        self.V_refined, self.F_refined, self.fine_ops = d.V_refined, d.F_refined, d.fine_ops
-        self.L, self.M, self.Lconn, self.t = d.L, d.M, d.Lconn, d.t
-        self.N, self.e1, self.e2, self.mean_edge = d.N, d.e1, d.e2, d.mean_edge
+        fr = self.frame  # attributes in input units (L, Lconn, P, frames are scale-free); fine_ops: frame units
+        self.n_vertices, self.V, self.P = d.n_vertices, V, d.P
+        self.V_refined, self.F_refined, self.fine_ops = fr.point(d.V_refined), d.F_refined, d.fine_ops
+        self.L, self.M, self.Lconn, self.t = d.L, fr.area(d.M), d.Lconn, float(fr.area(d.t))
+        self.N, self.e1, self.e2, self.mean_edge = d.N, d.e1, d.e2, float(fr.length(d.mean_edge))
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint="zero",
                          soft_weight=None, progress=None):

@@ -63,8 +63,8 @@ class SurfaceSignedHeatSolver:
 
     Scale: the mesh is mapped once into its frame (:class:`gsdf._normalize.Frame`: centred, power-of-two
     scale) and solved there, so results are scale-covariant (φ of ``s·V`` is ``s·φ``) from 1e-150 to 1e150;
-    ``V``, ``ops``, ``C`` and ``t`` are in frame units (``frame.length`` maps lengths back), ``V_world`` is the
-    input.
+    ``ops`` and ``C`` are in frame units (``frame.length`` / ``frame.area`` map lengths and areas back);
+    ``V`` (the input, also ``V_world``) and ``t`` are in input units.
 
     Components of the mesh without sources get an arbitrary (near-constant) value; unreferenced vertices
     get 0 before the final shift.
@@ -100,7 +100,7 @@ class SurfaceSignedHeatSolver:
         if bad.any():
             raise ValueError(f"F: face {int(np.flatnonzero(bad)[0])} has zero area ({int(bad.sum())} degenerate "
                              "faces); remove degenerate triangles first")
-        self.V, self.F = V, F
+        self.V, self.F = self.V_world, F
         self.intrinsic_delaunay = bool(intrinsic_delaunay)
         self.input_ops = TriangleMeshOperators(V, F)
         # a vertex point source weighs one input unit against the curves (its old meaning at every scale)
@@ -113,6 +113,7 @@ class SurfaceSignedHeatSolver:
         else:
             self.domain = TriangleDomain(t=self.t, connection=self.connection, ops=self.input_ops)
         self.core = SignedHeatCore(self.domain)
+        self.t = float(self.frame.area(self.t))  # reported in input units (the domain keeps the frame's)
 
     @property
     def ops(self) -> TriangleMeshOperators:
@@ -303,7 +304,8 @@ class SurfaceSignedHeatSolver:
         for (fa, ba), (fb, bb) in zip(nodes[:-1], nodes[1:]):
             common = _faces_of_node(self.input_ops, fa, ba) & _faces_of_node(self.input_ops, fb, bb)
             f = min(common)
-            pa, pb = ba @ self.V[self.F[fa]], bb @ self.V[self.F[fb]]
+            Vf = self.input_ops.V
+            pa, pb = ba @ Vf[self.F[fa]], bb @ Vf[self.F[fb]]
             out.append([(f, _bary_in_face(self.input_ops, pa, f)), (f, _bary_in_face(self.input_ops, pb, f))])
         return out
 
