@@ -63,6 +63,7 @@ class IntrinsicDomain(HeatDomain):
         if key not in self._states:
             Fi, L, nflips, log = intrinsic_delaunay(self.V, self.F, fixed_pairs, return_log=True)
             ops = TriangleMeshOperators(self.V, Fi, P=layout(L))
+            ops.point_weight = self.input_ops.point_weight
             ops.n_flips, ops.flip_log, ops.L_slots = nflips, log, L
             if len(self._states) >= self.MAX_STATES:
                 self._states.pop(next(iter(self._states)))

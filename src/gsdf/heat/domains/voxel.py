@@ -338,7 +338,9 @@ class VoxelSurfaceSignedHeatSolver:
         The voxels inside; the surface is the boundary of their union (quads between occupied and empty
         6-neighbours; the outside of the array counts as empty).
     spacing : float or (3,) float
-        Voxel size (world units per voxel along x, y, z).
+        Voxel size (world units per voxel along x, y, z). Any scale: the solve runs with the spacing divided by
+        a power of two (exact), so φ scales with it from 1e-150 to 1e150; ``vertices``, ``face_centres``, ``t``
+        and φ are in world units.
     normal_radius : float
         Integral-invariant radius of the corrected normals, in voxels (of the smallest spacing); 0 = trivial
         normals. Default 3 (DGtal's). A fixed radius in voxels leaves a normal bias that stops the convergence
@@ -372,10 +374,15 @@ class VoxelSurfaceSignedHeatSolver:
 
     def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, *, t_coef: float = 1.0, normals=None,
                  connection: str = "A"):
-        self.domain = d = VoxelSurfaceDomain(occupancy, spacing, normal_radius, normals=normals,
+        # scale invariance: solve with the spacing divided by the power of two 2^e that brings its largest
+        # entry into [1, 2) (exact; e = 0 for unit voxels), and scale lengths back by 2^e on output
+        sp = as_spacing(spacing)
+        self.exponent = e = int(np.frexp(float(sp.max()))[1]) - 1
+        self.domain = d = VoxelSurfaceDomain(occupancy, np.ldexp(sp, -e), normal_radius, normals=normals,
                                              connection=connection, t_coef=t_coef)
-        self.vertices, self.faces, self.face_centres, self.normals = d.vertices, d.faces, d.face_centres, d.normals
-        self.t = d.t
+        self.vertices, self.face_centres = np.ldexp(d.vertices, e), np.ldexp(d.face_centres, e)
+        self.faces, self.normals = d.faces, d.normals
+        self.t = float(np.ldexp(d.t, 2 * e))
         self.core = SignedHeatCore(d)
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
@@ -403,9 +410,10 @@ class VoxelSurfaceSignedHeatSolver:
         -------
         phi : (n,) float64
         """
-        return self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
-                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
-                                          progress=progress)
+        phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
+                                         level_set_constraint=level_set_constraint, soft_weight=soft_weight,
+                                         progress=progress)
+        return np.ldexp(phi, self.exponent)
 
 
 __all__ = ["VoxelSurfaceSignedHeatSolver", "VoxelSurfaceDomain", "as_occupancy", "as_spacing"]

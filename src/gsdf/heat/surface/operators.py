@@ -34,6 +34,10 @@ PREV = np.array([2, 0, 1])
 class TriangleMeshOperators:
     """Topology, geometry and sparse operators of a triangle mesh, built once.
 
+    ``point_weight`` (class default 1.0) is the length a vertex point source (App. A.1, Eq. 19: unit
+    vectors, no length) weighs against the length-weighted curve sources, in these operators' units: the
+    front-end running in a frame of scale s sets 1/s, so that a point keeps weighing one input unit.
+
     Parameters
     ----------
     V : (n, 3) float64
@@ -58,6 +62,8 @@ class TriangleMeshOperators:
     >>> float(abs(ops.cotan_laplacian().toarray().sum())) < 1e-12
     True
     """
+
+    point_weight = 1.0
 
     def __init__(self, V: np.ndarray, F: np.ndarray, P: np.ndarray | None = None):
         self.V, self.F = V, F

@@ -7,6 +7,10 @@ left-positive (its values are the negative of these).
 
 from __future__ import annotations
 
+import numpy as np
+
+from ... import _checks
+from ..._normalize import Frame
 from ..core import SignedHeatCore
 from ..domains.pointcloud import PointCloudDomain, point_cloud_operators  # noqa: F401
 
@@ -36,10 +40,19 @@ class PointCloudSignedHeatSolver:
     """
 
     def __init__(self, P, N=None, k: int = 30, t_coef: float = 1.0, mollify_factor: float = 1e-5):
-        self.domain = d = PointCloudDomain(P, N, k=k, t_coef=t_coef, mollify_factor=mollify_factor)
+        P = _checks.as_points(P, "P")
+        _check_spread(P)
+        # scale invariance: the cloud is solved in its frame (centred, power-of-two scale: exact), distances
+        # are mapped back on output (gsdf._normalize); the attributes below are in input units
+        self.frame = Frame.of(P)
+        self.P_world = P
+        self.domain = d = PointCloudDomain(self.frame.geometry(P, "P"), N, k=k, t_coef=t_coef,
+                                           mollify_factor=mollify_factor)
         self.core = SignedHeatCore(d)
-        self.P, self.N, self.L, self.M, self.Lconn = d.P, d.N, d.L, d.M, d.Lconn
-        self.e1, self.e2, self.t, self.n_edges, self.mean_edge = d.e1, d.e2, d.t, d.n_edges, d.mean_edge
+        fr = self.frame  # attributes in input units (L, Lconn and the frames are scale-free)
+        self.P, self.N, self.L, self.M, self.Lconn = P, d.N, d.L, fr.area(d.M), d.Lconn
+        self.e1, self.e2, self.n_edges = d.e1, d.e2, d.n_edges
+        self.t, self.mean_edge = float(fr.area(d.t)), float(fr.length(d.mean_edge))
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
                          soft_weight=None, progress=None):
@@ -49,6 +62,22 @@ class PointCloudSignedHeatSolver:
         curve component) or "none"; ``soft_weight`` replaces the hard constraint by a penalty (§7.1).
         ``points``: isolated point sources (unsigned); ``curve_signs``: False makes a curve unsigned.
         """
-        return self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
-                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
-                                          progress=progress)
+        phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
+                                         level_set_constraint=level_set_constraint, soft_weight=soft_weight,
+                                         progress=progress)
+        return self.frame.length(phi)
+
+
+def _check_spread(P: np.ndarray) -> None:
+    """Refuse clouds that span no surface: all points equal, or all on one line (ValueError naming it)."""
+    if len(P) < 4:
+        raise ValueError(f"P: need at least 4 points, got {len(P)}")
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    if not np.any(hi > lo):
+        raise ValueError("P: all points are identical (a point cloud domain needs points spanning a surface)")
+    Y = Frame.of(P).geometry(P, "P")
+    sv = np.linalg.svd(Y - Y.mean(axis=0), compute_uv=False)
+    if sv[1] <= 1e-12 * sv[0]:
+        raise ValueError("P: all points are collinear (a point cloud domain needs points spanning a surface)")
+    if len(np.unique(Y, axis=0)) < 4:
+        raise ValueError("P: fewer than 4 distinct points (a point cloud domain needs points spanning a surface)")

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from ... import _checks
+from ..._normalize import Frame
 from ..core import SignedHeatCore
 from ..domains.polygon import (PolygonDomain, connection_laplacian, frame_transport, tangent_frames,  # noqa: F401
                                virtual_vertex_refinement, virtual_vertex_weights)
@@ -40,12 +42,18 @@ class PolygonMeshSignedHeatSolver:
     """
 
     def __init__(self, V, polygons, t_coef: float = 1.0):
-        self.domain = d = PolygonDomain(V, polygons, t_coef=t_coef)
+        # scale invariance: solved in the geometry's frame (centred, power-of-two scale: exact), distances
+        # mapped back on output (gsdf._normalize); the attributes below are in input units
+        V = _checks.as_points(V, "V")
+        self.frame = Frame.of(V)
+        self.V_world = V
+        self.domain = d = PolygonDomain(self.frame.geometry(V), polygons, t_coef=t_coef)
         self.core = SignedHeatCore(d)
-        self.n_vertices, self.V, self.P = d.n_vertices, d.V, d.P
-        self.V_refined, self.F_refined, self.fine_ops = d.V_refined, d.F_refined, d.fine_ops
-        self.L, self.M, self.Lconn, self.t = d.L, d.M, d.Lconn, d.t
-        self.N, self.e1, self.e2, self.mean_edge = d.N, d.e1, d.e2, d.mean_edge
+        fr = self.frame  # attributes in input units (L, Lconn, P, frames are scale-free); fine_ops: frame units
+        self.n_vertices, self.V, self.P = d.n_vertices, V, d.P
+        self.V_refined, self.F_refined, self.fine_ops = fr.point(d.V_refined), d.F_refined, d.fine_ops
+        self.L, self.M, self.Lconn, self.t = d.L, fr.area(d.M), d.Lconn, float(fr.area(d.t))
+        self.N, self.e1, self.e2, self.mean_edge = d.N, d.e1, d.e2, float(fr.length(d.mean_edge))
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint="zero",
                          soft_weight=None, progress=None):
@@ -62,6 +70,7 @@ class PolygonMeshSignedHeatSolver:
         soft_weight : replaces the hard constraint by the penalty λ Σ (φ(v) - φ(v0))² (§7.1).
         progress : ``progress(stage, fraction)`` (:mod:`gsdf.heat.core`).
         """
-        return self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
-                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
-                                          progress=progress)
+        phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
+                                         level_set_constraint=level_set_constraint, soft_weight=soft_weight,
+                                         progress=progress)
+        return self.frame.length(phi)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ... import _checks
+from ..._normalize import Frame
 from ..core import SignedHeatCore
 from ..domains.intrinsic import IntrinsicDomain
 from ..domains.triangle import TriangleDomain, raw_curves, raw_points
@@ -60,6 +61,11 @@ class SurfaceSignedHeatSolver:
         orientation flips. ``"real"`` forces the block form (same result on orientable meshes, ~2× slower);
         ``"complex"`` forces Eq. 9 (wrong transport across orientation flips; for comparisons only).
 
+    Scale: the mesh is mapped once into its frame (:class:`gsdf._normalize.Frame`: centred, power-of-two
+    scale) and solved there, so results are scale-covariant (φ of ``s·V`` is ``s·φ``) from 1e-150 to 1e150;
+    ``ops`` and ``C`` are in frame units (``frame.length`` / ``frame.area`` map lengths and areas back);
+    ``V`` (the input, also ``V_world``) and ``t`` are in input units.
+
     Components of the mesh without sources get an arbitrary (near-constant) value; unreferenced vertices
     get 0 before the final shift.
 
@@ -78,6 +84,10 @@ class SurfaceSignedHeatSolver:
 
     def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False, connection: str = "auto"):
         V, F = _checks.as_mesh(V, F)
+        # scale invariance: everything runs in the geometry's frame (centre, power-of-two scale, exact);
+        # distances are mapped back on output (gsdf._normalize)
+        self.frame = Frame.of_mesh(V, F) if len(F) else Frame.of(V)
+        self.V_world, V = V, self.frame.geometry(V)
         self.connection = _checks.choice(connection, "connection", CONNECTIONS)
         self.t_coef = _checks.positive(t_coef, "t_coef")
         rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
@@ -90,9 +100,11 @@ class SurfaceSignedHeatSolver:
         if bad.any():
             raise ValueError(f"F: face {int(np.flatnonzero(bad)[0])} has zero area ({int(bad.sum())} degenerate "
                              "faces); remove degenerate triangles first")
-        self.V, self.F = V, F
+        self.V, self.F = self.V_world, F
         self.intrinsic_delaunay = bool(intrinsic_delaunay)
         self.input_ops = TriangleMeshOperators(V, F)
+        # a vertex point source weighs one input unit against the curves (its old meaning at every scale)
+        self.input_ops.point_weight = float(self.frame.inverse_length(1.0))
         self.t = self.t_coef * self.input_ops.h ** 2
         if self.intrinsic_delaunay:
             # the triangulation is built on first use: by the first solve (with its curve edges kept
@@ -101,6 +113,7 @@ class SurfaceSignedHeatSolver:
         else:
             self.domain = TriangleDomain(t=self.t, connection=self.connection, ops=self.input_ops)
         self.core = SignedHeatCore(self.domain)
+        self.t = float(self.frame.area(self.t))  # reported in input units (the domain keeps the frame's)
 
     @property
     def ops(self) -> TriangleMeshOperators:
@@ -186,9 +199,10 @@ class SurfaceSignedHeatSolver:
         >>> solver.compute_distance([np.array([6, 7, 12, 6])], level_set_constraint="none").shape
         (25,)
         """
-        return self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
-                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
-                                          progress=progress, curve_normals=curve_normals)
+        phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
+                                         level_set_constraint=level_set_constraint, soft_weight=soft_weight,
+                                         progress=progress, curve_normals=curve_normals)
+        return self.frame.length(phi)
 
     def compute_distance_l1(self, curves, *, points=(), curve_signs=None) -> np.ndarray:
         """Piecewise-continuous generalized signed distance (§7.2): per-corner values, shape (m, 3).
@@ -224,8 +238,8 @@ class SurfaceSignedHeatSolver:
             f0 = vf.indices[vf.indptr[v0]]
             vals = Phi[f0].mean(axis=1)
             if L.sum() > 0:
-                return Phi - float((vals * L).sum() / L.sum())
-        return Phi - float(Phi.min())
+                return self.frame.length(Phi - float((vals * L).sum() / L.sum()))
+        return self.frame.length(Phi - float(Phi.min()))
 
     def sharpen(self, phi0: np.ndarray, curves, *, points=(), iterations: int = 3000) -> np.ndarray:
         """Distance sharpening (§7.3, Eq. 18): the largest |∇φ| ≤ 1 function with the sign pattern of ``phi0``
@@ -244,6 +258,7 @@ class SurfaceSignedHeatSolver:
         phi0 = np.asarray(phi0, dtype=np.float64)
         if phi0.shape != (self.ops.n_vertices,) or not np.isfinite(phi0).all():
             raise ValueError(f"phi0: expected {self.ops.n_vertices} finite values, got shape {phi0.shape}")
+        phi0 = self.frame.inverse_length(phi0)
         raw, signs, _ = raw_curves(as_curves(curves))
         pts = raw_points(as_point_sources(points))
         if self.intrinsic_delaunay:
@@ -255,7 +270,8 @@ class SurfaceSignedHeatSolver:
         values = phi0.copy()
         fixed[isv[isv >= 0]] = True
         values[isv[isv >= 0]] = 0.0
-        return sharpen(self.ops, phi0, fixed, values, iterations=_checks.integer(iterations, "iterations"))[0]
+        out = sharpen(self.ops, phi0, fixed, values, iterations=_checks.integer(iterations, "iterations"))[0]
+        return self.frame.length(out)
 
     def split_curve(self, curve) -> list:
         """The nodes of ``curve`` as (face, barycentric) points, split where segments cross edges, so that
@@ -288,7 +304,8 @@ class SurfaceSignedHeatSolver:
         for (fa, ba), (fb, bb) in zip(nodes[:-1], nodes[1:]):
             common = _faces_of_node(self.input_ops, fa, ba) & _faces_of_node(self.input_ops, fb, bb)
             f = min(common)
-            pa, pb = ba @ self.V[self.F[fa]], bb @ self.V[self.F[fb]]
+            Vf = self.input_ops.V
+            pa, pb = ba @ Vf[self.F[fa]], bb @ Vf[self.F[fb]]
             out.append([(f, _bary_in_face(self.input_ops, pa, f)), (f, _bary_in_face(self.input_ops, pb, f))])
         return out
 

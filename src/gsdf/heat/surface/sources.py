@@ -467,7 +467,8 @@ def _vertex_point_source(ops, wv, X0):
     e1, w = _corner_frames(ops)
     a = ops.angles[f, k]
     v = F[f, k]
-    N = (np.sin(a)[:, None] * e1[f, k] + (1 - np.cos(a))[:, None] * w[f, k]) * (wv[v] / Theta[v])[:, None]
+    wt = wv[v] / Theta[v] if ops.point_weight == 1.0 else wv[v] * ops.point_weight / Theta[v]
+    N = (np.sin(a)[:, None] * e1[f, k] + (1 - np.cos(a))[:, None] * w[f, k]) * wt[:, None]
     _add_face_vectors(ops, f, N, X0)
 
 

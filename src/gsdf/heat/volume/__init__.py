@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._checks import as_points, choice, integer, positive
+from ..._checks import as_mesh, as_points, choice, integer, positive
+from ..._normalize import Frame
 from ...field import grid_shape
 from .memory import check_memory
 from .sources import Sources, mesh_sources, point_sources
@@ -16,6 +17,8 @@ MAX_RESOLUTION = 4096
 
 
 def _input_positions(mesh, points):
+    """(sources, positions, faces, frame): everything in the input's frame (gsdf._normalize: centred,
+    power-of-two scale, so the mapping is exact and results are scale-covariant)."""
     if (mesh is None) == (points is None):
         raise ValueError("pass exactly one of mesh=(V, F) or points=(P, N)")
     if mesh is not None:
@@ -23,14 +26,18 @@ def _input_positions(mesh, points):
             V, F = mesh
         except (TypeError, ValueError) as exc:
             raise ValueError("mesh: expected a pair (V, F)") from exc
-        src = mesh_sources(V, F)
-        return src, as_points(V, "V"), np.asarray(F, dtype=np.int64)
+        V, F = as_mesh(V, F)
+        frame = Frame.of_mesh(V, F) if len(F) else Frame.of(V)
+        V = frame.geometry(V, "V")
+        return mesh_sources(V, F), V, F, frame
     try:
         P, N = points
     except (TypeError, ValueError) as exc:
         raise ValueError("points: expected a pair (P, N); N are the normals") from exc
-    src = point_sources(P, N)
-    return src, as_points(P, "P"), None
+    P = as_points(P, "P")
+    frame = Frame.of(P)
+    P = frame.geometry(P, "P")
+    return point_sources(P, N), P, None, frame
 
 
 def input_spacing(X, F=None) -> float:
@@ -114,6 +121,8 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
         Grid nodes along the longest side (cubic cells), or exact node counts per axis.
     bbox_min, bbox_max : (3,) float, optional
         Box of the domain; defaults to the input's box padded by 10 % of its diagonal. Must contain the input.
+        (Everything runs in the input's frame — centred, power-of-two scale, exact — so φ of ``s·V`` is ``s·φ``
+        from 1e-150 to 1e150; the returned field, ``t`` and ``meta`` are in input units.)
     t_coef : float
         Diffusion time t = t_coef · h² (§10 of the seed: t = h² is accurate), h set by ``t_scale``.
     t_scale : {"grid", "input"}
@@ -170,18 +179,25 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     if isinstance(soft_weight, str) and soft_weight == "auto":
         soft_weight = (10.0 if domain == "grid" and level_set_constraint == "zero" and "constraint" not in kwargs
                        else None)
-    src, X, F = _input_positions(mesh, points)
+    src, X, F, frame = _input_positions(mesh, points)
+    # world-unit options into the frame (exact: power-of-two scale)
+    if bbox_min is not None:
+        bbox_min = frame.queries(as_points(bbox_min, "bbox_min"), "bbox_min")[0]
+    if bbox_max is not None:
+        bbox_max = frame.queries(as_points(bbox_max, "bbox_max"), "bbox_max")[0]
+    if "t" in kwargs and kwargs["t"] is not None:
+        kwargs["t"] = frame.inverse_area(positive(kwargs["t"], "t"))
     lo, hi, shape = volume_grid_box(X, resolution, bbox_min, bbox_max)
-    if t_scale == "input" and "t" not in kwargs:
+    if t_scale == "input" and kwargs.get("t") is None:
         kwargs["t"] = t_coef * input_spacing(X, F) ** 2
     if domain == "tet":
         from .solve import solve_tet
 
         return solve_tet(src, X, lo, hi, shape, t_coef=t_coef, level_set_constraint=level_set_constraint,
                          soft_weight=soft_weight, max_memory=max_memory, progress=progress, theta=theta, faces=F,
-                         **kwargs)
+                         frame=frame, **kwargs)
     from .solve import solve_grid
 
     check_memory(int(np.prod(shape)), max_memory)
     return solve_grid(src, lo, hi, shape, t_coef=t_coef, level_set_constraint=level_set_constraint,
-                      soft_weight=soft_weight, theta=theta, progress=progress, **kwargs)
+                      soft_weight=soft_weight, theta=theta, progress=progress, frame=frame, **kwargs)

@@ -10,6 +10,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..._checks import choice, positive
+from ..._normalize import Frame
 from ...field import GridField, TetField
 from ..core import SignedHeatCore, adapt_progress
 from ..domains.grid import GridDomain
@@ -20,6 +21,8 @@ from .sources import source_components
 from .tet import (BYTES_PER_TET_VERTEX, delaunay_mesh, input_points, tet_geometry, tetgen_mesh)
 
 __all__ = ["solve_grid", "solve_tet"]
+
+_IDENTITY = Frame(np.zeros(3), 0, True)
 
 
 def _mode(level_set_constraint, soft_weight, constraint, constraint_weight):
@@ -36,7 +39,7 @@ def _mode(level_set_constraint, soft_weight, constraint, constraint_weight):
 def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=None,
                level_set_constraint: str = "zero", soft_weight=None, theta: float = 1.5, eps: float = 1e-4,
                progress=None, constraint_tol: float = 1e-4, exact_rho: float = 1e5, constraint=None,
-               constraint_weight: float = 10.0) -> GridField:
+               constraint_weight: float = 10.0, frame=None) -> GridField:
     """Run Steps I–III on the grid ``shape`` spanning ``[bbox_min, bbox_max]``; returns a :class:`GridField`.
 
     ``t`` defaults to ``t_coef · h²``, h the largest grid spacing (the seed's t = h², §10). Level sets
@@ -44,7 +47,8 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     ``constraint_tol`` · h, penalty ``exact_rho``), ``"multiple"`` one constant per input component,
     ``soft_weight=c`` the penalty c Σ a_f φ(b_f)²/h⁴ (fast at every size; CG with the band/coarse/DCT
     preconditioner), ``"none"``. ``constraint="soft"|"exact"`` (with ``constraint_weight``) is the older
-    spelling of ``soft_weight`` / hard. ``progress(stage, fraction)``. ``eps`` prunes sources weighing less than
+    spelling of ``soft_weight`` / hard. ``progress(stage, fraction)``. ``frame``: the
+    :class:`gsdf._normalize.Frame` the inputs are in; the field is returned in world units. ``eps`` prunes sources weighing less than
     ``eps`` × the nearest one (Step I, :class:`YukawaTree`); 1e-4 instead of 1e-6 moves φ by < 3e-6 of the box
     diagonal on the broken bunny at 64³ and saves ~25 % of Step I.
     """
@@ -71,9 +75,10 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
         phi = core.shift(S, phi)
     report("poisson (step III)", 1.0)
     timings["step3"] = time.perf_counter() - t0
-    field = GridField(phi.reshape(shape), lo, hi)
+    fr = frame if frame is not None else _IDENTITY
+    field = GridField(fr.length(phi.reshape(shape)), fr.point(lo), fr.point(hi))
     info = core.poisson.info if (mode != "none" and lam is None) else {}
-    field.meta = {"method": "signed heat (grid)", "t": t, "theta": theta, "eps": eps, "timings": timings,
+    field.meta = {"method": "signed heat (grid)", "t": float(fr.area(t)), "theta": theta, "eps": eps, "timings": timings,
                   "level_set_constraint": mode, "soft_weight": lam, "n_sources": len(src.B), **info}
     return field
 
@@ -81,13 +86,15 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
 def solve_tet(src: Sources, X, lo, hi, shape, t_coef: float = 1.0, level_set_constraint: str = "zero",
               soft_weight=None, max_memory=None, progress=None, levels: int = 2, step1: str = "yukawa",
               mesher: str = "delaunay", min_quality: float = 0.02, theta: float = 1.5, faces=None,
-              amg_above: int = 400_000, grading: float = 2.0, surface_spacing: float = 1.0, t=None) -> TetField:
+              amg_above: int = 400_000, grading: float = 2.0, surface_spacing: float = 1.0, t=None,
+              frame=None) -> TetField:
     """Steps I–III on a tet mesh of the box graded toward the input; returns a :class:`TetField`.
 
     ``t`` defaults to ``t_coef · h²``, h the grid spacing the resolution gives (the lattice spacing near the input).
     ``faces`` are the input triangles (indices into ``X``) for meshes, None for clouds. ``soft_weight=λ``
     replaces the hard constraint by the penalty λ Σ (φ(z_i) − φ(z_0))² over the input points.
-    ``progress(stage, fraction)``.
+    ``progress(stage, fraction)``. ``frame``: the :class:`gsdf._normalize.Frame` the inputs are in; the field is
+    returned in world units.
     """
     mode, lam = _mode(level_set_constraint, soft_weight, None, None)
     step1 = choice(step1, "step1", {"yukawa", "heat"})
@@ -144,12 +151,37 @@ def solve_tet(src: Sources, X, lo, hi, shape, t_coef: float = 1.0, level_set_con
         phi[~used] = _eval(P, T[keep], None, phi, P[~used], None, exclude=~used)
     report("poisson (step III)", 1.0)
     timings["step3"] = time.perf_counter() - t0
-    field = TetField(P, T, phi, D)
-    field.meta = {"method": "signed heat (tet)", "t": tt, "h": h, "timings": timings, "n_vertices": nV,
+    fr = frame if frame is not None else _IDENTITY
+    field = TetField(P, T, phi, D) if fr.identity else FramedTetField(fr, P, T, phi, D)
+    field.meta = {"method": "signed heat (tet)", "t": float(fr.area(tt)), "h": float(fr.length(h)), "timings": timings, "n_vertices": nV,
                   "n_tets": len(T), "n_input_points": nZ, "n_dropped_tets": int((~keep).sum()),
                   "level_set_constraint": mode, "soft_weight": lam, "step1": step1, "mesher": mesher,
                   "n_components": int(comp.max()) + 1}
     return field
+
+
+class FramedTetField(TetField):
+    """A :class:`~gsdf.TetField` in input units whose evaluation and isosurfaces run in the input's frame.
+
+    ``vertices`` / ``values`` are in input units; queries are mapped into the frame (exact, power-of-two
+    scale), located there with the frame-unit Delaunay locator, and the distance mapped back, so that
+    evaluating at 1e±150 neither overflows nor underflows.
+    """
+
+    def __init__(self, frame, P, T, phi, delaunay=None):
+        super().__init__(frame.point(P), T, frame.length(phi))
+        self.frame = frame
+        self._inner = TetField(P, T, phi, delaunay)
+
+    def __call__(self, Q) -> np.ndarray:
+        from ..._checks import as_points
+
+        Q = as_points(Q, "Q", allow_empty=True)
+        return self.frame.length(self._inner(self.frame.queries(Q, "Q")))
+
+    def isosurface(self, level: float = 0.0, report: bool = False):
+        out = self._inner.isosurface(float(self.frame.inverse_length(float(level))), report=report)
+        return (self.frame.point(out[0]),) + tuple(out[1:])
 
 
 def _eval(P, T, D, phi, Q, field=None, exclude=None):
