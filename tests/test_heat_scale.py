@@ -198,3 +198,13 @@ def test_voxel_surface_scale(scale):
     phi = _quiet(lambda: s.compute_distance([], points=[0]))
     _close(phi / scale, ref)
     _close(s.vertices / scale, s0.vertices, 1e-15)
+
+
+@pytest.mark.parametrize("bad", [dict(eps=0.0), dict(eps=-1.0), dict(eps=2.0), dict(theta=-1.0), dict(eps=True)])
+def test_volume_tree_options_are_validated(bad):
+    from gsdf.heat.volume import signed_heat_volume
+
+    name = next(iter(bad))
+    P = np.random.default_rng(0).normal(size=(200, 3))
+    with pytest.raises(ValueError, match=name):
+        signed_heat_volume(points=(P, P), resolution=8, **bad)

@@ -38,6 +38,7 @@ import numpy as np
 from numba import njit, prange
 from scipy.spatial import cKDTree
 
+from ..._checks import nonnegative, positive
 from ...spatial.bvh import build_bvh
 
 INV_4PI = 1.0 / (4.0 * np.pi)
@@ -213,9 +214,9 @@ class YukawaTree:
         B = np.ascontiguousarray(B, dtype=np.float64)
         W = np.ascontiguousarray(W, dtype=np.float64)
         self.m = len(B)
-        self.lam = 1.0 / np.sqrt(float(t))
-        self.theta = float(theta)
-        self.tau = float(np.log(1.0 / float(eps)))
+        self.lam = 1.0 / np.sqrt(positive(t, "t"))
+        self.theta = nonnegative(theta, "theta")
+        self.tau = float(np.log(1.0 / positive(eps, "eps", most=0.5)))  # eps in (0, 1/2]: a relative tolerance
         self.tree = build_bvh(B, B, B, leaf_size)
         o = self.tree.order
         self._B = np.ascontiguousarray(B[o])
