@@ -251,3 +251,14 @@ def test_heat_tet_reports_its_nodes_and_refuses_vti(inputs, tmp_path):
     assert "-node tet mesh" in r.output and "?" not in r.output
     line = assert_clean_failure(invoke(["heat", inputs["mesh"], "--tet", "-q", "-o", str(tmp_path / "t.vti")]))
     assert ".npz, .npy, .vtk, .vtu" in line
+
+
+@pytest.mark.parametrize("name", ["heat-surface", "swn"])
+@pytest.mark.parametrize("view", ["0,0,0", "1,2", "a,b,c", "nan,0,1"])
+def test_bad_view_is_a_usage_error_before_any_work(name, view, inputs, tmp_path):
+    if name not in COMMANDS:
+        pytest.skip(f"{name} is not a subcommand here")
+    out = tmp_path / COMMANDS[name][1]
+    r = invoke(args_for(name, inputs, out) + ["--png", str(tmp_path / "p.png"), "--view", view])
+    assert r.exit_code == 2 and "--view" in r.output and "Traceback" not in r.output
+    assert not out.exists()

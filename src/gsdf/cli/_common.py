@@ -189,6 +189,17 @@ def check_output(path, extensions=None, what: str = "-o"):
                              make_parents=True, what=what)
 
 
+def parse_view(view: str) -> list[float]:
+    """``--view x,y,z`` of the PNG previews: three numbers, not all zero (a click usage error otherwise)."""
+    try:
+        d = [float(t) for t in view.split(",")]
+        if len(d) != 3 or not all(np.isfinite(d)) or not np.any(d):
+            raise ValueError
+    except ValueError:
+        raise click.BadParameter(f"expected x,y,z (finite, not all zero), got {view!r}", param_hint="--view")
+    return d
+
+
 def ensure_parent(path: str) -> None:
     """Create the parent folder of ``path`` (kept for older subcommands; :func:`output_file` does this itself)."""
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)

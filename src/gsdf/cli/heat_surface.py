@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from ._common import check_output, no_clobber_option, output_file, quiet_option, report_errors
+from ._common import check_output, no_clobber_option, output_file, parse_view, quiet_option, report_errors
 
 
 @click.command("heat-surface", help="""Signed distance to curves on the surface MESH (signed heat method).
@@ -58,6 +58,7 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
 
     check_output(output, (".ply",))  # only PLY stores the distance per vertex
     check_output(png, (".png",), "--png")
+    d = parse_view(view)  # checked before the work, used by the PNG
     if voxels:
         if swn:
             raise click.UsageError("--swn and --voxels cannot be combined")
@@ -98,12 +99,6 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
     if png:
         from ..heat.surface.render import render_function_png
 
-        try:
-            d = [float(t) for t in view.split(",")]
-            if len(d) != 3 or not np.any(d):
-                raise ValueError
-        except ValueError:
-            raise click.BadParameter(f"expected x,y,z (not all zero), got {view!r}", param_hint="--view")
         with output_file(png, what="--png") as tmp:
             render_function_png(tmp, V, F, phi, view=d)
         click.echo(f"image -> {os.path.abspath(png)}")

@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from ._common import check_output, no_clobber_option, output_file, quiet_option, report_errors
+from ._common import check_output, no_clobber_option, output_file, parse_view, quiet_option, report_errors
 
 
 def write_swn_obj(path, V, F, corner_values, face_labels) -> None:
@@ -76,6 +76,7 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
 
     check_output(output, (".ply", ".obj"))
     check_output(png, (".png",), "--png")
+    d = parse_view(view)  # checked before the work, used by the PNG
     ext = os.path.splitext(output)[1].lower()
     say = (lambda s: None) if quiet else (lambda s: click.echo(f"  {s} ...", err=True))
     say("reading")
@@ -105,12 +106,6 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     if png:
         from ..heat.surface.render import render_function_png
 
-        try:
-            d = [float(t) for t in view.split(",")]
-            if len(d) != 3 or not np.any(d):
-                raise ValueError
-        except ValueError:
-            raise click.BadParameter(f"expected x,y,z (not all zero), got {view!r}", param_hint="--view")
         m = len(F2)
         with output_file(png, (".png",), what="--png") as tmp:
             render_function_png(tmp, V2[F2].reshape(-1, 3), np.arange(3 * m).reshape(m, 3),
