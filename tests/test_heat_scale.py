@@ -208,3 +208,12 @@ def test_volume_tree_options_are_validated(bad):
     P = np.random.default_rng(0).normal(size=(200, 3))
     with pytest.raises(ValueError, match=name):
         signed_heat_volume(points=(P, P), resolution=8, **bad)
+
+
+@pytest.mark.parametrize("domain,bad", [("grid", "bogus_option"), ("grid", "mesher"), ("tet", "constraint_tol")])
+def test_volume_unknown_options_are_value_errors(domain, bad):
+    from gsdf.heat.volume import signed_heat_volume
+
+    P = np.random.default_rng(0).normal(size=(200, 3))
+    with pytest.raises(ValueError, match=f"unknown option.*{bad}"):
+        signed_heat_volume(points=(P, P), resolution=8, domain=domain, **{bad: 1})

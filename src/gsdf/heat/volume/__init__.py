@@ -176,6 +176,18 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     t_coef = positive(t_coef, "t_coef")
     level_set_constraint = choice(level_set_constraint, "level_set_constraint", {"none", "zero", "multiple"})
     t_scale = choice(t_scale, "t_scale", {"grid", "input"})
+    import inspect
+
+    from .solve import solve_grid, solve_tet
+
+    # options of the domain's solver (documented there); anything else is refused by name, not as a TypeError
+    own = {"src", "X", "lo", "hi", "shape", "bbox_min", "bbox_max", "frame", "faces", "t_coef", "level_set_constraint",
+           "soft_weight", "max_memory", "progress", "theta"}
+    allowed = set(inspect.signature(solve_tet if domain == "tet" else solve_grid).parameters) - own
+    unknown = sorted(set(kwargs) - allowed)
+    if unknown:
+        raise ValueError(f"signed_heat_volume: unknown option(s) {', '.join(unknown)} for domain={domain!r}; "
+                         f"known: {', '.join(sorted(allowed))}")
     if isinstance(soft_weight, str) and soft_weight == "auto":
         soft_weight = (10.0 if domain == "grid" and level_set_constraint == "zero" and "constraint" not in kwargs
                        else None)
