@@ -43,6 +43,21 @@ def _is_index_scalar(x) -> bool:
         return True
     return isinstance(x, (float, np.floating)) and np.isfinite(x) and float(x) == int(x)
 
+def _surface_point(item, name: str, expected: str):
+    """One ``(element index, barycentric coordinates)`` pair, validated (ValueError naming ``name``)."""
+    try:
+        e, b = item
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: expected {expected}, got {item!r}") from exc
+    if not _is_index_scalar(e):
+        raise ValueError(f"{name}: element index must be an integer, got {e!r}")
+    try:
+        b = np.asarray(b, dtype=np.float64).ravel()
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: barycentric coordinates must be numbers, got {b!r}") from exc
+    return int(e), b
+
+
 
 def index_array(a, name: str, ndim: int | None = 1) -> np.ndarray:
     """``a`` as an int64 array of indices; bools, non-whole floats, objects and strings raise ValueError naming
@@ -144,17 +159,7 @@ class Curve:
             raise ValueError(f"{name}: a curve needs at least 2 points, got {len(items)}")
         out = []
         for q, it in enumerate(items):
-            try:
-                e, b = it
-            except (TypeError, ValueError) as exc:
-                raise ValueError(f"{name}[{q}]: expected (face_index, barycentric (3,)), got {it!r}") from exc
-            if not _is_index_scalar(e):
-                raise ValueError(f"{name}[{q}]: element index must be an integer, got {e!r}")
-            try:
-                b = np.asarray(b, dtype=np.float64).ravel()
-            except (TypeError, ValueError) as exc:
-                raise ValueError(f"{name}[{q}]: barycentric coordinates must be numbers, got {b!r}") from exc
-            out.append((int(e), b))
+            out.append(_surface_point(it, f"{name}[{q}]", "(face_index, barycentric (3,))"))
         self.kind = "points"
         self.nodes = out
 
@@ -292,17 +297,7 @@ def as_point_sources(points, name: str = "points") -> list:
             continue
         if isinstance(it, (bool, np.bool_)) or np.isscalar(it):
             raise ValueError(f"{name}[{q}]: expected a vertex index or (face, barycentric), got {it!r}")
-        try:
-            e, b = it
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"{name}[{q}]: expected a vertex index or (face, barycentric), got {it!r}") from exc
-        if not _is_index_scalar(e):
-            raise ValueError(f"{name}[{q}]: element index must be an integer, got {e!r}")
-        try:
-            b = np.asarray(b, dtype=np.float64).ravel()
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"{name}[{q}]: barycentric coordinates must be numbers, got {b!r}") from exc
-        out.append((int(e), b))
+        out.append(_surface_point(it, f"{name}[{q}]", "a vertex index or (face, barycentric)"))
     return out
 
 

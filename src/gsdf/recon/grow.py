@@ -86,6 +86,24 @@ def _neighbour(tet_faces, tet_face_sign, face_tets, t, k):
 
 
 @nb.njit(cache=True)
+def _accept(t, r, T, tet_edges, tet_faces, tet_face_sign, face_tets, w, prio, allowed, threshold,
+            label, vcount, vowner, ecount, keys, vals, size):
+    """Add tet ``t`` to region ``r``: count its vertices and edges, queue its unlabelled neighbours above the
+    threshold; returns the new heap size."""
+    label[t] = r
+    for k in range(4):
+        vcount[T[t, k]] += 1
+        vowner[T[t, k]] = r
+    for k in range(6):
+        ecount[tet_edges[t, k]] += 1
+    for k in range(4):
+        t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
+        if t2 >= 0 and label[t2] < 0 and w[t2] > threshold and allowed[t2] == r:
+            size = _heap_push(keys, vals, size, prio[t2], t2)
+    return size
+
+
+@nb.njit(cache=True)
 def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, w, prio, allowed, seeds, threshold,
           n_vertices, n_edges):
     m = T.shape[0]
@@ -106,16 +124,8 @@ def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, w, pr
                 ok = False
         if not ok:
             continue
-        label[t] = r
-        for k in range(4):
-            vcount[T[t, k]] += 1
-            vowner[T[t, k]] = r
-        for k in range(6):
-            ecount[tet_edges[t, k]] += 1
-        for k in range(4):
-            t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
-            if t2 >= 0 and label[t2] < 0 and w[t2] > threshold and allowed[t2] == r:
-                size = _heap_push(keys, vals, size, prio[t2], t2)
+        size = _accept(t, r, T, tet_edges, tet_faces, tet_face_sign, face_tets, w, prio, allowed, threshold,
+                       label, vcount, vowner, ecount, keys, vals, size)
     while size > 0:
         t, size = _heap_pop(keys, vals, size)
         if label[t] >= 0:
@@ -154,16 +164,8 @@ def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, w, pr
             if ecount[tet_edges[t, pair_to_edge[s0, s1]]] > 0:
                 rejected += 1
                 continue
-        label[t] = r
-        for k in range(4):
-            vcount[T[t, k]] += 1
-            vowner[T[t, k]] = r
-        for k in range(6):
-            ecount[tet_edges[t, k]] += 1
-        for k in range(4):
-            t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
-            if t2 >= 0 and label[t2] < 0 and w[t2] > threshold and allowed[t2] == r:
-                size = _heap_push(keys, vals, size, prio[t2], t2)
+        size = _accept(t, r, T, tet_edges, tet_faces, tet_face_sign, face_tets, w, prio, allowed, threshold,
+                       label, vcount, vowner, ecount, keys, vals, size)
     return label, rejected
 
 
