@@ -23,10 +23,10 @@ from .executors import DaskExecutor, LocalExecutor
 from .inputs import Item, collect_inputs
 from .manifest import file_sha256, read_manifest
 from .run import BatchInterrupted, BatchResult, run_batch
-from .tasks import TASKS, Geometry, check_options, load_input, occupancy, run_task, sdf_grid, sdf_samples, surface
+from .tasks import TASKS, Geometry, check_options, load_geometry, occupancy, run_task, sdf_grid, sdf_samples, surface
 from .worker import process_item, write_npz_atomic
 
 __all__ = ["run_batch", "BatchResult", "BatchInterrupted", "collect_inputs", "Item", "read_manifest",
-           "file_sha256", "TASKS", "Geometry", "load_input", "check_options", "run_task", "sdf_samples",
+           "file_sha256", "TASKS", "Geometry", "load_geometry", "check_options", "run_task", "sdf_samples",
            "occupancy", "sdf_grid", "surface", "process_item", "write_npz_atomic", "LocalExecutor",
            "DaskExecutor"]

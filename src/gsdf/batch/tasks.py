@@ -35,96 +35,17 @@ import os
 import numpy as np
 
 from .._checks import choice, integer, positive
+from ..io.geometry import Geometry, load_geometry
 
 NORMALIZE = ("none", "sphere", "cube")
-POINT_EXTENSIONS = {".xyz", ".pwn", ".pc", ".npy", ".npz"}
 DTYPES = {"float32": np.float32, "float64": np.float64}
-
-
-class Geometry:
-    """One loaded input: a triangle mesh/soup ``(V, F)`` or an oriented point cloud ``(P, N)``.
-
-    Attributes
-    ----------
-    X : (n, 3) float64
-        Vertex or point positions.
-    F : (m, 3) int64 or None
-        Triangles (None for a cloud).
-    N : (n, 3) float64 or None
-        Cloud normals (None for a mesh).
-    """
-
-    def __init__(self, X, F=None, N=None, path=None):
-        self.X, self.F, self.N, self.path = X, F, N, path
-
-    @property
-    def is_mesh(self) -> bool:
-        return self.F is not None
-
-    def counts(self) -> dict:
-        if self.is_mesh:
-            return {"vertices": int(len(self.X)), "faces": int(len(self.F))}
-        return {"points": int(len(self.X))}
-
-    def digest(self) -> bytes:
-        """A hash of the geometry arrays (seeds the item's random samples)."""
-        h = hashlib.sha256()
-        for A in (self.X, self.F, self.N):
-            if A is not None:
-                h.update(np.ascontiguousarray(A).tobytes())
-        return h.digest()
-
-
-def load_input(path, estimate_normals: bool = False) -> Geometry:
-    """Read a mesh, or a point cloud when the file has no faces or a point-cloud extension.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        Any file :func:`gsdf.read_mesh` or :func:`gsdf.read_points` reads.
-    estimate_normals : bool
-        For clouds without normals: PCA normals oriented away from the centroid; otherwise such a cloud
-        is a ValueError (winding numbers need oriented normals).
-
-    Returns
-    -------
-    Geometry
-
-    Example
-    -------
-    >>> g = load_input("bunny.off")        # doctest: +SKIP
-    >>> g.is_mesh, g.X.shape               # doctest: +SKIP
-    (True, (34817, 3))
-    """
-    from ..io import read_mesh, read_points
-
-    path = os.fspath(path)
-    if os.path.splitext(path)[1].lower() not in POINT_EXTENSIONS:
-        try:
-            V, F = read_mesh(path)
-        except ValueError as exc:
-            if "no faces" not in str(exc):
-                raise
-        else:
-            if len(F) == 0:
-                raise ValueError(f"{path}: has no triangles")
-            return Geometry(V, F=F, path=path)
-    P, N = read_points(path)
-    if N is None:
-        if not estimate_normals:
-            raise ValueError(f"{path}: the point cloud has no normals; winding numbers need oriented normals "
-                             "(set estimate_normals to use PCA normals oriented away from the centroid)")
-        from ..winding.point_areas import estimate_normals as pca
-
-        N = pca(P, orient_towards=P.mean(axis=0))
-    return Geometry(P, N=N, path=path)
 
 
 def _geometry(source, estimate_normals=False) -> Geometry:
     if isinstance(source, Geometry):
         return source
     if isinstance(source, (str, os.PathLike)):
-        return load_input(source, estimate_normals)
+        return load_geometry(source, estimate_normals)
     raise ValueError(f"source: expected a path or a gsdf.batch.Geometry, got {type(source).__name__}")
 
 
@@ -169,14 +90,6 @@ def surface_points(geo: Geometry, n: int, rng: np.random.Generator) -> np.ndarra
     s = np.sqrt(r1)  # uniform on the triangle: (1 - √r1, √r1 (1 - r2), √r1 r2)
     T = geo.X[geo.F[f]]
     return ((1 - s)[:, None] * T[:, 0] + (s * (1 - r2))[:, None] * T[:, 1] + (s * r2)[:, None] * T[:, 2])
-
-
-def _winding(geo: Geometry, beta=None):
-    from ..winding import FastWindingNumber, FastWindingNumberPoints
-
-    if geo.is_mesh:
-        return FastWindingNumber(geo.X, geo.F, beta=2.0 if beta is None else beta)
-    return FastWindingNumberPoints(geo.X, geo.N, beta=2.3 if beta is None else beta)
 
 
 def _unsigned(geo: Geometry, Q) -> np.ndarray:
@@ -270,7 +183,7 @@ def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normali
     Q = _sample_queries(geo, o["n_samples"], o["uniform_fraction"], o["sigmas"], half, c, s, rng)
     d = _unsigned(geo, Q)
     if o["sign"] == "winding":
-        inside = _winding(geo, o["beta"])(Q) > 0.5
+        inside = geo.winding(o["beta"])(Q) > 0.5
     else:
         m = 1.1 * half * s  # the heat grid holds every query, the tails of the Gaussian offsets included
         m = max(m, float(np.abs(Q - c).max()) * 1.001)
@@ -305,7 +218,7 @@ def occupancy(source, n_points: int = 100_000, normalize: str = "none", uniform_
     c, s, c0, s0 = frame(geo.X, o["normalize"])
     rng = _rng(geo, o["seed"], "occupancy")
     Q = _sample_queries(geo, o["n_points"], o["uniform_fraction"], o["sigmas"], 1.0 + o["pad"], c, s, rng)
-    w = _winding(geo, o["beta"])(Q)
+    w = geo.winding(o["beta"])(Q)
     dt = DTYPES[o["dtype"]]
     return _stored({"points": ((Q - c0) / s0).astype(dt), "occupancy": w > 0.5, "winding": w.astype(dt)},
                    c0, s0, dt)
@@ -377,7 +290,7 @@ def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str
             values = PointsAsTori(geo.X, geo.N).signed_distance(Q)
         else:
             d = _unsigned(geo, Q)
-            values = np.where(_winding(geo, o["beta"])(Q) > 0.5, -d, d)
+            values = np.where(geo.winding(o["beta"])(Q) > 0.5, -d, d)
     dt = DTYPES[o["dtype"]]
     lo0, hi0 = (lo - c0) / s0, (hi - c0) / s0
     return _stored({"sdf": (np.asarray(values).reshape(R, R, R) / s0).astype(dt), "bbox_min": lo0,
@@ -415,7 +328,7 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
     else:
         from ..contour import extract_isosurface
 
-        V, F = extract_isosurface(_winding(geo, o["beta"]), lo, hi, resolution=R, level=0.5,
+        V, F = extract_isosurface(geo.winding(o["beta"]), lo, hi, resolution=R, level=0.5,
                                   bisection_steps=o["bisection"])
     dt = DTYPES[o["dtype"]]
     return _stored({"vertices": ((V - c0) / s0).astype(dt), "faces": np.asarray(F, np.int64)}, c0, s0, dt)

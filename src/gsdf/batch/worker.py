@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _threads
 from .manifest import file_sha256
-from .tasks import load_input, run_task
+from .tasks import load_geometry, run_task
 
 
 def write_npz_atomic(path, arrays: dict) -> None:
@@ -82,7 +82,7 @@ def process_item(job: dict) -> dict:
     try:
         rec["threads"] = _threads.limit_threads(worker_threads(job.get("threads"), job.get("threads_by_worker")))
         rec["input_sha256"] = file_sha256(job["input"])
-        geo = load_input(job["input"], job["options"].get("estimate_normals", False))
+        geo = load_geometry(job["input"], job["options"].get("estimate_normals", False))
         rec["counts"] = geo.counts()
         t1 = time.perf_counter()
         seconds["read"] = t1 - t0

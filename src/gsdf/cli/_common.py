@@ -28,61 +28,8 @@ import os
 import click
 import numpy as np
 
+from ..io.geometry import Geometry, load_geometry  # noqa: F401  (the CLI commands import them from here)
 from ..io.safe_write import atomic_output, check_output_path, same_file
-
-POINT_EXTENSIONS = {".xyz", ".pwn", ".pc", ".npy", ".npz"}
-
-
-class Geometry:
-    """A loaded input: a triangle mesh/soup ``(V, F)`` or an oriented point cloud ``(P, N)``."""
-
-    def __init__(self, path, V=None, F=None, P=None, N=None):
-        self.path, self.V, self.F, self.P, self.N = path, V, F, P, N
-
-    @property
-    def is_mesh(self) -> bool:
-        return self.F is not None
-
-    @property
-    def positions(self) -> np.ndarray:
-        return self.V if self.is_mesh else self.P
-
-    def describe(self) -> str:
-        if self.is_mesh:
-            return f"{self.path}: mesh, {len(self.V)} vertices, {len(self.F)} triangles"
-        return f"{self.path}: point cloud, {len(self.P)} oriented points"
-
-    def winding(self, beta=None):
-        """A reusable fast winding number object for this input."""
-        from ..winding import FastWindingNumber, FastWindingNumberPoints
-
-        if self.is_mesh:
-            return FastWindingNumber(self.V, self.F, beta=2.0 if beta is None else beta)
-        return FastWindingNumberPoints(self.P, self.N, beta=2.3 if beta is None else beta)
-
-
-def load_geometry(path: str, estimate_normals: bool = False) -> Geometry:
-    """Read a mesh, or a point cloud when the file has no faces (or has a point-cloud extension)."""
-    from ..io import read_mesh, read_points
-
-    ext = os.path.splitext(path)[1].lower()
-    if ext not in POINT_EXTENSIONS:
-        try:
-            V, F = read_mesh(path)
-            return Geometry(path, V=V, F=F)
-        except ValueError as exc:
-            if "no faces" not in str(exc):
-                raise
-    P, N = read_points(path)
-    if N is None:
-        if not estimate_normals:
-            raise ValueError(f"{path}: the point cloud has no normals; winding numbers need oriented normals "
-                             "(pass --estimate-normals to use PCA normals oriented away from the centroid)")
-        from ..winding.point_areas import estimate_normals as pca
-
-        N = pca(P, orient_towards=P.mean(axis=0))
-    return Geometry(path, P=P, N=N)
-
 
 def progress_bar(total: int, desc: str, enabled: bool = True):
     """A tqdm bar and an ``update(done, total)`` callback for the library's ``progress`` hooks."""

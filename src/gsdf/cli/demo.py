@@ -49,7 +49,7 @@ def demo(output_dir, resolution):
 
     # --- the triangle soup -----------------------------------------------------------------------------
     V, F = read_mesh(data.path("broken_soup.obj"))
-    soup = Geometry(data.path("broken_soup.obj"), V=V, F=F)
+    soup = Geometry(V, F=F, path=data.path("broken_soup.obj"))
     click.echo(f"[soup]  {soup.describe()}")
     fwn = soup.winding()
     lo, hi = bbox_of(V, 0.05)
@@ -78,7 +78,7 @@ def demo(output_dir, resolution):
 
     # --- the point cloud -------------------------------------------------------------------------------
     P, N = read_points(data.path("torus_cloud.xyz"))
-    cloud = Geometry(data.path("torus_cloud.xyz"), P=P, N=N)
+    cloud = Geometry(P, N=N, path=data.path("torus_cloud.xyz"))
     click.echo(f"[cloud] {cloud.describe()}")
     A = point_areas(P, N)
     click.echo(f"        point areas sum to {A.sum():.4f} (torus area 4π²Rr = {4 * np.pi**2 * 0.4:.4f})")

@@ -83,7 +83,7 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
     for path in surface_paths:
         check_output(path, None, "--offsets")
     geo = load_geometry(input, estimate_normals)
-    kw = dict(mesh=(geo.V, geo.F)) if geo.is_mesh else dict(points=(geo.P, geo.N))
+    kw = dict(mesh=(geo.X, geo.F)) if geo.is_mesh else dict(points=(geo.X, geo.N))
     if soft_weight is None and not tet:
         soft_weight = 10.0
     if soft_weight == 0 or constraint == "none":
@@ -101,7 +101,7 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
     if levels:
         from ..io import write_mesh
 
-        X = geo.positions
+        X = geo.X
         scale = float(np.linalg.norm(X.max(axis=0) - X.min(axis=0))) if relative else 1.0
         for v, path in zip(levels, surface_paths):
             Vs, Fs = field.isosurface(v * scale, close=True) if hasattr(field, "spacing") \

@@ -18,7 +18,7 @@ def signed_distance_grid(geo, resolution: int, pad: float, sign: str = "winding"
 
     if sign == "pseudonormal" and not geo.is_mesh:
         raise ValueError("--sign pseudonormal needs a mesh, not a point cloud")
-    kw = dict(V=geo.V, F=geo.F) if geo.is_mesh else dict(V=None, points=(geo.P, geo.N))
+    kw = dict(V=geo.X, F=geo.F) if geo.is_mesh else dict(V=None, points=(geo.X, geo.N))
     bar, update = progress_bar(1, "winding numbers", not quiet and sign == "winding")
 
     def progress(done, total):

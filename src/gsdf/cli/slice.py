@@ -40,7 +40,7 @@ def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, es
     check_output(output, (".svg",))
     geo = load_geometry(input, estimate_normals)
     ax = "xyz".index(axis)
-    lo, hi = bbox_of(geo.positions, 0.02)
+    lo, hi = bbox_of(geo.X, 0.02)
     zs = parse_floats(heights, "--heights")
     if zs is None:
         n = layers or 10

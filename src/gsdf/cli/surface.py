@@ -39,7 +39,7 @@ def surface(input, output, resolution, level, bisection, pad, beta, estimate_nor
 
     check_output(output, MESH_WRITE_FORMATS)
     geo = load_geometry(input, estimate_normals)
-    lo, hi = bbox_of(geo.positions, pad)
+    lo, hi = bbox_of(geo.X, pad)
     bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
     with bar:
         V, F = extract_isosurface(func, lo, hi, resolution=resolution, level=level, bisection_steps=bisection)

@@ -37,7 +37,7 @@ def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, q
     check_output(output, (".npz",))
     check_output(mesh_out, MESH_WRITE_FORMATS, "--mesh-out")
     geo = load_geometry(input, estimate_normals)
-    kw = {"mesh": (geo.V, geo.F)} if geo.is_mesh else {"points": (geo.P, geo.N)}
+    kw = {"mesh": (geo.X, geo.F)} if geo.is_mesh else {"points": (geo.X, geo.N)}
     bar, update = progress_bar(1, "voxelizing", not quiet)
     with bar:
         def progress(done, total):

@@ -68,12 +68,12 @@ def winding(input, queries, output, exact, order, beta, estimate_normals, quiet)
     geo = load_geometry(input, estimate_normals)
     Q = read_queries(queries)
     if exact:
-        w = winding_number(geo.V, geo.F, Q) if geo.is_mesh else winding_number_points(geo.P, geo.N, Q)
+        w = winding_number(geo.X, geo.F, Q) if geo.is_mesh else winding_number_points(geo.X, geo.N, Q)
     else:
         if geo.is_mesh:
-            fwn = FastWindingNumber(geo.V, geo.F, beta=2.0 if beta is None else beta, order=order)
+            fwn = FastWindingNumber(geo.X, geo.F, beta=2.0 if beta is None else beta, order=order)
         else:
-            fwn = FastWindingNumberPoints(geo.P, geo.N, beta=2.3 if beta is None else beta, order=order)
+            fwn = FastWindingNumberPoints(geo.X, geo.N, beta=2.3 if beta is None else beta, order=order)
         bar, update = progress_bar(len(Q), "winding numbers", not quiet)
         with bar:
             w = fwn(Q, progress=update)
