@@ -10,7 +10,6 @@ refined by bisection along their grid edges instead of linear interpolation.
 
 from __future__ import annotations
 
-import os
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -394,6 +393,9 @@ def write_svg(
     >>> open(out).read().count("<path")
     1
     """
+    from ..io.safe_write import atomic_output, check_output_path
+
+    path = check_output_path(path, extensions=(".svg",))
     choice(layout, "layout", {"layers", "stack"})
     unit = _finite(unit_mm, "unit_mm")
     if unit <= 0:
@@ -504,8 +506,8 @@ def write_svg(
             )
     tree = ET.ElementTree(root)
     ET.indent(tree)
-    path = os.fspath(path)
-    tree.write(path, encoding="utf-8", xml_declaration=True)
+    with atomic_output(path, extensions=(".svg",)) as tmp:
+        tree.write(tmp, encoding="utf-8", xml_declaration=True)
     return path
 
 

@@ -274,7 +274,7 @@ def _occupancy(occ) -> np.ndarray:
 
 
 def save_voxels(path, occ, bbox_min, bbox_max) -> None:
-    """Write a voxelization to a compressed ``.npz`` file.
+    """Write a voxelization to a compressed ``.npz`` file (atomically; another extension is a ValueError).
 
     Keys: ``occupancy`` (nx, ny, nz) bool, ``bbox_min``, ``bbox_max`` (3,) float64 (grid corners),
     ``voxel_size`` (3,) float64 and ``kind = "voxels"``. Read back with :func:`load_voxels`.
@@ -288,10 +288,14 @@ def save_voxels(path, occ, bbox_min, bbox_max) -> None:
     >>> int(load_voxels(p)[0].sum())
     8
     """
+    from ..io.safe_write import atomic_output, check_output_path
+
+    check_output_path(path, extensions=(".npz",))
     A = _occupancy(occ)
     lo, hi = _bbox(bbox_min, bbox_max)
-    np.savez_compressed(path, occupancy=A, bbox_min=lo, bbox_max=hi, voxel_size=(hi - lo) / np.array(A.shape),
-                        kind="voxels")
+    with atomic_output(path, extensions=(".npz",)) as tmp:
+        np.savez_compressed(tmp, occupancy=A, bbox_min=lo, bbox_max=hi, voxel_size=(hi - lo) / np.array(A.shape),
+                            kind="voxels")
 
 
 def load_voxels(path):

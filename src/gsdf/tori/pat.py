@@ -272,13 +272,19 @@ class PointsAsTori:
         return extract_isosurface(self.signed_distance, lo - m, hi + m, resolution, level=level, inside="below")
 
     def save(self, path) -> None:
-        """Write the fitted tori (and the cloud) to an ``.npz`` file; reload with :meth:`load`."""
+        """Write the fitted tori (and the cloud) to an ``.npz`` file; reload with :meth:`load`.
+
+        The file is written atomically; a name not ending in ``.npz`` is a ValueError (numpy would silently
+        append the extension)."""
+        from ..io.safe_write import atomic_output
+
         # coefficients and tori in input units (the normalised frame is recomputed from P on load)
         # and, for a bitwise round trip, the frame copies the kernels use (format 2)
-        np.savez_compressed(path, P=self.P, N=self.N, coefficients=self.coefficients, tori=self.tori,
-                            coefficients_frame=self._coefficients, tori_frame=self._tori,
-                            estimator=self.estimator, k=self.k, C=self.C, r_eval=self.r_eval,
-                            k_eval=self.k_eval, k_fallback=self.k_fallback, format=np.int64(2))
+        with atomic_output(path, extensions=(".npz",)) as tmp:
+            np.savez_compressed(tmp, P=self.P, N=self.N, coefficients=self.coefficients, tori=self.tori,
+                                coefficients_frame=self._coefficients, tori_frame=self._tori,
+                                estimator=self.estimator, k=self.k, C=self.C, r_eval=self.r_eval,
+                                k_eval=self.k_eval, k_fallback=self.k_fallback, format=np.int64(2))
 
     @classmethod
     def load(cls, path) -> "PointsAsTori":

@@ -166,8 +166,10 @@ def render_png(sdf, path, width: int = 256, height: int = 256, level: float = 0.
     >>> os.path.getsize(f) > 0
     True
     """
-    from PIL import Image
+    from ..io.image import write_png
+    from ..io.safe_write import check_output_path
 
+    check_output_path(path, extensions=(".png",))
     level = finite(level, "level")
     if bbox_min is None or bbox_max is None:
         if not hasattr(sdf, "P"):
@@ -179,4 +181,4 @@ def render_png(sdf, path, width: int = 256, height: int = 256, level: float = 0.
     if (img == 255).all():
         raise ValueError(f"no ray hit the level set {float(level):g} inside the box (nothing to render): wrong "
                          "level, box or view?")
-    Image.fromarray(img).save(path)
+    write_png(path, img, min_size=1)

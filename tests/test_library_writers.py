@@ -1,0 +1,40 @@
+"""Library writers (not only the CLI) keep the requested name, refuse extensions they cannot honour, and write
+atomically."""
+
+import numpy as np
+import pytest
+
+
+def test_library_writers_refuse_wrong_extensions_and_keep_names(tmp_path):
+    """save_voxels, PointsAsTori.save, write_svg and render_png: the named file or a ValueError, never a
+    silently renamed file (numpy appends .npz) and never a half-written one."""
+    import gsdf
+    from gsdf.contour import write_svg
+    from gsdf.ops import load_voxels, save_voxels
+    from gsdf.tori import render_png
+
+    occ = np.ones((2, 2, 2), bool)
+    with pytest.raises(ValueError, match=r"\.npz"):
+        save_voxels(tmp_path / "v.dat", occ, [0, 0, 0], [1, 1, 1])
+    assert not (tmp_path / "v.dat.npz").exists() and not (tmp_path / "v.dat").exists()
+    save_voxels(tmp_path / "v.npz", occ, [0, 0, 0], [1, 1, 1])
+    assert int(load_voxels(tmp_path / "v.npz")[0].sum()) == 8
+    sq = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    with pytest.raises(ValueError, match=r"\.svg"):
+        write_svg(tmp_path / "s.txt", [[sq]])
+    assert write_svg(tmp_path / "s.svg", [[sq]]) == str(tmp_path / "s.svg")
+    ball = lambda Q: np.linalg.norm(Q, axis=1) - 0.5  # noqa: E731
+    with pytest.raises(ValueError, match=r"\.png"):
+        render_png(ball, tmp_path / "b.jpg", 8, 8, bbox_min=[-1] * 3, bbox_max=[1] * 3)
+    render_png(ball, tmp_path / "b.png", 8, 8, bbox_min=[-1] * 3, bbox_max=[1] * 3)
+    assert (tmp_path / "b.png").stat().st_size > 0
+    rng = np.random.default_rng(0)
+    P = rng.normal(size=(300, 3))
+    P /= np.linalg.norm(P, axis=1, keepdims=True)
+    pat = gsdf.PointsAsTori(P, P)
+    with pytest.raises(ValueError, match=r"\.npz"):
+        pat.save(tmp_path / "t")
+    assert not (tmp_path / "t.npz").exists()
+    pat.save(tmp_path / "t.npz")
+    back = gsdf.PointsAsTori.load(tmp_path / "t.npz")
+    np.testing.assert_array_equal(back.signed_distance(P[:5]), pat.signed_distance(P[:5]))
