@@ -349,6 +349,8 @@ class MeshCases:
                 continue
             lmax = int(np.clip(n // 20, 2, 5))
             D = int(round(frac * n))
+            if D == 0:
+                continue
             gaps = []
             while sum(gaps) < D:
                 gaps.append(int(rng.integers(1, lmax + 1)))
