@@ -36,7 +36,7 @@ Usage::
 
     PYTHONPATH=src python3 bench/bench_swn.py --quick        # 50 cases, random intervals
     PYTHONPATH=src python3 bench/bench_swn.py                # 924 cases (+ scaling + author data)
-    PYTHONPATH=src python3 bench/bench_swn.py --breaking long   # the same 924 draws, few long gaps
+    PYTHONPATH=src python3 bench/bench_swn.py --breaking long   # the same 924 draws, few long gaps (cases only)
     PYTHONPATH=src python3 bench/bench_swn.py --topology simply # the 420 simply connected cases only (~1 min)
     PYTHONPATH=src python3 bench/bench_swn.py --only scaling|author|cases
     PYTHONPATH=src python3 bench/bench_swn.py --only offsets    # solver offset vs oracle (50 fresh cases)
@@ -208,6 +208,7 @@ def mesh_list(quick=False):
     return L
 
 
+NEW_ROWS = 0           # rows computed by this process (the rest of the CSV is read back)
 N_SIMPLY = 10          # mesh_list()[:10] are simply connected (b1 = 0)
 
 
@@ -456,6 +457,7 @@ def generate_cases(mc, n, breaking="random"):
 
 
 def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", topology="all"):
+    global NEW_ROWS
     meshes = list(enumerate(mesh_list()))
     if quick:
         meshes = [meshes[i] for i in (0, 2, 8, 10, 12, 14, 16, 18, 19, 21)]
@@ -505,6 +507,7 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", top
             row["lp_status"] = status
             wr.writerow(row)
             fh.flush()
+            NEW_ROWS += 1
         print(f"  done {name}", flush=True)
     fh.close()
 
@@ -519,7 +522,9 @@ def summarize():
     sc = [r for r in rows if int(r["b1"]) == 0]
     ns = [r for r in rows if int(r["b1"]) > 0]
     out = [f"{len(rows)} cases on {len({r['mesh'] for r in rows})} meshes ({len(sc)} simply connected, "
-           f"{len(ns)} not); per-case rows in bench/swn_cases.csv.", ""]
+           f"{len(ns)} not); per-case rows in bench/{os.path.basename(CSV)}"
+           + (f" ({NEW_ROWS} computed in this run, the others read back from earlier runs of the same generator; "
+              "--fresh recomputes all)" if NEW_ROWS < len(rows) else "") + ".", ""]
     if sc:
         e = np.array([f(r, "err_lp") for r in sc])
         en = np.array([f(r, "err_none") for r in sc])
@@ -795,8 +800,8 @@ def main():
     ap.add_argument("--time-limit", type=float, default=120.0)
     ap.add_argument("--fresh", action="store_true", help="discard this variant's per-case CSV first")
     a = ap.parse_args()
-    if a.topology == "simply" and a.only is None:
-        a.only = "cases"                                   # the simply connected cases alone: no scaling, authors
+    if (a.topology == "simply" or a.breaking == "long") and a.only is None:
+        a.only = "cases"                # the cases alone: scaling and author data do not depend on the breaking
     global CSV
     tag = ("" if a.breaking == "random" else "_long") + ("_quick" if a.quick else "")
     CSV = os.path.join(HERE, f"swn_cases{tag}.csv")
@@ -821,9 +826,7 @@ def main():
         parts["diagnose"] = diagnose(breaking=a.breaking)
     if a.only == "compare":
         text_cmp = compare_breakings(a.quick)
-    flags = "".join(f for f, on in ((" --quick", a.quick), (f" --only {a.only}", a.only),
-                                    (" --breaking long", a.breaking == "long"),
-                                    (" --topology simply", a.topology == "simply")) if on).replace(" --only cases --topology", " --topology")
+    flags = "".join(" " + t for t in sys.argv[1:])
     text = [f"Machine: {machine()}. Load at start: `{load}` (shared with other helpers; times are indicative).",
             f"Command: `PYTHONPATH=src python3 bench/bench_swn.py{flags}` ({time.perf_counter() - t0:.0f} s).",
             "", f"Breaking: {BREAKING_RULES[a.breaking]}.", ""]
@@ -846,7 +849,7 @@ def main():
     name = "swn" + ("-long" if a.breaking == "long" else "") + ("-quick" if a.quick else "")
     if a.topology == "simply" and a.only == "cases":
         name += "-simply"
-    elif a.only:
+    elif a.only and not (a.only == "cases" and a.breaking == "long"):
         name += "-" + a.only
     title = "## Surface winding numbers (issue 12)" + (", long gaps" if a.breaking == "long" else "")
     write_section(name, title + (" — " + a.only if a.only else "") + (" — simply connected meshes only"
