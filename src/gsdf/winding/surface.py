@@ -45,6 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, dijkstra
 
+from ..dec.cycles import TreeCotree
 from ..dec.hodge import HodgeDecomposition
 from ..dec.lp import dual_graph_l1
 from ..dec.triangle import TriangleDEC, forest_potentials
@@ -52,6 +53,7 @@ from ..dec.triangle import TriangleDEC, forest_potentials
 __all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "bounding_segments", "METHODS"]
 
 METHODS = ("lp", "reduced", "none")
+HOMOLOGY = ("integer", "real")
 NEXT = np.array([1, 2, 0])
 
 
@@ -131,6 +133,7 @@ class SurfaceWindingNumbers:
         self.betti_1 = self.topology.betti_1()
         self.simply_connected = self.betti_1 == 0
         self._hodge = None
+        self._cycles = None
         n = self.dec.n_vertices
         self._edge_key = self.dec.edges[:, 0] * n + self.dec.edges[:, 1]
 
@@ -192,9 +195,15 @@ class SurfaceWindingNumbers:
             self._hodge = HodgeDecomposition(d.d0, d.d1, d.star1)
         return self._hodge
 
+    def tree_cotree(self) -> TreeCotree:
+        """The tree–cotree homology basis of the mesh (built once, lazily)."""
+        if self._cycles is None:
+            self._cycles = TreeCotree(self.dec)
+        return self._cycles
+
     # ----------------------------------------------------------------------------------------------- solve
     def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
-              progress=None) -> SWNResult:
+              homology: str = "real", progress=None, _final: str = "curves") -> SWNResult:
         """Surface winding numbers of ``curves``.
 
         Parameters
@@ -203,6 +212,14 @@ class SurfaceWindingNumbers:
         method : "lp" (full residual LP, §6.1), "reduced" (reduced LP, §6.3) or "none" (naive rounding of u)
         epsilon : float in (0, 1], LP weight of jumps on the input's edges relative to gap-closing ones
         time_limit : float, seconds HiGHS may take; beyond it a ValueError names ``method="reduced"``
+        homology : "real" (default) or "integer" — the cohomology class of the harmonic part γ that the residual
+            must integrate. "real": γ itself, as thesis §6.1.2 writes; a broken *bounding* curve then leaves a
+            fractional class (the flux of the harmonic forms through its gaps) that the LP attributes to the
+            cheap input edges, turning parts of bounding curves partly nonbounding. "integer": γ's periods along
+            a homology basis (:class:`gsdf.dec.cycles.TreeCotree`) are rounded to the nearest integers first — the
+            input is an integer chain, so its nonbounding part is an integer class — and γ is corrected by the
+            closed form with the rounding error as periods (the LP only sees the class: exact parts are absorbed
+            by the face shifts). A class that rounds to 0 needs no LP at all; otherwise Jv is an integer chain.
         progress : callable(done, total), optional — the package's progress signature; called after each of the
             steps (jump solve, Darboux derivative, Hodge decomposition, residual LP, final solve)
 
@@ -215,6 +232,8 @@ class SurfaceWindingNumbers:
         if isinstance(epsilon, bool) or not isinstance(epsilon, (int, float, np.floating)) or \
                 not (0 < float(epsilon) <= 1):
             raise ValueError(f"epsilon: expected a number in (0, 1], got {epsilon!r}")
+        if homology not in HOMOLOGY:
+            raise ValueError(f"homology: expected one of {HOMOLOGY}, got {homology!r}")
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
         steps = iter(range(1, 6))
@@ -258,30 +277,49 @@ class SurfaceWindingNumbers:
             gamma = om - co
         else:
             gamma = om
+        integer = homology == "integer"
+        if integer:
+            # round the class of γ: periods along the tree–cotree loops to the nearest integers (docstring)
+            tc = self.tree_cotree()
+            per = tc.periods(gamma)
+            k = np.round(per)
+            gamma_lp = gamma + tc.closed_form(k - per) if np.any(k) else None
+        else:
+            gamma_lp = gamma
         T["hodge"] = time.perf_counter() - t0
 
         say(f"residual ({method} LP)")
         t0 = time.perf_counter()
-        try:
-            if method == "lp":
-                Jv, obj, lp_s = self._residual_full(gamma, g, float(epsilon), time_limit)
-            else:
-                Jv, obj, lp_s = self._residual_reduced(gamma, g, ends, time_limit)
-        except ValueError as exc:
-            hint = " — try method='reduced' (one unknown per curve piece)" if method == "lp" else ""
-            raise ValueError(f"method={method!r}: {exc}{hint}") from exc
+        if gamma_lp is None:                      # integer class 0: nothing nonbounding, no LP
+            Jv, obj, lp_s = zero.copy(), 0.0, 0.0
+        else:
+            try:
+                if method == "lp":
+                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit)
+                else:
+                    Jv, obj, lp_s = self._residual_reduced(gamma_lp, g, ends, time_limit)
+            except ValueError as exc:
+                hint = " — try method='reduced' (one unknown per curve piece)" if method == "lp" else ""
+                raise ValueError(f"method={method!r}: {exc}{hint}") from exc
+            if integer:                           # a network LP with an integer class: integer jumps
+                r = np.round(Jv)
+                Jv = np.where(np.abs(Jv - r) < 1e-6, r, Jv)
         T["lp"] = lp_s
         T["residual"] = time.perf_counter() - t0
 
         say("final jump solve")
         t0 = time.perf_counter()
         Jv = np.where(np.abs(Jv) < 1e-9, 0.0, Jv)
-        # Jv of the full LP is a closed dual chain (its jumps telescope around every vertex), so g − Jv closes
-        # wherever g does; the reduced LP ignores inconsistencies inside pieces, and vertices where g − Jv does
-        # not close become endpoints too (the spec's "cleaner alternative")
-        ends2 = ends | dec.chain_endpoints(g - Jv, tol=1e-6)
-        jc2 = dec.jump_coordinates(g - Jv, ends2)
-        _, w = dec.solve_jump(jc2)
+        # thesis §6.1.2 step ⑤: w jumps across "Γ ∖ Jv", the bounding part as a subset of the input — g − Jv on the
+        # input's edges only; the completion of the nonbounding part off the input (Jv across the gaps) is not a
+        # jump of w. Vertices where the bounding part does not close become endpoints (the spec's "cleaner
+        # alternative"). _final="all" (diagnosis only) also keeps −Jv off the input.
+        bnd = g - Jv if _final == "all" else np.where(g != 0, g - Jv, 0.0)
+        ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
+        if np.any(Jv):
+            _, w = dec.solve_jump(dec.jump_coordinates(bnd, ends2))
+        else:                                     # nothing nonbounding: w = u
+            w = u
         T["final_solve"] = time.perf_counter() - t0
         res = self._finish(w, u, g, Jv, ends, om, gamma, method, T)
         res.lp_objective = obj
