@@ -190,6 +190,9 @@ def mesh_list(quick=False):
     return L
 
 
+N_SIMPLY = 10          # mesh_list()[:10] are simply connected (b1 = 0)
+
+
 # ------------------------------------------------------------------------------------------------- cases
 class MeshCases:
     """Per-mesh data reused by all its cases: the solver, eigenfunctions, dual graph, generator loops."""
@@ -284,7 +287,100 @@ class MeshCases:
                 return S.astype(np.int64), g
         return None, None
 
-    def break_chain(self, g, frac, k):
+    def break_chain(self, g, frac, k, breaking="long"):
+        """Delete ~frac of every curve component's edges: ``breaking="long"`` in k long intervals
+        (:meth:`break_long`), ``"random"`` in many short random intervals (:meth:`break_random`; k unused)."""
+        if breaking == "random":
+            return self.break_random(g, frac)
+        if breaking != "long":
+            raise ValueError(f"breaking: expected 'random' or 'long', got {breaking!r}")
+        return self.break_long(g, frac, k)
+
+    def walks(self, g):
+        """The chain g cut into edge walks: (list of edge-index arrays, list of bools "closed"). Every edge is
+        oriented by the sign of g (tail -> head); walks start at vertices with more outgoing than incoming edges
+        (paths ending on the mesh boundary), the rest are cycles. Each walk turns, at a vertex with several
+        ways on, to the first unused outgoing edge (a figure-eight is one cycle, which is fine here)."""
+        on = np.flatnonzero(g != 0)
+        E = self.dec.edges[on]
+        tail = np.where(g[on] > 0, E[:, 0], E[:, 1])
+        head = np.where(g[on] > 0, E[:, 1], E[:, 0])
+        out = {}
+        for i, t in enumerate(tail):
+            out.setdefault(int(t), []).append(i)
+        indeg = {}
+        for h in head:
+            indeg[int(h)] = indeg.get(int(h), 0) + 1
+        used = np.zeros(len(on), bool)
+        walks, closed = [], []
+        starts = [v for v in out if len(out[v]) > indeg.get(v, 0)]
+        for v0 in starts + [int(t) for t in tail]:
+            while any(not used[i] for i in out.get(v0, [])):
+                w, v = [], v0
+                while True:
+                    nxt = next((i for i in out.get(v, []) if not used[i]), None)
+                    if nxt is None:
+                        break
+                    used[nxt] = True
+                    w.append(nxt)
+                    v = int(head[nxt])
+                    if v == v0 and v0 not in starts:
+                        break
+                walks.append(on[np.array(w)])
+                closed.append(v == v0)
+        return walks, closed
+
+    def break_random(self, g, frac):
+        """The "random intervals" breaking (default; thesis §6.3 Fig. 6.7, §7.1: curves deleted "at random
+        intervals"). Per walk of n edges (:meth:`walks`): delete D = round(frac·n) edges in gaps of
+        1..ℓmax edges each (uniform), ℓmax = clip(n // 20, 2, 5) — no gap longer than 5 edges (nor 5 % of a
+        loop of 40+ edges); the kept runs between gaps are a uniformly random composition of the other n − D
+        edges with at least 2 edges each (a run's end vertices become endpoints, excluded from the jump solve,
+        so 1-edge runs would vanish; 1 edge each when 2 do not fit), a path's end runs may be empty; on a cycle
+        the pattern starts at a random edge. Walks shorter than 8 edges are kept whole."""
+        out = g.copy()
+        if frac <= 0:
+            return out
+        walks, closed = self.walks(g)
+        rng = self.rng
+        for w, cyc in zip(walks, closed):
+            n = len(w)
+            if n < 8:
+                continue
+            lmax = int(np.clip(n // 20, 2, 5))
+            D = int(round(frac * n))
+            if D == 0:
+                continue
+            gaps = []
+            while sum(gaps) < D:
+                gaps.append(int(rng.integers(1, lmax + 1)))
+            gaps[-1] -= sum(gaps) - D
+            gaps = [x for x in gaps if x > 0]
+            k = len(gaps)
+            K = k if cyc else k + 1                            # kept runs (a path keeps both ends' runs)
+            for mk in (2, 1):                                  # at least 2 kept edges a run; 1 if they don't fit
+                mins = np.full(K, mk)
+                if not cyc:
+                    mins[0] = mins[-1] = 0
+                R = n - D - int(mins.sum())
+                if R >= 0:
+                    break
+            if R < 0:
+                continue
+            cuts = np.sort(rng.integers(0, R + 1, size=K - 1))
+            keeps = mins + np.diff(np.concatenate([[0], cuts, [R]]))
+            mask = np.zeros(n, bool)
+            pos = 0
+            for j in range(k):
+                pos += int(keeps[j])
+                mask[pos:pos + gaps[j]] = True
+                pos += gaps[j]
+            if cyc:
+                mask = np.roll(mask, int(rng.integers(n)))
+            out[w[mask]] = 0
+        return out
+
+    def break_long(self, g, frac, k):
         """Delete ~frac of every curve component's edges in k intervals (BFS along the curve from random seed
         edges), so no component disappears entirely."""
         on = np.flatnonzero(g != 0)
@@ -318,8 +414,9 @@ def mislabeled(W, truth, area):
     return best
 
 
-def generate_cases(mc, n):
-    """Cases 0..n-1 of one mesh, in the generator's fixed order (so a case id can be replayed):
+def generate_cases(mc, n, breaking="random"):
+    """Cases 0..n-1 of one mesh, in the generator's fixed order (so a case id can be replayed; both breaking
+    schemes draw the same numbers before breaking, so ``breaking="long"`` replays the cases of the first run):
     yields (c, case id, region kind, truth (m,), unbroken boundary chain g, broken input gb, fraction deleted,
     number of nonbounding loops added)."""
     for c in range(n):
@@ -329,20 +426,23 @@ def generate_cases(mc, n):
             continue
         frac = mc.rng.uniform(0.1, 0.5)
         k = int(mc.rng.integers(1, 5))
-        gb = mc.break_chain(g, frac, k)
+        gb = mc.break_chain(g, frac, k, breaking)
         nb = 0
         if mc.gens and mc.rng.random() < 0.5:
             for gi in mc.rng.choice(len(mc.gens), size=min(len(mc.gens), int(mc.rng.integers(1, 3))),
                                     replace=False):
-                gb = gb + mc.break_chain(mc.gens[gi], mc.rng.uniform(0.0, 0.3), int(mc.rng.integers(1, 3)))
+                gb = gb + mc.break_chain(mc.gens[gi], mc.rng.uniform(0.0, 0.3), int(mc.rng.integers(1, 3)),
+                                         breaking)
                 nb += 1
         yield c, f"{mc.name}:{c}", kind, truth, g, gb, frac, nb
 
 
-def run_cases(n_per_mesh, quick, time_limit, resume=True):
-    meshes = mesh_list()
+def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", topology="all"):
+    meshes = list(enumerate(mesh_list()))
     if quick:
         meshes = [meshes[i] for i in (0, 2, 8, 10, 12, 14, 16, 18, 19, 21)]
+    if topology == "simply":
+        meshes = [mm for mm in meshes if mm[0] < N_SIMPLY]
     done = set()
     if resume and os.path.exists(CSV):
         with open(CSV) as fh:
@@ -352,7 +452,7 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True):
     wr = csv.DictWriter(fh, fieldnames=FIELDS)
     if new:
         wr.writeheader()
-    for mi, (name, load) in enumerate(meshes):
+    for mi, (name, load) in meshes:
         ids = [f"{name}:{c}" for c in range(n_per_mesh)]
         if all(i in done for i in ids):
             continue
@@ -363,7 +463,7 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True):
             print(f"skip {name}: {exc}", flush=True)
             continue
         print(f"{name}: {mc.dec.n_faces} faces, b1 = {mc.swn.betti_1}, {len(mc.gens)} generators", flush=True)
-        for c, cid, kind, truth, g, gb, frac, nb in generate_cases(mc, n_per_mesh):
+        for c, cid, kind, truth, g, gb, frac, nb in generate_cases(mc, n_per_mesh, breaking):
             if cid in done or not np.any(gb):
                 continue
             row = {"case": cid, "mesh": name, "faces": mc.dec.n_faces, "b1": mc.swn.betti_1,
@@ -524,7 +624,7 @@ def author_data():
     return "\n".join(rows)
 
 
-def offsets_diagnostic(per_mesh=10):
+def offsets_diagnostic(per_mesh=10, breaking="random"):
     """How much of the error is the rounding offset: error with the offset of the solver vs the best offset in
     hindsight (an oracle over 101 offsets), full LP, on fresh cases of five meshes."""
     from gsdf.winding.surface import circular_mean
@@ -538,7 +638,7 @@ def offsets_diagnostic(per_mesh=10):
             truth, g = mc.region("eigen" if c % 2 == 0 else "grow")
             if truth is None:
                 continue
-            gb = mc.break_chain(g, mc.rng.uniform(0.1, 0.5), int(mc.rng.integers(1, 5)))
+            gb = mc.break_chain(g, mc.rng.uniform(0.1, 0.5), int(mc.rng.integers(1, 5)), breaking)
             r = mc.swn.solve(gb, method="lp")
             w = r.corner_values.mean(1) + r.offset
             E = lambda s: mislabeled(np.round(w - s).astype(int), truth, mc.area)  # noqa: E731
@@ -577,7 +677,7 @@ def gap_zones(mc, g, gb):
     return zone_v[d.F].any(1)
 
 
-def diagnose(n_worst=12, per_mesh=42):
+def diagnose(n_worst=12, per_mesh=42, breaking="random"):
     """Where the error of the simply connected cases comes from (replays cases 0..per_mesh-1 of the simply
     connected meshes of the full run, the same ids as bench/swn_cases.csv): the same truth with its unbroken
     boundary (tests the jump solve), the best offset in hindsight (the rounding), and the error outside the gap
@@ -594,7 +694,7 @@ def diagnose(n_worst=12, per_mesh=42):
             continue
         if mc.swn.betti_1 != 0:
             continue
-        for c, cid, kind, truth, g, gb, frac, nb in generate_cases(mc, per_mesh):
+        for c, cid, kind, truth, g, gb, frac, nb in generate_cases(mc, per_mesh, breaking):
             if not np.any(gb):
                 continue
             A = mc.area
@@ -631,24 +731,40 @@ def diagnose(n_worst=12, per_mesh=42):
     return "\n".join(out)
 
 
+BREAKING_RULES = {
+    "random": ("random intervals (default): per curve walk of n edges, round(f·n) edges deleted in gaps of "
+               "1..clip(n//20, 2, 5) edges (uniform), kept runs a uniform random composition of the rest with "
+               ">= 2 edges each, random start on loops; f ~ U(0.1, 0.5) per case (MeshCases.break_random)"),
+    "long": ("long gaps (the first run's scheme): per curve component, f·n edges deleted in k ~ U{1..4} "
+             "intervals grown by BFS from k random seed edges; f ~ U(0.1, 0.5) (MeshCases.break_long)"),
+}
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="50 cases on 10 meshes, small scaling run")
     ap.add_argument("--per-mesh", type=int, default=None)
     ap.add_argument("--only", choices=["cases", "scaling", "author", "summary", "offsets", "diagnose"], default=None)
+    ap.add_argument("--breaking", choices=["random", "long"], default="random",
+                    help="how boundaries are broken: many short random intervals (default) or few long gaps")
+    ap.add_argument("--topology", choices=["all", "simply"], default="all",
+                    help="'simply': only the 10 simply connected meshes (fast; no LP)")
     ap.add_argument("--time-limit", type=float, default=120.0)
-    ap.add_argument("--fresh", action="store_true", help="discard bench/swn_cases.csv first")
+    ap.add_argument("--fresh", action="store_true", help="discard this variant's per-case CSV first")
     a = ap.parse_args()
+    if a.topology == "simply" and a.only is None:
+        a.only = "cases"                                   # the simply connected cases alone: no scaling, authors
     global CSV
-    if a.quick:
-        CSV = os.path.join(HERE, "swn_cases_quick.csv")
+    tag = ("" if a.breaking == "random" else "_long") + ("_quick" if a.quick else "")
+    CSV = os.path.join(HERE, f"swn_cases{tag}.csv")
     if a.fresh and os.path.exists(CSV):
         os.remove(CSV)
     load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     t0 = time.perf_counter()
     parts = {}
     if a.only in (None, "cases"):
-        run_cases(a.per_mesh or (5 if a.quick else 42), a.quick, a.time_limit)
+        run_cases(a.per_mesh or (5 if a.quick else 42), a.quick, a.time_limit, breaking=a.breaking,
+                  topology=a.topology)
     if a.only in (None, "cases", "summary"):
         parts["cases"] = summarize()
     if a.only in (None, "scaling"):
@@ -657,12 +773,15 @@ def main():
     if a.only in (None, "author"):
         parts["author"] = author_data()
     if a.only == "offsets":
-        parts["offsets"] = offsets_diagnostic()
+        parts["offsets"] = offsets_diagnostic(breaking=a.breaking)
     if a.only == "diagnose":
-        parts["diagnose"] = diagnose()
+        parts["diagnose"] = diagnose(breaking=a.breaking)
+    flags = "".join(f for f, on in ((" --quick", a.quick), (f" --only {a.only}", a.only),
+                                    (" --breaking long", a.breaking == "long"),
+                                    (" --topology simply", a.topology == "simply")) if on).replace(" --only cases --topology", " --topology")
     text = [f"Machine: {machine()}. Load at start: `{load}` (shared with other helpers; times are indicative).",
-            f"Command: `PYTHONPATH=src python3 bench/bench_swn.py{' --quick' if a.quick else ''}"
-            f"{' --only ' + a.only if a.only else ''}` ({time.perf_counter() - t0:.0f} s).", ""]
+            f"Command: `PYTHONPATH=src python3 bench/bench_swn.py{flags}` ({time.perf_counter() - t0:.0f} s).",
+            "", f"Breaking: {BREAKING_RULES[a.breaking]}.", ""]
     if "cases" in parts:
         text += ["### Generated cases" + (" (quick)" if a.quick else ""), "", parts["cases"], ""]
     if "scaling" in parts:
@@ -674,11 +793,14 @@ def main():
         text += ["### Rounding offset: solver rule vs oracle", "", parts["offsets"], ""]
     if "diagnose" in parts:
         text += ["### Worst simply connected cases: where the error comes from", "", parts["diagnose"], ""]
-    name = "swn" if not a.quick else "swn-quick"
-    if a.only:
+    name = "swn" + ("-long" if a.breaking == "long" else "") + ("-quick" if a.quick else "")
+    if a.topology == "simply" and a.only == "cases":
+        name += "-simply"
+    elif a.only:
         name += "-" + a.only
-    write_section(name, "## Surface winding numbers (issue 12)" + (" — " + a.only if a.only else "") + "\n\n" +
-                  "\n".join(text))
+    title = "## Surface winding numbers (issue 12)" + (", long gaps" if a.breaking == "long" else "")
+    write_section(name, title + (" — " + a.only if a.only else "") + (" — simply connected meshes only"
+                  if a.topology == "simply" else "") + "\n\n" + "\n".join(text))
     print("\n".join(text))
 
 
