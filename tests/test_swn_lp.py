@@ -118,3 +118,13 @@ def test_homology_option_is_checked():
     swn = SurfaceWindingNumbers(V, F)
     with pytest.raises(ValueError, match="homology"):
         swn.solve([idx[2, :5]], homology="rational")
+
+
+def test_lp_algorithms_agree_and_are_checked():
+    V, F, idx = torus(24, 12)
+    swn = SurfaceWindingNumbers(V, F)
+    curves = [idx[3, :9]]
+    obj = [swn.solve(curves, lp_algorithm=a).lp_objective for a in ("highs-ds", "highs-ipm", "auto")]
+    assert np.allclose(obj, obj[0], rtol=1e-6)
+    with pytest.raises(ValueError, match="lp_algorithm"):
+        swn.solve(curves, lp_algorithm="simplex")

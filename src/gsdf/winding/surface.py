@@ -53,7 +53,10 @@ from ..dec.triangle import TriangleDEC, forest_potentials
 __all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "bounding_segments", "METHODS"]
 
 METHODS = ("lp", "reduced", "none")
-HOMOLOGY = ("integer", "real")
+HOMOLOGY = ("real", "integer")
+LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
+IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (measured in
+                        # bench/bench_swn_lp.py --only speed: 8k faces 1.5 s vs 2.1 s, 33k faces 36 s vs 16 s)
 NEXT = np.array([1, 2, 0])
 
 
@@ -203,7 +206,8 @@ class SurfaceWindingNumbers:
 
     # ----------------------------------------------------------------------------------------------- solve
     def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
-              homology: str = "real", progress=None, _final: str = "curves") -> SWNResult:
+              homology: str = "real", lp_algorithm: str = "auto", progress=None,
+              _final: str = "curves") -> SWNResult:
         """Surface winding numbers of ``curves``.
 
         Parameters
@@ -220,6 +224,8 @@ class SurfaceWindingNumbers:
             input is an integer chain, so its nonbounding part is an integer class — and γ is corrected by the
             closed form with the rounding error as periods (the LP only sees the class: exact parts are absorbed
             by the face shifts). A class that rounds to 0 needs no LP at all; otherwise Jv is an integer chain.
+        lp_algorithm : "auto" (default: interior point from 12k faces on, dual simplex below), "highs",
+            "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP
         progress : callable(done, total), optional — the package's progress signature; called after each of the
             steps (jump solve, Darboux derivative, Hodge decomposition, residual LP, final solve)
 
@@ -232,6 +238,8 @@ class SurfaceWindingNumbers:
         if isinstance(epsilon, bool) or not isinstance(epsilon, (int, float, np.floating)) or \
                 not (0 < float(epsilon) <= 1):
             raise ValueError(f"epsilon: expected a number in (0, 1], got {epsilon!r}")
+        if lp_algorithm not in LP_ALGORITHMS:
+            raise ValueError(f"lp_algorithm: expected one of {LP_ALGORITHMS}, got {lp_algorithm!r}")
         if homology not in HOMOLOGY:
             raise ValueError(f"homology: expected one of {HOMOLOGY}, got {homology!r}")
         if progress is not None and not callable(progress):
@@ -295,7 +303,9 @@ class SurfaceWindingNumbers:
         else:
             try:
                 if method == "lp":
-                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit)
+                    alg = lp_algorithm if lp_algorithm != "auto" else \
+                        ("highs-ipm" if self.dec.n_faces >= IPM_FACES else "highs-ds")
+                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit, alg)
                 else:
                     Jv, obj, lp_s = self._residual_reduced(gamma_lp, g, ends, time_limit)
             except ValueError as exc:
@@ -402,7 +412,7 @@ class SurfaceWindingNumbers:
         d_hi = vinit[A, (sa + 1) % 3] - vinit[B, sb]
         return 0.5 * (d_lo + d_hi)
 
-    def _residual_full(self, gamma, g, eps, time_limit):
+    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
         dec, topo = self.dec, self.topology
         interior = np.flatnonzero(topo.edge_face_count == 2)
         vinit = self._face_integrals(gamma)
@@ -414,7 +424,8 @@ class SurfaceWindingNumbers:
         lo = np.where(on, np.minimum(0.0, gi), -np.inf)
         hi = np.where(on, np.maximum(0.0, gi), np.inf)
         pairs = topo.edge_faces[interior]
-        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=np.column_stack([lo, hi]), time_limit=time_limit)
+        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=np.column_stack([lo, hi]), time_limit=time_limit,
+                          algorithm=algorithm)
         Jv = np.zeros(dec.n_edges)
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
@@ -515,7 +526,8 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
 
 
 def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
-                           time_limit: float = 300.0) -> SWNResult:
+                           time_limit: float = 300.0, homology: str = "real",
+                           lp_algorithm: str = "auto") -> SWNResult:
     """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
     Examples
@@ -523,4 +535,5 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float =
     >>> res = surface_winding_number(V, F, [loop])                          # doctest: +SKIP
     >>> res.face_labels                                                     # doctest: +SKIP
     """
-    return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit)
+    return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit,
+                                             homology=homology, lp_algorithm=lp_algorithm)
