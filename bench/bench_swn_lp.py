@@ -21,6 +21,7 @@ Usage::
     PYTHONPATH=src python3 bench/bench_swn_lp.py --quick           # 4 cases per mesh (48), small speed run
     PYTHONPATH=src python3 bench/bench_swn_lp.py                   # 42 per mesh (all 504), speed to 134k faces
     PYTHONPATH=src python3 bench/bench_swn_lp.py --only speed|cases [--breaking long|random]
+    PYTHONPATH=src python3 bench/bench_swn_lp.py --only summary    # the table of a partial run's CSV
 
 Per-case rows: bench/swn_lp_cases[_quick].csv; summary: section "swn-lp" ("swn-lp-quick") of bench/RESULTS.md.
 """
@@ -181,7 +182,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="4 cases per mesh and a small speed run")
     ap.add_argument("--per-mesh", type=int, default=None)
-    ap.add_argument("--only", choices=["cases", "speed"], default=None)
+    ap.add_argument("--only", choices=["cases", "speed", "summary"], default=None,
+                    help="summary: re-summarize the per-case CSV of an earlier (possibly partial) run")
     ap.add_argument("--breaking", choices=["random", "long"], default="random")
     ap.add_argument("--time-limit", type=float, default=300.0)
     a = ap.parse_args()
@@ -190,10 +192,11 @@ def main():
     text = [f"Machine: {machine()}. Load at start: `{load}` (shared with other helpers; times are indicative).",
             f"Command: `PYTHONPATH=src python3 bench/bench_swn_lp.py{' --quick' if a.quick else ''}"
             f"{' --only ' + a.only if a.only else ''} --breaking {a.breaking}`", ""]
-    if a.only in (None, "cases"):
+    if a.only in (None, "cases", "summary"):
         per = a.per_mesh or (4 if a.quick else 42)
         path = os.path.join(HERE, f"swn_lp_cases{'_quick' if a.quick else ''}_{a.breaking}.csv")
-        rows = run_cases(per, path, a.breaking, a.time_limit)
+        if a.only != "summary":
+            run_cases(per, path, a.breaking, a.time_limit)
         with open(path) as fh:
             rows = list(csv.DictReader(fh))
         text += [f"### Not simply connected cases, {a.breaking} breaking ({per} per mesh; rows in "
@@ -203,7 +206,7 @@ def main():
         text += ["### Full LP time vs faces (torus grid, one broken meridian + a 30 %-broken band boundary)", "",
                  speed(sizes, a.time_limit), ""]
     text[1] += f" ({time.perf_counter() - t0:.0f} s)."
-    name = "swn-lp" + ("-quick" if a.quick else "") + (f"-{a.only}" if a.only else "")
+    name = "swn-lp" + ("-quick" if a.quick else "") + ("-speed" if a.only == "speed" else "")
     write_section(name, "## Surface winding numbers, not simply connected: residual LP (issue 12)\n\n" +
                   "\n".join(text))
     print("\n".join(text))

@@ -14,8 +14,7 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    possible in the weighted L1 sense, jumps on the input being cheap (weight ε) and never "extra loops"
    (0 ≤ g Jv ≤ g²) — the dual-graph LP :func:`gsdf.dec.dual_graph_l1` (HiGHS). ``method="reduced"`` is §6.3's
    reduced LP: the curves are first completed by shortest paths between endpoints of opposite sign (Dijkstra on
-   edge lengths, the input's own edges forbidden — the demo's weights are inverted, see ``_complete_chain``;
-   the endpoint pairs of least total length),
+   edge lengths, the input's own edges forbidden — the demo's weights are inverted, see ``_complete_chain``),
    faces are flood-filled across the completed chain, γ integrated along a BFS tree in each piece, and the LP
    has one shift per piece;
    With ``homology="integer"`` the class of γ (its periods on a tree–cotree homology basis) is first rounded
@@ -141,7 +140,6 @@ class SurfaceWindingNumbers:
         self.simply_connected = self.betti_1 == 0
         self._hodge = None
         self._cycles = None
-        self._matching = "assignment"
         n = self.dec.n_vertices
         self._edge_key = self.dec.edges[:, 0] * n + self.dec.edges[:, 1]
 
@@ -436,11 +434,9 @@ class SurfaceWindingNumbers:
         return Jv, r.objective, r.seconds
 
     def _complete_chain(self, g: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        """Complete the chain by shortest paths (edge lengths) from the endpoints where curves arrive
-        (``(d0ᵀg)_i > 0``) to endpoints where curves leave, along edges that are not on the input (§6.3 step 1).
-        The pairs are an assignment of least total path length (``linear_sum_assignment``, endpoints counted
-        with multiplicity; ``self._matching = "greedy"`` pairs nearest first instead — measured worse in
-        bench/RESULTS.md "swn-lp", it links one curve's end to a nearby other curve). The demo's Dijkstra gives the input edges finite and all other edges
+        """Complete the chain by shortest paths (edge lengths) from each endpoint where curves arrive
+        (``(d0ᵀg)_i > 0``) to the nearest endpoint where curves leave, greedily by distance, along edges that are
+        not on the input (§6.3 step 1). The demo's Dijkstra gives the input edges finite and all other edges
         infinite weight, the inverse of the stated intent; here the input edges are the forbidden ones."""
         dec = self.dec
         div = dec.d0.T @ g                                     # Σ_in − Σ_out at every vertex
@@ -457,34 +453,16 @@ class SurfaceWindingNumbers:
         need_p = np.rint(div[pos]).astype(np.int64)
         need_n = np.rint(-div[neg]).astype(np.int64)
         dd = D[:, neg]
-        pairs = []
-        if self._matching == "greedy":
-            order = np.argsort(dd, axis=None)
-            for flat in order:                                 # greedy matching over the (few) endpoint pairs
-                i, j = divmod(int(flat), len(neg))
-                if not np.isfinite(dd[i, j]):
-                    break
-                if need_p[i] == 0 or need_n[j] == 0:
-                    continue
-                k = min(need_p[i], need_n[j])
-                need_p[i] -= k
-                need_n[j] -= k
-                pairs.append((i, j, k))
-        else:
-            # least total length (an assignment between the endpoints, counted with multiplicity): greedy
-            # nearest-first pairing links the end of one curve to a nearby curve's start across short
-            # distances and so merges different curves into loops of another homology class
-            from scipy.optimize import linear_sum_assignment
-
-            ip = np.repeat(np.arange(len(pos)), need_p)
-            jn = np.repeat(np.arange(len(neg)), need_n)
-            C = dd[ip][:, jn]
-            big = 10.0 * (np.nanmax(np.where(np.isfinite(C), C, 0.0)) + 1.0) * max(len(ip), 1)
-            ri, ci = linear_sum_assignment(np.where(np.isfinite(C), C, big))
-            ok = np.isfinite(C[ri, ci])
-            for i, j in zip(ip[ri[ok]], jn[ci[ok]]):
-                pairs.append((int(i), int(j), 1))
-        for i, j, k in pairs:
+        order = np.argsort(dd, axis=None)
+        for flat in order:                                     # greedy matching over the (few) endpoint pairs
+            i, j = divmod(int(flat), len(neg))
+            if not np.isfinite(dd[i, j]):
+                break
+            if need_p[i] == 0 or need_n[j] == 0:
+                continue
+            k = min(need_p[i], need_n[j])
+            need_p[i] -= k
+            need_n[j] -= k
             # walk the path back from neg[j] to pos[i]; orient + -> −
             v = int(neg[j])
             path = [v]
