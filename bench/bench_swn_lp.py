@@ -223,7 +223,8 @@ def main():
     t0 = time.perf_counter()
     text = [f"Machine: {machine()}. Load at start: `{load}` (shared with other helpers; times are indicative).",
             f"Command: `PYTHONPATH=src python3 bench/bench_swn_lp.py{' --quick' if a.quick else ''}"
-            f"{' --only ' + a.only if a.only else ''} --breaking {a.breaking}`", ""]
+            f"{' --only ' + a.only if a.only else ''}{f' --per-mesh {a.per_mesh}' if a.per_mesh else ''} "
+            f"--breaking {a.breaking}{f' --time-limit {a.time_limit:g}' if a.time_limit != 300 else ''}`", ""]
     if a.only in (None, "cases", "summary"):
         text += [NOTES, ""]
         per = a.per_mesh or (4 if a.quick else 42)
