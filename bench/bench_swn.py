@@ -4,10 +4,24 @@ of genus 0–3 with and without boundary, scored by mislabeled area; plus timing
 Cases (the thesis' 934 are not published; spec notes §1(e).4): for every mesh, ground-truth regions are
 either super-level sets of a low Laplace eigenfunction (L φ = λ M φ, eigenvectors 2–6, level at a random
 quantile) or region growing from 1–3 random seed faces (Dijkstra over face centroids up to 15–50 % of the
-area). The region's oriented boundary is broken by deleting 10–50 % of its edges in 1–4 random intervals. On
-closed surfaces of genus > 0, half the cases add 1–2 broken homology generators (tree–cotree loops, 0–30 %
-deleted) as nonbounding loops; they leave the truth unchanged. Error = area(W + k ≠ truth) / area, minimised
-over the integer k. Methods: full LP ("lp"), reduced LP ("reduced"), naive rounding of u ("none").
+area). The region's oriented boundary is broken by deleting a fraction f ~ U(0.1, 0.5) of its edges, by one
+of two schemes (``--breaking``; both seeded, same case draws):
+
+* ``random`` (default) — "random intervals", as the thesis describes its benchmark (§6.3, Fig. 6.7; §7.1:
+  curves deleted "at random intervals"): the chain is cut into edge walks (loops, or paths ending on the mesh
+  boundary); in a walk of n edges, round(f·n) edges go in many short gaps of 1..ℓmax edges each, uniform,
+  ℓmax = clip(n // 20, 2, 5), so no gap is longer than 5 edges (nor than 5 % of a loop of 40+ edges); the
+  kept runs between gaps are a uniformly random composition of the other edges with at least 2 edges each
+  (1 if 2 do not fit; a path's two end runs may be empty), and on a loop the pattern starts at a random edge.
+  Walks under 8 edges stay whole (:meth:`MeshCases.break_random`).
+* ``long`` — the first run's scheme: per connected curve component, f·n edges in k ~ U{1..4} intervals grown
+  by BFS along the curve from k random seed edges (few long gaps; :meth:`MeshCases.break_long`). With 40–50 %
+  deleted in one or two gaps the truth inside them is not determined by the input (see below).
+
+On closed surfaces of genus > 0, half the cases add 1–2 broken homology generators (tree–cotree loops, 0–30 %
+deleted by the same scheme) as nonbounding loops; they leave the truth unchanged. Error = area(W + k ≠ truth)
+/ area, minimised over the integer k. Methods: full LP ("lp"), reduced LP ("reduced"), naive rounding of u
+("none").
 
 How fair the error is (``--only diagnose``): the truth inside a gap is whatever the eigenfunction level set or
 the region growing did there, which the broken input does not determine — with 40–50 % of a boundary deleted
@@ -20,14 +34,18 @@ rounding offset). Both are reported beside the plain error; no case is dropped.
 
 Usage::
 
-    PYTHONPATH=src python3 bench/bench_swn.py --quick        # 50 cases
+    PYTHONPATH=src python3 bench/bench_swn.py --quick        # 50 cases, random intervals
     PYTHONPATH=src python3 bench/bench_swn.py                # 924 cases (+ scaling + author data)
+    PYTHONPATH=src python3 bench/bench_swn.py --breaking long   # the same 924 draws, few long gaps (cases only)
+    PYTHONPATH=src python3 bench/bench_swn.py --topology simply # the 420 simply connected cases only (~1 min)
     PYTHONPATH=src python3 bench/bench_swn.py --only scaling|author|cases
     PYTHONPATH=src python3 bench/bench_swn.py --only offsets    # solver offset vs oracle (50 fresh cases)
     PYTHONPATH=src python3 bench/bench_swn.py --only diagnose   # simply connected cases: where the error is
+    PYTHONPATH=src python3 bench/bench_swn.py --only compare    # both schemes side by side, from the CSVs
 
-Per-case rows go to bench/swn_cases.csv (appended as they finish, so a partial run is usable); the summary
-goes to the "swn" section of bench/RESULTS.md.
+Per-case rows go to bench/swn_cases.csv (random) / bench/swn_cases_long.csv (long), ``_quick`` for --quick,
+appended as they finish (a rerun resumes; ``--fresh`` starts over); the summary goes to the sections "swn" /
+"swn-long" (+ "-quick", "-simply", "-diagnose", ...) of bench/RESULTS.md.
 """
 
 from __future__ import annotations
@@ -190,6 +208,7 @@ def mesh_list(quick=False):
     return L
 
 
+NEW_ROWS = 0           # rows computed by this process (the rest of the CSV is read back)
 N_SIMPLY = 10          # mesh_list()[:10] are simply connected (b1 = 0)
 
 
@@ -438,6 +457,7 @@ def generate_cases(mc, n, breaking="random"):
 
 
 def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", topology="all"):
+    global NEW_ROWS
     meshes = list(enumerate(mesh_list()))
     if quick:
         meshes = [meshes[i] for i in (0, 2, 8, 10, 12, 14, 16, 18, 19, 21)]
@@ -487,6 +507,7 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", top
             row["lp_status"] = status
             wr.writerow(row)
             fh.flush()
+            NEW_ROWS += 1
         print(f"  done {name}", flush=True)
     fh.close()
 
@@ -501,7 +522,9 @@ def summarize():
     sc = [r for r in rows if int(r["b1"]) == 0]
     ns = [r for r in rows if int(r["b1"]) > 0]
     out = [f"{len(rows)} cases on {len({r['mesh'] for r in rows})} meshes ({len(sc)} simply connected, "
-           f"{len(ns)} not); per-case rows in bench/swn_cases.csv.", ""]
+           f"{len(ns)} not); per-case rows in bench/{os.path.basename(CSV)}"
+           + (f" ({NEW_ROWS} computed in this run, the others read back from earlier runs of the same generator; "
+              "--fresh recomputes all)" if NEW_ROWS < len(rows) else "") + ".", ""]
     if sc:
         e = np.array([f(r, "err_lp") for r in sc])
         en = np.array([f(r, "err_none") for r in sc])
@@ -548,6 +571,30 @@ def summarize():
                            f"{a('err_none'):.1f} % |")
         out.append("")
     return "\n".join(out)
+
+
+def compare_breakings(quick=False):
+    """One table of both breaking schemes from their per-case CSVs (those present)."""
+    f = lambda r, k: float(r[k]) if r.get(k) not in (None, "", "nan") else np.nan  # noqa: E731
+    body = []
+    for b in ("random", "long"):
+        path = os.path.join(HERE, "swn_cases" + ("" if b == "random" else "_long") + ("_quick" if quick else "")
+                            + ".csv")
+        if not os.path.exists(path):
+            continue
+        with open(path) as fh:
+            rows = list(csv.DictReader(fh))
+        sc = np.array([f(r, "err_lp") for r in rows if int(r["b1"]) == 0])
+        ns = [r for r in rows if int(r["b1"]) > 0]
+        a = lambda k: 100 * np.nanmean(np.array([f(r, k) for r in ns]) < 0.005) if ns else np.nan  # noqa: E731
+        body.append(f"| {b} | {len(rows)} | {100 * np.nanmean(sc):.3f} % / {100 * np.nanmax(sc):.2f} % / "
+                    f"{100 * np.nanmean(sc < 0.005):.0f} % | {len(ns)} | {a('err_lp'):.1f} % | "
+                    f"{a('err_reduced'):.1f} % | {a('err_none'):.1f} % |")
+    if not body:
+        return ""
+    return "\n".join(["| breaking | cases | simply connected: mean / max error / < 0.5 % | not simply connected: "
+                      "cases | full LP < 0.5 % | reduced < 0.5 % | naive < 0.5 % |", "|---|---|---|---|---|---|---|"]
+                     + body)
 
 
 # ----------------------------------------------------------------------------------------------- scaling
@@ -744,7 +791,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="50 cases on 10 meshes, small scaling run")
     ap.add_argument("--per-mesh", type=int, default=None)
-    ap.add_argument("--only", choices=["cases", "scaling", "author", "summary", "offsets", "diagnose"], default=None)
+    ap.add_argument("--only", choices=["cases", "scaling", "author", "summary", "offsets", "diagnose",
+                                                  "compare"], default=None)
     ap.add_argument("--breaking", choices=["random", "long"], default="random",
                     help="how boundaries are broken: many short random intervals (default) or few long gaps")
     ap.add_argument("--topology", choices=["all", "simply"], default="all",
@@ -752,8 +800,8 @@ def main():
     ap.add_argument("--time-limit", type=float, default=120.0)
     ap.add_argument("--fresh", action="store_true", help="discard this variant's per-case CSV first")
     a = ap.parse_args()
-    if a.topology == "simply" and a.only is None:
-        a.only = "cases"                                   # the simply connected cases alone: no scaling, authors
+    if (a.topology == "simply" or a.breaking == "long") and a.only is None:
+        a.only = "cases"                # the cases alone: scaling and author data do not depend on the breaking
     global CSV
     tag = ("" if a.breaking == "random" else "_long") + ("_quick" if a.quick else "")
     CSV = os.path.join(HERE, f"swn_cases{tag}.csv")
@@ -776,14 +824,17 @@ def main():
         parts["offsets"] = offsets_diagnostic(breaking=a.breaking)
     if a.only == "diagnose":
         parts["diagnose"] = diagnose(breaking=a.breaking)
-    flags = "".join(f for f, on in ((" --quick", a.quick), (f" --only {a.only}", a.only),
-                                    (" --breaking long", a.breaking == "long"),
-                                    (" --topology simply", a.topology == "simply")) if on).replace(" --only cases --topology", " --topology")
+    if a.only == "compare":
+        text_cmp = compare_breakings(a.quick)
+    flags = "".join(" " + t for t in sys.argv[1:])
     text = [f"Machine: {machine()}. Load at start: `{load}` (shared with other helpers; times are indicative).",
             f"Command: `PYTHONPATH=src python3 bench/bench_swn.py{flags}` ({time.perf_counter() - t0:.0f} s).",
             "", f"Breaking: {BREAKING_RULES[a.breaking]}.", ""]
     if "cases" in parts:
         text += ["### Generated cases" + (" (quick)" if a.quick else ""), "", parts["cases"], ""]
+        cmp_ = compare_breakings(a.quick)
+        if cmp_:
+            text += ["### Both breaking schemes (from bench/swn_cases*.csv)", "", cmp_, ""]
     if "scaling" in parts:
         text += ["### Time vs faces (torus grid, one broken meridian + a 30 %-broken band boundary)", "",
                  parts["scaling"], ""]
@@ -793,10 +844,12 @@ def main():
         text += ["### Rounding offset: solver rule vs oracle", "", parts["offsets"], ""]
     if "diagnose" in parts:
         text += ["### Worst simply connected cases: where the error comes from", "", parts["diagnose"], ""]
+    if a.only == "compare":
+        text += ["### Both breaking schemes (from bench/swn_cases*.csv)", "", text_cmp, ""]
     name = "swn" + ("-long" if a.breaking == "long" else "") + ("-quick" if a.quick else "")
     if a.topology == "simply" and a.only == "cases":
         name += "-simply"
-    elif a.only:
+    elif a.only and not (a.only == "cases" and a.breaking == "long"):
         name += "-" + a.only
     title = "## Surface winding numbers (issue 12)" + (", long gaps" if a.breaking == "long" else "")
     write_section(name, title + (" — " + a.only if a.only else "") + (" — simply connected meshes only"
