@@ -70,7 +70,7 @@ What was checked and what was wrong (cases replayed by their bench_swn.py ids):
 - **What is left:** (a) the LP's choice between homologous loops (thesis Fig. 6.10: e.g. author-torus:2, same
   error with the best offset); (b) the rounding offset after a partial correction (author-double-torus:2:
   9.9 % with the solver's offset, 0.8 % with the best one; a threshold vote over the input edges was tried:
-  better on simply connected cases — mean 0.49 % → 0.28 % on 60 — but worse here, 77 % → 69 % of cases < 0.5 %;
+  better on simply connected cases — mean 0.49 % → 0.28 % on 60 — but worse here, 77 % → 69 % of 48 cases < 0.5 %;
   not adopted); (c) the reduced LP with broken nonbounding loops: nearest-endpoint completion links one curve's
   end to another curve, the completed chain stops separating (torus:3: one piece with 99.4 % of the area, χ = −9,
   in which the BFS integration of γ is path dependent); pairing endpoints by least total length instead was
