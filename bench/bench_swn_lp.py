@@ -240,7 +240,8 @@ def main():
         text += ["### Full LP time vs faces (torus grid, one broken meridian + a 30 %-broken band boundary)", "",
                  speed(sizes, a.time_limit), ""]
     text[1] += f" ({time.perf_counter() - t0:.0f} s)."
-    name = "swn-lp" + ("-quick" if a.quick else "") + ("-speed" if a.only == "speed" else "")
+    name = "swn-lp" + ("-quick" if a.quick else "") + ("-speed" if a.only == "speed" else "") + \
+        ("-long" if a.breaking == "long" and a.only != "speed" else "")
     write_section(name, "## Surface winding numbers, not simply connected: residual LP (issue 12)\n\n" +
                   "\n".join(text))
     print("\n".join(text))
