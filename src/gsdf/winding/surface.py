@@ -21,8 +21,9 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    to the nearest integer class; a class 0 skips the LP;
 5. the jumps of v (Jv, the completed nonbounding part) are removed from the input: the jump Laplace equation is
    solved again with jumps "Γ ∖ Jv" (§6.1.2), g − Jv on the input's edges only — Jv off the input (where the
-   LP closed the gaps of nonbounding loops) is the completion of the nonbounding part, not a jump of w: w. Faces are labelled ``round(w − s)`` with the offset s the level of w on the
-   input curves minus ½ (circular mean of the mean of the two faces of every bounding input edge; see
+   LP closed the gaps of nonbounding loops) is the completion of the nonbounding part, not a jump of w: w.
+   Faces are labelled ``round(w − s)`` with the offset s the level of w on the input curves minus ½
+   (circular mean of the mean of the two faces of every bounding input edge; see
    :meth:`SurfaceWindingNumbers.rounding_offset`), then shifted so that the faces to the right of the curves get
    label 0 (the thesis' "+1 crossing from the right").
 
@@ -58,8 +59,9 @@ __all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "boun
 METHODS = ("lp", "reduced", "none")
 HOMOLOGY = ("real", "integer")
 LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
-IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (measured in
-                        # bench/bench_swn_lp.py --only speed: 8k faces 1.5 s vs 2.1 s, 33k faces 36 s vs 16 s)
+IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
+                        # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
+                        # 75 s vs 62 s; at load ≈ 9: 1.5 vs 2.1 s and 36 vs 16 s)
 NEXT = np.array([1, 2, 0])
 
 
