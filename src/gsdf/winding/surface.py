@@ -17,9 +17,13 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    edge lengths, the input's own edges forbidden — the demo's weights are inverted, see ``_complete_chain``),
    faces are flood-filled across the completed chain, γ integrated along a BFS tree in each piece, and the LP
    has one shift per piece;
-5. the jumps of v (Jv, the completed nonbounding part) are removed from the input, g − Jv, and the jump Laplace
-   equation solved again: w. Faces are labelled ``round(w − s)`` with the offset s the level of w on the
-   input curves minus ½ (circular mean of the mean of the two faces of every bounding input edge; see
+   With ``homology="integer"`` the class of γ (its periods on a tree–cotree homology basis) is first rounded
+   to the nearest integer class; a class 0 skips the LP;
+5. the jumps of v (Jv, the completed nonbounding part) are removed from the input: the jump Laplace equation is
+   solved again with jumps "Γ ∖ Jv" (§6.1.2), g − Jv on the input's edges only — Jv off the input (where the
+   LP closed the gaps of nonbounding loops) is the completion of the nonbounding part, not a jump of w: w.
+   Faces are labelled ``round(w − s)`` with the offset s the level of w on the input curves minus ½
+   (circular mean of the mean of the two faces of every bounding input edge; see
    :meth:`SurfaceWindingNumbers.rounding_offset`), then shifted so that the faces to the right of the curves get
    label 0 (the thesis' "+1 crossing from the right").
 
@@ -45,6 +49,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, dijkstra
 
+from ..dec.cycles import TreeCotree
 from ..dec.hodge import HodgeDecomposition
 from ..dec.lp import dual_graph_l1
 from ..dec.triangle import TriangleDEC, forest_potentials
@@ -52,6 +57,11 @@ from ..dec.triangle import TriangleDEC, forest_potentials
 __all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "bounding_segments", "METHODS"]
 
 METHODS = ("lp", "reduced", "none")
+HOMOLOGY = ("real", "integer")
+LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
+IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
+                        # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
+                        # 75 s vs 62 s; at load ≈ 9: 1.5 vs 2.1 s and 36 vs 16 s)
 NEXT = np.array([1, 2, 0])
 
 
@@ -131,6 +141,7 @@ class SurfaceWindingNumbers:
         self.betti_1 = self.topology.betti_1()
         self.simply_connected = self.betti_1 == 0
         self._hodge = None
+        self._cycles = None
         n = self.dec.n_vertices
         self._edge_key = self.dec.edges[:, 0] * n + self.dec.edges[:, 1]
 
@@ -192,9 +203,16 @@ class SurfaceWindingNumbers:
             self._hodge = HodgeDecomposition(d.d0, d.d1, d.star1)
         return self._hodge
 
+    def tree_cotree(self) -> TreeCotree:
+        """The tree–cotree homology basis of the mesh (built once, lazily)."""
+        if self._cycles is None:
+            self._cycles = TreeCotree(self.dec)
+        return self._cycles
+
     # ----------------------------------------------------------------------------------------------- solve
     def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
-              progress=None) -> SWNResult:
+              homology: str = "real", lp_algorithm: str = "auto", progress=None,
+              _final: str = "curves") -> SWNResult:
         """Surface winding numbers of ``curves``.
 
         Parameters
@@ -203,6 +221,16 @@ class SurfaceWindingNumbers:
         method : "lp" (full residual LP, §6.1), "reduced" (reduced LP, §6.3) or "none" (naive rounding of u)
         epsilon : float in (0, 1], LP weight of jumps on the input's edges relative to gap-closing ones
         time_limit : float, seconds HiGHS may take; beyond it a ValueError names ``method="reduced"``
+        homology : "real" (default) or "integer" — the cohomology class of the harmonic part γ that the residual
+            must integrate. "real": γ itself, as thesis §6.1.2 writes; a broken *bounding* curve then leaves a
+            fractional class (the flux of the harmonic forms through its gaps) that the LP attributes to the
+            cheap input edges, turning parts of bounding curves partly nonbounding. "integer": γ's periods along
+            a homology basis (:class:`gsdf.dec.cycles.TreeCotree`) are rounded to the nearest integers first — the
+            input is an integer chain, so its nonbounding part is an integer class — and γ is corrected by the
+            closed form with the rounding error as periods (the LP only sees the class: exact parts are absorbed
+            by the face shifts). A class that rounds to 0 needs no LP at all; otherwise Jv is an integer chain.
+        lp_algorithm : "auto" (default: interior point from 12k faces on, dual simplex below), "highs",
+            "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP
         progress : callable(done, total), optional — the package's progress signature; called after each of the
             steps (jump solve, Darboux derivative, Hodge decomposition, residual LP, final solve)
 
@@ -215,6 +243,10 @@ class SurfaceWindingNumbers:
         if isinstance(epsilon, bool) or not isinstance(epsilon, (int, float, np.floating)) or \
                 not (0 < float(epsilon) <= 1):
             raise ValueError(f"epsilon: expected a number in (0, 1], got {epsilon!r}")
+        if lp_algorithm not in LP_ALGORITHMS:
+            raise ValueError(f"lp_algorithm: expected one of {LP_ALGORITHMS}, got {lp_algorithm!r}")
+        if homology not in HOMOLOGY:
+            raise ValueError(f"homology: expected one of {HOMOLOGY}, got {homology!r}")
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
         steps = iter(range(1, 6))
@@ -258,30 +290,51 @@ class SurfaceWindingNumbers:
             gamma = om - co
         else:
             gamma = om
+        integer = homology == "integer"
+        if integer:
+            # round the class of γ: periods along the tree–cotree loops to the nearest integers (docstring)
+            tc = self.tree_cotree()
+            per = tc.periods(gamma)
+            k = np.round(per)
+            gamma_lp = gamma + tc.closed_form(k - per) if np.any(k) else None
+        else:
+            gamma_lp = gamma
         T["hodge"] = time.perf_counter() - t0
 
         say(f"residual ({method} LP)")
         t0 = time.perf_counter()
-        try:
-            if method == "lp":
-                Jv, obj, lp_s = self._residual_full(gamma, g, float(epsilon), time_limit)
-            else:
-                Jv, obj, lp_s = self._residual_reduced(gamma, g, ends, time_limit)
-        except ValueError as exc:
-            hint = " — try method='reduced' (one unknown per curve piece)" if method == "lp" else ""
-            raise ValueError(f"method={method!r}: {exc}{hint}") from exc
+        if gamma_lp is None:                      # integer class 0: nothing nonbounding, no LP
+            Jv, obj, lp_s = zero.copy(), 0.0, 0.0
+        else:
+            try:
+                if method == "lp":
+                    alg = lp_algorithm if lp_algorithm != "auto" else \
+                        ("highs-ipm" if self.dec.n_faces >= IPM_FACES else "highs-ds")
+                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit, alg)
+                else:
+                    Jv, obj, lp_s = self._residual_reduced(gamma_lp, g, ends, time_limit)
+            except ValueError as exc:
+                hint = " — try method='reduced' (one unknown per curve piece)" if method == "lp" else ""
+                raise ValueError(f"method={method!r}: {exc}{hint}") from exc
+            if integer:                           # a network LP with an integer class: integer jumps
+                r = np.round(Jv)
+                Jv = np.where(np.abs(Jv - r) < 1e-6, r, Jv)
         T["lp"] = lp_s
         T["residual"] = time.perf_counter() - t0
 
         say("final jump solve")
         t0 = time.perf_counter()
         Jv = np.where(np.abs(Jv) < 1e-9, 0.0, Jv)
-        # Jv of the full LP is a closed dual chain (its jumps telescope around every vertex), so g − Jv closes
-        # wherever g does; the reduced LP ignores inconsistencies inside pieces, and vertices where g − Jv does
-        # not close become endpoints too (the spec's "cleaner alternative")
-        ends2 = ends | dec.chain_endpoints(g - Jv, tol=1e-6)
-        jc2 = dec.jump_coordinates(g - Jv, ends2)
-        _, w = dec.solve_jump(jc2)
+        # thesis §6.1.2 step ⑤: w jumps across "Γ ∖ Jv", the bounding part as a subset of the input — g − Jv on the
+        # input's edges only; the completion of the nonbounding part off the input (Jv across the gaps) is not a
+        # jump of w. Vertices where the bounding part does not close become endpoints (the spec's "cleaner
+        # alternative"). _final="all" (diagnosis only) also keeps −Jv off the input.
+        bnd = g - Jv if _final == "all" else np.where(g != 0, g - Jv, 0.0)
+        ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
+        if np.any(Jv):
+            _, w = dec.solve_jump(dec.jump_coordinates(bnd, ends2))
+        else:                                     # nothing nonbounding: w = u
+            w = u
         T["final_solve"] = time.perf_counter() - t0
         res = self._finish(w, u, g, Jv, ends, om, gamma, method, T)
         res.lp_objective = obj
@@ -364,7 +417,7 @@ class SurfaceWindingNumbers:
         d_hi = vinit[A, (sa + 1) % 3] - vinit[B, sb]
         return 0.5 * (d_lo + d_hi)
 
-    def _residual_full(self, gamma, g, eps, time_limit):
+    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
         dec, topo = self.dec, self.topology
         interior = np.flatnonzero(topo.edge_face_count == 2)
         vinit = self._face_integrals(gamma)
@@ -376,7 +429,8 @@ class SurfaceWindingNumbers:
         lo = np.where(on, np.minimum(0.0, gi), -np.inf)
         hi = np.where(on, np.maximum(0.0, gi), np.inf)
         pairs = topo.edge_faces[interior]
-        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=np.column_stack([lo, hi]), time_limit=time_limit)
+        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=np.column_stack([lo, hi]), time_limit=time_limit,
+                          algorithm=algorithm)
         Jv = np.zeros(dec.n_edges)
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
@@ -477,7 +531,8 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
 
 
 def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
-                           time_limit: float = 300.0) -> SWNResult:
+                           time_limit: float = 300.0, homology: str = "real",
+                           lp_algorithm: str = "auto") -> SWNResult:
     """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
     Examples
@@ -485,4 +540,5 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float =
     >>> res = surface_winding_number(V, F, [loop])                          # doctest: +SKIP
     >>> res.face_labels                                                     # doctest: +SKIP
     """
-    return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit)
+    return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit,
+                                             homology=homology, lp_algorithm=lp_algorithm)
