@@ -37,6 +37,7 @@ from numba import njit, prange
 from .._checks import as_mesh, as_points, integer
 from .._normalize import Frame
 from ..spatial.bvh import BVH, build_bvh
+from ..spatial.wide import widen
 from ._query import map_queries
 from .exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w, triangle_corners
 
@@ -242,6 +243,94 @@ def _eval_triangles(Q, T, N, C, beta2, order, out):
         out[qi] = acc
 
 
+WIDTH = 4  # children per node of the wide walk (a compile-time constant: the lane loop is unrolled)
+_WF = 4 + COMPACT_WIDTH - 1  # fields per child slot: centre (3), β²r², the 23 compact coefficients
+
+
+def _pack_wide(D, C, tree, beta2, order, width=WIDTH):
+    """Per wide node, the far-field data of its children as (w, _WF, width) float64 (one lane per child, so
+    the lane loop of :func:`_eval_triangles_wide` reads contiguous memory), plus the child links and the
+    element ranges of the leaf children (w, width) int64."""
+    wt = widen(tree, width)
+    kids, child, depth = wt.kids, wt.child, wt.depth
+    if tree.right[0] >= 0:
+        # a first node whose one child is the root, so the root's own far field is tried too (a query far
+        # from a closed mesh then gets its c0 = 0 expansion, as in Algorithm 1, not the sum of its children's)
+        top = np.full((1, width), -1, np.int64)
+        top[0, 0] = 0
+        kids = np.vstack([top, kids])
+        top[0, :] = -2
+        top[0, 0] = 1
+        child = np.vstack([top, np.where(child >= 0, child + 1, child)])
+        depth += 1
+    ok = kids >= 0
+    kk = np.where(ok, kids, 0)
+    W = np.zeros((kids.shape[0], _WF, width))
+    W[:, 0:3, :] = np.where(ok[:, None, :], D[kk, 0:3].transpose(0, 2, 1), 0.0)
+    # the far-field test d² > β² r²; an empty slot is never far (and never descended: child = -2)
+    W[:, 3, :] = np.where(ok, beta2 * D[kk, 3], np.inf)
+    Cm = C[:, : COMPACT_WIDTH - 1].copy()
+    if order < 2:   # the unused orders' coefficients are zero: one kernel evaluates every order
+        Cm[:, 13:] = 0.0
+        Cm[:, 10:13] = 0.0
+    if order < 1:
+        Cm[:, 3:10] = 0.0
+    W[:, 4:, :] = np.where(ok[:, None, :], Cm[kk].transpose(0, 2, 1), 0.0)
+    LS = np.where(ok, tree.start[kk], 0)
+    LE = np.where(ok, tree.end[kk], 0)
+    return W, np.ascontiguousarray(child), LS, LE, depth * (width - 1) + 2
+
+
+@njit(parallel=True, cache=True, fastmath=_FASTMATH)
+def _eval_triangles_wide(Q, T, W, CH, LS, LE, stack_size, out):
+    n = Q.shape[0]
+    chunk = 256
+    nchunks = (n + chunk - 1) // chunk
+    for ch in prange(nchunks):
+        stack = np.empty(stack_size, np.int64)
+        for qi in range(ch * chunk, min(n, (ch + 1) * chunk)):
+            qx, qy, qz = Q[qi, 0], Q[qi, 1], Q[qi, 2]
+            acc = 0.0
+            stack[0] = 0
+            sp = 1
+            while sp > 0:
+                sp -= 1
+                nd = stack[sp]
+                near = 0
+                for c in range(WIDTH):
+                    rx = W[nd, 0, c] - qx
+                    ry = W[nd, 1, c] - qy
+                    rz = W[nd, 2, c] - qz
+                    d2 = rx * rx + ry * ry + rz * rz
+                    far = d2 > W[nd, 3, c]
+                    if not far:
+                        near |= 1 << c
+                        d2 = 1.0
+                    inv_d2 = 1.0 / d2
+                    inv_d3 = np.sqrt(inv_d2) * inv_d2
+                    xx, yy, zz = rx * rx, ry * ry, rz * rz
+                    a = W[nd, 4, c] * rx + W[nd, 5, c] * ry + W[nd, 6, c] * rz + W[nd, 7, c]
+                    b = (W[nd, 8, c] * xx + W[nd, 9, c] * yy + W[nd, 10, c] * zz
+                         + W[nd, 11, c] * (rx * ry) + W[nd, 12, c] * (rx * rz) + W[nd, 13, c] * (ry * rz)
+                         + W[nd, 14, c] * rx + W[nd, 15, c] * ry + W[nd, 16, c] * rz)
+                    cc = (rx * (W[nd, 17, c] * xx + W[nd, 20, c] * (rx * ry) + W[nd, 21, c] * (rx * rz)
+                                + W[nd, 22, c] * yy + W[nd, 24, c] * zz + W[nd, 26, c] * (ry * rz))
+                          + ry * (W[nd, 18, c] * yy + W[nd, 23, c] * (ry * rz) + W[nd, 25, c] * zz)
+                          + rz * (W[nd, 19, c] * zz))
+                    v = (a + (b + cc * inv_d2) * inv_d2) * inv_d3
+                    acc += v if far else 0.0
+                if near:
+                    for c in range(WIDTH - 1, -1, -1):
+                        if (near >> c) & 1:
+                            cw = CH[nd, c]
+                            if cw >= 0:
+                                stack[sp] = cw
+                                sp += 1
+                            elif cw == -1:
+                                acc += _leaf_triangles(T, LS[nd, c], LE[nd, c], qx, qy, qz)
+            out[qi] = acc
+
+
 @njit(parallel=True, cache=True, fastmath=_FASTMATH)
 def _eval_points(Q, P, NA, N, C, beta2, order, out):
     k = N.shape[0]
@@ -353,11 +442,12 @@ class FastWindingNumber(_FastWindingBase):
         t = self.tree
         far = np.maximum(np.abs(t.lo - self._D[:, :3]), np.abs(t.hi - self._D[:, :3]))
         self._D[:, 3] = np.maximum(self._D[:, 3], (far ** 2).sum(axis=1))
-        self._N = _pack_nodes(self._D, t)  # hot data of the walk: centre, r², links
-        self._C = _compact_moments(self._D)
+        # the walk tests the WIDTH children of a node together (see _eval_triangles_wide)
+        self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(
+            self._D, _compact_moments(self._D), t, self.beta ** 2, self.order)
 
     def _kernel(self, q, out):
-        _eval_triangles(q, self._T, self._N, self._C, self.beta ** 2, self.order, out)
+        _eval_triangles_wide(q, self._T, self._W, self._CH, self._LS, self._LE, self._stack, out)
 
 
 class FastWindingNumberPoints(_FastWindingBase):
