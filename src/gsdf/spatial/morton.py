@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 @njit(cache=True, inline="always")
@@ -45,3 +45,54 @@ def morton_order(Q: np.ndarray) -> np.ndarray:
     if Q.shape[0] < 2:
         return np.arange(Q.shape[0])
     return np.argsort(morton_codes(Q), kind="stable")
+
+
+def cell_order(Q: np.ndarray) -> np.ndarray:
+    """Permutation grouping points ``Q`` (n, 3) by cells of a coarse Morton grid (at most 2^15 cells, so the
+    counts stay in cache; about 4 points per cell for small n), cells in Z-order: the locality of :func:`morton_order` for tree walks at O(n) cost (one counting sort,
+    no comparison sort). Points inside one cell keep their input order.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> Q = np.random.default_rng(0).random((1000, 3))
+    >>> o = cell_order(Q)
+    >>> bool((np.sort(o) == np.arange(1000)).all())
+    True
+    """
+    n = Q.shape[0]
+    if n < 2:
+        return np.arange(n)
+    # 2^(3 bits) cells; more than 2^15 measured no better on 10^6 queries (bench/bench_winding.py) and the
+    # histogram then leaves the L2 cache
+    bits = int(min(5, max(1, round(np.log2(max(n / 4, 2)) / 3))))
+    return _counting_order(Q, Q.min(axis=0), Q.max(axis=0), bits)
+
+
+@njit(cache=True, parallel=True)
+def _counting_order(Q, lo, hi, bits):
+    n = Q.shape[0]
+    cells = 1 << (3 * bits)
+    top = (1 << bits) - 1
+    scale = np.empty(3)
+    for d in range(3):
+        ext = hi[d] - lo[d]
+        scale[d] = (top + 1) / ext if ext > 0 else 0.0
+    code = np.empty(n, np.int64)
+    count = np.zeros(cells + 1, np.int64)
+    for i in prange(n):
+        c = 0
+        for d in range(3):
+            g = min(top, np.int64((Q[i, d] - lo[d]) * scale[d]))
+            c |= _spread(g) << d
+        code[i] = c
+    for i in range(n):
+        count[code[i] + 1] += 1
+    for c in range(cells):
+        count[c + 1] += count[c]
+    order = np.empty(n, np.int64)
+    for i in range(n):
+        c = code[i]
+        order[count[c]] = i
+        count[c] += 1
+    return order
