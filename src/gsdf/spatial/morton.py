@@ -66,7 +66,38 @@ def cell_order(Q: np.ndarray) -> np.ndarray:
     # 2^(3 bits) cells; more than 2^15 measured no better on 10^6 queries (bench/bench_winding.py) and the
     # histogram then leaves the L2 cache
     bits = int(min(5, max(1, round(np.log2(max(n / 4, 2)) / 3))))
-    return _counting_order(Q, Q.min(axis=0), Q.max(axis=0), bits)
+    lo, hi = _bounds(Q)
+    return _counting_order(Q, lo, hi, bits)
+
+
+def gather_rows(Q: np.ndarray, order: np.ndarray) -> np.ndarray:
+    """``Q[order]`` as a new C-contiguous (n, 3) float64 array, copied in parallel."""
+    return _gather(Q, order)
+
+
+@njit(parallel=True, cache=True)
+def _gather(Q, order):
+    out = np.empty((order.shape[0], 3))
+    for i in prange(order.shape[0]):
+        j = order[i]
+        out[i, 0] = Q[j, 0]
+        out[i, 1] = Q[j, 1]
+        out[i, 2] = Q[j, 2]
+    return out
+
+
+@njit(cache=True)
+def _bounds(Q):  # one pass; numpy's axis-0 min/max on (n, 3) rows is several times slower
+    lo = Q[0].copy()
+    hi = Q[0].copy()
+    for i in range(1, Q.shape[0]):
+        for d in range(3):
+            x = Q[i, d]
+            if x < lo[d]:
+                lo[d] = x
+            elif x > hi[d]:
+                hi[d] = x
+    return lo, hi
 
 
 @njit(cache=True, parallel=True)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..spatial.morton import cell_order
+from ..spatial.morton import cell_order, gather_rows
 from ..threads import apply_env
 
 CHUNK = 1 << 20
@@ -42,7 +42,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         if coherent and e - s > 4096 and not _already_coherent(q):
             o = cell_order(q)
             tmp = np.empty(e - s)
-            kernel(np.ascontiguousarray(q[o]), tmp)
+            kernel(gather_rows(q, o) if dim == 3 else np.ascontiguousarray(q[o]), tmp)
             out[s:e][o] = tmp
         else:
             kernel(q, out[s:e])
@@ -56,5 +56,5 @@ def _already_coherent(q: np.ndarray) -> bool:
     step = max(1, q.shape[0] // 2048)
     a = q[: -1 : step]
     b = q[1::step][: a.shape[0]]
-    diag = float(np.linalg.norm(q.max(axis=0) - q.min(axis=0))) or 1.0
+    diag = float(np.linalg.norm(a.max(axis=0) - a.min(axis=0))) or 1.0  # of the sample: cheap, close enough
     return float(np.median(np.linalg.norm(a - b, axis=1))) < 0.01 * diag

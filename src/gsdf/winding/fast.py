@@ -243,7 +243,7 @@ def _eval_triangles(Q, T, N, C, beta2, order, out):
         out[qi] = acc
 
 
-WIDTH = 4  # children per node of the wide walk (a compile-time constant: the lane loop is unrolled)
+WIDTH = int(__import__("os").environ.get("FWN_W", 4))  # children per node of the wide walk (a compile-time constant: the lane loop is unrolled)
 _WF = 4 + COMPACT_WIDTH - 1  # fields per child slot: centre (3), β²r², the 23 compact coefficients
 
 
