@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 
 @njit(cache=True, inline="always")
@@ -71,14 +71,14 @@ def cell_order(Q: np.ndarray) -> np.ndarray:
 
 
 def gather_rows(Q: np.ndarray, order: np.ndarray) -> np.ndarray:
-    """``Q[order]`` as a new C-contiguous (n, 3) float64 array, copied in parallel."""
+    """``Q[order]`` as a new C-contiguous (n, 3) float64 array (one compiled pass)."""
     return _gather(Q, order)
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def _gather(Q, order):
     out = np.empty((order.shape[0], 3))
-    for i in prange(order.shape[0]):
+    for i in range(order.shape[0]):
         j = order[i]
         out[i, 0] = Q[j, 0]
         out[i, 1] = Q[j, 1]
@@ -100,7 +100,7 @@ def _bounds(Q):  # one pass; numpy's axis-0 min/max on (n, 3) rows is several ti
     return lo, hi
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)  # serial: ~10 ns per point; a parallel launch costs more than that under load
 def _counting_order(Q, lo, hi, bits):
     n = Q.shape[0]
     cells = 1 << (3 * bits)
@@ -111,7 +111,7 @@ def _counting_order(Q, lo, hi, bits):
         scale[d] = (top + 1) / ext if ext > 0 else 0.0
     code = np.empty(n, np.int64)
     count = np.zeros(cells + 1, np.int64)
-    for i in prange(n):
+    for i in range(n):
         c = 0
         for d in range(3):
             g = min(top, np.int64((Q[i, d] - lo[d]) * scale[d]))

@@ -31,6 +31,9 @@ Cost: precompute O(m log m); a query O(log m) for well-distributed input (bench/
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
+import numba
 import numpy as np
 from numba import njit, prange
 
@@ -462,6 +465,27 @@ def _check_params(beta, order):
     return beta, int(order)
 
 
+# Below these sizes the build kernels / the walk run on the calling thread: a numba parallel launch waits
+# for its worker threads, which on a loaded machine took 30-200 ms per launch (issue 17: measured the build
+# of rotor.off, 1200 faces, at 192 ms with 2 threads and 1 ms with one, at load 16).
+SERIAL_BUILD_FACES = 100_000
+SERIAL_QUERIES = 16_384
+
+
+@contextmanager
+def _single_thread(serial: bool):
+    """numba kernels called inside run on one thread when ``serial`` (numba's setting is per calling thread)."""
+    if not serial:
+        yield
+        return
+    before = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
+
+
 class _FastWindingBase:
     tree: BVH
     _D: np.ndarray
@@ -509,6 +533,11 @@ class FastWindingNumber(_FastWindingBase):
         self.beta, self.order = _check_params(beta, order)
         leaf_size = integer(leaf_size, "leaf_size", 1)
         self._frame = Frame.of_mesh(V, F)  # scale invariance: the tree lives in the normalised frame
+        with _single_thread(F.shape[0] < SERIAL_BUILD_FACES):
+            self._build(V, F, leaf_size)
+
+    def _build(self, V, F, leaf_size):
+        """Tree, leaf rows, node moments and the wide walk's lane data (in the normalised frame)."""
         T, X, lo, hi = _triangle_boxes(np.ascontiguousarray(self._frame.geometry(V)), F)
         self.tree = build_bvh(X, lo, hi, leaf_size, split="volume")
         self._T, X, AN, M = _triangle_rows(T, X, self.tree.order)
@@ -525,7 +554,8 @@ class FastWindingNumber(_FastWindingBase):
             self._D, _compact_moments(self._D), t, self.beta ** 2, self.order)
 
     def _kernel(self, q, out):
-        _eval_triangles_wide(q, self._T, self._W, self._CH, self._LS, self._LE, self._stack, out)
+        with _single_thread(q.shape[0] < SERIAL_QUERIES):
+            _eval_triangles_wide(q, self._T, self._W, self._CH, self._LS, self._LE, self._stack, out)
 
 
 class FastWindingNumberPoints(_FastWindingBase):
