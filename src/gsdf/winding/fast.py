@@ -26,6 +26,14 @@ Then
 which :func:`_compact_moments` folds into 23 numbers per node (constants and 1/4π included) evaluated by
 :func:`_far_field_c` as (A + (B + C/d²)/d²)/d³.
 
+Triangle walk (:func:`_eval_triangles_wide`): the binary tree is viewed as a 4-wide one
+(:mod:`gsdf.spatial.wide`); a query pops a node and evaluates the test and the expansion of all 4 children
+in one loop over lanes (data stored lane-last, (node, field, lane), so LLVM vectorises it to 4-wide SIMD),
+adds the far ones and pushes the near ones (leaves: exact solid angles). A first node holding the root
+alone keeps Algorithm 1's root test. This tests a node's grandchildren where the binary walk might have
+accepted the child: the far-field cut is finer, never coarser, so the error is lower (RMS at β = 2 on the
+CGAL meshes: 6.0e-4 vs 7.8e-4 on bunny00) at half the time per query.
+
 Cost: precompute O(m log m); a query O(log m) for well-distributed input (bench/ measures both).
 """
 
@@ -300,30 +308,9 @@ def _pack_nodes(D, tree):
     return N
 
 
-@njit(parallel=True, cache=True, fastmath=_FASTMATH)
-def _eval_triangles(Q, T, N, C, beta2, order, out):
-    k = N.shape[0]
-    for qi in prange(Q.shape[0]):
-        qx, qy, qz = Q[qi, 0], Q[qi, 1], Q[qi, 2]
-        acc = 0.0
-        i = 0
-        while i < k:
-            rx = N[i, 0] - qx
-            ry = N[i, 1] - qy
-            rz = N[i, 2] - qz
-            d2 = rx * rx + ry * ry + rz * rz
-            if d2 > beta2 * N[i, 3]:
-                acc += _far_field_c(C, i, rx, ry, rz, d2, order)
-                i = int(N[i, 4])
-            elif N[i, 5] < 0.0:
-                acc += _leaf_triangles(T, int(N[i, 6]), int(N[i, 7]), qx, qy, qz)
-                i = int(N[i, 4])
-            else:
-                i += 1
-        out[qi] = acc
-
-
-WIDTH = int(__import__("os").environ.get("FWN_W", 4))  # children per node of the wide walk (a compile-time constant: the lane loop is unrolled)
+# children per node of the wide walk (a compile-time constant: the lane loop is unrolled). 8 measured no
+# faster than 4 on the CGAL meshes (fewer visits, but 8 lanes do not fit one AVX2 register)
+WIDTH = 4
 _WF = 4 + COMPACT_WIDTH - 1  # fields per child slot: centre (3), β²r², the 23 compact coefficients
 
 
@@ -392,6 +379,9 @@ def _eval_triangles_wide(Q, T, W, CH, LS, LE, stack_size, out):
                 sp -= 1
                 nd = stack[sp]
                 near = 0
+                # the children's order-2 far fields, one SIMD lane each: Barill et al. 2018 §3.2 Eq. 13 with
+                # the App. A derivatives (Eqs. 22-24) and the §3.3 / App. B triangle moments, folded into the
+                # 23 per-node numbers of _compact_moments: w = (A + (B + C/d²)/d²)/d³
                 for c in range(WIDTH):
                     rx = W[nd, 0, c] - qx
                     ry = W[nd, 1, c] - qy
