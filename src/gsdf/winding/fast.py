@@ -458,7 +458,7 @@ def _check_params(beta, order):
 # Below these sizes the build kernels / the walk run on the calling thread: a numba parallel launch waits
 # for its worker threads, which on a loaded machine took 30-200 ms per launch (issue 17: measured the build
 # of rotor.off, 1200 faces, at 192 ms with 2 threads and 1 ms with one, at load 16).
-SERIAL_BUILD_FACES = 100_000
+SERIAL_BUILD_FACES = 100_000  # faces (triangles) or points (clouds)
 SERIAL_QUERIES = 16_384
 
 
@@ -577,17 +577,19 @@ class FastWindingNumberPoints(_FastWindingBase):
         self._frame, P, NA = oriented_area_normals(P, N, areas)  # normalised frame (gsdf._normalize)
         self.beta, self.order = _check_params(beta, order)
         leaf_size = integer(leaf_size, "leaf_size", 1)
-        self.tree = build_bvh(P, P, P, leaf_size)
-        o = self.tree.order
-        self._P = np.ascontiguousarray(P[o])
-        self._NA = np.ascontiguousarray(NA[o])
-        self._D = _node_moments(self.tree.start, self.tree.end, self._P, self._NA,
-                                np.zeros((len(P), 6)), self._P, NODE_WIDTH)
-        self._N = _pack_nodes(self._D, self.tree)
-        self._C = _compact_moments(self._D)
+        with _single_thread(len(P) < SERIAL_BUILD_FACES):
+            self.tree = build_bvh(P, P, P, leaf_size)
+            o = self.tree.order
+            self._P = np.ascontiguousarray(P[o])
+            self._NA = np.ascontiguousarray(NA[o])
+            self._D = _node_moments(self.tree.start, self.tree.end, self._P, self._NA,
+                                    np.zeros((len(P), 6)), self._P, NODE_WIDTH)
+            self._N = _pack_nodes(self._D, self.tree)
+            self._C = _compact_moments(self._D)
 
     def _kernel(self, q, out):
-        _eval_points(q, self._P, self._NA, self._N, self._C, self.beta ** 2, self.order, out)
+        with _single_thread(q.shape[0] < SERIAL_QUERIES):
+            _eval_points(q, self._P, self._NA, self._N, self._C, self.beta ** 2, self.order, out)
 
 
 def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarray:
