@@ -37,6 +37,15 @@ LOAD_NOTE = ("\n\"loaded\" columns: the same build + query timings with two busy
              "by the idle one (issue 17 asks for ≤ 1.25).")
 
 
+READING = """
+
+Triangle walk (src/gsdf/winding/fast.py): the binary tree (volume splits, leaves of 4 triangles) is walked
+4 children at a time: per node the 4 children's far-field tests and order-2 expansions are evaluated
+together in one unrolled loop that LLVM turns into 4-lane SIMD (AVX2 doubles), the near children are
+descended. The query points of a chunk are grouped by a counting sort on coarse Morton cells, and small
+builds / query sets run on the calling thread (a parallel launch waits for workers under load)."""
+
+
 def queries_in_box(X, n, rng, pad=0.1):
     lo, hi = X.min(0), X.max(0)
     return rng.uniform(lo - pad * (hi - lo), hi + pad * (hi - lo), (n, 3))
@@ -167,6 +176,8 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="10^5 queries, no 100^3 voxel check")
     ap.add_argument("--load", action="store_true",
                     help="also time the fast triangle winding numbers with two busy processes running")
+    ap.add_argument("--queries", type=int, default=0,
+                    help="queries per input for the speed tables (default 10^6, 10^5 with --quick)")
     ap.add_argument("--only", default="", help="comma list of parts: triangles,points,growth (default all)")
     args = ap.parse_args(argv)
     parts = set(args.only.split(",")) if args.only else {"triangles", "points", "growth"}
@@ -174,7 +185,9 @@ def main(argv=None):
 
     root = data_dir()
     rng = np.random.default_rng(0)
-    n_q = 100_000 if args.quick else 1_000_000
+    n_q = args.queries or (100_000 if args.quick else 1_000_000)
+    if n_q < 10_000:
+        raise SystemExit("--queries: need at least 10000 (the accuracy columns use the first 10^4)")
     info = machine()
     print("machine:", info, flush=True)
     t0 = time.time()
@@ -187,12 +200,15 @@ def main(argv=None):
     tri = bench_triangles(igl, root, n_q, not args.quick, rng, load=args.load) if "triangles" in parts else skipped
     pts = bench_points(igl, root, n_q, rng) if "points" in parts else skipped
     growth = bench_growth(igl, 100_000, rng) if "growth" in parts else skipped
-    text = f"""## Winding numbers (bench/bench_winding.py{' --quick' if args.quick else ''}{' --load' if args.load else ''})
+    flags = (f"{' --quick' if args.quick else ''}{f' --queries {args.queries}' if args.queries else ''}"
+             f"{' --load' if args.load else ''}{f' --only {args.only}' if args.only else ''}")
+    text = f"""## Winding numbers (bench/bench_winding.py{flags})
 
 Machine: {info}. Run took {time.time() - t0:.0f} s. Times are medians of 3 runs in one process.
 The machine is shared with other work: the `uptime` column is the load average when each row was measured;
 ratios against libigl measured in the same run are what count.{LOAD_NOTE if args.load else ""}
-Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_winding.py{' --quick' if args.quick else ''}{' --load' if args.load else ''}`.
+Command: `NUMBA_NUM_THREADS=2 PYTHONPATH=src /work/anchors/bin/python bench/bench_winding.py{flags}`
+(gsdf and libigl both use all cores of this machine: {os.cpu_count()}).{{reading}}
 
 ### Triangle meshes and soups, β = 2, order 2 (RMS against exact on 10⁴ random queries in the padded box)
 
@@ -211,6 +227,7 @@ error of 1/2 and either method may flip a voxel. "ratio" is (gsdf precompute + q
 
 {growth}
 """
+    text = text.replace("{reading}", READING if "triangles" in parts else "")
     # a partial run (--only) gets its own section, so the full tables of the last full run stay
     write_section("winding" if not args.only else "winding-" + "-".join(sorted(parts)), text)
     print(text)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..spatial.morton import morton_order
+from ..spatial.morton import cell_order, gather_rows
 from ..threads import apply_env
 
 CHUNK = 1 << 20
@@ -16,8 +16,9 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
 
     Only one float64 copy of one chunk exists at a time, so 10^8 float32 queries need ~chunk×24 bytes of
     scratch beyond the output. ``progress(done, total)`` is called after each chunk when given.
-    ``coherent=True`` evaluates each chunk in Morton order (tree walks of neighbouring queries then share
-    cached nodes) and scatters the results back. ``frame`` (a :class:`gsdf._normalize.Frame`) maps each
+    ``coherent=True`` evaluates each chunk grouped by cells of a coarse Morton grid
+    (:func:`gsdf.spatial.morton.cell_order`: tree walks of neighbouring queries then share cached nodes) and
+    scatters the results back. ``frame`` (a :class:`gsdf._normalize.Frame`) maps each
     validated chunk into the geometry's normalised frame first (the kernel's geometry lives there).
     """
     apply_env()  # GSDF_NUM_THREADS
@@ -39,9 +40,9 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         if frame is not None:
             q = frame.queries(q, row0=s)
         if coherent and e - s > 4096 and not _already_coherent(q):
-            o = morton_order(q)
+            o = cell_order(q)
             tmp = np.empty(e - s)
-            kernel(np.ascontiguousarray(q[o]), tmp)
+            kernel(gather_rows(q, o) if dim == 3 else np.ascontiguousarray(q[o]), tmp)
             out[s:e][o] = tmp
         else:
             kernel(q, out[s:e])
@@ -55,5 +56,5 @@ def _already_coherent(q: np.ndarray) -> bool:
     step = max(1, q.shape[0] // 2048)
     a = q[: -1 : step]
     b = q[1::step][: a.shape[0]]
-    diag = float(np.linalg.norm(q.max(axis=0) - q.min(axis=0))) or 1.0
+    diag = float(np.linalg.norm(a.max(axis=0) - a.min(axis=0))) or 1.0  # of the sample: cheap, close enough
     return float(np.median(np.linalg.norm(a - b, axis=1))) < 0.01 * diag
