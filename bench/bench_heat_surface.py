@@ -726,11 +726,163 @@ def time_step_study(levels):
     return txt
 
 
+# ------------------------------------------------------------------------------------------ speed (issue 17)
+#: The --speed inputs: CGAL scans, CAD parts, meshes with holes / boundaries, the author data of the paper.
+SPEED_MESHES = ["bunny00.off", "refined_elephant.off", "armadillo.off", "mannequin-devil.off",
+                "ChineseDragon-10kv.off", "camel.off", "cow.off", "fandisk.off", "blade.off", "turbine.off",
+                "mech-holes-shark.off", "holes.off", "elephant-with-holes.off", "shm:bumpy-sphere.obj",
+                "shm:fish-unsigned.obj", "shm:hemisphere.obj"]
+SPEED_QUICK = ["bunny00.off", "camel.off", "fandisk.off", "holes.off", "elephant-with-holes.off",
+               "shm:bumpy-sphere.obj"]
+SHM_DATA = "/work/shared/data/shm-surface"
+
+
+def _rss_kb(field="VmHWM"):
+    """Peak (VmHWM) or current (VmRSS) resident set of this process, kB (Linux /proc; 0 elsewhere)."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1])
+    except OSError:
+        pass
+    return 0
+
+
+def _reset_peak_rss():
+    """Reset VmHWM to the current RSS (Linux ≥ 4.0: ``echo 5 > /proc/self/clear_refs``); False if unavailable."""
+    try:
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")
+        return True
+    except OSError:
+        return False
+
+
+def _speed_case(path):
+    """Mesh (degenerate faces dropped) and the curves: boundary loops of {y < median} along edges."""
+    V, F = gsdf.read_mesh(path)
+    V, F, _ = clean(V, F)
+    f = V[:, 1] - np.median(V[:, 1])
+    loops = region_boundary_curves(F, (f[F] < 0).all(1))
+    return V, F, loops
+
+
+def _time_first_repeat(make, solve, repeat):
+    """(first = constructor + first solve, repeated = median of ``repeat`` further solves, peak RSS increase MB)."""
+    import gc
+
+    gc.collect()
+    base = _rss_kb("VmRSS")
+    _reset_peak_rss()
+    t0 = time.perf_counter()
+    s = make()
+    out = solve(s)
+    first = time.perf_counter() - t0
+    rep, _ = median_time(lambda: solve(s), repeat)
+    peak = (_rss_kb() - base) / 1024
+    del s
+    return first, rep, peak, out
+
+
+def speed_table(names, rounds=3, label="idle"):
+    """Per mesh: gsdf vs potpourri3d, first (constructor + first solve) and repeated solve, medians over
+    ``rounds`` fresh solvers each (the libraries interleaved, the order alternating), constraint "zero" =
+    potpourri3d's default ZeroSet; peak RSS increase of one first + repeated run."""
+    rows, ratios = [], []
+    for name in names:
+        path = os.path.join(SHM_DATA, name[4:]) if name.startswith("shm:") else os.path.join(data_dir(), "meshes", name)
+        V, F, loops = _speed_case(path)
+        pp_loops = [[(int(v), []) for v in c] for c in loops]
+        res = {"gsdf": [], "pp3d": []}
+        runs = {"gsdf": (lambda: SurfaceSignedHeatSolver(V, F), lambda s: s.compute_distance(loops)),
+                "pp3d": (lambda: pp3d.MeshSignedHeatSolver(V, F), lambda s: s.compute_distance(pp_loops))}
+        for r in range(rounds):
+            for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
+                res[lib].append(_time_first_repeat(*runs[lib], repeat=3))
+        med = {k: [float(np.median([x[i] for x in v])) for i in range(3)] for k, v in res.items()}
+        p, q = res["gsdf"][-1][3], -res["pp3d"][-1][3]
+        d = float(np.linalg.norm(p - q) / np.linalg.norm(q))
+        rf, rr = med["gsdf"][0] / med["pp3d"][0], med["gsdf"][1] / med["pp3d"][1]
+        ratios.append((name, rf, rr))
+        rows.append([name.replace("shm:", ""), len(V), len(F), len(loops), f"{med['gsdf'][0]:.3f}",
+                     f"{med['pp3d'][0]:.3f}", f"**{rf:.2f}**", f"{med['gsdf'][1]:.4f}", f"{med['pp3d'][1]:.4f}",
+                     f"**{rr:.2f}**", f"{med['gsdf'][2]:.0f} / {med['pp3d'][2]:.0f}", f"{d:.1e}"])
+        print("speed", label, rows[-1], os.getloadavg()[0], flush=True)
+    hdr = ["mesh", "vertices", "faces", "loops", "gsdf first s", "pp3d first s", "first ratio", "gsdf repeat s",
+           "pp3d repeat s", "repeat ratio", "peak RSS +MB gsdf / pp3d", "rel. L2 diff"]
+    return table(hdr, rows), ratios
+
+
+def speed(quick=False, load=False):
+    """Issue 17 goals 4–5: the surface signed heat method against potpourri3d on ≥ 10 meshes, idle and with two
+    busy processes competing (bench/load.py)."""
+    from importlib.metadata import version
+
+    from load import BusyLoad, uptime
+
+    names = SPEED_QUICK if quick else SPEED_MESHES
+    rounds = 3
+    # warm-up: numba kernels and first-call costs of both libraries outside the timings
+    Vw, Fw = sphere_mesh(2)
+    lw = level_set_curves(Vw, Fw, Vw[:, 2] - 0.1)
+    SurfaceSignedHeatSolver(Vw, Fw).compute_distance(lw)
+    lv = region_boundary_curves(Fw, Vw[Fw].mean(1)[:, 2] < 0)
+    SurfaceSignedHeatSolver(Vw, Fw).compute_distance(lv)
+    pp3d.MeshSignedHeatSolver(Vw, Fw).compute_distance([[(int(v), []) for v in c] for c in lv])
+    start = uptime()
+    t_idle, r_idle = speed_table(names, rounds, "idle")
+    parts = [f"### Idle ({start} at start, {uptime()} at end)\n\n" + t_idle]
+    r_load = None
+    if load:
+        with BusyLoad(2):
+            s2 = uptime()
+            t_load, r_load = speed_table(names, rounds, "load")
+            e2 = uptime()
+        parts.append(f"### Two busy processes competing (bench/load.py BusyLoad(2); {s2} at start, {e2} at end)"
+                     "\n\n" + t_load)
+    fi = [r[1] for r in r_idle]
+    ri = [r[2] for r in r_idle]
+    summ = (f"Idle: first-solve ratio gsdf / potpourri3d {min(fi):.2f}–{max(fi):.2f} (≤ 1.0 on "
+            f"{sum(x <= 1.0 for x in fi)}/{len(fi)}), repeated {min(ri):.2f}–{max(ri):.2f} (≤ 0.5 on "
+            f"{sum(x <= 0.5 for x in ri)}/{len(ri)}).")
+    if r_load is not None:
+        fl = [r[1] for r in r_load]
+        rl = [r[2] for r in r_load]
+        gf = [b / a for a, b in zip(fi, fl)]
+        gr = [b / a for a, b in zip(ri, rl)]
+        summ += (f" Under load: first {min(fl):.2f}–{max(fl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in fl)}/{len(fl)}), "
+                 f"repeated {min(rl):.2f}–{max(rl):.2f} (≤ 0.5 on {sum(x <= 0.5 for x in rl)}/{len(rl)}); "
+                 f"loaded ratio / idle ratio: first {min(gf):.2f}–{max(gf):.2f}, repeated {min(gr):.2f}–"
+                 f"{max(gr):.2f} (≤ 1.25 on {sum(x <= 1.25 for x in gf)}/{len(gf)} and "
+                 f"{sum(x <= 1.25 for x in gr)}/{len(gr)}).")
+    txt = (f"## Surface signed heat method: speed against potpourri3d on {len(names)} meshes (issue 17)\n\n"
+           f"Machine: {machine()}; shared with other helpers (load averages per table). Command: "
+           f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --load{' --quick' if quick else ''}`. "
+           f"potpourri3d {version('potpourri3d')} `MeshSignedHeatSolver`, gsdf `SurfaceSignedHeatSolver`, one "
+           "process, same mesh and curves (the boundary loops of {y < median} along edges), constraint \"zero\" = "
+           "potpourri3d's default `ZeroSet` (both: φ = 0 at the curve vertices). first = constructor + first "
+           "solve; repeat = median of 3 further solves with the same curves; each the median over "
+           f"{rounds} fresh solvers, the libraries interleaved with alternating order. Peak RSS = growth of the "
+           "process's VmHWM over the RSS before the case (median). Ratios = gsdf / potpourri3d (goal: first ≤ 1.0, "
+           "repeat ≤ 0.5, loaded ratio within 1.25× of the idle one).\n\n" + summ + "\n\n" + "\n\n".join(parts)
+           + "\n")
+    return txt
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="smaller sizes, no RESULTS.md update")
     ap.add_argument("--time-step", action="store_true", help="only the diffusion-time / convergence-order study")
+    ap.add_argument("--speed", action="store_true", help="only the speed table against potpourri3d (issue 17)")
+    ap.add_argument("--load", action="store_true", help="with --speed: also under two busy processes")
     args = ap.parse_args()
+    if args.speed:
+        txt = speed(quick=args.quick, load=args.load)
+        print(txt)
+        if args.load:
+            write_section("heat-surface-speed" + ("-quick" if args.quick else ""), txt)
+        return
     if args.time_step:
         time_step_study([20, 40, 80] if args.quick else [28, 56, 112, 224])
         return
