@@ -830,17 +830,21 @@ def speed(quick=False, load=False):
     lv = region_boundary_curves(Fw, Vw[Fw].mean(1)[:, 2] < 0)
     SurfaceSignedHeatSolver(Vw, Fw).compute_distance(lv)
     pp3d.MeshSignedHeatSolver(Vw, Fw).compute_distance([[(int(v), []) for v in c] for c in lv])
+    pnames = POLY_QUICK if quick else POLY_SPEED
     start = uptime()
     t_idle, r_idle = speed_table(names, rounds, "idle")
-    parts = [f"### Idle ({start} at start, {uptime()} at end)\n\n" + t_idle]
-    r_load = None
+    tp_idle, rp_idle = poly_speed_table(pnames, rounds, "idle")
+    parts = [f"### Idle ({start} at start, {uptime()} at end)\n\n" + t_idle + "\n\nPolygon meshes (§8.3):\n\n"
+             + tp_idle]
+    r_load = rp_load = None
     if load:
         with BusyLoad(2):
             s2 = uptime()
             t_load, r_load = speed_table(names, rounds, "load")
+            tp_load, rp_load = poly_speed_table(pnames, rounds, "load")
             e2 = uptime()
         parts.append(f"### Two busy processes competing (bench/load.py BusyLoad(2); {s2} at start, {e2} at end)"
-                     "\n\n" + t_load)
+                     "\n\n" + t_load + "\n\nPolygon meshes (§8.3):\n\n" + tp_load)
     fi = [r[1] for r in r_idle]
     ri = [r[2] for r in r_idle]
     summ = (f"Idle: first-solve ratio gsdf / potpourri3d {min(fi):.2f}–{max(fi):.2f} (≤ 1.0 on "
@@ -856,6 +860,15 @@ def speed(quick=False, load=False):
                  f"loaded ratio / idle ratio: first {min(gf):.2f}–{max(gf):.2f}, repeated {min(gr):.2f}–"
                  f"{max(gr):.2f} (≤ 1.25 on {sum(x <= 1.25 for x in gf)}/{len(gf)} and "
                  f"{sum(x <= 1.25 for x in gr)}/{len(gr)}).")
+    pi = [r[1] for r in rp_idle]
+    summ += (f" Polygon meshes, idle: first {min(pi):.2f}–{max(pi):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in pi)}/"
+             f"{len(pi)}), repeated {min(r[2] for r in rp_idle):.2f}–{max(r[2] for r in rp_idle):.2f}")
+    if rp_load is not None:
+        pl = [r[1] for r in rp_load]
+        summ += (f"; under load: first {min(pl):.2f}–{max(pl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in pl)}/{len(pl)}), "
+                 f"loaded / idle ratio {min(b / a for a, b in zip(pi, pl)):.2f}–"
+                 f"{max(b / a for a, b in zip(pi, pl)):.2f}")
+    summ += "."
     txt = (f"## Surface signed heat method: speed against potpourri3d on {len(names)} meshes (issue 17)\n\n"
            f"Machine: {machine()}; shared with other helpers (load averages per table). Command: "
            f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --load{' --quick' if quick else ''}`. "
@@ -870,13 +883,95 @@ def speed(quick=False, load=False):
     return txt
 
 
+# ------------------------------------------------------------------------------------------ factorization rule
+#: SuperLU options compared by --solver-rule: (label, permc_spec, relax, panel_size); None = SuperLU's default
+SUPERLU_OPTIONS = [("MMD, default supernodes", "MMD_AT_PLUS_A", None, None),
+                   ("MMD, relax 20, panel 5", "MMD_AT_PLUS_A", 20, 5),
+                   ("MMD, relax 40, panel 5", "MMD_AT_PLUS_A", 40, 5),
+                   ("MMD, relax 80, panel 5", "MMD_AT_PLUS_A", 80, 5),
+                   ("MMD, relax 40, panel 10", "MMD_AT_PLUS_A", 40, 10),
+                   ("COLAMD, default", "COLAMD", None, None)]
+
+
+def _solver_matrices(name):
+    """The two systems of a first "zero" solve: the vector heat operator (complex Hermitian, CR edges) and the
+    Dirichlet-reduced Poisson operator (real SPD) of the --speed curves."""
+    import scipy.sparse as sp
+
+    if name.startswith("poly:"):
+        from gsdf.heat import PolygonMeshSignedHeatSolver
+
+        V, polys, loops = _poly_speed_case(name)
+        d = PolygonMeshSignedHeatSolver(V, polys).domain
+        C, Mv = d.L, d.Mv
+    else:
+        path = os.path.join(SHM_DATA, name[4:]) if name.startswith("shm:") else os.path.join(data_dir(), "meshes", name)
+        V, F, loops = _speed_case(path)
+        d = SurfaceSignedHeatSolver(V, F).domain
+        C, Mv = d.C, d._Mv
+    A = sp.csc_matrix(d.vector_heat_matrix())
+    fixed = np.unique(np.concatenate(loops))
+    free = np.setdiff1d(np.arange(C.shape[0]), fixed)
+    eps_ = 1e-10 * float(np.abs(C.diagonal()).mean()) / float(Mv.mean())
+    P = sp.csc_matrix(C[free][:, free] + sp.diags(eps_ * Mv[free]))
+    return A, P
+
+
+def solver_rule(names, repeat=3):
+    """Factorization time of the two systems per mesh for SuperLU orderings / supernode settings and CHOLMOD."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from gsdf.linalg import CholeskyFactorization, HermitianFactorization
+    from gsdf.threads import blas_region
+
+    def best(fn):
+        ts = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            fn()
+            ts.append(time.perf_counter() - t0)
+        return min(ts)
+
+    rows = []
+    wins = {}
+    for name in names:
+        A, P = _solver_matrices(name)
+        for lab, M in (("vector heat (complex)", A), ("Poisson, Dirichlet (real)", P)):
+            t = {}
+            with blas_region():
+                for olab, spec, relax, panel in SUPERLU_OPTIONS:
+                    t[olab] = best(lambda: spla.splu(M, permc_spec=spec, diag_pivot_thresh=0.0, relax=relax,
+                                                     panel_size=panel, options={"SymmetricMode": True}))
+            if M.dtype == np.complex128:
+                t["CHOLMOD (2n real form)"] = best(lambda: HermitianFactorization(M, backend="cholmod"))
+            else:
+                t["CHOLMOD"] = best(lambda: CholeskyFactorization(M))
+            ref = t[SUPERLU_OPTIONS[0][0]]
+            win = min(t, key=t.get)
+            wins.setdefault(lab, []).append(win)
+            rows.append([name.replace("shm:", "").replace("poly:", "polygon "), lab, M.shape[0], M.nnz]
+                        + [f"{t[k]:.3f}" + (f" ({t[k] / ref:.2f})" if k != SUPERLU_OPTIONS[0][0] else "")
+                           for k in t] + [win])
+            print("rule", rows[-1], os.getloadavg()[0], flush=True)
+    hdr = (["mesh", "system", "unknowns", "nonzeros"] + [o[0] for o in SUPERLU_OPTIONS] + ["CHOLMOD"]
+           + ["fastest"])
+    return table(hdr, rows), wins
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="smaller sizes, no RESULTS.md update")
     ap.add_argument("--time-step", action="store_true", help="only the diffusion-time / convergence-order study")
     ap.add_argument("--speed", action="store_true", help="only the speed table against potpourri3d (issue 17)")
+    ap.add_argument("--solver-rule", action="store_true", help="factorization options per mesh (issue 17)")
     ap.add_argument("--load", action="store_true", help="with --speed: also under two busy processes")
     args = ap.parse_args()
+    if args.solver_rule:
+        txt, wins = solver_rule(SPEED_QUICK if args.quick else SPEED_MESHES + POLY_SPEED)
+        print(txt)
+        print(wins)
+        return
     if args.speed:
         txt = speed(quick=args.quick, load=args.load)
         print(txt)
@@ -905,8 +1000,6 @@ def main():
         write_section("heat-surface", text)
 
 
-if __name__ == "__main__" and "--polygon-pointcloud" not in sys.argv:
-    main()
 
 
 # ------------------------------------------------------------------------------------------ §8.3 / §8.4 vs potpourri3d
@@ -1172,3 +1265,84 @@ def polygon_pointcloud_vs_potpourri():
 
 if __name__ == "__main__" and "--polygon-pointcloud" in sys.argv:
     polygon_pointcloud_vs_potpourri()
+
+
+# ------------------------------------------------------------------------------------------ polygon speed (issue 17)
+POLY_SPEED = ["poly:cube sphere 32", "poly:cube sphere 64", "poly:UV sphere", "poly:quad torus",
+              "poly:polygon_mesh merged", "poly:polygon-bear.obj"]
+POLY_QUICK = ["poly:cube sphere 32", "poly:quad torus", "poly:polygon-bear.obj"]
+
+
+def _poly_region_loops(V, polys, inside):
+    """Boundary loops (along polygon edges) of the polygons flagged ``inside``: via the fan triangulation."""
+    tri, owner = [], []
+    for k, p in enumerate(polys):
+        for i in range(1, len(p) - 1):
+            tri.append((p[0], p[i], p[i + 1]))
+            owner.append(k)
+    return region_boundary_curves(np.array(tri, np.int64), inside[np.array(owner)])
+
+
+def _poly_speed_case(name):
+    """(V, polygons, loops) of a polygon-mesh --speed case; loops = boundary of {centroid y < median}."""
+    key = name[5:]
+    if key.startswith("cube sphere"):
+        V, Q = _cube_sphere(int(key.split()[-1]))
+        polys = Q
+    elif key == "UV sphere":
+        nl, nlon = 48, 96
+        th = np.linspace(0, np.pi, nl + 1)[1:-1]
+        T, Pp = np.meshgrid(th, np.linspace(0, 2 * np.pi, nlon, endpoint=False), indexing="ij")
+        V = np.vstack([[0, 0, 1], np.stack([np.sin(T) * np.cos(Pp), np.sin(T) * np.sin(Pp), np.cos(T)],
+                                          -1).reshape(-1, 3), [0, 0, -1]])
+        idx = 1 + np.arange((nl - 1) * nlon).reshape(nl - 1, nlon)
+        nx = np.roll(idx, -1, axis=1)
+        polys = [list(q) for q in np.stack([idx[:-1], idx[1:], nx[1:], nx[:-1]], -1).reshape(-1, 4)]
+        polys += [[0, a, b] for a, b in zip(idx[0], nx[0])] + [[len(V) - 1, b, a] for a, b in zip(idx[-1], nx[-1])]
+    elif key == "quad torus":
+        V, polys, _ = _quad_torus(128, 64)
+    elif key == "polygon_mesh merged":
+        V, F = gsdf.read_mesh(os.path.join(data_dir(), "meshes", "polygon_mesh.off"))
+        polys, _ = _merge_triangle_pairs(F)
+    else:
+        V, polys = gsdf.read_mesh(os.path.join(SHM_DATA, key), triangulate=False)
+    cen = np.array([V[p].mean(0) for p in polys])
+    loops = _poly_region_loops(V, polys, cen[:, 1] < np.median(cen[:, 1]))
+    return V, polys, loops
+
+
+def poly_speed_table(names, rounds=3, label="idle"):
+    """Polygon meshes: gsdf PolygonMeshSignedHeatSolver vs potpourri3d PolygonMeshHeatSolver, constructor + first
+    signed-distance solve and a repeated solve, "zero" = potpourri3d's default ZeroSet."""
+    from gsdf.heat import PolygonMeshSignedHeatSolver
+
+    rows, ratios = [], []
+    for name in names:
+        V, polys, loops = _poly_speed_case(name)
+        arr = np.asarray(polys) if len({len(p) for p in polys}) == 1 else None
+        pp_polys = arr if arr is not None else [list(map(int, p)) for p in polys]
+        pp_loops = [list(map(int, c)) for c in loops]
+        res = {"gsdf": [], "pp3d": []}
+        runs = {"gsdf": (lambda: PolygonMeshSignedHeatSolver(V, polys), lambda s: s.compute_distance(loops)),
+                "pp3d": (lambda: pp3d.PolygonMeshHeatSolver(V, pp_polys),
+                         lambda s: s.compute_signed_distance(pp_loops))}
+        for r in range(rounds):
+            for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
+                res[lib].append(_time_first_repeat(*runs[lib], repeat=3))
+        med = {k: [float(np.median([x[i] for x in v])) for i in range(3)] for k, v in res.items()}
+        p, q = res["gsdf"][-1][3], res["pp3d"][-1][3]
+        d = float(np.linalg.norm(p - q) / np.linalg.norm(q))
+        rf, rr = med["gsdf"][0] / med["pp3d"][0], med["gsdf"][1] / med["pp3d"][1]
+        ratios.append((name, rf, rr))
+        rows.append([name[5:], len(V), len(polys), len(loops), f"{med['gsdf'][0]:.3f}", f"{med['pp3d'][0]:.3f}",
+                     f"**{rf:.2f}**", f"{med['gsdf'][1]:.4f}", f"{med['pp3d'][1]:.4f}", f"**{rr:.2f}**",
+                     f"{med['gsdf'][2]:.0f} / {med['pp3d'][2]:.0f}", f"{d:.1e}"])
+        print("poly-speed", label, rows[-1], os.getloadavg()[0], flush=True)
+    hdr = ["polygon mesh", "vertices", "polygons", "loops", "gsdf first s", "pp3d first s", "first ratio",
+           "gsdf repeat s", "pp3d repeat s", "repeat ratio", "peak RSS +MB gsdf / pp3d",
+           "rel. L2 diff (two discretizations)"]
+    return table(hdr, rows), ratios
+
+
+if __name__ == "__main__" and "--polygon-pointcloud" not in sys.argv:
+    main()
