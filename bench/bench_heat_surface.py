@@ -885,12 +885,11 @@ def speed(quick=False, load=False):
 
 # ------------------------------------------------------------------------------------------ factorization rule
 #: SuperLU options compared by --solver-rule: (label, permc_spec, relax, panel_size); None = SuperLU's default
-SUPERLU_OPTIONS = [("MMD, default supernodes", "MMD_AT_PLUS_A", None, None),
-                   ("MMD, relax 20, panel 5", "MMD_AT_PLUS_A", 20, 5),
-                   ("MMD, relax 40, panel 5", "MMD_AT_PLUS_A", 40, 5),
-                   ("MMD, relax 80, panel 5", "MMD_AT_PLUS_A", 80, 5),
-                   ("MMD, relax 40, panel 10", "MMD_AT_PLUS_A", 40, 10),
-                   ("COLAMD, default", "COLAMD", None, None)]
+SUPERLU_OPTIONS = [("MMD, SuperLU defaults", "MMD_AT_PLUS_A", None, None, False),
+                   ("MMD, relax 40, panel 5", "MMD_AT_PLUS_A", 40, 5, False),
+                   ("RCM + MMD, SuperLU defaults", "MMD_AT_PLUS_A", None, None, True),
+                   ("RCM + MMD, relax 40, panel 5 (gsdf)", "MMD_AT_PLUS_A", 40, 5, True),
+                   ("COLAMD, SuperLU defaults", "COLAMD", None, None, False)]
 
 
 def _solver_matrices(name):
@@ -921,6 +920,7 @@ def solver_rule(names, repeat=3):
     """Factorization time of the two systems per mesh for SuperLU orderings / supernode settings and CHOLMOD."""
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
 
     from gsdf.linalg import CholeskyFactorization, HermitianFactorization
     from gsdf.threads import blas_region
@@ -940,9 +940,15 @@ def solver_rule(names, repeat=3):
         for lab, M in (("vector heat (complex)", A), ("Poisson, Dirichlet (real)", P)):
             t = {}
             with blas_region():
-                for olab, spec, relax, panel in SUPERLU_OPTIONS:
-                    t[olab] = best(lambda: spla.splu(M, permc_spec=spec, diag_pivot_thresh=0.0, relax=relax,
-                                                     panel_size=panel, options={"SymmetricMode": True}))
+                for olab, spec, relax, panel, rcm in SUPERLU_OPTIONS:
+                    def run():
+                        B = M
+                        if rcm:
+                            p = reverse_cuthill_mckee(M.tocsr(), symmetric_mode=True)
+                            B = sp.csc_matrix(M[p][:, p])
+                        spla.splu(B, permc_spec=spec, diag_pivot_thresh=0.0, relax=relax, panel_size=panel,
+                                  options={"SymmetricMode": True})
+                    t[olab] = best(run)
             if M.dtype == np.complex128:
                 t["CHOLMOD (2n real form)"] = best(lambda: HermitianFactorization(M, backend="cholmod"))
             else:
