@@ -196,9 +196,11 @@ class TriangleMeshOperators:
         Eq. 3; the boundary term n·Y is omitted as in the paper). With the PSD cotan Laplacian C, ``C φ = b``
         is the least-squares fit ∇φ ≈ Y of Eq. 2."""
         F = self.F
-        E = self.P[:, NEXT] - self.P                            # slot vectors
-        # |f| ∇λ_k = ½ n × (v_{k+2} - v_{k+1}) = ½ n × E[:, k+1]
-        G = 0.5 * np.cross(self.normals[:, None, :], E[:, NEXT])
+        G = getattr(self, "_div_G", None)
+        if G is None:                                           # per mesh, kept for repeated solves
+            E = self.P[:, NEXT] - self.P                        # slot vectors
+            # |f| ∇λ_k = ½ n × (v_{k+2} - v_{k+1}) = ½ n × E[:, k+1]
+            G = self._div_G = 0.5 * np.cross(self.normals[:, None, :], E[:, NEXT])
         contrib = np.einsum("fkj,fj->fk", G, Y)
         return np.bincount(F.ravel(), weights=contrib.ravel(), minlength=self.n_vertices)
 
