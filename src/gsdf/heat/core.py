@@ -89,7 +89,10 @@ def hash_key(*arrays) -> str:
 
 def normalize(Y: np.ndarray) -> np.ndarray:
     """Step II: Y / |Y| per row; rows with |Y| = 0 stay 0."""
-    nrm = np.linalg.norm(Y, axis=1)
+    sq = Y[:, 0] * Y[:, 0]                                  # |Y|² summed left to right, as np.linalg.norm does
+    for j in range(1, Y.shape[1]):
+        sq += Y[:, j] * Y[:, j]
+    nrm = np.sqrt(sq)
     out = np.zeros_like(Y)
     np.divide(Y, nrm[:, None], out=out, where=nrm[:, None] > 0)
     return out
