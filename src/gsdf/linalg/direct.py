@@ -42,25 +42,23 @@ __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorizati
            "cholesky", "cached_factorization"]
 
 
-
-
 class Factorization:
     """A sparse LU factorization of a square (typically symmetric / Hermitian) matrix, reused across solves.
 
     Parameters
     ----------
     A : scipy.sparse matrix, shape (n, n), real or complex
-    reorder : bool
-        Renumber the unknowns by reverse Cuthill–McKee before SuperLU's minimum-degree ordering (same fill; the
-        ordering step is up to ~15× faster on badly numbered inputs, bench_heat_surface.py --solver-rule).
-        Rounding then differs from the unreordered factorization (≈ 1e-15 relative on well-conditioned
-        systems, so it is used for the vector heat and Dirichlet systems, not for the ε-regularized ones).
     symmetric : bool
         Use the symmetric mode of SuperLU (ordering of A + Aᵀ, diagonal pivots first): several times less fill
         for the Laplacian-like matrices of the heat method. Falls back to the general LU below when a pivot
         vanishes.
     ordering, pivot : str, float
         Column ordering (``permc_spec``) and partial-pivoting threshold of the general LU.
+    reorder : bool
+        Renumber the unknowns by reverse Cuthill–McKee before SuperLU's minimum-degree ordering (same fill; the
+        ordering step is up to ~15× faster on badly numbered inputs, bench_heat_surface.py --solver-rule).
+        Rounding then differs from the unreordered factorization (≈ 1e-15 relative on well-conditioned
+        systems, so it is used for the vector heat and Dirichlet systems, not for the ε-regularized ones).
     """
 
     def __init__(self, A, symmetric: bool = True, ordering: str = "MMD_AT_PLUS_A", pivot: float = 0.1,
