@@ -978,12 +978,13 @@ def main():
         from load import uptime
 
         start = uptime()
-        tab, wins = solver_rule(SPEED_QUICK if args.quick else SPEED_MESHES + POLY_SPEED)
+        tab, wins = solver_rule(SPEED_QUICK + POLY_QUICK if args.quick else SPEED_MESHES + POLY_SPEED,
+                                repeat=2 if args.quick else 3)
         count = {lab: {k: v.count(k) for k in sorted(set(v))} for lab, v in wins.items()}
         txt = ("## Surface signed heat method: factorization rule (issue 17)\n\n"
                f"Machine: {machine()}; shared ({start} at start, {uptime()} at end). Command: "
-               "`/work/anchors/bin/python bench/bench_heat_surface.py --solver-rule`. Factorization time (best of "
-               "3, seconds; in parentheses the ratio to plain MMD) of the two systems of a first \"zero\" solve "
+               f"`/work/anchors/bin/python bench/bench_heat_surface.py --solver-rule{' --quick' if args.quick else ''}`. "
+               f"Factorization time (best of {2 if args.quick else 3}, seconds; in parentheses the ratio to plain MMD) of the two systems of a first \"zero\" solve "
                "of the --speed cases: the vector heat operator M + tL∇ (complex Hermitian; CR edges on triangle "
                "meshes, vertices on polygon meshes) and the Poisson operator with the curve vertices eliminated "
                "(real SPD). SuperLU in symmetric mode with one BLAS thread (gsdf.threads.blas_region); CHOLMOD = "
@@ -991,8 +992,7 @@ def main():
                + "; ".join(f"{lab}: " + ", ".join(f"{k} {n}×" for k, n in c.items()) for lab, c in count.items())
                + ".\n\n" + tab + "\n")
         print(txt)
-        if not args.quick:
-            write_section("heat-surface-solver-rule", txt)
+        write_section("heat-surface-solver-rule" + ("-quick" if args.quick else ""), txt)
         return
     if args.speed:
         txt = speed(quick=args.quick, load=args.load)
