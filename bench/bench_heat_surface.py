@@ -732,6 +732,7 @@ SPEED_MESHES = ["bunny00.off", "refined_elephant.off", "armadillo.off", "mannequ
                 "ChineseDragon-10kv.off", "camel.off", "cow.off", "fandisk.off", "blade.off", "turbine.off",
                 "mech-holes-shark.off", "holes.off", "elephant-with-holes.off", "shm:bumpy-sphere.obj",
                 "shm:fish-unsigned.obj", "shm:hemisphere.obj"]
+SPEED_LARGE = ["bunny00.off", "refined_elephant.off", "armadillo.off"]
 SPEED_QUICK = ["bunny00.off", "camel.off", "fandisk.off", "holes.off", "elephant-with-holes.off",
                "shm:bumpy-sphere.obj"]
 SHM_DATA = "/work/shared/data/shm-surface"
@@ -814,7 +815,7 @@ def speed_table(names, rounds=3, label="idle"):
     return table(hdr, rows), ratios
 
 
-def speed(quick=False, load=False):
+def speed(quick=False, load=False, small=False):
     """Issue 17 goals 4–5: the surface signed heat method against potpourri3d on ≥ 10 meshes, idle and with two
     busy processes competing (bench/load.py)."""
     from importlib.metadata import version
@@ -822,6 +823,8 @@ def speed(quick=False, load=False):
     from load import BusyLoad, uptime
 
     names = SPEED_QUICK if quick else SPEED_MESHES
+    if small:                                               # the 13 meshes below 20k vertices
+        names = [m for m in names if m not in SPEED_LARGE]
     rounds = 3
     # warm-up: numba kernels and first-call costs of both libraries outside the timings
     Vw, Fw = sphere_mesh(2)
@@ -871,7 +874,8 @@ def speed(quick=False, load=False):
     summ += "."
     txt = (f"## Surface signed heat method: speed against potpourri3d on {len(names)} meshes (issue 17)\n\n"
            f"Machine: {machine()}; shared with other helpers (load averages per table). Command: "
-           f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --load{' --quick' if quick else ''}`. "
+           f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --load{' --quick' if quick else ''}"
+           f"{' --small' if small else ''}`. "
            f"potpourri3d {version('potpourri3d')} `MeshSignedHeatSolver`, gsdf `SurfaceSignedHeatSolver`, one "
            "process, same mesh and curves (the boundary loops of {y < median} along edges), constraint \"zero\" = "
            "potpourri3d's default `ZeroSet` (both: φ = 0 at the curve vertices). first = constructor + first "
@@ -972,6 +976,7 @@ def main():
     ap.add_argument("--time-step", action="store_true", help="only the diffusion-time / convergence-order study")
     ap.add_argument("--speed", action="store_true", help="only the speed table against potpourri3d (issue 17)")
     ap.add_argument("--solver-rule", action="store_true", help="factorization options per mesh (issue 17)")
+    ap.add_argument("--small", action="store_true", help="with --speed: without the three meshes above 20k vertices")
     ap.add_argument("--load", action="store_true", help="with --speed: also under two busy processes")
     args = ap.parse_args()
     if args.solver_rule:
@@ -995,7 +1000,7 @@ def main():
         write_section("heat-surface-solver-rule" + ("-quick" if args.quick else ""), txt)
         return
     if args.speed:
-        txt = speed(quick=args.quick, load=args.load)
+        txt = speed(quick=args.quick, load=args.load, small=args.small)
         print(txt)
         if args.load:
             write_section("heat-surface-speed" + ("-quick" if args.quick else ""), txt)
