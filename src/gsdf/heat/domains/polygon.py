@@ -51,8 +51,8 @@ def _parse_polygons(polygons, n: int) -> dict:
     """Validate polygons; return {degree: (q, degree) int64 array} (vectorized per degree)."""
     import itertools
 
-    if not isinstance(polygons, np.ndarray) and len(polygons) and all(isinstance(p, np.ndarray) and p.ndim == 1
-                                                                     for p in polygons[:1]):
+    if isinstance(polygons, (list, tuple)) and polygons and isinstance(polygons[0], np.ndarray) \
+            and polygons[0].ndim == 1:
         try:                                                  # a list of equal-length index arrays: one array
             stacked = np.array(polygons)
         except ValueError:                                    # ragged
