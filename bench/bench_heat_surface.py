@@ -726,11 +726,285 @@ def time_step_study(levels):
     return txt
 
 
+# ------------------------------------------------------------------------------------------ speed (issue 17)
+#: The --speed inputs: CGAL scans, CAD parts, meshes with holes / boundaries, the author data of the paper.
+SPEED_MESHES = ["bunny00.off", "refined_elephant.off", "armadillo.off", "mannequin-devil.off",
+                "ChineseDragon-10kv.off", "camel.off", "cow.off", "fandisk.off", "blade.off", "turbine.off",
+                "mech-holes-shark.off", "holes.off", "elephant-with-holes.off", "shm:bumpy-sphere.obj",
+                "shm:fish-unsigned.obj", "shm:hemisphere.obj"]
+SPEED_LARGE = ["bunny00.off", "refined_elephant.off", "armadillo.off"]
+SPEED_QUICK = ["bunny00.off", "camel.off", "fandisk.off", "holes.off", "elephant-with-holes.off",
+               "shm:bumpy-sphere.obj"]
+SHM_DATA = "/work/shared/data/shm-surface"
+
+
+def _rss_kb(field="VmHWM"):
+    """Peak (VmHWM) or current (VmRSS) resident set of this process, kB (Linux /proc; 0 elsewhere)."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1])
+    except OSError:
+        pass
+    return 0
+
+
+def _reset_peak_rss():
+    """Reset VmHWM to the current RSS (Linux ≥ 4.0: ``echo 5 > /proc/self/clear_refs``); False if unavailable."""
+    try:
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")
+        return True
+    except OSError:
+        return False
+
+
+def _speed_case(path):
+    """Mesh (degenerate faces dropped) and the curves: boundary loops of {y < median} along edges."""
+    V, F = gsdf.read_mesh(path)
+    V, F, _ = clean(V, F)
+    f = V[:, 1] - np.median(V[:, 1])
+    loops = region_boundary_curves(F, (f[F] < 0).all(1))
+    return V, F, loops
+
+
+def _time_first_repeat(make, solve, repeat):
+    """(first = constructor + first solve, repeated = median of ``repeat`` further solves, peak RSS increase MB)."""
+    import gc
+
+    gc.collect()
+    base = _rss_kb("VmRSS")
+    _reset_peak_rss()
+    t0 = time.perf_counter()
+    s = make()
+    out = solve(s)
+    first = time.perf_counter() - t0
+    rep, _ = median_time(lambda: solve(s), repeat)
+    peak = (_rss_kb() - base) / 1024
+    del s
+    return first, rep, peak, out
+
+
+def speed_table(names, rounds=3, label="idle"):
+    """Per mesh: gsdf vs potpourri3d, first (constructor + first solve) and repeated solve, medians over
+    ``rounds`` fresh solvers each (the libraries interleaved, the order alternating), constraint "zero" =
+    potpourri3d's default ZeroSet; peak RSS increase of one first + repeated run."""
+    rows, ratios = [], []
+    for name in names:
+        path = os.path.join(SHM_DATA, name[4:]) if name.startswith("shm:") else os.path.join(data_dir(), "meshes", name)
+        V, F, loops = _speed_case(path)
+        pp_loops = [[(int(v), []) for v in c] for c in loops]
+        res = {"gsdf": [], "pp3d": []}
+        runs = {"gsdf": (lambda: SurfaceSignedHeatSolver(V, F), lambda s: s.compute_distance(loops)),
+                "pp3d": (lambda: pp3d.MeshSignedHeatSolver(V, F), lambda s: s.compute_distance(pp_loops))}
+        for r in range(rounds):
+            for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
+                res[lib].append(_time_first_repeat(*runs[lib], repeat=3))
+        med = {k: [float(np.median([x[i] for x in v])) for i in range(3)] for k, v in res.items()}
+        p, q = res["gsdf"][-1][3], -res["pp3d"][-1][3]
+        d = float(np.linalg.norm(p - q) / np.linalg.norm(q))
+        rf, rr = med["gsdf"][0] / med["pp3d"][0], med["gsdf"][1] / med["pp3d"][1]
+        ratios.append((name, rf, rr))
+        rows.append([name.replace("shm:", ""), len(V), len(F), len(loops), f"{med['gsdf'][0]:.3f}",
+                     f"{med['pp3d'][0]:.3f}", f"**{rf:.2f}**", f"{med['gsdf'][1]:.4f}", f"{med['pp3d'][1]:.4f}",
+                     f"**{rr:.2f}**", f"{med['gsdf'][2]:.0f} / {med['pp3d'][2]:.0f}", f"{d:.1e}"])
+        print("speed", label, rows[-1], os.getloadavg()[0], flush=True)
+    hdr = ["mesh", "vertices", "faces", "loops", "gsdf first s", "pp3d first s", "first ratio", "gsdf repeat s",
+           "pp3d repeat s", "repeat ratio", "peak RSS +MB gsdf / pp3d", "rel. L2 diff"]
+    return table(hdr, rows), ratios
+
+
+def speed(quick=False, load=False, small=False):
+    """Issue 17 goals 4–5: the surface signed heat method against potpourri3d on ≥ 10 meshes, idle and with two
+    busy processes competing (bench/load.py)."""
+    from importlib.metadata import version
+
+    from load import BusyLoad, uptime
+
+    names = SPEED_QUICK if quick else SPEED_MESHES
+    if small:                                               # the 13 meshes below 20k vertices
+        names = [m for m in names if m not in SPEED_LARGE]
+    rounds = 3
+    # warm-up: numba kernels and first-call costs of both libraries outside the timings
+    Vw, Fw = sphere_mesh(2)
+    lw = level_set_curves(Vw, Fw, Vw[:, 2] - 0.1)
+    SurfaceSignedHeatSolver(Vw, Fw).compute_distance(lw)
+    lv = region_boundary_curves(Fw, Vw[Fw].mean(1)[:, 2] < 0)
+    SurfaceSignedHeatSolver(Vw, Fw).compute_distance(lv)
+    pp3d.MeshSignedHeatSolver(Vw, Fw).compute_distance([[(int(v), []) for v in c] for c in lv])
+    pnames = POLY_QUICK if quick else POLY_SPEED
+    start = uptime()
+    t_idle, r_idle = speed_table(names, rounds, "idle")
+    tp_idle, rp_idle = poly_speed_table(pnames, rounds, "idle")
+    parts = [f"### Idle ({start} at start, {uptime()} at end)\n\n" + t_idle + "\n\nPolygon meshes (§8.3):\n\n"
+             + tp_idle]
+    r_load = rp_load = None
+    if load:
+        with BusyLoad(2):
+            s2 = uptime()
+            t_load, r_load = speed_table(names, rounds, "load")
+            tp_load, rp_load = poly_speed_table(pnames, rounds, "load")
+            e2 = uptime()
+        parts.append(f"### Two busy processes competing (bench/load.py BusyLoad(2); {s2} at start, {e2} at end)"
+                     "\n\n" + t_load + "\n\nPolygon meshes (§8.3):\n\n" + tp_load)
+    fi = [r[1] for r in r_idle]
+    ri = [r[2] for r in r_idle]
+    summ = (f"Idle: first-solve ratio gsdf / potpourri3d {min(fi):.2f}–{max(fi):.2f} (≤ 1.0 on "
+            f"{sum(x <= 1.0 for x in fi)}/{len(fi)}), repeated {min(ri):.2f}–{max(ri):.2f} (≤ 0.5 on "
+            f"{sum(x <= 0.5 for x in ri)}/{len(ri)}).")
+    if r_load is not None:
+        fl = [r[1] for r in r_load]
+        rl = [r[2] for r in r_load]
+        gf = [b / a for a, b in zip(fi, fl)]
+        gr = [b / a for a, b in zip(ri, rl)]
+        summ += (f" Under load: first {min(fl):.2f}–{max(fl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in fl)}/{len(fl)}), "
+                 f"repeated {min(rl):.2f}–{max(rl):.2f} (≤ 0.5 on {sum(x <= 0.5 for x in rl)}/{len(rl)}); "
+                 f"loaded ratio / idle ratio: first {min(gf):.2f}–{max(gf):.2f}, repeated {min(gr):.2f}–"
+                 f"{max(gr):.2f} (≤ 1.25 on {sum(x <= 1.25 for x in gf)}/{len(gf)} and "
+                 f"{sum(x <= 1.25 for x in gr)}/{len(gr)}).")
+    pi = [r[1] for r in rp_idle]
+    summ += (f" Polygon meshes, idle: first {min(pi):.2f}–{max(pi):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in pi)}/"
+             f"{len(pi)}), repeated {min(r[2] for r in rp_idle):.2f}–{max(r[2] for r in rp_idle):.2f}")
+    if rp_load is not None:
+        pl = [r[1] for r in rp_load]
+        summ += (f"; under load: first {min(pl):.2f}–{max(pl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in pl)}/{len(pl)}), "
+                 f"loaded / idle ratio {min(b / a for a, b in zip(pi, pl)):.2f}–"
+                 f"{max(b / a for a, b in zip(pi, pl)):.2f}")
+    summ += "."
+    txt = (f"## Surface signed heat method: speed against potpourri3d on {len(names)} meshes (issue 17)\n\n"
+           f"Machine: {machine()}; shared with other helpers (load averages per table). Command: "
+           f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --load{' --quick' if quick else ''}"
+           f"{' --small' if small else ''}`. "
+           f"potpourri3d {version('potpourri3d')} `MeshSignedHeatSolver`, gsdf `SurfaceSignedHeatSolver`, one "
+           "process, same mesh and curves (the boundary loops of {y < median} along edges), constraint \"zero\" = "
+           "potpourri3d's default `ZeroSet` (both: φ = 0 at the curve vertices). first = constructor + first "
+           "solve; repeat = median of 3 further solves with the same curves; each the median over "
+           f"{rounds} fresh solvers, the libraries interleaved with alternating order. Peak RSS = growth of the "
+           "process's VmHWM over the RSS before the case (median). Ratios = gsdf / potpourri3d (goal: first ≤ 1.0, "
+           "repeat ≤ 0.5, loaded ratio within 1.25× of the idle one).\n\n" + summ + "\n\n" + "\n\n".join(parts)
+           + "\n")
+    return txt
+
+
+# ------------------------------------------------------------------------------------------ factorization rule
+#: SuperLU options compared by --solver-rule: (label, permc_spec, renumber by RCM first). SuperLU's supernode
+#: settings (splu's relax / panel_size) are not varied: relax 40 with panel_size 5 factorized 10–40 % faster in
+#: a first measurement but corrupted the heap (glibc "corrupted size vs. prev_size", LLVM assertions later in
+#: the process), so gsdf keeps SuperLU's defaults.
+SUPERLU_OPTIONS = [("MMD", "MMD_AT_PLUS_A", False),
+                   ("RCM + MMD (gsdf)", "MMD_AT_PLUS_A", True),
+                   ("COLAMD", "COLAMD", False),
+                   ("RCM + COLAMD", "COLAMD", True)]
+
+
+def _solver_matrices(name):
+    """The two systems of a first "zero" solve: the vector heat operator (complex Hermitian, CR edges) and the
+    Dirichlet-reduced Poisson operator (real SPD) of the --speed curves."""
+    import scipy.sparse as sp
+
+    if name.startswith("poly:"):
+        from gsdf.heat import PolygonMeshSignedHeatSolver
+
+        V, polys, loops = _poly_speed_case(name)
+        d = PolygonMeshSignedHeatSolver(V, polys).domain
+        C, Mv = d.L, d.Mv
+    else:
+        path = os.path.join(SHM_DATA, name[4:]) if name.startswith("shm:") else os.path.join(data_dir(), "meshes", name)
+        V, F, loops = _speed_case(path)
+        d = SurfaceSignedHeatSolver(V, F).domain
+        C, Mv = d.C, d._Mv
+    A = sp.csc_matrix(d.vector_heat_matrix())
+    fixed = np.unique(np.concatenate(loops))
+    free = np.setdiff1d(np.arange(C.shape[0]), fixed)
+    eps_ = 1e-10 * float(np.abs(C.diagonal()).mean()) / float(Mv.mean())
+    P = sp.csc_matrix(C[free][:, free] + sp.diags(eps_ * Mv[free]))
+    return A, P
+
+
+def solver_rule(names, repeat=3):
+    """Factorization time of the two systems per mesh for SuperLU orderings / supernode settings and CHOLMOD."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    from gsdf.linalg import CholeskyFactorization, HermitianFactorization
+    from gsdf.threads import blas_region
+
+    def best(fn):
+        ts = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            fn()
+            ts.append(time.perf_counter() - t0)
+        return min(ts)
+
+    rows = []
+    wins = {}
+    for name in names:
+        A, P = _solver_matrices(name)
+        for lab, M in (("vector heat (complex)", A), ("Poisson, Dirichlet (real)", P)):
+            t = {}
+            with blas_region():
+                for olab, spec, rcm in SUPERLU_OPTIONS:
+                    def run():
+                        B = M
+                        if rcm:
+                            p = reverse_cuthill_mckee(M.tocsr(), symmetric_mode=True)
+                            B = sp.csc_matrix(M[p][:, p])
+                        spla.splu(B, permc_spec=spec, diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+                    t[olab] = best(run)
+            if M.dtype == np.complex128:
+                t["CHOLMOD (2n real form)"] = best(lambda: HermitianFactorization(M, backend="cholmod"))
+            else:
+                t["CHOLMOD"] = best(lambda: CholeskyFactorization(M))
+            ref = t[SUPERLU_OPTIONS[0][0]]
+            win = min(t, key=t.get)
+            wins.setdefault(lab, []).append(win)
+            rows.append([name.replace("shm:", "").replace("poly:", "polygon "), lab, M.shape[0], M.nnz]
+                        + [f"{t[k]:.3f}" + (f" ({t[k] / ref:.2f})" if k != SUPERLU_OPTIONS[0][0] else "")
+                           for k in t] + [win])
+            print("rule", rows[-1], os.getloadavg()[0], flush=True)
+    hdr = (["mesh", "system", "unknowns", "nonzeros"] + [o[0] for o in SUPERLU_OPTIONS] + ["CHOLMOD"]
+           + ["fastest"])
+    return table(hdr, rows), wins
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="smaller sizes, no RESULTS.md update")
     ap.add_argument("--time-step", action="store_true", help="only the diffusion-time / convergence-order study")
+    ap.add_argument("--speed", action="store_true", help="only the speed table against potpourri3d (issue 17)")
+    ap.add_argument("--solver-rule", action="store_true", help="factorization options per mesh (issue 17)")
+    ap.add_argument("--small", action="store_true", help="with --speed: without the three meshes above 20k vertices")
+    ap.add_argument("--load", action="store_true", help="with --speed: also under two busy processes")
     args = ap.parse_args()
+    if args.solver_rule:
+        from load import uptime
+
+        start = uptime()
+        tab, wins = solver_rule(SPEED_QUICK + POLY_QUICK if args.quick else SPEED_MESHES + POLY_SPEED,
+                                repeat=2 if args.quick else 3)
+        count = {lab: {k: v.count(k) for k in sorted(set(v))} for lab, v in wins.items()}
+        txt = ("## Surface signed heat method: factorization rule (issue 17)\n\n"
+               f"Machine: {machine()}; shared ({start} at start, {uptime()} at end). Command: "
+               f"`/work/anchors/bin/python bench/bench_heat_surface.py --solver-rule{' --quick' if args.quick else ''}`. "
+               f"Factorization time (best of {2 if args.quick else 3}, seconds; in parentheses the ratio to plain MMD) of the two systems of a first \"zero\" solve "
+               "of the --speed cases: the vector heat operator M + tL∇ (complex Hermitian; CR edges on triangle "
+               "meshes, vertices on polygon meshes) and the Poisson operator with the curve vertices eliminated "
+               "(real SPD). SuperLU in symmetric mode with one BLAS thread (gsdf.threads.blas_region); CHOLMOD = "
+               "cholespy (the complex system as its 2n real form). Fastest per system: "
+               + "; ".join(f"{lab}: " + ", ".join(f"{k} {n}×" for k, n in c.items()) for lab, c in count.items())
+               + ".\n\n" + tab + "\n")
+        print(txt)
+        write_section("heat-surface-solver-rule" + ("-quick" if args.quick else ""), txt)
+        return
+    if args.speed:
+        txt = speed(quick=args.quick, load=args.load, small=args.small)
+        print(txt)
+        if args.load:
+            write_section("heat-surface-speed" + ("-quick" if args.quick else ""), txt)
+        return
     if args.time_step:
         time_step_study([20, 40, 80] if args.quick else [28, 56, 112, 224])
         return
@@ -753,8 +1027,6 @@ def main():
         write_section("heat-surface", text)
 
 
-if __name__ == "__main__" and "--polygon-pointcloud" not in sys.argv:
-    main()
 
 
 # ------------------------------------------------------------------------------------------ §8.3 / §8.4 vs potpourri3d
@@ -1020,3 +1292,84 @@ def polygon_pointcloud_vs_potpourri():
 
 if __name__ == "__main__" and "--polygon-pointcloud" in sys.argv:
     polygon_pointcloud_vs_potpourri()
+
+
+# ------------------------------------------------------------------------------------------ polygon speed (issue 17)
+POLY_SPEED = ["poly:cube sphere 32", "poly:cube sphere 64", "poly:UV sphere", "poly:quad torus",
+              "poly:polygon_mesh merged", "poly:polygon-bear.obj"]
+POLY_QUICK = ["poly:cube sphere 32", "poly:quad torus", "poly:polygon-bear.obj"]
+
+
+def _poly_region_loops(V, polys, inside):
+    """Boundary loops (along polygon edges) of the polygons flagged ``inside``: via the fan triangulation."""
+    tri, owner = [], []
+    for k, p in enumerate(polys):
+        for i in range(1, len(p) - 1):
+            tri.append((p[0], p[i], p[i + 1]))
+            owner.append(k)
+    return region_boundary_curves(np.array(tri, np.int64), inside[np.array(owner)])
+
+
+def _poly_speed_case(name):
+    """(V, polygons, loops) of a polygon-mesh --speed case; loops = boundary of {centroid y < median}."""
+    key = name[5:]
+    if key.startswith("cube sphere"):
+        V, Q = _cube_sphere(int(key.split()[-1]))
+        polys = Q
+    elif key == "UV sphere":
+        nl, nlon = 48, 96
+        th = np.linspace(0, np.pi, nl + 1)[1:-1]
+        T, Pp = np.meshgrid(th, np.linspace(0, 2 * np.pi, nlon, endpoint=False), indexing="ij")
+        V = np.vstack([[0, 0, 1], np.stack([np.sin(T) * np.cos(Pp), np.sin(T) * np.sin(Pp), np.cos(T)],
+                                          -1).reshape(-1, 3), [0, 0, -1]])
+        idx = 1 + np.arange((nl - 1) * nlon).reshape(nl - 1, nlon)
+        nx = np.roll(idx, -1, axis=1)
+        polys = [list(q) for q in np.stack([idx[:-1], idx[1:], nx[1:], nx[:-1]], -1).reshape(-1, 4)]
+        polys += [[0, a, b] for a, b in zip(idx[0], nx[0])] + [[len(V) - 1, b, a] for a, b in zip(idx[-1], nx[-1])]
+    elif key == "quad torus":
+        V, polys, _ = _quad_torus(128, 64)
+    elif key == "polygon_mesh merged":
+        V, F = gsdf.read_mesh(os.path.join(data_dir(), "meshes", "polygon_mesh.off"))
+        polys, _ = _merge_triangle_pairs(F)
+    else:
+        V, polys = gsdf.read_mesh(os.path.join(SHM_DATA, key), triangulate=False)
+    cen = np.array([V[p].mean(0) for p in polys])
+    loops = _poly_region_loops(V, polys, cen[:, 1] < np.median(cen[:, 1]))
+    return V, polys, loops
+
+
+def poly_speed_table(names, rounds=3, label="idle"):
+    """Polygon meshes: gsdf PolygonMeshSignedHeatSolver vs potpourri3d PolygonMeshHeatSolver, constructor + first
+    signed-distance solve and a repeated solve, "zero" = potpourri3d's default ZeroSet."""
+    from gsdf.heat import PolygonMeshSignedHeatSolver
+
+    rows, ratios = [], []
+    for name in names:
+        V, polys, loops = _poly_speed_case(name)
+        arr = np.asarray(polys) if len({len(p) for p in polys}) == 1 else None
+        pp_polys = arr if arr is not None else [list(map(int, p)) for p in polys]
+        pp_loops = [list(map(int, c)) for c in loops]
+        res = {"gsdf": [], "pp3d": []}
+        runs = {"gsdf": (lambda: PolygonMeshSignedHeatSolver(V, polys), lambda s: s.compute_distance(loops)),
+                "pp3d": (lambda: pp3d.PolygonMeshHeatSolver(V, pp_polys),
+                         lambda s: s.compute_signed_distance(pp_loops))}
+        for r in range(rounds):
+            for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
+                res[lib].append(_time_first_repeat(*runs[lib], repeat=3))
+        med = {k: [float(np.median([x[i] for x in v])) for i in range(3)] for k, v in res.items()}
+        p, q = res["gsdf"][-1][3], res["pp3d"][-1][3]
+        d = float(np.linalg.norm(p - q) / np.linalg.norm(q))
+        rf, rr = med["gsdf"][0] / med["pp3d"][0], med["gsdf"][1] / med["pp3d"][1]
+        ratios.append((name, rf, rr))
+        rows.append([name[5:], len(V), len(polys), len(loops), f"{med['gsdf'][0]:.3f}", f"{med['pp3d'][0]:.3f}",
+                     f"**{rf:.2f}**", f"{med['gsdf'][1]:.4f}", f"{med['pp3d'][1]:.4f}", f"**{rr:.2f}**",
+                     f"{med['gsdf'][2]:.0f} / {med['pp3d'][2]:.0f}", f"{d:.1e}"])
+        print("poly-speed", label, rows[-1], os.getloadavg()[0], flush=True)
+    hdr = ["polygon mesh", "vertices", "polygons", "loops", "gsdf first s", "pp3d first s", "first ratio",
+           "gsdf repeat s", "pp3d repeat s", "repeat ratio", "peak RSS +MB gsdf / pp3d",
+           "rel. L2 diff (two discretizations)"]
+    return table(hdr, rows), ratios
+
+
+if __name__ == "__main__" and "--polygon-pointcloud" not in sys.argv:
+    main()

@@ -89,7 +89,10 @@ def hash_key(*arrays) -> str:
 
 def normalize(Y: np.ndarray) -> np.ndarray:
     """Step II: Y / |Y| per row; rows with |Y| = 0 stay 0."""
-    nrm = np.linalg.norm(Y, axis=1)
+    sq = Y[:, 0] * Y[:, 0]                                  # |Y|² summed left to right, as np.linalg.norm does
+    for j in range(1, Y.shape[1]):
+        sq += Y[:, j] * Y[:, j]
+    nrm = np.sqrt(sq)
     out = np.zeros_like(Y)
     np.divide(Y, nrm[:, None], out=out, where=nrm[:, None] > 0)
     return out
@@ -146,6 +149,8 @@ class FactorizedPoisson(PoissonSolver):
         self._eps = 0.0 if exact_gauge else 1e-10 * float(np.abs(self.L.diagonal()).mean()) / float(self.Mv.mean())
         self._active = self.L.diagonal() != 0 if exact_gauge else np.ones(self.n, bool)
         self._spd = spd or (lambda A: Factorization(sp.csc_matrix(A)))
+        # the Dirichlet systems (no ε: well-conditioned) may take a bandwidth renumbering before the ordering
+        self._spd_dirichlet = (lambda A: Factorization(sp.csc_matrix(A), reorder=True)) if spd is None else self._spd
         self._cache: dict = {}
 
     def _cached(self, key, build):
@@ -185,7 +190,7 @@ class FactorizedPoisson(PoissonSolver):
 
         def build():
             A = self.L[free][:, free]
-            return self._spd((A + sp.diags(self._eps * self.Mv[free])).tocsc() if self._eps else A.tocsc())
+            return self._spd_dirichlet((A + sp.diags(self._eps * self.Mv[free])).tocsc() if self._eps else A.tocsc())
 
         phi = np.zeros(self.n)
         if len(free):

@@ -51,6 +51,14 @@ def _parse_polygons(polygons, n: int) -> dict:
     """Validate polygons; return {degree: (q, degree) int64 array} (vectorized per degree)."""
     import itertools
 
+    if isinstance(polygons, (list, tuple)) and polygons and isinstance(polygons[0], np.ndarray) \
+            and polygons[0].ndim == 1:
+        try:                                                  # a list of equal-length index arrays: one array
+            stacked = np.array(polygons)
+        except ValueError:                                    # ragged
+            stacked = None
+        if stacked is not None and stacked.ndim == 2 and stacked.dtype != object:
+            polygons = stacked
     if isinstance(polygons, np.ndarray) and polygons.ndim == 2 and polygons.dtype != object:
         arr = polygons
         if not np.issubdtype(arr.dtype, np.integer):
@@ -110,27 +118,70 @@ def virtual_vertex_weights(X: np.ndarray) -> np.ndarray:
     A = X - c                                                   # centred corners (translation invariance)
     B = np.roll(A, -1, axis=1)
     D = B - A
-    # (a - x) × (b - x) = a × b - x × (b - a) = a × b + [d]_× x   (d = b - a)
-    Dx = np.zeros((q, s, 3, 3))
-    Dx[..., 0, 1], Dx[..., 0, 2] = -D[..., 2], D[..., 1]
-    Dx[..., 1, 0], Dx[..., 1, 2] = D[..., 2], -D[..., 0]
-    Dx[..., 2, 0], Dx[..., 2, 1] = -D[..., 1], D[..., 0]
-    H = np.einsum("qsij,qsik->qjk", Dx, Dx)
-    rhs = -np.einsum("qsij,qsi->qj", Dx, np.cross(A, B))
+    # (a - x) × (b - x) = a × b - x × (b - a) = a × b + [d]_× x   (d = b - a); with [d]_×ᵀ[d]_× = |d|² I − d dᵀ
+    # the normal equations are H x = rhs, H = Σ (|d|² I − d dᵀ), rhs = −Σ [d]_×ᵀ (a × b) = Σ d × (a × b)
+    DD = np.einsum("qsi,qsj->qij", D, D)
+    H = np.einsum("qs,ij->qij", np.einsum("qsi,qsi->qs", D, D), np.eye(3)) - DD
+    rhs = np.cross(D, np.cross(A, B)).sum(axis=1)
     scale = np.trace(H, axis1=1, axis2=2)
     ok = scale > 0
-    lam, U = np.linalg.eigh(H)                                   # H is symmetric PSD: a safe pseudo-inverse
-    keep = lam > 1e-10 * np.maximum(scale, 1e-300)[:, None]
-    inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
-    x = np.einsum("qij,qj,qkj,qk->qi", U, inv, U, rhs)
-    ok &= keep.sum(1) == 3                                       # collinear corners: no unique minimizer
-    # minimum-norm affine weights: w = K⁺ r with K = [Aᵀ; 1ᵀ] (4 × s), r = [x; 1]
-    K = np.concatenate([np.transpose(A, (0, 2, 1)), np.ones((q, 1, s))], axis=1)
-    r = np.concatenate([x, np.ones((q, 1))], axis=1)
-    w = np.einsum("qij,qj->qi", np.linalg.pinv(K, rcond=1e-10), r)
+    # well-conditioned H (the usual case): x = H⁻¹ rhs by the adjugate; the others by the eigen-decomposition
+    # (a safe pseudo-inverse; collinear corners have no unique minimizer)
+    lmin = _sym3_min_eigenvalue(H)
+    fast = lmin > 1e-6 * np.maximum(scale, 1e-300)
+    x = np.zeros((q, 3))
+    x[fast] = _solve3(H[fast], rhs[fast])
+    slow = np.flatnonzero(~fast)
+    if len(slow):
+        lam, U = np.linalg.eigh(H[slow])                        # H is symmetric PSD
+        keep = lam > 1e-10 * np.maximum(scale[slow], 1e-300)[:, None]
+        inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
+        x[slow] = np.einsum("qij,qj,qkj,qk->qi", U, inv, U, rhs[slow])
+        ok[slow] &= keep.sum(1) == 3
+    # minimum-norm affine weights: w = K⁺ r with K = [Aᵀ; 1ᵀ] (4 × s), r = [x; 1]. A is centred, so the rows of
+    # K are orthogonal blocks and K⁺ r = A (AᵀA)⁻¹ x + 1/s when AᵀA is well-conditioned (non-planar polygons);
+    # planar and nearly planar ones (singular values near pinv's cutoff) take the SVD pseudo-inverse
+    G = np.einsum("qsi,qsj->qij", A, A)
+    gtr = np.trace(G, axis1=1, axis2=2)
+    gmin = _sym3_min_eigenvalue(G)
+    cut = 1e-10 * np.sqrt(np.maximum(s, gtr))                   # ≥ pinv's cutoff 1e-10 σ_max(K)
+    fastw = (gmin > 1e-6 * gtr) & (gmin > (1e4 * cut) ** 2)
+    w = np.empty((q, s))
+    w[fastw] = np.einsum("qsi,qi->qs", A[fastw], _solve3(G[fastw], x[fastw])) + 1.0 / s
+    slow = np.flatnonzero(~fastw)
+    if len(slow):
+        K = np.concatenate([np.transpose(A[slow], (0, 2, 1)), np.ones((len(slow), 1, s))], axis=1)
+        r = np.concatenate([x[slow], np.ones((len(slow), 1))], axis=1)
+        w[slow] = np.einsum("qij,qj->qi", np.linalg.pinv(K, rcond=1e-10), r)
     ok &= np.isfinite(w).all(1) & (np.abs(w.sum(1) - 1) < 1e-6)
     w[~ok] = 1.0 / s
     return w
+
+
+def _sym3_min_eigenvalue(H: np.ndarray) -> np.ndarray:
+    """Smallest eigenvalue of symmetric 3×3 matrices (q, 3, 3), closed form (trigonometric; absolute error a few
+    ulps of the largest eigenvalue — used only to choose between a direct solve and a pseudo-inverse)."""
+    q3 = np.trace(H, axis1=1, axis2=2) / 3.0
+    p1 = H[:, 0, 1] ** 2 + H[:, 0, 2] ** 2 + H[:, 1, 2] ** 2
+    p2 = (H[:, 0, 0] - q3) ** 2 + (H[:, 1, 1] - q3) ** 2 + (H[:, 2, 2] - q3) ** 2 + 2.0 * p1
+    p = np.sqrt(p2 / 6.0)
+    Bm = (H - q3[:, None, None] * np.eye(3)) / np.where(p > 0, p, 1.0)[:, None, None]
+    r = np.clip(0.5 * np.linalg.det(Bm), -1.0, 1.0)
+    phi = np.arccos(r) / 3.0
+    return np.where(p > 0, q3 + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0), q3)
+
+
+def _solve3(H: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """x = H⁻¹ b for well-conditioned symmetric 3×3 matrices (q, 3, 3), by the adjugate."""
+    a, bb, c = H[:, 0, 0], H[:, 0, 1], H[:, 0, 2]
+    d, e, f = H[:, 1, 1], H[:, 1, 2], H[:, 2, 2]
+    A00, A01, A02 = d * f - e * e, c * e - bb * f, bb * e - c * d
+    A11, A12, A22 = a * f - c * c, bb * c - a * e, a * d - bb * bb
+    det = a * A00 + bb * A01 + c * A02
+    x0 = A00 * b[:, 0] + A01 * b[:, 1] + A02 * b[:, 2]
+    x1 = A01 * b[:, 0] + A11 * b[:, 1] + A12 * b[:, 2]
+    x2 = A02 * b[:, 0] + A12 * b[:, 1] + A22 * b[:, 2]
+    return np.stack([x0, x1, x2], 1) / det[:, None]
 
 
 def virtual_vertex_refinement(V: np.ndarray, polygons):
@@ -242,17 +293,18 @@ class PolygonDomain(VertexSurfaceDomain):
         if not good.any():
             raise ValueError("polygons: all polygons have zero area")
         self.F_refined = F[good]
-        ops = TriangleMeshOperators(self.V_refined, self.F_refined)
+        ops = TriangleMeshOperators(self.V_refined, self.F_refined, edges=False)   # vertex operators only
         self.fine_ops = ops
         Pt = self.P.T.tocsr()
         L = (Pt @ ops.cotan_laplacian() @ self.P).tocsr()               # Bunge et al. 2020 §4: L = Pᵀ L_fan P
         L = (0.5 * (L + L.T)).tocsr()
         self.M = Pt @ ops.vertex_mass()                                  # lumped Pᵀ M_fan P (rows of P sum to 1)
         # vertex normals: area-weighted fine triangle normals (§8.3)
-        An = np.zeros((len(self.V_refined), 3))
-        for k in range(3):
-            np.add.at(An, self.F_refined[:, k], ops.normals * ops.areas[:, None])
-        An = An[:n]
+        # (the sum over the corners k = 0, 1, 2 in that order, as np.add.at did it, by one bincount per axis)
+        An = ops.normals * ops.areas[:, None]
+        idx = self.F_refined.T.ravel()
+        An = np.stack([np.bincount(idx, weights=np.tile(An[:, c], 3), minlength=len(self.V_refined))[:n]
+                       for c in range(3)], 1)
         nrm = np.linalg.norm(An, axis=1)
         An[nrm == 0] = [0, 0, 1.0]
         N = An / np.maximum(nrm, 1e-300)[:, None]
@@ -269,7 +321,8 @@ class PolygonDomain(VertexSurfaceDomain):
         them over every fine triangle and project into its plane (normalized by the core)."""
         ops = self.fine_ops
         Xf = self.P @ self.to_3d(X)                                      # (n + #virtual, 3)
-        Y = Xf[ops.F].sum(axis=1)
+        F = ops.F
+        Y = Xf[F[:, 0]] + Xf[F[:, 1]] + Xf[F[:, 2]]                     # (a + b) + c, as .sum(axis=1) adds
         Y -= ops.normals * np.einsum("fj,fj->f", Y, ops.normals)[:, None]
         return Y
 

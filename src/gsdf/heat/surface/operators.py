@@ -45,6 +45,9 @@ class TriangleMeshOperators:
     P : (m, 3, 3) float64, optional
         Per-face corner positions to use instead of ``V[F]`` (planar layouts of an intrinsic triangulation,
         :mod:`gsdf.heat.surface.intrinsic`); then only vertex-based sources are meaningful.
+    edges : bool
+        False: only the vertex operators (``cotan_laplacian``, ``vertex_mass``, ``divergence``, ``areas``,
+        ``normals``, ``cot``) — no edge topology, angles or Crouzeix–Raviart operators (polygon fine meshes).
 
     Attributes
     ----------
@@ -65,19 +68,13 @@ class TriangleMeshOperators:
 
     point_weight = 1.0
 
-    def __init__(self, V: np.ndarray, F: np.ndarray, P: np.ndarray | None = None):
+    def __init__(self, V: np.ndarray, F: np.ndarray, P: np.ndarray | None = None, edges: bool = True):
         self.V, self.F = V, F
         # intrinsic triangulations (§9.4) pass per-face planar layouts P instead of using V[F]; the operators
         # below only need per-face corner positions, so they run unchanged in these face frames
         self.intrinsic = P is not None
         n, m = len(V), len(F)
         self.n_vertices, self.n_faces = n, m
-        # slot a: edge (v_a, v_{a+1}); unique edges lower -> higher index, as everywhere (gsdf.mesh.connectivity)
-        self.edges, self.face_edges, signs = unique_edges(F, n)
-        self.edge_keys = self.edges[:, 0] * n + self.edges[:, 1]
-        self.n_edges = len(self.edges)
-        self.slot_sign = signs.astype(np.float64)
-
         P = V[F] if P is None else P                           # (m, 3, 3) corner positions
         self.P = P
         E = P[:, NEXT] - P                                     # slot vectors v_a -> v_{a+1}
@@ -89,6 +86,15 @@ class TriangleMeshOperators:
         self.slot_len = np.sqrt(L2)
         # cot of the angle at vertex k (opposite slot k+1), Eq. 5: (|ki|^2 + |ij|^2 - |jk|^2) / (4 area)
         self.cot = (L2[:, PREV] + L2 - L2[:, NEXT]) / (4.0 * self.areas[:, None])
+        self._vf = None
+        if not edges:
+            # vertex operators only (cotan Laplacian, mass, divergence): the fine meshes of polygon Laplacians
+            return
+        # slot a: edge (v_a, v_{a+1}); unique edges lower -> higher index, as everywhere (gsdf.mesh.connectivity)
+        self.edges, self.face_edges, signs = unique_edges(F, n)
+        self.edge_keys = self.edges[:, 0] * n + self.edges[:, 1]
+        self.n_edges = len(self.edges)
+        self.slot_sign = signs.astype(np.float64)
         cosang = np.einsum("fij,fij->fi", E, -E[:, PREV]) / (self.slot_len * self.slot_len[:, PREV])
         self.angles = np.arccos(np.clip(cosang, -1.0, 1.0))
         self.edge_len = np.zeros(self.n_edges)
@@ -112,7 +118,6 @@ class TriangleMeshOperators:
         self.slot_sigma = np.where(np.arange(3 * m) == first[fe], 1.0,
                                    np.where(ss == ss[first[fe]], -1.0, 1.0)).reshape(m, 3)
         self.consistent = bool((self.slot_sigma > 0).all())
-        self._vf = None
 
     # ------------------------------------------------------------------ Crouzeix–Raviart operators (§5.3–5.4)
     def cr_mass(self) -> sp.csr_matrix:
@@ -191,9 +196,11 @@ class TriangleMeshOperators:
         Eq. 3; the boundary term n·Y is omitted as in the paper). With the PSD cotan Laplacian C, ``C φ = b``
         is the least-squares fit ∇φ ≈ Y of Eq. 2."""
         F = self.F
-        E = self.P[:, NEXT] - self.P                            # slot vectors
-        # |f| ∇λ_k = ½ n × (v_{k+2} - v_{k+1}) = ½ n × E[:, k+1]
-        G = 0.5 * np.cross(self.normals[:, None, :], E[:, NEXT])
+        G = getattr(self, "_div_G", None)
+        if G is None:                                           # per mesh, kept for repeated solves
+            E = self.P[:, NEXT] - self.P                        # slot vectors
+            # |f| ∇λ_k = ½ n × (v_{k+2} - v_{k+1}) = ½ n × E[:, k+1]
+            G = self._div_G = 0.5 * np.cross(self.normals[:, None, :], E[:, NEXT])
         contrib = np.einsum("fkj,fj->fk", G, Y)
         return np.bincount(F.ravel(), weights=contrib.ravel(), minlength=self.n_vertices)
 
