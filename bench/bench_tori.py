@@ -387,8 +387,8 @@ def main():
     skip = set(args.skip.split(","))
     if args.quick:
         skip |= {"speed", "real", "landscape"}
-    head = (f"Machine: {machine()}. Command: `python bench/bench_tori.py --grid {args.grid}"
-            f"{' --full' if args.full else ''}` (parts can be run separately with --skip; each part's text is kept "
+    head = (f"Machine: {machine()}. Command: `python bench/bench_tori.py "
+            f"{'--quick' if args.quick else f'--grid {args.grid}'}{' --full' if args.full else ''}` (parts can be run separately with --skip; each part's text is kept "
             f"in bench/tori_part_<name>.md and the section is assembled from them).")
     if "speed-load" not in skip:
         _save_part("speed-load", f"### Speed against the k-nearest-neighbour query, idle and under load (issue 17)\n\n"
