@@ -43,3 +43,14 @@ def test_blas_is_one_thread_during_the_run_and_restored_after():
     # and the field is still a signed distance of the unit sphere
     d = f([[0.0, 0, 0], [1.3, 0, 0]])
     assert d[0] < -0.7 and abs(d[1] - 0.3) < 0.1
+
+
+def test_direct_laplacian_equals_the_kronecker_assembly():
+    from gsdf.heat.volume.grid import _neumann_laplacian_kron, neumann_laplacian
+
+    for shape, h in (((7, 5, 6), (0.1, 0.37, 1.3)), ((2, 2, 2), (1e-3, 7.0, 0.3)), ((3, 9, 2), (0.5, 0.5, 0.5))):
+        A, B = neumann_laplacian(shape, np.array(h)), _neumann_laplacian_kron(shape, np.array(h))
+        B.sort_indices()
+        assert np.array_equal(A.indptr, B.indptr) and np.array_equal(A.indices, B.indices)
+        assert np.array_equal(A.data, B.data)  # bit for bit
+        assert np.abs(A @ np.ones(A.shape[0])).max() <= 1e-9 * np.abs(A.data).max()  # constants in the kernel

@@ -37,7 +37,72 @@ from .memory import available_memory, check_memory  # noqa: F401  (re-exported)
 
 
 def neumann_laplacian(shape, spacing) -> sp.csr_matrix:
-    """The 7-point Laplacian with Neumann boundary, positive semidefinite: Σ_a K_a / h_a², K_a = D_aᵀ D_a."""
+    """The 7-point Laplacian with Neumann boundary, positive semidefinite: Σ_a K_a / h_a², K_a = D_aᵀ D_a.
+
+    K_a is the path Laplacian along axis a (2 on the diagonal, 1 at both ends, −1 off it). Assembled directly in
+    CSR by :func:`_laplacian_csr` — entry for entry what ``kron(K_x, I, I) + kron(I, K_y, I) + kron(I, I, K_z)``
+    gives (:func:`_neumann_laplacian_kron`, kept for the test), ~10× faster at 32³.
+    """
+    shape = tuple(int(s) for s in shape)
+    w = np.array([float(spacing[a]) ** 2 for a in range(3)])
+    n = shape[0] * shape[1] * shape[2]
+    itype = np.int32 if 7 * n < 2 ** 31 else np.int64  # scipy's own index type for this size
+    indptr, indices, data = np.zeros(n + 1, itype), np.empty(7 * n, itype), np.empty(7 * n)
+    p = _laplacian_csr(shape[0], shape[1], shape[2], w, indptr, indices, data)
+    return sp.csr_matrix((data[:p], indices[:p], indptr), shape=(n, n))
+
+
+@njit(cache=True)
+def _laplacian_csr(n0, n1, n2, w, indptr, indices, data):
+    """Fill the CSR arrays of :func:`neumann_laplacian` (returns the entry count): row-major nodes, columns
+    ascending (x−1, y−1, z−1, self, z+1, y+1, x+1); the diagonal summed x, y, z in that order (so it equals the
+    Kronecker assembly bit for bit)."""
+    dims = (n0, n1, n2)
+    s1, s0 = n2, n1 * n2
+    p = 0
+    for i in range(n0):
+        for j in range(n1):
+            for k in range(n2):
+                r = (i * n1 + j) * n2 + k
+                diag = 0.0
+                for a in range(3):
+                    c = i if a == 0 else (j if a == 1 else k)
+                    m = dims[a]
+                    main = 1.0 if (c == 0 or c == m - 1) else 2.0
+                    diag = main / w[a] if a == 0 else diag + main / w[a]
+                if i > 0:
+                    indices[p] = r - s0
+                    data[p] = -1.0 / w[0]
+                    p += 1
+                if j > 0:
+                    indices[p] = r - s1
+                    data[p] = -1.0 / w[1]
+                    p += 1
+                if k > 0:
+                    indices[p] = r - 1
+                    data[p] = -1.0 / w[2]
+                    p += 1
+                indices[p] = r
+                data[p] = diag
+                p += 1
+                if k < n2 - 1:
+                    indices[p] = r + 1
+                    data[p] = -1.0 / w[2]
+                    p += 1
+                if j < n1 - 1:
+                    indices[p] = r + s1
+                    data[p] = -1.0 / w[1]
+                    p += 1
+                if i < n0 - 1:
+                    indices[p] = r + s0
+                    data[p] = -1.0 / w[0]
+                    p += 1
+                indptr[r + 1] = p
+    return p
+
+
+def _neumann_laplacian_kron(shape, spacing) -> sp.csr_matrix:
+    """The Kronecker-product assembly of :func:`neumann_laplacian` (reference for the test)."""
     shape = tuple(int(s) for s in shape)
     mats = []
     for a in range(3):
