@@ -120,12 +120,12 @@ def divergence_rhs(Y, spacing) -> np.ndarray:
     """Right-hand side Gᵀ Ŷ / h of the edge least-squares problem (forward-difference divergence of Y)."""
     rhs = np.zeros(Y.shape[:3])
     for a in range(3):
-        E = 0.5 * (np.take(Y[..., a], range(1, Y.shape[a]), axis=a)
-                   + np.take(Y[..., a], range(0, Y.shape[a] - 1), axis=a)) / spacing[a]
         sl_hi = [slice(None)] * 3
         sl_lo = [slice(None)] * 3
         sl_hi[a] = slice(1, None)
         sl_lo[a] = slice(0, -1)
+        Ya = Y[..., a]
+        E = 0.5 * (Ya[tuple(sl_hi)] + Ya[tuple(sl_lo)]) / spacing[a]  # slices, not np.take (a copy per call)
         rhs[tuple(sl_hi)] += E
         rhs[tuple(sl_lo)] -= E
     return rhs.ravel()
