@@ -94,7 +94,7 @@ def main(argv=None):
             f"Machine: {info}. Total {total / 60:.1f} min. The machine is shared: load averages before and after "
             "each part are listed; each part's own section states what it measured. Peak RSS: the part's "
             "process (largest of it and the children it waited for; per-case figures are in the parts' sections). "
-            f"Command: `PYTHONPATH=src {os.path.basename(py)} bench/run_all.py {' '.join(sys.argv[1:] if argv is None else argv)}`."
+            f"Command: `PYTHONPATH=src {py} bench/run_all.py {' '.join(sys.argv[1:] if argv is None else argv)}`."
             "\n\n"
             + table(["part", "command", "status", "seconds", "peak RSS MB", "uptime before", "uptime after"], rows))
     write_section("run-all", text)
