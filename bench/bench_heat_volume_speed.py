@@ -4,7 +4,7 @@ Issue 17, goals 6 and 7. Run in the anchors' venv (it has signedheat3d):
 
     PYTHONPATH=src /work/anchors/bin/python bench/bench_heat_volume_speed.py            # 10 inputs, medians of 3
     PYTHONPATH=src /work/anchors/bin/python bench/bench_heat_volume_speed.py --quick    # 5 inputs, anchor once
-    ... --only oni.pwn,holes.off      --no-scaling      --load (also under two busy processes, bench/load.py)
+    ... --only=oni.pwn,holes.off   --no-scaling   --only-scaling   --load (also under two busy processes, bench/load.py)
 
 Every case (one input, one solver) runs in its own process, so its peak RSS (``ru_maxrss``) is its own; the
 baseline RSS of that process after imports (and, for gsdf, after the numba kernels are loaded) is listed too.
@@ -179,6 +179,15 @@ def worker(args):
     peak = rss_mb()
     out = {"who": who, "name": name, "size": size, "shape": list(shape), "times": times,
            "median": float(np.median(times)), "rss_mb": peak, "base_rss_mb": base, "first_call": t_first}
+    if who == "gsdf":  # the solve's own array memory: numpy / scipy buffers seen by tracemalloc (not timed)
+        import tracemalloc
+
+        from gsdf.heat.volume import signed_heat_volume
+
+        tracemalloc.start()
+        signed_heat_volume(resolution=shape, bbox_min=lo, bbox_max=hi, **kw)
+        out["traced_mb"] = tracemalloc.get_traced_memory()[1] / 2 ** 20
+        tracemalloc.stop()
     if who == "gsdf" and ref is not None:
         from gsdf.heat.volume import signed_heat_volume
 
@@ -221,7 +230,7 @@ def speed_table(names, repeat_gsdf, repeat_anchor, label, partial=None):
         print(f"[{label}] {name}: gsdf {g.get('median', 'failed')} anchor {a.get('median', 'failed')} "
               f"({uptime()})", flush=True)
         if "failed" in g or "failed" in a:
-            rows.append([name, KIND[name], "—", "—", "—", "—", "—", "—", "—", "—",
+            rows.append([name, KIND[name], "—", "—", "—", "—", "—", "—", "—", "—", "—",
                          f"failed: {g.get('failed', '')} {a.get('failed', '')}"])
             continue
         ratio = a["median"] / g["median"]
@@ -229,7 +238,8 @@ def speed_table(names, repeat_gsdf, repeat_anchor, label, partial=None):
         rows.append([name, KIND[name], f"{g['size']:,}", str(tuple(g["shape"])), f"{g['median']:.3f}",
                      f"{a['median']:.2f}{nrep}", f"**{ratio:.0f}×**" if ratio >= 20 else f"{ratio:.1f}×",
                      f"{g['err']:.5f}", f"{g['err_input_t']:.5f}", f"{a['err']:.5f}",
-                     f"{g['rss_mb']:.0f} ({g['base_rss_mb']:.0f}) / {a['rss_mb']:.0f} ({a['base_rss_mb']:.0f})"])
+                     f"{g['rss_mb']:.0f} ({g['base_rss_mb']:.0f}) / {a['rss_mb']:.0f} ({a['base_rss_mb']:.0f})",
+                     f"{g.get('traced_mb', float('nan')):.1f}"])
         s = g["stages"]
         srows.append([name] + [f"{s.get(k, 0.0) * 1e3:.0f}" for k in
                                ("sources", "step I tree build", "step I nearest", "step I sum", "step II normalize",
@@ -251,10 +261,12 @@ def scaling_table(quick):
                     continue
                 grow = ""
                 if prev is not None:
-                    grow = (f"{(r['median'] / prev['median']):.2f} / {(r['rss_mb'] - r['base_rss_mb']) / max(prev['rss_mb'] - prev['base_rss_mb'], 1):.2f}"
-                            f" (input ×{r['size'] / prev['size']:.1f})")
+                    mem = (f"{r['traced_mb'] / prev['traced_mb']:.2f}" if "traced_mb" in r and "traced_mb" in prev
+                           else "—")
+                    grow = f"{(r['median'] / prev['median']):.2f} / {mem} (input ×{r['size'] / prev['size']:.1f})"
                 rows.append([kind, f"{r['size']:,}", str(tuple(r["shape"])), f"{r['median']:.3f}",
-                             f"{r['rss_mb']:.0f}", f"{r['rss_mb'] - r['base_rss_mb']:.0f}", grow])
+                             f"{r['rss_mb']:.0f}", f"{r['rss_mb'] - r['base_rss_mb']:.0f}",
+                             f"{r['traced_mb']:.1f}" if "traced_mb" in r else "—", grow])
                 print(rows[-1], flush=True)
                 prev = r
     return rows
@@ -280,7 +292,7 @@ def main(argv):
         return ["### 32³ grid: time, accuracy, peak RSS, gsdf vs signedheat3d", "",
                 table(["input", "kind", "faces / points", "nodes", "gsdf s", "signedheat3d s",
                        "speed-up", "gsdf err", "gsdf err input t", "signedheat3d err",
-                       "peak RSS MB gsdf / signedheat3d"], rows), "",
+                       "peak RSS MB gsdf / signedheat3d", "gsdf arrays MB"], rows), "",
                 "### gsdf stages at 32³ (ms, one cProfile'd run; first call = numba load/compile of the process, s)",
                 "", table(["input", "sources", "tree build", "nearest", "step I sum", "normalize", "divergence",
                            "coarse LU", "CG", "shift", "other", "total", "first call s"], srows), ""]
@@ -289,9 +301,14 @@ def main(argv):
         write_section(section, title + "\n".join(head + tables(rows, srows))
                       + f"\n(partial: {len(rows)} of {len(names)} inputs so far; {uptime()})\n")
 
-    rows, srows, _ = speed_table(names, rep_g, rep_a, "idle", partial)
-    text = head + tables(rows, srows)
-    if "--load" in argv:
+    if "--only-scaling" in argv:  # just the growth table, in its own section
+        section, names = "heat-volume-scaling" + ("-quick" if quick else ""), []
+        title = "## Volume signed heat: growth with input size at a fixed grid (issue 17, goal 7)\n\n"
+        text = list(head)
+    else:
+        rows, srows, _ = speed_table(names, rep_g, rep_a, "idle", partial)
+        text = head + tables(rows, srows)
+    if "--load" in argv and names:
         with BusyLoad(2):
             lrows, _, _ = speed_table(names, rep_g, rep_a, "load")
         text += ["### Same, with two busy processes (bench/load.py)", "",
@@ -300,10 +317,13 @@ def main(argv):
     if "--no-scaling" not in argv:
         srows2 = scaling_table(quick)
         text += ["### Scaling with input size at a fixed grid (gsdf, peak RSS per case)", "",
-                 "Growth = time ratio / RSS-above-baseline ratio to the previous row; linear in the input would be "
-                 "≤ the input ratio.", "",
+                 "Peak RSS is the case's own process (interpreter, numba and SciPy included: ~185–210 MB before "
+                 "any work); \"RSS above baseline\" its growth during the solves (0: below the peak of the "
+                 "imports and kernel loading); \"arrays MB\" the peak of numpy / SciPy buffers during one solve "
+                 "(tracemalloc; SuperLU's and numba's own allocations are not seen). Growth = time ratio / arrays "
+                 "ratio to the previous row; linear in the input would be ≤ the input ratio.", "",
                  table(["input", "faces / points", "nodes", "s (median)", "peak RSS MB", "RSS above baseline MB",
-                        "growth time / memory"], srows2), ""]
+                        "arrays MB", "growth time / memory"], srows2), ""]
     text += [f"Total {time.perf_counter() - t0:.0f} s; load at end: {uptime()}."]
     out = title + "\n".join(text)
     print(out)
