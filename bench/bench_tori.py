@@ -24,6 +24,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from common import data_dir, machine, median_time, table, write_section  # noqa: E402
+from load import BusyLoad, uptime  # noqa: E402
 
 from gsdf.tori import shapes as S  # noqa: E402
 from gsdf.tori.baselines import (SignedHopfCole, SmoothedSignedPlanarDistance,  # noqa: E402
@@ -322,16 +323,80 @@ def speed(args):
         f"CPU seconds of the numba-parallel call), which load inflates much less."
 
 
+def speed_load(args):
+    """PAT queries/s against the k-nearest-neighbour query it replaces, idle and under two busy processes.
+
+    Issue 17, goal 5: on the same points and queries, PAT's ``signed_distance`` (fit excluded) vs
+    ``scipy.spatial.cKDTree(P).query(Q, k=64, workers=-1)`` (tree build excluded), medians of ``args.repeat``;
+    the same again inside ``BusyLoad(2)`` (bench/load.py: two spinning processes the benchmark starts and
+    stops). The ratio under load should stay within 1.25× of the idle ratio."""
+    import resource
+
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(0)
+    sizes = [50000] if args.quick else [12500, 50000, 200000]
+    nq = 30000 if args.quick else 100000
+    P, N = _elephant_cloud(2000, np.random.default_rng(1))
+    PointsAsTori(P, N).signed_distance(P[:100] + 0.01)  # numba load / compile, not timed
+    rows, ratios = [], []
+    for n in sizes:
+        P, N = _elephant_cloud(n, rng)
+        lo, hi = P.min(0), P.max(0)
+        diag = np.linalg.norm(hi - lo)
+        Q = np.vstack([rng.uniform(lo - 0.1 * diag, hi + 0.1 * diag, size=(nq // 2, 3)),
+                       P[rng.choice(n, nq // 2)] + rng.normal(scale=0.02 * diag, size=(nq // 2, 3))])
+        pat, kd = PointsAsTori(P, N), cKDTree(P)
+        for label in ("no added load", "2 busy processes"):
+            def measure():
+                tp, _ = median_time(lambda: pat.signed_distance(Q), repeat=args.repeat)
+                tk, _ = median_time(lambda: kd.query(Q, k=64, workers=-1), repeat=args.repeat)
+                return tp, tk, uptime()
+
+            if label == "no added load":
+                tp, tk, up = measure()
+            else:
+                with BusyLoad(2):
+                    tp, tk, up = measure()
+            ratios.append((n, label, tk / tp))
+            rows.append([n, label, f"{nq / tp:.3g}", f"{nq / tk:.3g}", f"{tk / tp:.2f}", up])
+            print(rows[-1], flush=True)
+    summary = []
+    for n in sizes:
+        r = {lab: v for m, lab, v in ratios if m == n}
+        r0, r2 = r["no added load"], r["2 busy processes"]
+        summary.append(f"{n} points: ratio without added load {r0:.2f}, with 2 busy processes {r2:.2f} (the first "
+                       f"over the second = {r0 / r2:.2f}; target ≤ 1.25: PAT must not collapse where the kNN does not)")
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return (table(["points (elephant.off resampled)", "machine", "PAT queries/s", "cKDTree k=64 queries/s",
+                   "PAT / kNN (speed ratio)", "load average during"], rows)
+            + f"\n\n{nq} queries (half uniform in the padded box, half near the surface), medians of {args.repeat}; "
+            "PAT = `PointsAsTori(P, N).signed_distance(Q)` (jet estimator, fit not timed); kNN = "
+            "`cKDTree(P).query(Q, k=64, workers=-1)` (build not timed). \"no added load\" is the machine as it is "
+            "(on a shared machine: other jobs running, see the load column; on a quiet one, idle); \"2 busy "
+            "processes\" adds bench/load.py's "
+            f"BusyLoad(2). Peak RSS of this benchmark process: {rss:.0f} MB.\n\n" + "\n".join("* " + s for s in summary))
+
+
 def main():
     ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true", help="only the speed-under-load part, one cloud size")
+    ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--grid", type=int, default=48)
     ap.add_argument("--full", action="store_true")
     ap.add_argument("--skip", default="", help="comma list of parts to skip: landscape,real,speed")
     args = ap.parse_args()
     skip = set(args.skip.split(","))
-    head = (f"Machine: {machine()}. Command: `python bench/bench_tori.py --grid {args.grid}"
-            f"{' --full' if args.full else ''}` (parts can be run separately with --skip; each part's text is kept "
+    if args.quick:
+        skip |= {"speed", "real", "landscape"}
+    head = (f"Machine: {machine()}. Command: `python bench/bench_tori.py "
+            f"{'--quick' if args.quick else f'--grid {args.grid}'}{' --full' if args.full else ''}` (parts can be run separately with --skip; each part's text is kept "
             f"in bench/tori_part_<name>.md and the section is assembled from them).")
+    if "speed-load" not in skip:
+        _save_part("speed-load", f"### Speed against the k-nearest-neighbour query, idle and under load (issue 17)\n\n"
+                   f"Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_tori.py "
+                   f"{'--quick' if args.quick else '--skip landscape,real,speed'}`; machine: {machine()}; "
+                   f"load at start {uptime()}.\n\n" + speed_load(args))
     if "speed" not in skip:
         _save_part("speed", "### Speed (Fig. 5.15 analogue)\n\n" + speed(args))
     if "real" not in skip:
@@ -341,7 +406,7 @@ def main():
         _save_part("landscape", f"### Corruption landscapes (§7.2), grid {args.grid}³ over [-1,1]³\n\n"
                    f"Levels: {levels}; clean = 2048 points. Heatmaps: bench/tori_landscape_cylinder.png, "
                    f"bench/tori_landscape_sphere.png; all numbers: bench/tori_landscape.csv.\n\n" + summarize(rows, radii))
-    parts = [head] + [open(_part(n)).read() for n in ("speed", "real", "landscape") if os.path.exists(_part(n))]
+    parts = [head] + [open(_part(n)).read() for n in ("speed-load", "speed", "real", "landscape") if os.path.exists(_part(n))]
     text = "## Points as Tori (issue 5)\n\n" + "\n\n".join(parts)
     print(text)
     write_section("tori", text)

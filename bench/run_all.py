@@ -1,14 +1,17 @@
 """Every speed table in one command: runs the benchmark scripts, each rewriting its RESULTS.md section.
 
-    PYTHONPATH=src /work/anchors/bin/python bench/run_all.py --quick     # < 20 min on 2 cores (target)
+    PYTHONPATH=src /work/anchors/bin/python bench/run_all.py --quick     # < 20 min on 2 idle cores
     PYTHONPATH=src /work/anchors/bin/python bench/run_all.py             # everything, full sizes (hours)
     PYTHONPATH=src /work/anchors/bin/python bench/run_all.py --only winding,cold-start --load
 
 Each part runs in its own process (the anchors' venv when it exists, so libigl / potpourri3d / signedheat3d
 are importable) with this source tree first on PYTHONPATH. The machine and the load average (`uptime`)
-are printed before and after every part and written, with each part's duration and exit status, to the
-"run-all" section of RESULTS.md. ``--load`` asks the parts that support it (winding) to time everything a
-second time with two busy processes that the benchmark starts and stops itself (bench/load.py).
+are printed before and after every part and written, with each part's duration, peak RSS (``wait4``: the
+part's process; parts that start a process per case report those in their own sections) and exit status, to the
+"run-all" section of RESULTS.md. ``--load`` asks the parts that support it (winding, heat-volume-speed) to time
+everything a second time with two busy processes that the benchmark starts and stops itself (bench/load.py);
+the tori part measures under that load in every mode. A part without a quick mode (``None``) is skipped by
+``--quick``.
 """
 
 from __future__ import annotations
@@ -27,15 +30,25 @@ from load import uptime  # noqa: E402
 
 ANCHORS_PYTHON = "/work/anchors/bin/python"
 
-# name -> (script, quick arguments, full arguments, takes --load)
+# name -> (script, quick arguments or None (not in --quick), full arguments, takes --load)
 PARTS = {
     "cold-start": ("bench_cold_start.py", ["--only", "demo,sdf"], [], False),
     "winding": ("bench_winding.py", ["--quick"], [], True),
     "distance": ("bench_distance.py", ["--queries", "50000"], [], False),
-    "tori": ("bench_tori.py", ["--skip", "landscape,real"], [], False),
+    "tori": ("bench_tori.py", ["--quick"], [], False),
     "heat-surface": ("bench_heat_surface.py", ["--quick"], [], False),
-    "heat-volume": ("bench_heat_volume.py", ["--quick"], [], False),
+    "heat-volume-speed": ("bench_heat_volume_speed.py", ["--quick"], [], True),
+    "heat-volume": ("bench_heat_volume.py", None, [], False),  # accuracy tables incl. tets: tens of minutes
 }
+
+
+def run_part(cmd, env):
+    """Run ``cmd``; (exit status, seconds, peak RSS in MB of its process tree's largest waited process)."""
+    t = time.perf_counter()
+    p = subprocess.Popen(cmd, env=env, cwd=ROOT)
+    _, status, usage = os.wait4(p.pid, 0)
+    p.returncode = os.waitstatus_to_exitcode(status)
+    return p.returncode, time.perf_counter() - t, usage.ru_maxrss / 1024.0
 
 
 def python_for_benchmarks() -> str:
@@ -60,26 +73,30 @@ def main(argv=None):
     rows, t_all = [], time.perf_counter()
     for n in names:
         script, quick, full, takes_load = PARTS[n]
+        if a.quick and quick is None:
+            print(f"\n=== {n}: no quick mode, skipped by --quick", flush=True)
+            continue
         cmd = [py, os.path.join(HERE, script), *(quick if a.quick else full), *(["--load"] if a.load and takes_load else [])]
         print(f"\n=== {n}: {' '.join(cmd)}\n    before: {uptime()}", flush=True)
         if a.dry_run:
             continue
         before = uptime()
-        t = time.perf_counter()
-        status = subprocess.run(cmd, env=env, cwd=ROOT).returncode
-        dt = time.perf_counter() - t
+        status, dt, rss = run_part(cmd, env)
         after = uptime()
-        print(f"    {n}: exit {status}, {dt:.0f} s; after: {after}", flush=True)
+        print(f"    {n}: exit {status}, {dt:.0f} s, peak RSS {rss:.0f} MB; after: {after}", flush=True)
         rel = os.path.relpath(cmd[1], ROOT)
         rows.append([n, f"`{os.path.basename(py)} {rel} {' '.join(cmd[2:])}`".replace("  ", " "),
-                     "ok" if status == 0 else f"exit {status}", f"{dt:.0f}", before, after])
+                     "ok" if status == 0 else f"exit {status}", f"{dt:.0f}", f"{rss:.0f}", before, after])
     if a.dry_run:
         return 0
     total = time.perf_counter() - t_all
     text = (f"## All speed tables (bench/run_all.py{' --quick' if a.quick else ''}{' --load' if a.load else ''})\n\n"
             f"Machine: {info}. Total {total / 60:.1f} min. The machine is shared: load averages before and after "
-            "each part are listed; each part's own section states what it measured.\n\n"
-            + table(["part", "command", "status", "seconds", "uptime before", "uptime after"], rows))
+            "each part are listed; each part's own section states what it measured. Peak RSS: the part's "
+            "process (largest of it and the children it waited for; per-case figures are in the parts' sections). "
+            f"Command: `PYTHONPATH=src {py} bench/run_all.py {' '.join(sys.argv[1:] if argv is None else argv)}`."
+            "\n\n"
+            + table(["part", "command", "status", "seconds", "peak RSS MB", "uptime before", "uptime after"], rows))
     write_section("run-all", text)
     print("\n" + text)
     return 0 if all(r[2] == "ok" for r in rows) else 1

@@ -172,6 +172,19 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     >>> bool(d[0] < -0.8 and abs(d[1] - 0.1) < 0.05)
     True
     """
+    from ...threads import blas_region
+
+    # BLAS on one thread (or the explicit gsdf.threads setting) for the whole run: the CG loops of step III
+    # call BLAS dot / norm on 10⁴–10⁶-vectors, where OpenBLAS's threads cost more than they save (32³ grid:
+    # 12 ms per dot with 2 threads on a shared machine vs 20 µs with one; bench/bench_heat_volume_speed.py).
+    with blas_region():
+        return _signed_heat_volume(mesh, points, domain, resolution, bbox_min, bbox_max, t_coef,
+                                   level_set_constraint, soft_weight, theta, max_memory, progress, t_scale, kwargs)
+
+
+def _signed_heat_volume(mesh, points, domain, resolution, bbox_min, bbox_max, t_coef, level_set_constraint,
+                        soft_weight, theta, max_memory, progress, t_scale, kwargs):
+    """The body of :func:`signed_heat_volume` (BLAS already limited)."""
     domain = choice(domain, "domain", {"grid", "tet"})
     t_coef = positive(t_coef, "t_coef")
     level_set_constraint = choice(level_set_constraint, "level_set_constraint", {"none", "zero", "multiple"})

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from ...linalg import Factorization, pcg
 from .memory import available_memory, check_memory  # noqa: F401  (re-exported)
@@ -36,7 +37,72 @@ from .memory import available_memory, check_memory  # noqa: F401  (re-exported)
 
 
 def neumann_laplacian(shape, spacing) -> sp.csr_matrix:
-    """The 7-point Laplacian with Neumann boundary, positive semidefinite: Σ_a K_a / h_a², K_a = D_aᵀ D_a."""
+    """The 7-point Laplacian with Neumann boundary, positive semidefinite: Σ_a K_a / h_a², K_a = D_aᵀ D_a.
+
+    K_a is the path Laplacian along axis a (2 on the diagonal, 1 at both ends, −1 off it). Assembled directly in
+    CSR by :func:`_laplacian_csr` — entry for entry what ``kron(K_x, I, I) + kron(I, K_y, I) + kron(I, I, K_z)``
+    gives (:func:`_neumann_laplacian_kron`, kept for the test), ~10× faster at 32³.
+    """
+    shape = tuple(int(s) for s in shape)
+    w = np.array([float(spacing[a]) ** 2 for a in range(3)])
+    n = shape[0] * shape[1] * shape[2]
+    itype = np.int32 if 7 * n < 2 ** 31 else np.int64  # scipy's own index type for this size
+    indptr, indices, data = np.zeros(n + 1, itype), np.empty(7 * n, itype), np.empty(7 * n)
+    p = _laplacian_csr(shape[0], shape[1], shape[2], w, indptr, indices, data)
+    return sp.csr_matrix((data[:p], indices[:p], indptr), shape=(n, n))
+
+
+@njit(cache=True)
+def _laplacian_csr(n0, n1, n2, w, indptr, indices, data):
+    """Fill the CSR arrays of :func:`neumann_laplacian` (returns the entry count): row-major nodes, columns
+    ascending (x−1, y−1, z−1, self, z+1, y+1, x+1); the diagonal summed x, y, z in that order (so it equals the
+    Kronecker assembly bit for bit)."""
+    dims = (n0, n1, n2)
+    s1, s0 = n2, n1 * n2
+    p = 0
+    for i in range(n0):
+        for j in range(n1):
+            for k in range(n2):
+                r = (i * n1 + j) * n2 + k
+                diag = 0.0
+                for a in range(3):
+                    c = i if a == 0 else (j if a == 1 else k)
+                    m = dims[a]
+                    main = 1.0 if (c == 0 or c == m - 1) else 2.0
+                    diag = main / w[a] if a == 0 else diag + main / w[a]
+                if i > 0:
+                    indices[p] = r - s0
+                    data[p] = -1.0 / w[0]
+                    p += 1
+                if j > 0:
+                    indices[p] = r - s1
+                    data[p] = -1.0 / w[1]
+                    p += 1
+                if k > 0:
+                    indices[p] = r - 1
+                    data[p] = -1.0 / w[2]
+                    p += 1
+                indices[p] = r
+                data[p] = diag
+                p += 1
+                if k < n2 - 1:
+                    indices[p] = r + 1
+                    data[p] = -1.0 / w[2]
+                    p += 1
+                if j < n1 - 1:
+                    indices[p] = r + s1
+                    data[p] = -1.0 / w[1]
+                    p += 1
+                if i < n0 - 1:
+                    indices[p] = r + s0
+                    data[p] = -1.0 / w[0]
+                    p += 1
+                indptr[r + 1] = p
+    return p
+
+
+def _neumann_laplacian_kron(shape, spacing) -> sp.csr_matrix:
+    """The Kronecker-product assembly of :func:`neumann_laplacian` (reference for the test)."""
     shape = tuple(int(s) for s in shape)
     mats = []
     for a in range(3):
@@ -54,12 +120,12 @@ def divergence_rhs(Y, spacing) -> np.ndarray:
     """Right-hand side Gᵀ Ŷ / h of the edge least-squares problem (forward-difference divergence of Y)."""
     rhs = np.zeros(Y.shape[:3])
     for a in range(3):
-        E = 0.5 * (np.take(Y[..., a], range(1, Y.shape[a]), axis=a)
-                   + np.take(Y[..., a], range(0, Y.shape[a] - 1), axis=a)) / spacing[a]
         sl_hi = [slice(None)] * 3
         sl_lo = [slice(None)] * 3
         sl_hi[a] = slice(1, None)
         sl_lo[a] = slice(0, -1)
+        Ya = Y[..., a]
+        E = 0.5 * (Ya[tuple(sl_hi)] + Ya[tuple(sl_lo)]) / spacing[a]  # slices, not np.take (a copy per call)
         rhs[tuple(sl_hi)] += E
         rhs[tuple(sl_lo)] -= E
     return rhs.ravel()
@@ -107,13 +173,25 @@ def dct_poisson(rhs, shape, spacing, shift: float = 0.0, lam=None) -> np.ndarray
 
     if lam is None:
         lam = _dct_eigenvalues(shape, spacing, shift)
-    c = dctn(np.asarray(rhs, float).reshape(shape), type=2, norm="ortho", workers=-1)
+    workers = _fft_workers(int(np.prod(shape)))
+    c = dctn(np.asarray(rhs, float).reshape(shape), type=2, norm="ortho", workers=workers)
     if shift == 0.0:
         c[0, 0, 0] = 0.0
         lam = lam.copy()
         lam[0, 0, 0] = 1.0
     c /= lam
-    return idctn(c, type=2, norm="ortho", workers=-1).ravel()
+    return idctn(c, type=2, norm="ortho", workers=workers).ravel()
+
+
+def _fft_workers(n: int) -> int:
+    """Threads of scipy.fft for an n-node transform: one below 2¹⁸ nodes (a 32³ DCT takes ~1 ms, starting and
+    joining threads costs more, and under load a descheduled worker stalls the call), else gsdf's thread
+    setting (:func:`gsdf.threads.get_num_threads`). The result is the same for any count."""
+    if n < 1 << 18:
+        return 1
+    from ...threads import get_num_threads
+
+    return get_num_threads()
 
 
 def _aggregation(shape, block: int) -> sp.csr_matrix:
@@ -147,7 +225,7 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     shape = tuple(shape)
     if penalty is None:
         return dct_poisson(rhs, shape, spacing)
-    from scipy.sparse.linalg import LinearOperator, spsolve_triangular
+    from scipy.sparse.linalg import LinearOperator
 
     n = int(np.prod(shape))
     L = neumann_laplacian(shape, spacing)
@@ -158,15 +236,17 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     A_bb = A[band][:, band]
     lower = sp.tril(A_bb, format="csr")
     upper = sp.triu(A_bb, format="csr")
+    lower.sort_indices()
+    upper.sort_indices()
     block = max(2, int(np.ceil((n / coarse_size) ** (1.0 / 3.0))))
     R = _aggregation(shape, block)
-    coarse = Factorization((R @ A @ R.T).tocsc(), symmetric=False, ordering="COLAMD", pivot=1.0)  # SPD: P > 0
+    coarse = Factorization((R @ A @ R.T).tocsc())  # SPD (P > 0): SuperLU's symmetric mode, 2× faster than COLAMD
 
     def precondition(r):
         x = R.T @ coarse.solve(R @ r)
-        x[band] += spsolve_triangular(lower, (r - A @ x)[band], lower=True)
+        x[band] += _triangular_solve(lower.indptr, lower.indices, lower.data, (r - A @ x)[band], True)
         x += dct_poisson(r - A @ x, shape, spacing, delta, lam)
-        x[band] += spsolve_triangular(upper, (r - A @ x)[band], lower=False)
+        x[band] += _triangular_solve(upper.indptr, upper.indices, upper.data, (r - A @ x)[band], False)
         x += R.T @ coarse.solve(R @ (r - A @ x))
         return x
 
@@ -174,6 +254,26 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
     x0 += (rhs.sum() - (A @ x0).sum()) / penalty.sum()  # best constant shift (L annihilates constants)
     x, _ = pcg(A, rhs, M=M, x0=x0, rtol=tol, maxiter=maxiter, warn="step III")
+    return x
+
+
+@njit(cache=True)
+def _triangular_solve(indptr, indices, data, b, lower):
+    """Solve T x = b for a CSR triangular T with sorted indices (the Gauss–Seidel sweeps of
+    :func:`solve_poisson`): forward substitution when ``lower``, else backward. Serial by nature."""
+    n = b.shape[0]
+    x = np.empty(n)
+    for k in range(n):
+        i = k if lower else n - 1 - k
+        acc = b[i]
+        diag = 0.0
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if j == i:
+                diag = data[p]
+            else:
+                acc -= data[p] * x[j]
+        x[i] = acc / diag
     return x
 
 
