@@ -8,7 +8,7 @@ Each part runs in its own process (the anchors' venv when it exists, so libigl /
 are importable) with this source tree first on PYTHONPATH. The machine and the load average (`uptime`)
 are printed before and after every part and written, with each part's duration, peak RSS (``wait4``: the
 part's process; parts that start a process per case report those in their own sections) and exit status, to the
-"run-all" section of RESULTS.md. ``--load`` asks the parts that support it (winding, heat-volume-speed) to time
+"run-all" section of RESULTS.md. ``--load`` asks the parts that support it (winding, heat-surface, heat-volume-speed) to time
 everything a second time with two busy processes that the benchmark starts and stops itself (bench/load.py);
 the tori part measures under that load in every mode. A part without a quick mode (``None``) is skipped by
 ``--quick``.
@@ -36,7 +36,7 @@ PARTS = {
     "winding": ("bench_winding.py", ["--quick"], [], True),
     "distance": ("bench_distance.py", ["--queries", "50000"], [], False),
     "tori": ("bench_tori.py", ["--quick"], [], False),
-    "heat-surface": ("bench_heat_surface.py", ["--quick"], [], False),
+    "heat-surface": ("bench_heat_surface.py", ["--speed", "--quick"], ["--speed"], True),
     "heat-volume-speed": ("bench_heat_volume_speed.py", ["--quick"], [], True),
     "heat-volume": ("bench_heat_volume.py", None, [], False),  # accuracy tables incl. tets: tens of minutes
 }
