@@ -36,7 +36,7 @@ from scipy.spatial import Delaunay, QhullError, cKDTree
 
 from .._checks import as_normals, as_points, choice, integer
 from ..dec.tet import TetComplex, correction_chain
-from .grow import grow_regions, region_boundary
+from .grow import carve_regions, grow_regions, region_boundary
 from .orient import face_chain, orient_normals
 from .steiner import octree_steiner_points
 
@@ -74,7 +74,7 @@ def prepare_cloud(P, N=None):
 
 
 def _prefilter(X: np.ndarray, k: int = 10, factor: float = 2.5, residual: float = 0.4, planarity: float = 0.1,
-               rounds: int = 3) -> np.ndarray:
+               rounds: int = 3, rescue: bool = True) -> np.ndarray:
     """(n,) bool inliers of the statistical pre-filter (§3.3's outlier removal, first pass).
 
     A point is kept when the mean distance to its ``k`` nearest kept neighbours is at most ``factor`` × the
@@ -105,6 +105,16 @@ def _prefilter(X: np.ndarray, k: int = 10, factor: float = 2.5, residual: float 
         if np.array_equal(new, keep):
             break
         keep = new
+    if rescue and keep.sum() > 1:
+        # thin parts (legs, ears) have curved, non-planar neighbourhoods: keep a dropped point anyway when it
+        # is densely surrounded — its nearest point within 1.5 spacings and 3 points within 2 spacings, as on
+        # a surface sampled at that spacing and rarely among outliers, which are sparse
+        idx = np.flatnonzero(keep)
+        dk, _ = cKDTree(X[idx]).query(X[idx], k=2)
+        sp_ = float(np.median(dk[:, 1]))
+        d4, _ = cKDTree(X).query(X, k=min(4, len(X)))
+        dense = (d4[:, 1] <= 1.5 * sp_) & (d4[:, -1] <= 2.0 * sp_)
+        keep = keep | dense
     return keep
 
 
@@ -180,9 +190,44 @@ def _seeds(K, w, allowed, n_regions):
     return np.array(seeds, dtype=np.int64)
 
 
+def _circumradii(V, T):
+    """(m,) circumradius of each tet (inf for flat ones)."""
+    a = V[T[:, 0]]
+    B = V[T[:, 1:]] - a[:, None]
+    rhs = 0.5 * np.einsum("mkx,mkx->mk", B, B)
+    det = np.linalg.det(B)
+    ok = np.abs(det) > 1e-14 * np.einsum("mkx,mkx->m", B, B) ** 1.5
+    B[~ok] = np.eye(3)
+    c = np.linalg.solve(B, rhs[..., None])[..., 0]
+    r = np.linalg.norm(c, axis=1)
+    r[~ok] = np.inf
+    return r
+
+
+def _grow_thin(K, label, allowed, n_p, use, Xi, alpha):
+    """Extend the grown balls by simple tets of the α-complex of the inlier samples (thin parts).
+
+    Where a part is thinner than the sample spacing (legs, ears, tails), PCA and pole normals are unreliable
+    and the jump field misses it; but there the Delaunay tets spanned by four inlier samples with a
+    circumradius below ``alpha`` × their local spacing fill it (the α-shape), while outside space between
+    separate surface sheets is spanned by larger balls.  Growth is by simple tets, so each region stays a ball.
+    """
+    from .orient import local_spacing
+    h = np.full(K.n_vertices, np.inf)
+    idx = np.flatnonzero(use)
+    h[idx] = local_spacing(Xi[idx])
+    hT = h[K.T].mean(axis=1)
+    R = _circumradii(K.V, K.T)
+    ratio = np.where(np.isfinite(hT), R / np.where(np.isfinite(hT), hT, 1.0), np.inf)
+    eligible = np.isfinite(ratio) & (ratio <= alpha) & (label < 0)
+    label, _ = grow_regions(K, np.zeros(K.n_tets), 0.5, allowed=allowed, priority=-np.minimum(ratio, 1e30), label=label,
+                            eligible=eligible)
+    return label
+
+
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
-                                 sign: str = "tangent", hodge: bool = False, project: bool = True, band: float = 10.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 sign: str = "tangent", hodge: bool = False, project: bool = True, band: float = 10.0, thin: float = 1.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -366,6 +411,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
             sd[m] = np.linalg.norm(cen[m] - cen[sdt], axis=1)
         prio = np.minimum(w, 1.0) - 0.05 * sd
         label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed, priority=prio)
+        if thin > 0:
+            label = _grow_thin(K, label, allowed, n_p, use, Xi, thin)
         rejected_hist.append(int(rejected))
         timings["grow"] += time.perf_counter() - t
         t = time.perf_counter()
