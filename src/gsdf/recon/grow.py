@@ -194,13 +194,32 @@ def _carve(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, remo
            n_vertices, n_edges):
     """Remove removable boundary tets of the regions, largest ``prio`` first, while each removal is simple.
 
-    Removing T from R is the inverse of adding T to R \ T, so it keeps R a ball exactly when T is simple for
-    R \ T: T shares 1–3 faces with R \ T and ∂T ∩ (R \ T) is their union (|S| = 1: the opposite vertex is in
-    no other tet of R; |S| = 2: the opposite edge is in no other tet of R).  A removal that would drop a vertex
-    with ``keep_vertex`` (an inlier sample) from its region is refused; a region is never emptied.
+    In the 3-sphere (space closed by a point at infinity) the complement C of a PL ball R is a ball, so
+    removing T from R is *adding* T to C, and that keeps C — hence R — a ball exactly when T is simple for
+    C: the faces of T shared with C (hull faces count) number 1–3 and ∂T ∩ C is their union, i.e.
+
+    * 1 face shared with C: the vertex opposite it is not in C (every tet around it is in R, not on the hull);
+    * 2 faces: the edge opposite their common edge is not in C;
+    * 3 faces: always.
+
+    A vertex or edge is in C when one of its tets is outside R or it lies on the hull.  A removal that drops a
+    vertex with ``keep_vertex`` from R is refused, and a region is never emptied.
     """
     m = T.shape[0]
     vcount, vowner, ecount = _counts(T, tet_edges, label, n_vertices, n_edges)
+    vdeg, _, edeg = _counts(T, tet_edges, np.zeros(m, dtype=np.int64), n_vertices, n_edges)
+    vhull = np.zeros(n_vertices, dtype=np.bool_)
+    ehull = np.zeros(n_edges, dtype=np.bool_)
+    for t in range(m):
+        for k in range(4):
+            if _neighbour(tet_faces, tet_face_sign, face_tets, t, k) < 0:
+                # the hull face opposite local vertex k: its vertices and edges touch the outside
+                for j in range(4):
+                    if j != k:
+                        vhull[T[t, j]] = True
+                        for i in range(j + 1, 4):
+                            if i != k:
+                                ehull[tet_edges[t, pair_to_edge[j, i]]] = True
     cap = 8 * m + 1
     keys = np.empty(cap)
     vals = np.empty(cap, dtype=np.int64)
@@ -218,32 +237,33 @@ def _carve(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, remo
         r = label[t]
         if r < 0:
             continue
-        ns = 0
-        s0 = -1
-        s1 = -1
+        nc = 0
+        c0 = -1
+        c1 = -1
         for k in range(4):
             t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
-            if t2 >= 0 and label[t2] == r:
-                if ns == 0:
-                    s0 = k
+            if t2 < 0 or label[t2] != r:
+                if nc == 0:
+                    c0 = k
                 else:
-                    s1 = k
-                ns += 1
-        if ns == 0 or ns == 4:
+                    c1 = k
+                nc += 1
+        if nc == 0 or nc == 4:
             continue
-        # the local vertices not on a shared face ... (|S| = 1: vertex s0; |S| = 2: edge s0–s1) must leave R
-        if ns == 1:
-            v = T[t, s0]
-            if vcount[v] > 1 or keep_vertex[v]:
+        if nc == 1:
+            v = T[t, c0]
+            if vhull[v] or vcount[v] < vdeg[v]:
                 continue
-        elif ns == 2:
-            if ecount[tet_edges[t, pair_to_edge[s0, s1]]] > 1:
+        elif nc == 2:
+            e = tet_edges[t, pair_to_edge[c0, c1]]
+            if ehull[e] or ecount[e] < edeg[e]:
                 continue
-            if (keep_vertex[T[t, s0]] and vcount[T[t, s0]] == 1) or (keep_vertex[T[t, s1]] and vcount[T[t, s1]] == 1):
-                continue
-        else:
-            # |S| = 3: every vertex stays (it is on a shared face)
-            pass
+        drop = False
+        for k in range(4):
+            if vcount[T[t, k]] == 1 and keep_vertex[T[t, k]]:
+                drop = True
+        if drop:
+            continue
         label[t] = -1
         removed += 1
         for k in range(4):
@@ -252,7 +272,7 @@ def _carve(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, remo
                 vowner[T[t, k]] = -1
         for k in range(6):
             ecount[tet_edges[t, k]] -= 1
-        # newly exposed removable tets of R, and t's neighbours whose test may have changed
+        # newly exposed removable tets of R (and neighbours whose test may have changed)
         for k in range(4):
             t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
             if t2 >= 0 and label[t2] == r and removable[t2] and size < cap:

@@ -190,44 +190,46 @@ def _seeds(K, w, allowed, n_regions):
     return np.array(seeds, dtype=np.int64)
 
 
-def _circumradii(V, T):
-    """(m,) circumradius of each tet (inf for flat ones)."""
-    a = V[T[:, 0]]
-    B = V[T[:, 1:]] - a[:, None]
-    rhs = 0.5 * np.einsum("mkx,mkx->mk", B, B)
-    det = np.linalg.det(B)
-    ok = np.abs(det) > 1e-14 * np.einsum("mkx,mkx->m", B, B) ** 1.5
-    B[~ok] = np.eye(3)
-    c = np.linalg.solve(B, rhs[..., None])[..., 0]
-    r = np.linalg.norm(c, axis=1)
-    r[~ok] = np.inf
-    return r
+def _sculpt(K, label, Xs, Ns, n_p, samples, spacing, gap: float = 2.0, level: float = 0.5):
+    """Peel wrong bulges and bridges off the grown balls by simple-tet removals (the guarantee is kept).
 
+    A tet of a region is *outside evidence* when its centroid is farther than ``gap`` × ``spacing`` from every
+    sample (a true surface passes through the samples, so a region boundary far from them is a bulge or a
+    bridge over a concavity) and the fast winding number of the oriented samples there is below ``level``.
+    Such tets are removed from the region boundary inward, farthest from the samples first, each only when
+    the removal is simple (:func:`.grow.carve_regions`) and cuts no sample vertex off the surface.
 
-def _grow_thin(K, label, allowed, n_p, use, Xi, alpha):
-    """Extend the grown balls by simple tets of the α-complex of the inlier samples (thin parts).
+    Parameters
+    ----------
+    K : TetComplex; label : (m,) int regions; Xs, Ns : (s, 3) samples (inliers of this round) and oriented
+    normals; n_p : int — vertices ``0..n_p-1`` of ``K`` are the inlier points; samples : (n_p,) bool — which of
+    them are samples; spacing : float.
 
-    Where a part is thinner than the sample spacing (legs, ears, tails), PCA and pole normals are unreliable
-    and the jump field misses it; but there the Delaunay tets spanned by four inlier samples with a
-    circumradius below ``alpha`` × their local spacing fill it (the α-shape), while outside space between
-    separate surface sheets is spanned by larger balls.  Growth is by simple tets, so each region stays a ball.
+    Returns
+    -------
+    label : (m,) int64; removed : int.
     """
-    from .orient import local_spacing
-    h = np.full(K.n_vertices, np.inf)
-    idx = np.flatnonzero(use)
-    h[idx] = local_spacing(Xi[idx])
-    hT = h[K.T].mean(axis=1)
-    R = _circumradii(K.V, K.T)
-    ratio = np.where(np.isfinite(hT), R / np.where(np.isfinite(hT), hT, 1.0), np.inf)
-    eligible = np.isfinite(ratio) & (ratio <= alpha) & (label < 0)
-    label, _ = grow_regions(K, np.zeros(K.n_tets), 0.5, allowed=allowed, priority=-np.minimum(ratio, 1e30), label=label,
-                            eligible=eligible)
-    return label
+    from ..winding import fast_winding_number_points
+    cen = K.V[K.T].mean(axis=1)
+    cand = np.flatnonzero(label >= 0)
+    d, _ = cKDTree(Xs).query(cen[cand])
+    far = d > gap * spacing
+    cand, d = cand[far], d[far]
+    removable = np.zeros(K.n_tets, dtype=bool)
+    prio = np.zeros(K.n_tets)
+    if cand.size:
+        wn = fast_winding_number_points(Xs, Ns, cen[cand])
+        out = wn < level
+        removable[cand[out]] = True
+        prio[cand[out]] = d[out]
+    keep_vertex = np.zeros(K.n_vertices, dtype=bool)
+    keep_vertex[:n_p] = samples
+    return carve_regions(K, label, removable, prio, keep_vertex=keep_vertex)
 
 
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
-                                 sign: str = "tangent", hodge: bool = False, project: bool = True, band: float = 10.0, thin: float = 1.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 sign: str = "tangent", hodge: bool = False, project: bool = True, sculpt: bool = True, band: float = 10.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -375,6 +377,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     label = G = best = H = None
     gamma_ratios = []
     cavities = []
+    carved = []
     rounds = max_iterations if outliers == "auto" else 1
     for it in range(rounds):
         t = time.perf_counter()
@@ -411,8 +414,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
             sd[m] = np.linalg.norm(cen[m] - cen[sdt], axis=1)
         prio = np.minimum(w, 1.0) - 0.05 * sd
         label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed, priority=prio)
-        if thin > 0:
-            label = _grow_thin(K, label, allowed, n_p, use, Xi, thin)
+        if sculpt:
+            label, n_carved = _sculpt(K, label, Xi[use], Ni[use], n_p, use, spacing)
+            carved.append(n_carved)
         rejected_hist.append(int(rejected))
         timings["grow"] += time.perf_counter() - t
         t = time.perf_counter()
@@ -460,7 +464,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     dup = np.ones(n_in, dtype=bool)
     dup[keep] = False
     report = {
-        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "cavity_tets": cavities, "rejected_non_simple": rejected_hist,
+        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "cavity_tets": cavities, "rejected_non_simple": rejected_hist, "sculpted_tets": carved,
         "outliers": outlier_mask & ~dup, "prefiltered": int((~inl).sum()), "duplicates": int(dup.sum()),
         "surface_fraction": float(inl.mean()), "n_steiner": int(len(S)), "n_tets": int(K.n_tets), "n_regions": int(n_regions),
         "region_tets": int((label >= 0).sum()), "timings": timings,
