@@ -190,41 +190,42 @@ def _seeds(K, w, allowed, n_regions):
     return np.array(seeds, dtype=np.int64)
 
 
-def _sculpt(K, label, Xs, Ns, n_p, samples, spacing, gap: float = 2.0, level: float = 0.5):
-    """Peel wrong bulges and bridges off the grown balls by simple-tet removals (the guarantee is kept).
+def _sculpt(K, label, allowed, Xs, Ns, n_p, samples, spacing, gap: float = 2.0, level: float = 0.5,
+            fill: float = 0.6):
+    """Correct the grown balls where the winding evidence contradicts them, by simple-tet moves only.
 
-    A tet of a region is *outside evidence* when its centroid is farther than ``gap`` × ``spacing`` from every
-    sample (a true surface passes through the samples, so a region boundary far from them is a bulge or a
-    bridge over a concavity) and the fast winding number of the oriented samples there is below ``level``.
-    Such tets are removed from the region boundary inward, farthest from the samples first, each only when
-    the removal is simple (:func:`.grow.carve_regions`) and cuts no sample vertex off the surface.
+    The fast winding number of the oriented samples (Barill et al. 2018) is a second, more global inside
+    test than the jump field, which follows the local tangent planes.  First, tets outside the region with
+    winding > ``fill`` are added by simple tets (:func:`.grow.grow_regions` resumed: pockets and slits that
+    a wrongly oriented patch left in the body are filled).  Then, away from the samples (centroid farther
+    than ``gap`` × ``spacing`` from every sample: a true surface passes through the samples, and near them,
+    in thin parts, the winding number is unreliable), region tets with winding < ``level`` are removed from
+    the boundary inward, farthest from the samples first, by simple removals that cut no sample off the
+    surface (:func:`.grow.carve_regions`: bulges and bridges over concavities are peeled).  Each region stays a PL ball, so the output stays one sphere per region.
 
     Parameters
     ----------
-    K : TetComplex; label : (m,) int regions; Xs, Ns : (s, 3) samples (inliers of this round) and oriented
-    normals; n_p : int — vertices ``0..n_p-1`` of ``K`` are the inlier points; samples : (n_p,) bool — which of
-    them are samples; spacing : float.
+    K : TetComplex; label, allowed : (m,) int regions and the region each tet may join; Xs, Ns : (s, 3)
+    samples (inliers of this round) and their oriented normals; n_p : int — vertices ``0..n_p-1`` of ``K``
+    are the inlier points; samples : (n_p,) bool — which of them are samples; spacing : float.
 
     Returns
     -------
-    label : (m,) int64; removed : int.
+    label : (m,) int64; added, removed : int.
     """
     from ..winding import fast_winding_number_points
     cen = K.V[K.T].mean(axis=1)
-    cand = np.flatnonzero(label >= 0)
-    d, _ = cKDTree(Xs).query(cen[cand])
+    d, _ = cKDTree(Xs).query(cen)
+    wn = fast_winding_number_points(Xs, Ns, cen)
     far = d > gap * spacing
-    cand, d = cand[far], d[far]
-    removable = np.zeros(K.n_tets, dtype=bool)
-    prio = np.zeros(K.n_tets)
-    if cand.size:
-        wn = fast_winding_number_points(Xs, Ns, cen[cand])
-        out = wn < level
-        removable[cand[out]] = True
-        prio[cand[out]] = d[out]
+    n0 = int((label >= 0).sum())
+    label, _ = grow_regions(K, wn, level, allowed=allowed, priority=wn, label=label,
+                            eligible=(label < 0) & (wn > fill))
+    added = int((label >= 0).sum()) - n0
     keep_vertex = np.zeros(K.n_vertices, dtype=bool)
     keep_vertex[:n_p] = samples
-    return carve_regions(K, label, removable, prio, keep_vertex=keep_vertex)
+    label, removed = carve_regions(K, label, far & (wn < level), d, keep_vertex=keep_vertex)
+    return label, added, int(removed)
 
 
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
@@ -415,8 +416,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         prio = np.minimum(w, 1.0) - 0.05 * sd
         label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed, priority=prio)
         if sculpt:
-            label, n_carved = _sculpt(K, label, Xi[use], Ni[use], n_p, use, spacing)
-            carved.append(n_carved)
+            label, n_add, n_cut = _sculpt(K, label, allowed, Xi[use], Ni[use], n_p, use, spacing)
+            carved.append((n_add, n_cut))
         rejected_hist.append(int(rejected))
         timings["grow"] += time.perf_counter() - t
         t = time.perf_counter()
