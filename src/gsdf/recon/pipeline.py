@@ -13,7 +13,10 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
    with w > ½ is grown by simple tets only from a seed in the largest inside component, in the order of
    min(w, 1) − 0.05 × distance to the seed (concentric inside the plateau w ≈ 1, so fronts do not meet and
    leave slits); its boundary is one PL sphere — closed, edge- and vertex-manifold, genus 0 — by construction;
-6. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``).
+6. sculpting (:func:`_sculpt`): where the fast winding number of the oriented samples contradicts the grown
+   ball — pockets inside the body, bulges and bridges far from every sample — tets are added or removed by
+   simple-tet moves only (:func:`.grow.carve_regions`), so the output is still one PL sphere;
+7. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``).
 
 Example
 -------
@@ -105,7 +108,7 @@ def _prefilter(X: np.ndarray, k: int = 10, factor: float = 2.5, residual: float 
         if np.array_equal(new, keep):
             break
         keep = new
-    if rescue and keep.sum() > 1:
+    if rescue and keep.mean() >= 0.5:
         # thin parts (legs, ears) have curved, non-planar neighbourhoods: keep a dropped point anyway when it
         # is densely surrounded — its nearest point within 1.5 spacings and 3 points within 2 spacings, as on
         # a surface sampled at that spacing and rarely among outliers, which are sparse
@@ -251,6 +254,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         §4.2 (costly: it factorizes the face Laplacian).  On the Delaunay tetrahedralisation used here (a ball)
         the harmonic part is zero up to solver tolerance (reported as ``gamma_ratio``), so the correction is the
         identity and the default skips it.
+    sculpt : bool — after each growth, fill pockets where the winding number of the oriented samples is
+        > 0.6 and peel region tets farther than 2 spacings from every sample where it is < ½, by simple-tet
+        moves (the topology promise is kept; :func:`_sculpt`).  False: the grown ball as it is.
     project : bool — move the Steiner vertices of the output onto the tangent planes of their nearest inliers
         (vertex positions only; the mesh's combinatorics and topology are those of the grown ball).
     band : float — F0 lies within ``band`` × median spacing of the inliers (:func:`.orient.face_chain`).
