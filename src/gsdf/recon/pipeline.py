@@ -13,9 +13,10 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
    with w > ½ is grown by simple tets only from a seed in the largest inside component, in the order of
    min(w, 1) − 0.05 × distance to the seed (concentric inside the plateau w ≈ 1, so fronts do not meet and
    leave slits); its boundary is one PL sphere — closed, edge- and vertex-manifold, genus 0 — by construction;
-6. sculpting (:func:`_sculpt`): where the fast winding number of the oriented samples contradicts the grown
-   ball — pockets inside the body, bulges and bridges far from every sample — tets are added or removed by
-   simple-tet moves only (:func:`.grow.carve_regions`), so the output is still one PL sphere;
+6. winding evidence: the growth field is raised where the fast winding number of the oriented samples says
+   inside (:func:`_with_winding`: no holes in the body for the front to wrap around), and after growth the
+   region tets far from every sample where it says outside — bulges, bridges — are peeled by simple-tet
+   removals only (:func:`_sculpt`, :func:`.grow.carve_regions`), so the output is still one PL sphere;
 7. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``).
 
 Example
@@ -193,41 +194,55 @@ def _seeds(K, w, allowed, n_regions):
     return np.array(seeds, dtype=np.int64)
 
 
-def _sculpt(K, label, allowed, Xs, Ns, n_p, samples, spacing, gap: float = 2.0, level: float = 0.5,
-            fill: float = 0.6):
-    """Correct the grown balls where the winding evidence contradicts them, by simple-tet moves only.
+def _winding_evidence(K, Xs, Ns):
+    """(m,) fast winding number of the oriented samples ``Xs, Ns`` at the tet centroids, and (m,) the
+    centroids' distance to the nearest sample."""
+    from ..winding import fast_winding_number_points
+    cen = K.V[K.T].mean(axis=1)
+    d, _ = cKDTree(Xs).query(cen)
+    return fast_winding_number_points(Xs, Ns, cen), d
 
-    The fast winding number of the oriented samples (Barill et al. 2018) is a second, more global inside
-    test than the jump field, which follows the local tangent planes.  First, tets outside the region with
-    winding > ``fill`` are added by simple tets (:func:`.grow.grow_regions` resumed: pockets and slits that
-    a wrongly oriented patch left in the body are filled).  Then, away from the samples (centroid farther
-    than ``gap`` × ``spacing`` from every sample: a true surface passes through the samples, and near them,
-    in thin parts, the winding number is unreliable), region tets with winding < ``level`` are removed from
-    the boundary inward, farthest from the samples first, by simple removals that cut no sample off the
-    surface (:func:`.grow.carve_regions`: bulges and bridges over concavities are peeled).  Each region stays a PL ball, so the output stays one sphere per region.
+
+def _with_winding(w, wn, fill: float = 0.6):
+    """The growth field: the jump field ``w`` raised to the winding number ``wn`` where ``wn > fill``.
+
+    The jump field follows the local tangent planes, so one wrongly oriented patch leaves a hole of w < ½
+    inside the body; the growing front wraps around it and meets itself, leaving a slit that no simple tet
+    can fill afterwards.  The winding number of the oriented samples (Barill et al. 2018) is more global and
+    says "inside" there, so such tets join the growth from the start.
+    """
+    return np.where(wn > fill, np.maximum(w, wn), w)
+
+
+def _sculpt(K, label, allowed, wn, d, n_p, samples, spacing, gap: float = 2.0, level: float = 0.5,
+            fill: float = 0.6):
+    """Fill pockets in and peel bulges off the grown balls by simple-tet moves (the guarantee is kept).
+
+    First, the growth is resumed into tets with winding number ``wn`` > ``fill`` (pockets left open to the
+    outside).  Then, away from the samples (centroid distance ``d`` > ``gap`` × ``spacing``: a true surface passes through
+    the samples, and near them, in thin parts, the winding number is unreliable), region tets whose winding
+    number ``wn`` is below ``level`` are removed from the boundary inward, farthest from the samples first,
+    each only when the removal is simple and cuts no sample off the surface (:func:`.grow.carve_regions`).
+    Each region stays a PL ball, so the output stays one sphere per region.
 
     Parameters
     ----------
-    K : TetComplex; label, allowed : (m,) int regions and the region each tet may join; Xs, Ns : (s, 3)
-    samples (inliers of this round) and their oriented normals; n_p : int — vertices ``0..n_p-1`` of ``K``
-    are the inlier points; samples : (n_p,) bool — which of them are samples; spacing : float.
+    K : TetComplex; label, allowed : (m,) int regions and the region each tet may join; wn, d : (m,) from
+    :func:`_winding_evidence`; n_p : int —
+    vertices ``0..n_p-1`` of ``K`` are the inlier points; samples : (n_p,) bool — which of them are samples
+    (kept on the surface); spacing : float.
 
     Returns
     -------
     label : (m,) int64; added, removed : int.
     """
-    from ..winding import fast_winding_number_points
-    cen = K.V[K.T].mean(axis=1)
-    d, _ = cKDTree(Xs).query(cen)
-    wn = fast_winding_number_points(Xs, Ns, cen)
-    far = d > gap * spacing
     n0 = int((label >= 0).sum())
     label, _ = grow_regions(K, wn, level, allowed=allowed, priority=wn, label=label,
                             eligible=(label < 0) & (wn > fill))
     added = int((label >= 0).sum()) - n0
     keep_vertex = np.zeros(K.n_vertices, dtype=bool)
     keep_vertex[:n_p] = samples
-    label, removed = carve_regions(K, label, far & (wn < level), d, keep_vertex=keep_vertex)
+    label, removed = carve_regions(K, label, (d > gap * spacing) & (wn < level), d, keep_vertex=keep_vertex)
     return label, added, int(removed)
 
 
@@ -254,9 +269,10 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         §4.2 (costly: it factorizes the face Laplacian).  On the Delaunay tetrahedralisation used here (a ball)
         the harmonic part is zero up to solver tolerance (reported as ``gamma_ratio``), so the correction is the
         identity and the default skips it.
-    sculpt : bool — after each growth, fill pockets where the winding number of the oriented samples is
-        > 0.6 and peel region tets farther than 2 spacings from every sample where it is < ½, by simple-tet
-        moves (the topology promise is kept; :func:`_sculpt`).  False: the grown ball as it is.
+    sculpt : bool — use the fast winding number of the oriented samples as second inside evidence: tets
+        where it is > 0.6 join the growth, and region tets farther than 2 spacings from every sample where it
+        is < ½ are peeled afterwards by simple-tet removals (the topology promise is kept; :func:`_sculpt`).
+        False: the jump field alone.
     project : bool — move the Steiner vertices of the output onto the tangent planes of their nearest inliers
         (vertex positions only; the mesh's combinatorics and topology are those of the grown ball).
     band : float — F0 lies within ``band`` × median spacing of the inliers (:func:`.orient.face_chain`).
@@ -406,6 +422,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
                 Lam, _ = correction_chain(K, gamma)
                 u, info = K.jump_laplace(G + Lam, solver=_solver)
         w = u.mean(axis=1)
+        if sculpt:
+            wn, dS = _winding_evidence(K, Xi[use], Ni[use])
+            w = _with_winding(w, wn)
         w, n_cav = _fill_cavities(K, w)
         cavities.append(n_cav)
         timings["core"] += time.perf_counter() - t
@@ -422,7 +441,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         prio = np.minimum(w, 1.0) - 0.05 * sd
         label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed, priority=prio)
         if sculpt:
-            label, n_add, n_cut = _sculpt(K, label, allowed, Xi[use], Ni[use], n_p, use, spacing)
+            label, n_add, n_cut = _sculpt(K, label, allowed, wn, dS, n_p, use, spacing)
             carved.append((n_add, n_cut))
         rejected_hist.append(int(rejected))
         timings["grow"] += time.perf_counter() - t
