@@ -204,14 +204,16 @@ def _winding_evidence(K, Xs, Ns):
 
 
 def _with_winding(w, wn, fill: float = 0.6):
-    """The growth field: the jump field ``w`` raised to the winding number ``wn`` where ``wn > fill``.
+    """The growth field: the jump field ``w`` raised to its inside plateau 1 where the winding number ``wn > fill``.
 
     The jump field follows the local tangent planes, so one wrongly oriented patch leaves a hole of w < ½
     inside the body; the growing front wraps around it and meets itself, leaving a slit that no simple tet
     can fill afterwards.  The winding number of the oriented samples (Barill et al. 2018) is more global and
-    says "inside" there, so such tets join the growth from the start.
+    says "inside" there, so such tets join the growth from the start.  They get the plateau value 1, not
+    ``wn`` itself: inside the plateau the growth order is the distance to the seed (concentric fronts), which
+    the variations of ``wn`` would break up into fronts that meet and leave slits.
     """
-    return np.where(wn > fill, np.maximum(w, wn), w)
+    return np.where(wn > fill, np.maximum(w, 1.0), w)
 
 
 def _sculpt(K, label, allowed, wn, d, n_p, samples, spacing, gap: float = 2.0, level: float = 0.5,
