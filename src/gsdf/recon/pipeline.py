@@ -13,7 +13,11 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
    with w > ½ is grown by simple tets only from a seed in the largest inside component, in the order of
    min(w, 1) − 0.05 × distance to the seed (concentric inside the plateau w ≈ 1, so fronts do not meet and
    leave slits); its boundary is one PL sphere — closed, edge- and vertex-manifold, genus 0 — by construction;
-6. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``).
+6. winding evidence: the growth field is raised where the fast winding number of the oriented samples says
+   inside (:func:`_with_winding`: no holes in the body for the front to wrap around), and after growth the
+   region tets far from every sample where it says outside — bulges, bridges — are peeled by simple-tet
+   removals only (:func:`_sculpt`, :func:`.grow.carve_regions`), so the output is still one PL sphere;
+7. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``).
 
 Example
 -------
@@ -36,7 +40,7 @@ from scipy.spatial import Delaunay, QhullError, cKDTree
 
 from .._checks import as_normals, as_points, choice, integer
 from ..dec.tet import TetComplex, correction_chain
-from .grow import grow_regions, region_boundary
+from .grow import carve_regions, grow_regions, region_boundary
 from .orient import face_chain, orient_normals
 from .steiner import octree_steiner_points
 
@@ -74,7 +78,7 @@ def prepare_cloud(P, N=None):
 
 
 def _prefilter(X: np.ndarray, k: int = 10, factor: float = 2.5, residual: float = 0.4, planarity: float = 0.1,
-               rounds: int = 3) -> np.ndarray:
+               rounds: int = 3, rescue: bool = True) -> np.ndarray:
     """(n,) bool inliers of the statistical pre-filter (§3.3's outlier removal, first pass).
 
     A point is kept when the mean distance to its ``k`` nearest kept neighbours is at most ``factor`` × the
@@ -105,6 +109,16 @@ def _prefilter(X: np.ndarray, k: int = 10, factor: float = 2.5, residual: float 
         if np.array_equal(new, keep):
             break
         keep = new
+    if rescue and keep.mean() >= 0.5:
+        # thin parts (legs, ears) have curved, non-planar neighbourhoods: keep a dropped point anyway when it
+        # is densely surrounded — its nearest point within 1.5 spacings and 3 points within 2 spacings, as on
+        # a surface sampled at that spacing and rarely among outliers, which are sparse
+        idx = np.flatnonzero(keep)
+        dk, _ = cKDTree(X[idx]).query(X[idx], k=2)
+        sp_ = float(np.median(dk[:, 1]))
+        d4, _ = cKDTree(X).query(X, k=min(4, len(X)))
+        dense = (d4[:, 1] <= 1.5 * sp_) & (d4[:, -1] <= 2.0 * sp_)
+        keep = keep | dense
     return keep
 
 
@@ -180,9 +194,63 @@ def _seeds(K, w, allowed, n_regions):
     return np.array(seeds, dtype=np.int64)
 
 
+def _winding_evidence(K, Xs, Ns):
+    """(m,) fast winding number of the oriented samples ``Xs, Ns`` at the tet centroids, and (m,) the
+    centroids' distance to the nearest sample."""
+    from ..winding import fast_winding_number_points
+    cen = K.V[K.T].mean(axis=1)
+    d, _ = cKDTree(Xs).query(cen)
+    return fast_winding_number_points(Xs, Ns, cen), d
+
+
+def _with_winding(w, wn, fill: float = 0.6):
+    """The growth field: the jump field ``w`` raised to its inside plateau 1 where the winding number ``wn > fill``.
+
+    The jump field follows the local tangent planes, so one wrongly oriented patch leaves a hole of w < ½
+    inside the body; the growing front wraps around it and meets itself, leaving a slit that no simple tet
+    can fill afterwards.  The winding number of the oriented samples (Barill et al. 2018) is more global and
+    says "inside" there, so such tets join the growth from the start.  They get the plateau value 1, not
+    ``wn`` itself: inside the plateau the growth order is the distance to the seed (concentric fronts), which
+    the variations of ``wn`` would break up into fronts that meet and leave slits.
+    """
+    return np.where(wn > fill, np.maximum(w, 1.0), w)
+
+
+def _sculpt(K, label, allowed, wn, d, n_p, samples, spacing, gap: float = 2.0, level: float = 0.5,
+            fill: float = 0.6):
+    """Fill pockets in and peel bulges off the grown balls by simple-tet moves (the guarantee is kept).
+
+    First, the growth is resumed into tets with winding number ``wn`` > ``fill`` (pockets left open to the
+    outside).  Then, away from the samples (centroid distance ``d`` > ``gap`` × ``spacing``: a true surface passes through
+    the samples, and near them, in thin parts, the winding number is unreliable), region tets whose winding
+    number ``wn`` is below ``level`` are removed from the boundary inward, farthest from the samples first,
+    each only when the removal is simple and cuts no sample off the surface (:func:`.grow.carve_regions`).
+    Each region stays a PL ball, so the output stays one sphere per region.
+
+    Parameters
+    ----------
+    K : TetComplex; label, allowed : (m,) int regions and the region each tet may join; wn, d : (m,) from
+    :func:`_winding_evidence`; n_p : int —
+    vertices ``0..n_p-1`` of ``K`` are the inlier points; samples : (n_p,) bool — which of them are samples
+    (kept on the surface); spacing : float.
+
+    Returns
+    -------
+    label : (m,) int64; added, removed : int.
+    """
+    n0 = int((label >= 0).sum())
+    label, _ = grow_regions(K, wn, level, allowed=allowed, priority=wn, label=label,
+                            eligible=(label < 0) & (wn > fill))
+    added = int((label >= 0).sum()) - n0
+    keep_vertex = np.zeros(K.n_vertices, dtype=bool)
+    keep_vertex[:n_p] = samples
+    label, removed = carve_regions(K, label, (d > gap * spacing) & (wn < level), d, keep_vertex=keep_vertex)
+    return label, added, int(removed)
+
+
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
-                                 sign: str = "tangent", hodge: bool = False, project: bool = True, band: float = 10.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 sign: str = "tangent", hodge: bool = False, project: bool = True, sculpt: bool = True, band: float = 10.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -203,6 +271,10 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         §4.2 (costly: it factorizes the face Laplacian).  On the Delaunay tetrahedralisation used here (a ball)
         the harmonic part is zero up to solver tolerance (reported as ``gamma_ratio``), so the correction is the
         identity and the default skips it.
+    sculpt : bool — use the fast winding number of the oriented samples as second inside evidence: tets
+        where it is > 0.6 join the growth, and region tets farther than 2 spacings from every sample where it
+        is < ½ are peeled afterwards by simple-tet removals (the topology promise is kept; :func:`_sculpt`).
+        False: the jump field alone.
     project : bool — move the Steiner vertices of the output onto the tangent planes of their nearest inliers
         (vertex positions only; the mesh's combinatorics and topology are those of the grown ball).
     band : float — F0 lies within ``band`` × median spacing of the inliers (:func:`.orient.face_chain`).
@@ -330,6 +402,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     label = G = best = H = None
     gamma_ratios = []
     cavities = []
+    carved = []
     rounds = max_iterations if outliers == "auto" else 1
     for it in range(rounds):
         t = time.perf_counter()
@@ -351,6 +424,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
                 Lam, _ = correction_chain(K, gamma)
                 u, info = K.jump_laplace(G + Lam, solver=_solver)
         w = u.mean(axis=1)
+        if sculpt:
+            wn, dS = _winding_evidence(K, Xi[use], Ni[use])
+            w = _with_winding(w, wn)
         w, n_cav = _fill_cavities(K, w)
         cavities.append(n_cav)
         timings["core"] += time.perf_counter() - t
@@ -366,6 +442,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
             sd[m] = np.linalg.norm(cen[m] - cen[sdt], axis=1)
         prio = np.minimum(w, 1.0) - 0.05 * sd
         label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed, priority=prio)
+        if sculpt:
+            label, n_add, n_cut = _sculpt(K, label, allowed, wn, dS, n_p, use, spacing)
+            carved.append((n_add, n_cut))
         rejected_hist.append(int(rejected))
         timings["grow"] += time.perf_counter() - t
         t = time.perf_counter()
@@ -413,7 +492,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     dup = np.ones(n_in, dtype=bool)
     dup[keep] = False
     report = {
-        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "cavity_tets": cavities, "rejected_non_simple": rejected_hist,
+        "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "cavity_tets": cavities, "rejected_non_simple": rejected_hist, "sculpted_tets": carved,
         "outliers": outlier_mask & ~dup, "prefiltered": int((~inl).sum()), "duplicates": int(dup.sum()),
         "surface_fraction": float(inl.mean()), "n_steiner": int(len(S)), "n_tets": int(K.n_tets), "n_regions": int(n_regions),
         "region_tets": int((label >= 0).sum()), "timings": timings,
