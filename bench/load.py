@@ -2,7 +2,8 @@
 
 Issue 17 asks for every speed ratio both on the (shared, never really idle) machine and with two extra
 busy processes competing for the two cores. :class:`BusyLoad` starts ``n`` pure-Python spinning processes
-(no I/O, no memory) and stops them, by their own pids, on exit from the ``with`` block.
+(no I/O, no memory) and stops them, by their own pids, on exit from the ``with`` block; a spinner whose
+parent died (the benchmark was killed) stops by itself.
 
     with BusyLoad(2):
         t = time_something()
@@ -15,7 +16,9 @@ import subprocess
 import sys
 import time
 
-_SPIN = "import time\nwhile True:\n    sum(i * i for i in range(10000))\n"
+# each spinner exits by itself once its parent is gone (a benchmark killed before its ``with`` block ended)
+_SPIN = ("import os, sys\nparent = int(sys.argv[1])\nwhile os.getppid() == parent:\n"
+         "    sum(i * i for i in range(10000))\n")
 
 
 class BusyLoad:
@@ -27,7 +30,7 @@ class BusyLoad:
         self.n, self.procs = n, []
 
     def __enter__(self):
-        self.procs = [subprocess.Popen([sys.executable, "-c", _SPIN], stdin=subprocess.DEVNULL,
+        self.procs = [subprocess.Popen([sys.executable, "-c", _SPIN, str(os.getpid())], stdin=subprocess.DEVNULL,
                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
                       for _ in range(self.n)]
         time.sleep(0.5)  # let them reach the loop
