@@ -87,6 +87,10 @@ def test_carve_and_resume_validate():
         grow_regions(K, 1 - r, label=label[:-1])
     with pytest.raises(ValueError, match="eligible"):
         grow_regions(K, 1 - r, eligible=np.ones(3, dtype=bool))
+    with pytest.raises(ValueError, match="allowed"):
+        grow_regions(K, 1 - r, allowed=np.zeros(3, dtype=np.int64))
+    with pytest.raises(ValueError, match="allowed"):
+        grow_regions(K, 1 - r, allowed=np.full(K.n_tets, -2))
 
 
 def test_grow_resumes_from_a_region():

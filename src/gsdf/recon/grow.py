@@ -104,6 +104,24 @@ def _accept(t, r, T, tet_edges, tet_faces, tet_face_sign, face_tets, prio, allow
 
 
 @nb.njit(cache=True)
+def _faces_towards(tet_faces, tet_face_sign, face_tets, label, t, r, inside):
+    """How many faces of tet ``t`` face region ``r`` (``inside``) or its complement (hull faces count as the
+    complement), and the local indices of the first two of them (-1 if absent)."""
+    n = 0
+    k0 = -1
+    k1 = -1
+    for k in range(4):
+        t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
+        if (t2 >= 0 and label[t2] == r) == inside:
+            if n == 0:
+                k0 = k
+            elif n == 1:
+                k1 = k
+            n += 1
+    return n, k0, k1
+
+
+@nb.njit(cache=True)
 def _counts(T, tet_edges, label, n_vertices, n_edges):
     """Per-vertex / per-edge tet counts of the labelled tets, and the region owning each vertex."""
     vcount = np.zeros(n_vertices, dtype=np.int64)
@@ -160,17 +178,7 @@ def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, eligi
         if not ok:
             rejected += 1
             continue
-        ns = 0
-        s0 = -1
-        s1 = -1
-        for k in range(4):
-            t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
-            if t2 >= 0 and label[t2] == r:
-                if ns == 0:
-                    s0 = k
-                else:
-                    s1 = k
-                ns += 1
+        ns, s0, s1 = _faces_towards(tet_faces, tet_face_sign, face_tets, label, t, r, True)
         if ns == 0 or ns == 4:
             rejected += 1
             continue
@@ -237,17 +245,7 @@ def _carve(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, remo
         r = label[t]
         if r < 0:
             continue
-        nc = 0
-        c0 = -1
-        c1 = -1
-        for k in range(4):
-            t2 = _neighbour(tet_faces, tet_face_sign, face_tets, t, k)
-            if t2 < 0 or label[t2] != r:
-                if nc == 0:
-                    c0 = k
-                else:
-                    c1 = k
-                nc += 1
+        nc, c0, c1 = _faces_towards(tet_faces, tet_face_sign, face_tets, label, t, r, False)
         if nc == 0 or nc == 4:
             continue
         if nc == 1:
@@ -323,6 +321,8 @@ def grow_regions(K, w, threshold: float = 0.5, seeds=None, allowed=None, priorit
     if allowed is None:
         allowed = np.zeros(K.n_tets, dtype=np.int64)
     allowed = np.ascontiguousarray(allowed, dtype=np.int64)
+    if allowed.shape != (K.n_tets,) or allowed.min(initial=-1) < -1:
+        raise ValueError(f"allowed: expected region ids >= -1 of shape ({K.n_tets},), got {allowed.shape}")
     prio = w if priority is None else np.ascontiguousarray(priority, dtype=np.float64)
     if prio.shape != (K.n_tets,) or not np.isfinite(prio).all():
         raise ValueError(f"priority: expected a finite array of shape ({K.n_tets},), got {prio.shape}")
