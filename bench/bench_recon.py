@@ -37,7 +37,7 @@ from common import data_dir, machine, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf.recon.compare import reconstruct_heat, reconstruct_pat, reconstruct_winding  # noqa: E402
-from gsdf.recon.topology import mesh_topology  # noqa: E402
+from gsdf.mesh.topology import mesh_topology  # noqa: E402
 
 MESHES = ["bunny00.off", "armadillo.off", "bull.off", "camel.off", "fandisk.off", "homer.off"]
 INLIERS = [8000, 4000, 2000, 1000]

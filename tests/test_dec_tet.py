@@ -111,7 +111,7 @@ def test_hodge_canary_ball_and_solid_torus():
     chi = Kt.n_vertices - Kt.n_edges + Kt.n_faces - Kt.n_tets
     assert chi == 0                                                    # χ(solid torus) = 0
     # b1 by Alexander duality, independently of any solver: b1 = b0 − χ + b2, b2 = #∂-components − b0
-    from gsdf.recon.topology import mesh_topology
+    from gsdf.mesh.topology import mesh_topology
     hull = (Kt.face_tets < 0).any(axis=1)
     top = mesh_topology(Kt.V, Kt.faces[hull])
     assert top["closed"] and top["genus"] == [1]

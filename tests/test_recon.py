@@ -8,7 +8,7 @@ import gsdf
 from gsdf.dec.tet import TetComplex
 from gsdf.recon.grow import grow_regions, region_boundary
 from gsdf.recon.orient import orient_normals
-from gsdf.recon.topology import is_sphere, mesh_topology
+from gsdf.mesh.topology import is_sphere, mesh_topology
 from tests.shapes import cube, uv_sphere
 
 

@@ -9,7 +9,7 @@ from gsdf.dec.tet import TetComplex
 from gsdf.recon.grow import carve_regions, grow_regions, region_boundary
 from gsdf.recon.pipeline import _prefilter, _sculpt, _winding_evidence, _with_winding
 from gsdf.recon.steiner import octree_steiner_points
-from gsdf.recon.topology import is_sphere
+from gsdf.mesh.topology import is_sphere
 
 
 def _sphere(n, seed=0):

@@ -44,7 +44,7 @@ def reconstruct(cloud, out, method, outliers, clusters, max_iterations, resoluti
     import numpy as np
 
     from ..io import read_points, write_mesh
-    from ..recon.topology import mesh_topology
+    from ..mesh.topology import mesh_topology
 
     check_output(out, (".ply", ".obj", ".off", ".stl"))
     check_output(png, (".png",), "--png")

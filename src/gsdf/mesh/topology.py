@@ -1,5 +1,6 @@
-"""Topology of triangle meshes: welding coincident vertices, splitting non-manifold vertices, and a report
-saying whether a mesh is welded, edge-manifold, vertex-manifold and closed.
+"""Topology of triangle meshes: welding coincident vertices, splitting non-manifold vertices, a report
+saying whether a mesh is welded, edge-manifold, vertex-manifold and closed (:func:`manifold_report`), and a
+summary with components, Euler characteristic and genus (:func:`mesh_topology`, :func:`is_sphere`).
 
 Every function of gsdf that returns a surface as "closed" or "watertight" checks it with
 :func:`manifold_report` and hands the report back (``report=True``), so the claim can be verified.
@@ -23,8 +24,10 @@ Example
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
-__all__ = ["weld", "manifold_report", "split_nonmanifold_vertices"]
+__all__ = ["weld", "manifold_report", "split_nonmanifold_vertices", "mesh_topology", "is_sphere"]
 
 
 def weld(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -53,9 +56,6 @@ def _fan_components(F, pair_ok=None):
     """Connected components of face corners: the corners of two faces that share an edge (exactly two faces
     on it, or a pair chosen by ``pair_ok`` on an edge with more) are joined at both shared endpoints.
     Returns (corner labels (m, 3), number of labels). Vectorized (scipy connected components)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     m = len(F)
     flat = F.reshape(-1)
     E, _ = _edges(F)
@@ -77,7 +77,7 @@ def _fan_components(F, pair_ok=None):
     same = flat[ca[h1]] == flat[ca[h2]]
     u = np.r_[ca[h1], cb[h1]]
     v = np.r_[np.where(same, ca[h2], cb[h2]), np.where(same, cb[h2], ca[h2])]
-    G = coo_matrix((np.ones(len(u)), (u, v)), shape=(3 * m, 3 * m))
+    G = sp.coo_matrix((np.ones(len(u)), (u, v)), shape=(3 * m, 3 * m))
     n, lab = connected_components(G, directed=False)
     return lab.reshape(m, 3), int(n)
 
@@ -131,3 +131,72 @@ def manifold_report(V, F) -> dict:
                boundary_edges=boundary, nonmanifold_edges=nonman_e, nonmanifold_vertices=nonman_v,
                duplicate_vertices=int(dup))
     return rep
+
+
+def mesh_topology(V, F) -> dict:
+    """Topological summary of the triangle mesh (V, F).
+
+    Returns
+    -------
+    dict with ``closed`` (every edge in exactly two faces; also False if some edge has one), ``edge_manifold``
+    (no edge in more than two faces), ``vertex_manifold`` (the faces around every used vertex form one fan),
+    ``oriented`` (every interior edge used once in each direction), ``components`` (face-connected through
+    edges), ``euler`` (V − E + F over used vertices), ``genus`` (list, per component, ``(2 − χ_c) / 2`` when the
+    mesh is closed and manifold, else None), ``degenerate_faces`` (faces repeating a vertex), ``n_faces``.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    >>> t = gsdf.mesh_topology(V, F)
+    >>> t["closed"], t["oriented"], t["genus"]
+    (True, True, [0])
+    """
+    F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
+    nF = len(F)
+    out = {"n_faces": nF, "closed": False, "edge_manifold": False, "vertex_manifold": False, "oriented": False,
+           "components": 0, "euler": 0, "genus": [], "degenerate_faces": 0}
+    if nF == 0:
+        return out
+    deg = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 0] == F[:, 2])
+    out["degenerate_faces"] = int(deg.sum())
+    H, _ = _edges(F)                                            # directed half-edges
+    key = np.sort(H, axis=1)
+    E, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    inv = inv.ravel()
+    out["edge_manifold"] = bool(cnt.max() <= 2) and not deg.any()
+    out["closed"] = bool(cnt.min() == 2 and cnt.max() == 2)
+    dirs = np.bincount(inv, (H[:, 0] < H[:, 1]).astype(float), minlength=len(E))
+    out["oriented"] = bool(out["edge_manifold"] and np.all((cnt == 1) | (dirs == 1)))
+    used = np.unique(F)
+    out["euler"] = int(len(used) - len(E) + nF)
+    # face components through shared edges
+    hf = np.repeat(np.arange(nF), 3)
+    A = sp.csr_matrix((np.ones(len(hf)), (hf, inv)), shape=(nF, len(E)))
+    ncomp, comp = connected_components(A @ A.T, directed=False)
+    out["components"] = int(ncomp)
+    if out["edge_manifold"]:
+        # the faces around every used vertex form one fan: one corner component per used vertex
+        _, nfan = _fan_components(F)
+        out["vertex_manifold"] = bool(nfan == len(used))
+    if out["closed"] and out["edge_manifold"] and out["vertex_manifold"]:
+        nfc = np.bincount(comp, minlength=ncomp)
+        e_comp = np.zeros(len(E), dtype=np.int64)
+        e_comp[inv] = comp[hf]
+        nec = np.bincount(e_comp, minlength=ncomp)
+        v_comp = np.zeros(int(F.max()) + 1, dtype=np.int64)
+        v_comp[F.ravel()] = np.repeat(comp, 3)
+        nvc = np.bincount(v_comp[used], minlength=ncomp)
+        g = [int((2 - chi) // 2) for chi in (nvc - nec + nfc)]
+        out["genus"] = g
+    else:
+        out["genus"] = None
+    return out
+
+
+def is_sphere(V, F, components: int = 1) -> bool:
+    """True when (V, F) is ``components`` closed, oriented, edge- and vertex-manifold spheres (genus 0 each)."""
+    t = mesh_topology(V, F)
+    return bool(t["closed"] and t["edge_manifold"] and t["vertex_manifold"] and t["oriented"]
+                and t["components"] == components and t["genus"] == [0] * components)

@@ -7,6 +7,6 @@ signed-heat and Points-as-Tori reconstructions on the same API shape).
 """
 
 from .pipeline import reconstruct_simply_connected
-from .topology import is_sphere, mesh_topology
+from ..mesh.topology import is_sphere, mesh_topology
 
 __all__ = ["reconstruct_simply_connected", "mesh_topology", "is_sphere"]

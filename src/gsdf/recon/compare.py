@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from .._checks import as_normals, as_points, integer
-from .topology import mesh_topology
+from ..mesh.topology import mesh_topology
 
 __all__ = ["reconstruct_winding", "reconstruct_heat", "reconstruct_pat", "oriented_normals"]
 

@@ -353,7 +353,7 @@ def carve_regions(K, label, removable, priority, keep_vertex=None) -> tuple[np.n
     >>> import numpy as np
     >>> from scipy.spatial import Delaunay
     >>> from gsdf.dec.tet import TetComplex
-    >>> from gsdf.recon.topology import is_sphere
+    >>> from gsdf.mesh.topology import is_sphere
     >>> P = np.random.default_rng(0).uniform(-1, 1, (400, 3)); K = TetComplex(P, Delaunay(P).simplices)
     >>> r = np.linalg.norm(P[K.T].mean(1), axis=1)
     >>> lab, _ = grow_regions(K, 1.0 - r, threshold=0.2)

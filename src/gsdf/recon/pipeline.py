@@ -25,7 +25,7 @@ Example
 >>> rng = np.random.default_rng(0)
 >>> P = rng.normal(size=(2000, 3)); P /= np.linalg.norm(P, axis=1)[:, None]
 >>> V, F = gsdf.reconstruct_simply_connected(P)
->>> from gsdf.recon.topology import is_sphere
+>>> from gsdf.mesh.topology import is_sphere
 >>> is_sphere(V, F)
 True
 """
