@@ -51,12 +51,8 @@ def point_cloud_operators(P: np.ndarray, k: int = 30, mollify_factor: float = 1e
 class PointCloudDomain(VertexSurfaceDomain):
     """A point cloud as the domain (§8.4; see module docs).
 
-    Parameters
-    ----------
-    P : (n, 3) points; N : (n, 3) consistently oriented normals, or None for PCA normals oriented away from
-        the centroid (fine for star-shaped clouds); k : neighbours per local triangulation of the tufted cover
-        (``n_neighbors`` of robust-laplacian); t_coef : diffusion time ``t = t_coef · ℓ̄²``;
-        mollify_factor : intrinsic mollification of the cover (robust-laplacian's default 1e-5).
+    Parameters: those of :class:`gsdf.heat.surface.pointcloud.PointCloudSignedHeatSolver`, the public
+    front-end (points, normals, neighbours k, diffusion-time coefficient, mollification).
 
     Example
     -------

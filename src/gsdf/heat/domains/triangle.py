@@ -22,7 +22,7 @@ import scipy.sparse as sp
 
 from ..sources import Sources
 from ..surface.operators import TriangleMeshOperators
-from ..surface.sources import build_sources
+from ..surface.sources import build_sources, per_curve_normals
 from .base import HeatDomain
 
 __all__ = ["TriangleDomain", "raw_curves", "raw_points", "to_core_sources"]
@@ -34,12 +34,7 @@ def raw_curves(curves, curve_normals=None):
     """Curves (list of :class:`~gsdf.heat.sources.Curve`) in the raw form of ``build_sources``: vertex arrays or
     lists of (face, barycentric); edge curves are chained into polylines. Returns (raw, signs, normals)."""
     raw, signs, normals = [], [], [] if curve_normals is not None else None
-    if curve_normals is not None:
-        if isinstance(curve_normals, np.ndarray) and curve_normals.shape == (3,):
-            curve_normals = [curve_normals] * len(curves)      # one vector for every curve
-        curve_normals = list(curve_normals)
-        if len(curve_normals) != len(curves):
-            raise ValueError(f"curve_normals: has {len(curve_normals)} entries but there are {len(curves)} curves")
+    curve_normals = per_curve_normals(curve_normals, len(curves))
     for k, c in enumerate(curves):
         parts = c.polylines() if c.kind == "edges" else [c.nodes]
         if c.kind == "edges" and curve_normals is not None and curve_normals[k] is not None \

@@ -284,6 +284,19 @@ def _to_face(F, f, b, g):
 
 
 # ---------------------------------------------------------------------------------------------- X0
+def per_curve_normals(curve_normals, n_curves: int):
+    """``curve_normals`` as a list with one entry per curve (None stays None): one (3,) vector is used for
+    every curve; a list must have ``n_curves`` entries (ValueError otherwise)."""
+    if curve_normals is None:
+        return None
+    if isinstance(curve_normals, np.ndarray) and curve_normals.shape == (3,):
+        return [curve_normals] * n_curves
+    curve_normals = list(curve_normals)
+    if len(curve_normals) != n_curves:
+        raise ValueError(f"curve_normals: has {len(curve_normals)} entries but there are {n_curves} curves")
+    return curve_normals
+
+
 def _parse_normals(curve_normals, k, n_nodes, name="curve_normals"):
     """Normals of curve k: None, or unit (n_nodes, 3) per node (a single (3,) vector is broadcast)."""
     if curve_normals is None:
@@ -366,12 +379,7 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve
         signs = [bool(s) for s in curve_signs]
         if len(signs) != len(curves):
             raise ValueError(f"curve_signs: has {len(signs)} entries but there are {len(curves)} curves")
-    if curve_normals is not None:
-        if isinstance(curve_normals, np.ndarray) and curve_normals.shape == (3,):
-            curve_normals = [curve_normals] * len(curves)      # one vector for every curve
-        curve_normals = list(curve_normals)
-        if len(curve_normals) != len(curves):
-            raise ValueError(f"curve_normals: has {len(curve_normals)} entries but there are {len(curves)} curves")
+    curve_normals = per_curve_normals(curve_normals, len(curves))
     pts = parse_points(points, ops)
     if not curves and pts is None:
         raise ValueError("curves: no sources given (empty curve list and no points)")
