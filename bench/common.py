@@ -52,7 +52,8 @@ def median_time(fn, repeat: int = 3):
 
 
 def write_section(name: str, text: str) -> None:
-    """Replace (or append) the section between ``<!-- name:start -->`` and ``<!-- name:end -->``."""
+    """Replace (or append) the section between ``<!-- name:start -->`` and ``<!-- name:end -->``, then
+    rebuild the index at the top of RESULTS.md (see :func:`results_index`)."""
     start, end = f"<!-- {name}:start -->", f"<!-- {name}:end -->"
     body = open(RESULTS).read() if os.path.exists(RESULTS) else "# gsdf benchmark results\n\n"
     block = f"{start}\n{text.rstrip()}\n{end}"
@@ -61,7 +62,33 @@ def write_section(name: str, text: str) -> None:
     else:
         body = body.rstrip() + "\n\n" + block + "\n"
     with open(RESULTS, "w") as f:
-        f.write(body)
+        f.write(with_index(body))
+
+
+_SECTION = re.compile(r"<!-- ([A-Za-z0-9_-]+):start -->\n(.*?)<!-- \1:end -->", re.S)
+
+
+def results_index(body: str) -> str:
+    """A table of every section of RESULTS.md: its name, its heading and the command that rewrites it
+    (the first quoted command of the section that runs a script in bench/)."""
+    rows = []
+    for name, text in _SECTION.findall(body):
+        if name == "index":
+            continue
+        heading = next((ln.lstrip("#").strip() for ln in text.splitlines() if ln.startswith("#")), "")
+        cmd = re.search(r"`[^`\n]*bench/[^`\n]+\.py[^`\n]*`", text)
+        rows.append((f"`{name}`", heading.replace("|", "/"), cmd.group(0) if cmd else ""))
+    return ("## Index\n\nEvery section below is rewritten by the command beside it; `bench/run_all.py` runs "
+            "all speed tables.\n\n" + table(["section", "heading", "command"], rows))
+
+
+def with_index(body: str) -> str:
+    """``body`` with its index block (placed after the title line) rebuilt from its sections."""
+    start, end = "<!-- index:start -->", "<!-- index:end -->"
+    if start in body and end in body:
+        body = body[: body.index(start)].rstrip() + "\n\n" + body[body.index(end) + len(end):].lstrip()
+    title, _, rest = body.partition("\n")
+    return f"{title}\n\n{start}\n{results_index(body)}\n{end}\n\n{rest.lstrip()}"
 
 
 def table(header, rows) -> str:
