@@ -239,7 +239,8 @@ def main(quick: bool, relocation: bool = False, only_relocation: bool = False):
     failures = []
     lines = [f"Machine: {machine()}. Load at start: `{up}` (2 cores shared by ~8 helpers: absolute times are "
              "inflated; compare methods within a row). Command: `PYTHONPATH=src /work/anchors/bin/python "
-             f"bench/bench_recon.py{' --quick' if quick else ''}`.", ""]
+             f"bench/bench_recon.py{' --quick' if quick else ''}"
+             f"{(' --only-relocation' if only_relocation else ' --relocation') if relocation else ''}`.", ""]
 
     section = "recon" + ("-quick" if quick else "")
     title = "## recon: guaranteed simply connected reconstruction" + (" (quick)" if quick else "")
