@@ -68,6 +68,28 @@ def _perm_sign(A: np.ndarray) -> np.ndarray:
     return 1 - 2 * (inv % 2)
 
 
+def _unique_rows(R: np.ndarray, n: int):
+    """``np.unique(R, axis=0, return_inverse=True)`` for rows of k ≤ 3 vertex ids < ``n``, same result.
+
+    Each row is packed into one int64 (base ``n`` digits), whose numeric order is the rows' lexicographic
+    order, so a 1-D unique gives the same rows, order and inverse — ~10× faster than the row-wise unique
+    (a structured-view sort) on millions of rows.  Falls back to it when the key would overflow.
+    """
+    k = R.shape[1]
+    if n ** k >= 2 ** 63:
+        u, inv = np.unique(R, axis=0, return_inverse=True)
+        return u, inv.ravel()
+    key = np.zeros(len(R), dtype=np.int64)
+    for j in range(k):
+        key = key * n + R[:, j].astype(np.int64)
+    uk, inv = np.unique(key, return_inverse=True)
+    u = np.empty((len(uk), k), dtype=R.dtype)
+    for j in range(k - 1, -1, -1):
+        u[:, j] = uk % n
+        uk = uk // n
+    return u, inv.ravel()
+
+
 class TetComplex:
     """A tetrahedral mesh as a cell complex with DEC operators.
 
@@ -103,12 +125,12 @@ class TetComplex:
         m = T.shape[0]
         # edges
         Eall = np.sort(T[:, _EDGE_PAIRS].reshape(-1, 2), axis=1)
-        self.edges, inv = np.unique(Eall, axis=0, return_inverse=True)
+        self.edges, inv = _unique_rows(Eall, V.shape[0])
         self.tet_edges = inv.reshape(m, 6).astype(np.int64)
         # faces
         Floc = T[:, _FACE_LOCAL].reshape(-1, 3)
         sign = _perm_sign(Floc)
-        self.faces, finv = np.unique(np.sort(Floc, axis=1), axis=0, return_inverse=True)
+        self.faces, finv = _unique_rows(np.sort(Floc, axis=1), V.shape[0])
         self.tet_faces = finv.reshape(m, 4).astype(np.int64)
         self.tet_face_sign = sign.reshape(m, 4).astype(np.int64)
         nF = self.faces.shape[0]

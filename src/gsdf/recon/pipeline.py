@@ -17,7 +17,10 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
    inside (:func:`_with_winding`: no holes in the body for the front to wrap around), and after growth the
    region tets far from every sample where it says outside — bulges, bridges — are peeled by simple-tet
    removals only (:func:`_sculpt`, :func:`.grow.carve_regions`), so the output is still one PL sphere;
-7. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``).
+7. the alternation (§3.3): F0 ← F0 ∩ F* (F* = faces of the output), until F0 is stable (≤ ``max_iterations``);
+8. vertex relocation (geometry only, :mod:`.relocate`): Steiner vertices and input points off their
+   neighbours' surface (kept outliers) move onto the moving-least-squares surface of the inliers, with
+   tangential smoothing, damped so that no face flips; the faces — hence the topology — are unchanged.
 
 Example
 -------
@@ -248,9 +251,30 @@ def _sculpt(K, label, allowed, wn, d, n_p, samples, spacing, gap: float = 2.0, l
     return label, added, int(removed)
 
 
+def _relocate(Vn, F, is_pt, S, spacing, tol: float = 0.35):
+    """Relocate the output vertices onto the local surface of the samples ``S`` (:mod:`.relocate`).
+
+    Input-point vertices that lie on their neighbours' surface (leave-one-out quadric height ≤ ``tol`` ×
+    spacing) stay fixed, exactly where they were measured; the others — Steiner points, kept outliers — are
+    smoothed tangentially and projected.  Returns ``(V, exact, report)``: ``exact`` (v,) marks the vertices
+    left at their input coordinates.
+    """
+    from .relocate import local_surface, relocate_vertices
+    exact = is_pt.copy()
+    if is_pt.any() and len(S) > 4:
+        _, _, hgt = local_surface(Vn[is_pt], S, spacing, exclude_self=True)
+        exact[np.flatnonzero(is_pt)[np.abs(hgt) > tol * spacing]] = False
+    if len(S) < 3:
+        return Vn, exact, None
+    V, rep = relocate_vertices(Vn, F, S, spacing, fixed=exact, return_report=True)
+    rep["free_input_points"] = int((is_pt & ~exact).sum())
+    return V, exact, rep
+
+
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
-                                 sign: str = "tangent", hodge: bool = False, project: bool = True, sculpt: bool = True, band: float = 10.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 sign: str = "tangent", hodge: bool = False, project: bool = True, sculpt: bool = True,
+                                 relocate: bool = True, band: float = 10.0, outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -277,6 +301,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         False: the jump field alone.
     project : bool — move the Steiner vertices of the output onto the tangent planes of their nearest inliers
         (vertex positions only; the mesh's combinatorics and topology are those of the grown ball).
+    relocate : bool — move the output's Steiner vertices and off-surface input points (kept outliers) onto
+        the moving-least-squares surface of the inliers (:func:`.relocate.relocate_vertices`; faces, hence
+        topology, untouched; input points on their neighbours' surface keep their exact coordinates).
     band : float — F0 lies within ``band`` × median spacing of the inliers (:func:`.orient.face_chain`).
     outlier_gap : float — in the alternation, points farther than this × median spacing from the output are
         judged outliers for the next round.
@@ -285,11 +312,13 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
 
     Returns
     -------
-    V : (k, 3) float64, F : (f, 3) int64 — outward-oriented; vertices are input points and Steiner points.
+    V : (k, 3) float64, F : (f, 3) int64 — outward-oriented; vertices are input points (at their exact
+        coordinates) and Steiner points, the latter and off-surface input points relocated (``relocate``).
     report : dict, only with ``return_report=True``: ``iterations``, ``f0_sizes`` and ``inlier_counts`` per
         alternation round, ``outliers`` (n,) bool (pre-filtered, or farther than ``outlier_gap`` spacings
         from the returned surface; duplicates are not flagged), ``surface_fraction`` (share of distinct
-        points with a flat, dense neighbourhood), ``gamma_ratio``, ``timings`` (s), sizes.
+        points with a flat, dense neighbourhood), ``gamma_ratio``, ``relocation`` (vertices moved / damped /
+        reverted, ``free_input_points``; None without ``relocate``), ``timings`` (s), sizes.
 
     Notes
     -----
@@ -317,8 +346,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     outliers = choice(outliers, "outliers", ("auto", "none"))
     sign = choice(sign, "sign", ("tangent", "winding"))
     max_iterations = integer(max_iterations, "max_iterations", lo=1)
-    if not isinstance(clusters, (bool, np.bool_)):
-        raise ValueError(f"clusters: expected a bool, got {type(clusters).__name__}")
+    for name, val in (("clusters", clusters), ("relocate", relocate)):
+        if not isinstance(val, (bool, np.bool_)):
+            raise ValueError(f"{name}: expected a bool, got {type(val).__name__}")
     for name, val in (("cluster_gap", cluster_gap), ("band", band), ("outlier_gap", outlier_gap)):
         if isinstance(val, bool) or not np.isfinite(float(val)) or float(val) <= 0:
             raise ValueError(f"{name}: expected a positive finite number, got {val!r}")
@@ -477,13 +507,20 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
             nrm = Nn.mean(axis=1)
             nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
             Vn[st] = Vn[st] - off[:, None] * nrm
-    Vout = Vn * scale + centre
     Fout = remap[Fout]
-    # exact input coordinates for input vertices
+    is_pt = used < n_p
+    exact = is_pt.copy()
+    t = time.perf_counter()
+    reloc = None
+    if relocate:
+        say("relocating vertices")
+        Vn, exact, reloc = _relocate(Vn, Fout, is_pt, Xi[use], spacing)
+    timings["relocate"] = time.perf_counter() - t
+    Vout = Vn * scale + centre
+    # exact input coordinates for the input vertices that stay where they are
     orig_rows = keep[np.flatnonzero(inl)]
     P_arr = np.asarray(P, dtype=np.float64)
-    is_pt = used < n_p
-    Vout[is_pt] = P_arr[orig_rows[used[is_pt]]]
+    Vout[exact] = P_arr[orig_rows[used[exact]]]
     timings["total"] = time.perf_counter() - t0
     if not return_report:
         return Vout, Fout
@@ -495,6 +532,6 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "cavity_tets": cavities, "rejected_non_simple": rejected_hist, "sculpted_tets": carved,
         "outliers": outlier_mask & ~dup, "prefiltered": int((~inl).sum()), "duplicates": int(dup.sum()),
         "surface_fraction": float(inl.mean()), "n_steiner": int(len(S)), "n_tets": int(K.n_tets), "n_regions": int(n_regions),
-        "region_tets": int((label >= 0).sum()), "timings": timings,
+        "region_tets": int((label >= 0).sum()), "relocation": reloc, "timings": timings,
     }
     return Vout, Fout, report

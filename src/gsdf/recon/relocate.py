@@ -1,0 +1,224 @@
+"""Vertex relocation of a reconstructed mesh onto the local surface of the samples (geometry only).
+
+The guarantee layer (:mod:`.grow`) outputs the boundary of a tet region: its vertices are sample points and
+Steiner points, so the surface is faceted, and Steiner vertices (and kept outliers) stand off the sampled
+surface.  This module moves vertices onto the *local surface* of the samples — a moving-least-squares fit
+(Levin 2003; Alexa et al. 2003): around each vertex, the Gaussian-weighted plane of its k nearest samples,
+then a weighted least-squares quadric height function z(x, y) over that plane — and smooths them
+tangentially, keeping the face list as it is.  The combinatorics, hence the topology (one closed manifold
+sphere per region), are untouched; moves that would flip a face are damped and, failing that, undone.
+
+Example
+-------
+>>> import numpy as np
+>>> from gsdf.recon.relocate import local_surface
+>>> rng = np.random.default_rng(0)
+>>> S = rng.normal(size=(3000, 3)); S /= np.linalg.norm(S, axis=1)[:, None]      # unit sphere samples
+>>> foot, normal, height = local_surface(np.array([[0.0, 0.0, 1.1]]), S, spacing=0.04)
+>>> bool(abs(np.linalg.norm(foot) - 1.0) < 1e-3), bool(abs(height[0] - 0.1) < 1e-2)
+(True, True)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from .._checks import as_faces, as_points, integer, nonnegative, positive
+
+__all__ = ["local_surface", "relocate_vertices"]
+
+
+def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False, tree=None,
+                  return_fit: bool = False):
+    """Project queries onto the moving-least-squares quadric of their nearest samples.
+
+    For each query q: the ``k`` nearest samples get Gaussian weights exp(−(d / h)²) with h = max(1.5 ×
+    ``spacing``, the median neighbour distance); their weighted centroid c and smallest-eigenvalue direction n
+    of the weighted covariance give the local plane; in the frame (t1, t2, n) at c, the weighted least-squares
+    quadric z = a0 + a1 x + a2 y + a3 x² + a4 xy + a5 y² (a small ridge on the quadratic terms keeps flat or
+    sparse neighbourhoods well posed) is the local surface, and q moves along n onto it.
+
+    Parameters
+    ----------
+    Q : (q, 3) float — queries.  S : (s, 3) float — samples, s ≥ 3.  spacing : float > 0 — sample spacing.
+    k : int ≥ 3 — neighbours per query (clipped to the number of samples).
+    exclude_self : bool — drop each query's nearest sample (use when the queries are samples: the
+        leave-one-out height then says how far a sample is from its neighbours' surface).
+    tree : cKDTree of ``S`` or None (built here).
+    return_fit : bool — also return the weighted rms residual of the quadric fit (q,): large where the
+        neighbours are not one smooth sheet (creases, both sides of a thin part).
+
+    Returns
+    -------
+    foot : (q, 3) float — the query moved along n onto the quadric.  normal : (q, 3) float — n (unoriented).
+    height : (q,) float — signed offset of the query from the quadric along n.  rms : (q,) float, with
+    ``return_fit``.
+    """
+    Q = np.asarray(Q, dtype=np.float64).reshape(-1, 3)
+    S = np.asarray(S, dtype=np.float64).reshape(-1, 3)
+    extra = 1 if exclude_self else 0
+    k = int(min(k, len(S) - extra))
+    if k < 3:
+        raise ValueError(f"S: needs at least {3 + extra} samples for a local surface, got {len(S)}")
+    tree = cKDTree(S) if tree is None else tree
+    d, I = tree.query(Q, k=k + extra)
+    d, I = d.reshape(len(Q), -1)[:, extra:], I.reshape(len(Q), -1)[:, extra:]
+    Y = S[I]                                                   # (q, k, 3)
+    h = np.maximum(1.5 * spacing, np.median(d, axis=1))
+    w = np.exp(-(d / h[:, None]) ** 2)
+    w /= np.maximum(w.sum(axis=1, keepdims=True), 1e-300)
+    c = np.einsum("qk,qkx->qx", w, Y)
+    R = Y - c[:, None, :]
+    C = np.einsum("qk,qki,qkj->qij", w, R, R)
+    _, vec = np.linalg.eigh(C)
+    t1, t2, n = vec[:, :, 2], vec[:, :, 1], vec[:, :, 0]
+    x, y, z = (np.einsum("qkx,qx->qk", R, t) for t in (t1, t2, n))
+    # weighted least squares for the quadric height: normal equations (6×6 per query), coordinates over h
+    xs, ys = x / h[:, None], y / h[:, None]
+    B = np.stack([np.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys], axis=2)     # (q, k, 6)
+    A = np.einsum("qk,qka,qkb->qab", w, B, B)
+    A += np.diag([1e-9, 1e-9, 1e-9, 1e-2, 1e-2, 1e-2])[None]
+    rhs = np.einsum("qk,qka,qk->qa", w, B, z)
+    coef = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
+    Rq = Q - c
+    xq, yq, zq = (np.einsum("qx,qx->q", Rq, t) for t in (t1, t2, n))
+    xqs, yqs = xq / h, yq / h
+    zf = coef[:, 0] + coef[:, 1] * xqs + coef[:, 2] * yqs + coef[:, 3] * xqs ** 2 + coef[:, 4] * xqs * yqs \
+        + coef[:, 5] * yqs ** 2
+    foot = Q + (zf - zq)[:, None] * n
+    if not return_fit:
+        return foot, n, zq - zf
+    fit = np.einsum("qka,qa->qk", B, coef)
+    return foot, n, zq - zf, np.sqrt(np.einsum("qk,qk->q", w, (z - fit) ** 2))
+
+
+def _face_normals(V, F):
+    return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+
+
+def relocate_vertices(V, F, S, spacing: float, *, fixed=None, rounds: int = 3, smooth: float = 0.5,
+                      k: int = 12, max_step: float = 3.0, fit_tol: float = 0.2,
+                      return_report: bool = False):
+    """Move the free vertices of a mesh onto the local surface of samples, keeping the faces (and topology).
+
+    Each round: (1) tangential umbrella smoothing of the free vertices — the mean of the mesh neighbours minus
+    the vertex, with its component along the vertex normal removed, times ``smooth``; (2) projection of the
+    free vertices onto the moving-least-squares quadric of their ``k`` nearest samples
+    (:func:`local_surface`), unless that fit's rms residual exceeds ``fit_tol`` × ``spacing`` (the samples
+    there are not one smooth sheet: projecting would pull the vertex between two sheets of a thin part or
+    round off a crease); a vertex moves at most ``max_step`` × ``spacing`` per round.  (3) Damping: a face
+    whose normal turns by more than 90° (or whose area vanishes) in the round or since the start halves the moves of its free
+    vertices, up to three times, then those moves are undone — so no face is flipped by the relocation.
+
+    Parameters
+    ----------
+    V : (v, 3) float — vertices.  F : (f, 3) int — faces (kept as they are).
+    S : (s, 3) float — samples of the surface (s ≥ 3).  spacing : float > 0 — their typical spacing.
+    fixed : (v,) bool or None — vertices that do not move (say exact samples); None: all move.
+    rounds : int ≥ 0; smooth : float in [0, 1]; k : int ≥ 3; max_step, fit_tol : float > 0 (in spacings).
+    return_report : bool — also return a dict (``moved``: vertices moved, ``reverted``: moves undone,
+        ``damped``: moves halved at least once, ``mean_shift``: mean displacement of the free vertices).
+
+    Returns
+    -------
+    V : (v, 3) float64 — a new array (the input is not modified); (V, report) with ``return_report``.
+
+    Raises
+    ------
+    ValueError : bad shapes, NaN / inf, out-of-range faces, a ``fixed`` mask of the wrong shape or type, a
+        non-positive spacing, fewer than 3 samples, bad option values.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> from gsdf.recon.relocate import relocate_vertices
+    >>> V = np.array([[0, 0, 0.2], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], float)
+    >>> F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]])
+    >>> g = np.linspace(-1.2, 1.2, 25); S = np.array([[x, y, 0.0] for x in g for y in g])
+    >>> W = relocate_vertices(V, F, S, 0.1, fixed=np.arange(5) > 0)
+    >>> bool(abs(W[0, 2]) < 1e-6)
+    True
+    """
+    V = as_points(V, "V")
+    F = as_faces(F, len(V), "F")
+    S = as_points(S, "S")
+    spacing = positive(spacing, "spacing")
+    rounds = integer(rounds, "rounds", lo=0)
+    k = integer(k, "k", lo=3)
+    smooth = nonnegative(smooth, "smooth", most=1.0)
+    max_step = positive(max_step, "max_step")
+    fit_tol = positive(fit_tol, "fit_tol")
+    if fixed is None:
+        fixed = np.zeros(len(V), dtype=bool)
+    else:
+        fixed = np.asarray(fixed)
+        if fixed.dtype != np.bool_ or fixed.shape != (len(V),):
+            raise ValueError(f"fixed: expected a ({len(V)},) bool mask, got {fixed.dtype} of shape {fixed.shape}")
+    if len(S) < 3:
+        raise ValueError(f"S: needs at least 3 samples for a local surface, got {len(S)}")
+    V = V.copy()
+    free = np.flatnonzero(~fixed & np.isin(np.arange(len(V)), F))
+    report = {"moved": 0, "reverted": 0, "damped": 0, "mean_shift": 0.0}
+    if free.size == 0 or rounds == 0 or len(F) == 0:
+        return (V, report) if return_report else V
+    tree = cKDTree(S)
+    E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    A = sp.csr_matrix((np.ones(2 * len(E)), (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
+                      shape=(len(V), len(V)))
+    A.data[:] = 1.0                                             # each neighbour once
+    deg = np.maximum(np.asarray(A.sum(axis=1)).ravel(), 1.0)
+    V0 = V.copy()
+    N_in = _face_normals(V0, F)
+    ever_damped = np.zeros(len(V), dtype=bool)
+    ever_reverted = np.zeros(len(V), dtype=bool)
+    for _ in range(rounds):
+        Vr = V.copy()
+        Nf = _face_normals(Vr, F)
+        Nv = np.zeros_like(V)
+        np.add.at(Nv, F.ravel(), np.repeat(Nf, 3, axis=0))
+        Nv /= np.maximum(np.linalg.norm(Nv, axis=1), 1e-300)[:, None]
+        U = (A @ Vr) / deg[:, None] - Vr
+        U -= np.einsum("vx,vx->v", U, Nv)[:, None] * Nv
+        P = Vr[free] + smooth * U[free]
+        P, _, _, rms = local_surface(P, S, spacing, k=k, tree=tree, return_fit=True)
+        step = P - Vr[free]
+        # no move where the samples are not one smooth sheet (sharp creases; both sides of a thin part
+        # within reach, whose fitted surface runs between them)
+        step[rms > fit_tol * spacing] = 0.0
+        L = np.linalg.norm(step, axis=1)
+        cap = max_step * spacing
+        step *= np.minimum(1.0, cap / np.maximum(L, 1e-300))[:, None]
+        scale = np.ones(len(free))
+        pos = -np.ones(len(V), dtype=np.int64)
+        pos[free] = np.arange(len(free))
+        a0 = np.linalg.norm(Nf, axis=1)
+        def flipped():
+            """Free-vertex slots on faces that the moves flip or collapse."""
+            V[free] = Vr[free] + scale[:, None] * step
+            Nn = _face_normals(V, F)
+            # flipped against the round's start or against the input (rounds must not add up to a flip)
+            bad = (np.einsum("fx,fx->f", Nn, Nf) <= 0) | (np.einsum("fx,fx->f", Nn, N_in) <= 0) \
+                | (np.linalg.norm(Nn, axis=1) <= 1e-6 * a0)
+            bad &= a0 > 0
+            hit = pos[np.unique(F[bad])]
+            return hit[hit >= 0]
+
+        for _attempt in range(3):            # damp: halve the moves around flipped faces
+            hit = flipped()
+            if hit.size == 0:
+                break
+            scale[hit] *= 0.5
+            ever_damped[free[hit]] = True
+        while True:                          # then undo them (terminates: all undone = the unflipped start)
+            hit = flipped()
+            hit = hit[scale[hit] > 0]
+            if hit.size == 0:
+                break
+            scale[hit] = 0.0
+            ever_reverted[free[hit]] = True
+    shift = np.linalg.norm(V[free] - V0[free], axis=1)
+    report.update(moved=int((shift > 0).sum()), reverted=int(ever_reverted.sum()), damped=int(ever_damped.sum()),
+                  mean_shift=float(shift.mean()))
+    return (V, report) if return_report else V
