@@ -6,7 +6,7 @@ import pytest
 
 import gsdf
 from gsdf.recon.relocate import _face_normals, local_surface, relocate_vertices
-from gsdf.recon.topology import is_sphere
+from gsdf.mesh.topology import is_sphere
 
 
 def _fibonacci(n, r=1.0):
