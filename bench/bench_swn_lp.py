@@ -78,7 +78,7 @@ What was checked and what was wrong (cases replayed by their bench_swn.py ids):
 """
 
 METHODS = [("naive", dict(method="none")),
-           ("lp, as before", dict(method="lp", _final="all")),
+           ("lp, as before", dict(method="lp", _final="all", bounding="fractional")),
            ("lp", dict(method="lp")),
            ("lp, integer class", dict(method="lp", homology="integer")),
            ("reduced", dict(method="reduced")),
