@@ -20,8 +20,12 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    With ``homology="integer"`` the class of γ (its periods on a tree–cotree homology basis) is first rounded
    to the nearest integer class; a class 0 skips the LP;
 5. the jumps of v (Jv, the completed nonbounding part) are removed from the input: the jump Laplace equation is
-   solved again with jumps "Γ ∖ Jv" (§6.1.2), g − Jv on the input's edges only — Jv off the input (where the
+   solved again with jumps "Γ ∖ Jv" (§6.1.2) on the input's edges only — Jv off the input (where the
    LP closed the gaps of nonbounding loops) is the completion of the nonbounding part, not a jump of w: w.
+   "Γ ∖ Jv" is read as a subset of the input (``bounding="subset"``, default): an input edge is nonbounding
+   when Jv explains at least half of its jump, the bounding part is g − round(Jv); a remainder that still
+   has a harmonic part (a broken loop the LP explained only partly) is decomposed again (steps ①–④, at
+   most ``MAX_PASSES``). ``bounding="fractional"`` keeps g − Jv (one pass).
    Faces are labelled ``round(w − s)`` with the offset s the level of w on the input curves minus ½
    (circular mean of the mean of the two faces of every bounding input edge; see
    :meth:`SurfaceWindingNumbers.rounding_offset`), then shifted so that the faces to the right of the curves get
@@ -594,7 +598,7 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
 
 def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
                            time_limit: float = 300.0, homology: str = "real",
-                           lp_algorithm: str = "auto") -> SWNResult:
+                           lp_algorithm: str = "auto", bounding: str = "subset") -> SWNResult:
     """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
     Examples
@@ -603,4 +607,4 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float =
     >>> res.face_labels                                                     # doctest: +SKIP
     """
     return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit,
-                                             homology=homology, lp_algorithm=lp_algorithm)
+                                             homology=homology, lp_algorithm=lp_algorithm, bounding=bounding)
