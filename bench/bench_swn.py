@@ -438,6 +438,13 @@ def generate_cases(mc, n, breaking="random"):
     schemes draw the same numbers before breaking, so ``breaking="long"`` replays the cases of the first run):
     yields (c, case id, region kind, truth (m,), unbroken boundary chain g, broken input gb, fraction deleted,
     number of nonbounding loops added)."""
+    for c, cid, kind, truth, g, gb, frac, nb, _parts in generate_cases_parts(mc, n, breaking):
+        yield c, cid, kind, truth, g, gb, frac, nb
+
+
+def generate_cases_parts(mc, n, breaking="random"):
+    """:func:`generate_cases` (same draws), also yielding the input's parts for diagnosis: a dict with the broken
+    region boundary "region", the broken generator loops "loops" (list) and the unbroken ones "loops_full"."""
     for c in range(n):
         kind = "eigen" if c % 2 == 0 else "grow"
         truth, g = mc.region(kind)
@@ -446,14 +453,17 @@ def generate_cases(mc, n, breaking="random"):
         frac = mc.rng.uniform(0.1, 0.5)
         k = int(mc.rng.integers(1, 5))
         gb = mc.break_chain(g, frac, k, breaking)
+        parts = {"region": gb.copy(), "loops": [], "loops_full": []}
         nb = 0
         if mc.gens and mc.rng.random() < 0.5:
             for gi in mc.rng.choice(len(mc.gens), size=min(len(mc.gens), int(mc.rng.integers(1, 3))),
                                     replace=False):
-                gb = gb + mc.break_chain(mc.gens[gi], mc.rng.uniform(0.0, 0.3), int(mc.rng.integers(1, 3)),
-                                         breaking)
+                loop = mc.break_chain(mc.gens[gi], mc.rng.uniform(0.0, 0.3), int(mc.rng.integers(1, 3)), breaking)
+                gb = gb + loop
+                parts["loops"].append(loop)
+                parts["loops_full"].append(mc.gens[gi])
                 nb += 1
-        yield c, f"{mc.name}:{c}", kind, truth, g, gb, frac, nb
+        yield c, f"{mc.name}:{c}", kind, truth, g, gb, frac, nb, parts
 
 
 def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", topology="all"):

@@ -20,8 +20,12 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    With ``homology="integer"`` the class of γ (its periods on a tree–cotree homology basis) is first rounded
    to the nearest integer class; a class 0 skips the LP;
 5. the jumps of v (Jv, the completed nonbounding part) are removed from the input: the jump Laplace equation is
-   solved again with jumps "Γ ∖ Jv" (§6.1.2), g − Jv on the input's edges only — Jv off the input (where the
+   solved again with jumps "Γ ∖ Jv" (§6.1.2) on the input's edges only — Jv off the input (where the
    LP closed the gaps of nonbounding loops) is the completion of the nonbounding part, not a jump of w: w.
+   "Γ ∖ Jv" is read as a subset of the input (``bounding="subset"``, default): an input edge is nonbounding
+   when Jv explains at least half of its jump, the bounding part is g − round(Jv); a remainder that still
+   has a harmonic part (a broken loop the LP explained only partly) is decomposed again (steps ①–④, at
+   most ``MAX_PASSES``). ``bounding="fractional"`` keeps g − Jv (one pass).
    Faces are labelled ``round(w − s)`` with the offset s the level of w on the input curves minus ½
    (circular mean of the mean of the two faces of every bounding input edge; see
    :meth:`SurfaceWindingNumbers.rounding_offset`), then shifted so that the faces to the right of the curves get
@@ -58,6 +62,8 @@ __all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "boun
 
 METHODS = ("lp", "reduced", "none")
 HOMOLOGY = ("real", "integer")
+BOUNDING = ("subset", "fractional")
+MAX_PASSES = 3          # bounding="subset": decompositions of the remainder at most (bench: a third pass is rare)
 LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
 IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
                         # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
@@ -74,14 +80,17 @@ class SWNResult:
     corner_values : (m, 3) winding number per corner, offset so that ``face_labels == round(mean of corners)``
     face_labels : (m,) int64 integer winding number per face (0 to the right of the curves)
     residual : (nE,) the jump chain Jv of the residual function: ≈ the completed nonbounding part of the curves
-    bounding : (nE,) the bounding part, ``g - Jv`` on the input's edges (0 elsewhere)
+    bounding : (nE,) the bounding part on the input's edges (0 elsewhere): ``g - round(Jv)`` over the passes
+        (``bounding="subset"``, integer) or ``g - Jv`` (``bounding="fractional"``)
     u : (m, 3) the jump-harmonic function of step ① per corner (the "naive" winding number)
     chain : (nE,) the input as an integer edge chain g
     endpoints : (n,) bool interior endpoints of the input
     omega, gamma : (nE,) Darboux derivative of u and its harmonic (non-coexact) part
     offset : the rounding offset s (plus the integer shift)
     method : the method that produced ``corner_values``
-    lp_objective : objective of the residual LP (nan when no LP ran)
+    lp_objective : objective of the residual LP (nan when no LP ran; summed over the passes)
+    passes : number of decompositions (steps ①–④) run: 0 without an LP, more than 1 when ``bounding="subset"``
+        decomposed a remainder again
     timings : dict of seconds per step ("lp" is the HiGHS part of "residual"; "total" the sum of the steps)
     """
 
@@ -97,6 +106,7 @@ class SWNResult:
     offset: float
     method: str
     lp_objective: float = float("nan")
+    passes: int = 0
     timings: dict = field(default_factory=dict)
 
 
@@ -211,7 +221,7 @@ class SurfaceWindingNumbers:
 
     # ----------------------------------------------------------------------------------------------- solve
     def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
-              homology: str = "real", lp_algorithm: str = "auto", progress=None,
+              homology: str = "real", lp_algorithm: str = "auto", bounding: str = "subset", progress=None,
               _final: str = "curves") -> SWNResult:
         """Surface winding numbers of ``curves``.
 
@@ -231,6 +241,17 @@ class SurfaceWindingNumbers:
             by the face shifts). A class that rounds to 0 needs no LP at all; otherwise Jv is an integer chain.
         lp_algorithm : "auto" (default: interior point from 12k faces on, dual simplex below), "highs",
             "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP
+        bounding : "subset" (default) or "fractional" — how step ⑤ reads the bounding part "Γ ∖ Jv" (§6.1.2)
+            off the residual. "subset": as a *subset* of the input, the thesis' words ("the bounding components
+            of Γ are … the complement of the nonbounding components, taken as a subset of Γ"): an input edge
+            belongs to the nonbounding part when the residual explains at least half of its jump,
+            ``round(Jv)``, and the bounding part is the integer chain ``g − round(Jv)`` on the input. When the
+            LP explained a broken nonbounding loop only partly (Jv < ½ on some of its edges; thesis Fig. 6.6:
+            coefficients below 1 on broken loops), this remainder still holds nonbounding pieces, so it is
+            decomposed again (steps ①–④ on the remainder, at most ``MAX_PASSES`` decompositions) until the
+            residual removes no further input edge. "fractional": the bounding part is ``g − Jv`` itself
+            (fractional jumps left on partly explained loops), one decomposition — the behaviour before.
+            Simply connected surfaces and ``method="none"`` are unaffected.
         progress : callable(done, total), optional — the package's progress signature; called after each of the
             steps (jump solve, Darboux derivative, Hodge decomposition, residual LP, final solve)
 
@@ -247,6 +268,8 @@ class SurfaceWindingNumbers:
             raise ValueError(f"lp_algorithm: expected one of {LP_ALGORITHMS}, got {lp_algorithm!r}")
         if homology not in HOMOLOGY:
             raise ValueError(f"homology: expected one of {HOMOLOGY}, got {homology!r}")
+        if not isinstance(bounding, str) or bounding not in BOUNDING:
+            raise ValueError(f"bounding: expected one of {BOUNDING}, got {bounding!r}")
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
         steps = iter(range(1, 6))
@@ -280,9 +303,69 @@ class SurfaceWindingNumbers:
             return res
 
         say("Darboux derivative")
+        for key in ("darboux", "hodge", "lp", "residual"):
+            T[key] = 0.0
+        Jv = zero.copy()                    # the residual, summed over the passes
+        removed = zero.copy()               # input edges read as nonbounding (bounding="subset")
+        obj = 0.0
+        cur, ends_cur, u_cur = g, ends, u
+        n_pass = 1 if bounding == "fractional" else MAX_PASSES
+        for k_pass in range(n_pass):
+            if k_pass:                       # ① again on the remainder (new endpoints where pieces were removed)
+                t0 = time.perf_counter()
+                ends_cur = ends | dec.chain_endpoints(cur, tol=1e-6)
+                _, u_cur = dec.solve_jump(dec.jump_coordinates(cur, ends_cur))
+                T["jump_solve"] += time.perf_counter() - t0
+            om_k, gamma_k, Jv_k, obj_k = self._decompose(u_cur, cur, ends_cur, method, homology, epsilon,
+                                                         time_limit, lp_algorithm, T, say if k_pass == 0 else None)
+            if k_pass == 0:
+                om, gamma = om_k, gamma_k
+            Jv = Jv + Jv_k
+            obj += obj_k
+            if bounding == "fractional":
+                break
+            # "Γ ∖ Jv" as a subset of the input: edges whose jump the residual explains by at least a half
+            cut = np.where(cur != 0, np.round(Jv_k), 0.0)
+            if not np.any(cut):
+                break
+            removed = removed + cut
+            cur = np.where(cur != 0, cur - cut, 0.0)
+            if not np.any(cur):
+                break
+
+        say("final jump solve")
+        t0 = time.perf_counter()
+        Jv = np.where(np.abs(Jv) < 1e-9, 0.0, Jv)
+        # thesis §6.1.2 step ⑤: w jumps across "Γ ∖ Jv", the bounding part as a subset of the input — g − Jv on the
+        # input's edges only; the completion of the nonbounding part off the input (Jv across the gaps) is not a
+        # jump of w. Vertices where the bounding part does not close become endpoints (the spec's "cleaner
+        # alternative"). _final="all" (diagnosis only) also keeps −Jv off the input.
+        if bounding == "subset":
+            bnd = np.where(g != 0, g - removed, 0.0)
+        elif _final == "all":
+            bnd = g - Jv
+        else:
+            bnd = np.where(g != 0, g - Jv, 0.0)
+        ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
+        if np.any(bnd != g):
+            _, w = dec.solve_jump(dec.jump_coordinates(bnd, ends2))
+        else:                                     # nothing nonbounding: w = u
+            w = u
+        T["final_solve"] = time.perf_counter() - t0
+        res = self._finish(w, u, g, Jv, ends, om, gamma, method, T, bnd)
+        res.lp_objective = obj
+        res.passes = k_pass + 1
+        if progress is not None:
+            progress(5, 5)
+        return res
+
+    def _decompose(self, u, g, ends, method, homology, epsilon, time_limit, lp_algorithm, T, say=None):
+        """Steps ②–④ for the chain g with jump-harmonic u: (ω, γ, Jv, LP objective); adds to T's steps."""
+        dec = self.dec
+        say = say if say is not None else (lambda _name: None)
         t0 = time.perf_counter()
         om = dec.darboux(u, ends)
-        T["darboux"] = time.perf_counter() - t0
+        T["darboux"] += time.perf_counter() - t0
         t0 = time.perf_counter()
         say("Hodge decomposition")
         if ends.any():
@@ -299,12 +382,14 @@ class SurfaceWindingNumbers:
             gamma_lp = gamma + tc.closed_form(k - per) if np.any(k) else None
         else:
             gamma_lp = gamma
-        T["hodge"] = time.perf_counter() - t0
+        T["hodge"] += time.perf_counter() - t0
 
         say(f"residual ({method} LP)")
         t0 = time.perf_counter()
-        if gamma_lp is None:                      # integer class 0: nothing nonbounding, no LP
-            Jv, obj, lp_s = zero.copy(), 0.0, 0.0
+        if gamma_lp is not None and not np.abs(gamma_lp).max() > 1e-9:
+            gamma_lp = None                       # ω has no harmonic part: u is already a labeling (§6.1.1)
+        if gamma_lp is None:                      # integer class 0 / γ = 0: nothing nonbounding, no LP
+            Jv, obj, lp_s = np.zeros(dec.n_edges), 0.0, 0.0
         else:
             try:
                 if method == "lp":
@@ -319,34 +404,15 @@ class SurfaceWindingNumbers:
             if integer:                           # a network LP with an integer class: integer jumps
                 r = np.round(Jv)
                 Jv = np.where(np.abs(Jv - r) < 1e-6, r, Jv)
-        T["lp"] = lp_s
-        T["residual"] = time.perf_counter() - t0
+        T["lp"] += lp_s
+        T["residual"] += time.perf_counter() - t0
+        return om, gamma, Jv, obj
 
-        say("final jump solve")
-        t0 = time.perf_counter()
-        Jv = np.where(np.abs(Jv) < 1e-9, 0.0, Jv)
-        # thesis §6.1.2 step ⑤: w jumps across "Γ ∖ Jv", the bounding part as a subset of the input — g − Jv on the
-        # input's edges only; the completion of the nonbounding part off the input (Jv across the gaps) is not a
-        # jump of w. Vertices where the bounding part does not close become endpoints (the spec's "cleaner
-        # alternative"). _final="all" (diagnosis only) also keeps −Jv off the input.
-        bnd = g - Jv if _final == "all" else np.where(g != 0, g - Jv, 0.0)
-        ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
-        if np.any(Jv):
-            _, w = dec.solve_jump(dec.jump_coordinates(bnd, ends2))
-        else:                                     # nothing nonbounding: w = u
-            w = u
-        T["final_solve"] = time.perf_counter() - t0
-        res = self._finish(w, u, g, Jv, ends, om, gamma, method, T)
-        res.lp_objective = obj
-        if progress is not None:
-            progress(5, 5)
-        return res
-
-    def _finish(self, w, u, g, Jv, ends, om, gamma, method, T) -> SWNResult:
+    def _finish(self, w, u, g, Jv, ends, om, gamma, method, T, bnd=None) -> SWNResult:
         dec, topo = self.dec, self.topology
         t0 = time.perf_counter()
         wf = w.mean(axis=1)
-        s = self.rounding_offset(wf, g, Jv)
+        s = self.rounding_offset(wf, g, Jv if bnd is None else np.where(g != 0, g - bnd, 0.0))
         W = np.round(wf - s)
         # label 0 on the right of the curves: the length-weighted most frequent label of the right faces
         ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
@@ -358,7 +424,7 @@ class SurfaceWindingNumbers:
             k = 0.0
         W = (W - k).astype(np.int64)
         off = s + k
-        bounding = np.where(g != 0, g - Jv, 0.0)
+        bounding = np.where(g != 0, g - Jv, 0.0) if bnd is None else np.where(g != 0, bnd, 0.0)
         T["round"] = time.perf_counter() - t0
         T["total"] = float(sum(v for k, v in T.items() if k != "lp"))      # "lp" is part of "residual"
         return SWNResult(w - off, W, Jv, bounding, u, g, ends, om, gamma, float(off), method, timings=T)
@@ -532,7 +598,7 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
 
 def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
                            time_limit: float = 300.0, homology: str = "real",
-                           lp_algorithm: str = "auto") -> SWNResult:
+                           lp_algorithm: str = "auto", bounding: str = "subset") -> SWNResult:
     """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
     Examples
@@ -541,4 +607,4 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float =
     >>> res.face_labels                                                     # doctest: +SKIP
     """
     return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit,
-                                             homology=homology, lp_algorithm=lp_algorithm)
+                                             homology=homology, lp_algorithm=lp_algorithm, bounding=bounding)
