@@ -5,8 +5,9 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
 
 0. classify: the surface is simply connected when its first Betti number is 0 (χ ∈ {1, 2} per component);
    interior endpoints are the interior vertices where the integer edge chain g of the curves does not close;
-1. jump Laplace solve ``u`` (jump g across the curves, harmonic elsewhere, endpoints excluded, projective
-   interpolation next to them) — :meth:`gsdf.dec.TriangleDEC.solve_jump`;
+1. jump Laplace solve ``u`` (jump g across the curves, harmonic elsewhere; at interior endpoints a discrete
+   branch point (default on simply connected surfaces), or the endpoints excluded with projective interpolation
+   next to them (``endpoint_rule="exclude"``, the default with an LP)) — :meth:`SurfaceWindingNumbers._jump_solve`;
 2. Darboux derivative ω = Du (du with the jumps removed);
 3. for open curves, the coexact part is removed by Hodge decomposition: γ = ω − ⋆1⁻¹d1ᵀβ (u harmonic: no exact
    part). γ is the harmonic part that nonbounding components leave behind;
@@ -59,6 +60,7 @@ __all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "boun
 METHODS = ("lp", "reduced", "none")
 HOMOLOGY = ("real", "integer")
 LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
+ENDPOINT_RULES = ("auto", "branch", "exclude")
 IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
                         # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
                         # 75 s vs 62 s; at load ≈ 9: 1.5 vs 2.1 s and 36 vs 16 s)
@@ -212,7 +214,7 @@ class SurfaceWindingNumbers:
     # ----------------------------------------------------------------------------------------------- solve
     def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
               homology: str = "real", lp_algorithm: str = "auto", progress=None,
-              _final: str = "curves") -> SWNResult:
+              endpoint_rule: str = "auto", _final: str = "curves") -> SWNResult:
         """Surface winding numbers of ``curves``.
 
         Parameters
@@ -233,6 +235,14 @@ class SurfaceWindingNumbers:
             "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP
         progress : callable(done, total), optional — the package's progress signature; called after each of the
             steps (jump solve, Darboux derivative, Hodge decomposition, residual LP, final solve)
+        endpoint_rule : "auto" (default), "branch" or "exclude" — how the jump solves (steps ① and ⑤) treat
+            interior endpoints: "branch" keeps them with a discrete branch point (an angular ramp of the corner
+            values around the endpoint, :meth:`gsdf.dec.TriangleDEC.branch_coordinates`); "exclude" drops them
+            and every halfedge touching them, with projective interpolation of their corners (the authors' rule;
+            its one-rings act as holes, see :meth:`_jump_solve`). "auto": "branch" on simply connected
+            surfaces, "exclude" otherwise — on 64 replayed not simply connected bench cases "branch" had the
+            same mean error (2.15 % vs 2.16 %) but 2 more cases over 0.5 % (73.4 % vs 76.6 % under), so the
+            surfaces with an LP keep the rule their LP was validated with
 
         Returns
         -------
@@ -247,6 +257,10 @@ class SurfaceWindingNumbers:
             raise ValueError(f"lp_algorithm: expected one of {LP_ALGORITHMS}, got {lp_algorithm!r}")
         if homology not in HOMOLOGY:
             raise ValueError(f"homology: expected one of {HOMOLOGY}, got {homology!r}")
+        if endpoint_rule not in ENDPOINT_RULES:
+            raise ValueError(f"endpoint_rule: expected one of {ENDPOINT_RULES}, got {endpoint_rule!r}")
+        if endpoint_rule == "auto":
+            endpoint_rule = "branch" if self.simply_connected else "exclude"
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
         steps = iter(range(1, 6))
@@ -267,8 +281,7 @@ class SurfaceWindingNumbers:
 
         say("jump Laplace solve")
         t0 = time.perf_counter()
-        jc = dec.jump_coordinates(g, ends)
-        _, u = dec.solve_jump(jc)
+        u = self._jump_solve(g, ends, endpoint_rule)
         T["jump_solve"] = time.perf_counter() - t0
         nE = dec.n_edges
         zero = np.zeros(nE)
@@ -332,7 +345,7 @@ class SurfaceWindingNumbers:
         bnd = g - Jv if _final == "all" else np.where(g != 0, g - Jv, 0.0)
         ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
         if np.any(Jv):
-            _, w = dec.solve_jump(dec.jump_coordinates(bnd, ends2))
+            w = self._jump_solve(bnd, ends2, endpoint_rule)
         else:                                     # nothing nonbounding: w = u
             w = u
         T["final_solve"] = time.perf_counter() - t0
@@ -341,6 +354,27 @@ class SurfaceWindingNumbers:
         if progress is not None:
             progress(5, 5)
         return res
+
+    def _jump_solve(self, chain: np.ndarray, ends: np.ndarray, rule: str = "branch") -> np.ndarray:
+        """Corner values (m, 3) of the jump Laplace solve (thesis Eq. 6.2, step ①) with jumps ``chain``.
+
+        ``rule="branch"``: interior endpoints keep their degree of freedom, with the angular ramp of a branch point
+        around them (thesis §2.3.3: the angle-valued u fails to be harmonic only at endpoints, a branch point;
+        §6.2: ω behaves like dθ there) — :meth:`gsdf.dec.TriangleDEC.branch_coordinates`. Nothing is removed
+        from the energy, and the Laplacian is the same for every curve set (one cached factorization).
+        ``rule="exclude"``: endpoints and their halfedges are dropped, their corners filled by projective
+        interpolation (spec §1(b) step ①, the authors' demo). The one-ring of an excluded endpoint is a hole
+        with zero-Neumann walls: on curves broken into runs of a few edges the holes leak (the far-field jump of
+        a broken leg loop, bench case dino:3, was 0.29 against 0.456 on the same curve on 4× and 16× refined
+        meshes, where the ramp gives 0.453), and neighbouring holes can wall a region off the solve entirely
+        (dino:37: w ≡ 0 on 7 % of the area; ramp 0.660 vs refined 0.659). Simply connected bench cases
+        (``bench/bench_swn.py --topology simply``, 420 cases): mean / max error 0.40 % / 13.5 % excluded,
+        0.32 % / 4.7 % branched.
+        """
+        dec = self.dec
+        if rule == "branch":
+            return dec.solve_jump(dec.branch_coordinates(chain, ends))[1]
+        return dec.solve_jump(dec.jump_coordinates(chain, ends))[1]
 
     def _finish(self, w, u, g, Jv, ends, om, gamma, method, T) -> SWNResult:
         dec, topo = self.dec, self.topology
@@ -532,7 +566,7 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
 
 def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
                            time_limit: float = 300.0, homology: str = "real",
-                           lp_algorithm: str = "auto") -> SWNResult:
+                           lp_algorithm: str = "auto", endpoint_rule: str = "auto") -> SWNResult:
     """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
     Examples
@@ -541,4 +575,5 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float =
     >>> res.face_labels                                                     # doctest: +SKIP
     """
     return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit,
-                                             homology=homology, lp_algorithm=lp_algorithm)
+                                             homology=homology, lp_algorithm=lp_algorithm,
+                                             endpoint_rule=endpoint_rule)
