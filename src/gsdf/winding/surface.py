@@ -61,6 +61,7 @@ METHODS = ("lp", "reduced", "none")
 HOMOLOGY = ("real", "integer")
 LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
 ENDPOINT_RULES = ("auto", "branch", "exclude")
+LP_FORMS = ("cycles", "faces")    # the full residual LP: cycle form (default) or face shifts (dual_graph_l1)
 IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
                         # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
                         # 75 s vs 62 s; at load ≈ 9: 1.5 vs 2.1 s and 36 vs 16 s)
@@ -118,6 +119,11 @@ class SurfaceWindingNumbers:
     V : (n, 3) float
     F : (m, 3) int — a manifold, consistently oriented mesh (any genus, boundary allowed); a ValueError names
         the first non-manifold edge / vertex or misoriented edge otherwise.
+    lp_form : "cycles" (default) or "faces" — how the full residual LP (``method="lp"``) is written for HiGHS:
+        "faces" is the program of spec §1(b) ④ (a shift per face, :func:`gsdf.dec.lp.dual_graph_l1`); "cycles"
+        the same program without face unknowns (:class:`gsdf.dec.cycle_lp.CycleL1`: the jumps J must differ from
+        the offsets by a boundary — vertex rows plus a row per homology generator), about a third of the rows;
+        same optimal objective (tested), faster (bench/RESULTS.md "swn-lp-speed"); ties may pick another optimum
 
     Attributes
     ----------
@@ -137,7 +143,11 @@ class SurfaceWindingNumbers:
     32
     """
 
-    def __init__(self, V, F):
+    def __init__(self, V, F, lp_form: str = "cycles"):
+        if lp_form not in LP_FORMS:
+            raise ValueError(f"lp_form: expected one of {LP_FORMS}, got {lp_form!r}")
+        self.lp_form = lp_form
+        self._cycle_lp = None
         self.dec = TriangleDEC(V, F)
         self.topology = self.dec.topology
         self.betti_1 = self.topology.betti_1()
@@ -451,7 +461,8 @@ class SurfaceWindingNumbers:
         d_hi = vinit[A, (sa + 1) % 3] - vinit[B, sb]
         return 0.5 * (d_lo + d_hi)
 
-    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
+    def _full_lp_terms(self, gamma, g, eps):
+        """The full residual LP's data (spec §1(b) ④): interior edges, offsets d, weights, bounds (k, 2)."""
         dec, topo = self.dec, self.topology
         interior = np.flatnonzero(topo.edge_face_count == 2)
         vinit = self._face_integrals(gamma)
@@ -462,10 +473,29 @@ class SurfaceWindingNumbers:
         # "no extra loops": 0 ≤ g·Jv ≤ g² on the input's edges
         lo = np.where(on, np.minimum(0.0, gi), -np.inf)
         hi = np.where(on, np.maximum(0.0, gi), np.inf)
+        return interior, d, w, np.column_stack([lo, hi])
+
+    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
+        if self.lp_form == "cycles":
+            return self._residual_cycles(gamma, g, eps, time_limit, algorithm)
+        dec, topo = self.dec, self.topology
+        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps)
         pairs = topo.edge_faces[interior]
-        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=np.column_stack([lo, hi]), time_limit=time_limit,
-                          algorithm=algorithm)
+        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=bounds, time_limit=time_limit, algorithm=algorithm)
         Jv = np.zeros(dec.n_edges)
+        Jv[interior] = r.jumps
+        return Jv, r.objective, r.seconds
+
+    def _residual_cycles(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
+        """The full residual LP in cycle form (:class:`gsdf.dec.cycle_lp.CycleL1`: the same program without face
+        unknowns — vertex conservation rows plus one row per homology generator; same optimum, built once)."""
+        from ..dec.cycle_lp import CycleL1
+
+        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps)
+        if self._cycle_lp is None:
+            self._cycle_lp = CycleL1(self.dec, interior)
+        r = self._cycle_lp.solve(d, w, bounds=bounds, time_limit=time_limit, algorithm=algorithm)
+        Jv = np.zeros(self.dec.n_edges)
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
 
