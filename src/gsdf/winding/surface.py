@@ -61,7 +61,7 @@ METHODS = ("lp", "reduced", "none")
 HOMOLOGY = ("real", "integer")
 LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
 ENDPOINT_RULES = ("auto", "branch", "exclude")
-LP_FORMS = ("cycles", "faces")    # the full residual LP: cycle form (default) or face shifts (dual_graph_l1)
+LP_FORMS = ("faces", "cycles")    # the full residual LP: face shifts (dual_graph_l1, default) or cycle form
 IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
                         # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
                         # 75 s vs 62 s; at load ≈ 9: 1.5 vs 2.1 s and 36 vs 16 s)
@@ -119,11 +119,14 @@ class SurfaceWindingNumbers:
     V : (n, 3) float
     F : (m, 3) int — a manifold, consistently oriented mesh (any genus, boundary allowed); a ValueError names
         the first non-manifold edge / vertex or misoriented edge otherwise.
-    lp_form : "cycles" (default) or "faces" — how the full residual LP (``method="lp"``) is written for HiGHS:
+    lp_form : "faces" (default) or "cycles" — how the full residual LP (``method="lp"``) is written for HiGHS:
         "faces" is the program of spec §1(b) ④ (a shift per face, :func:`gsdf.dec.lp.dual_graph_l1`); "cycles"
         the same program without face unknowns (:class:`gsdf.dec.cycle_lp.CycleL1`: the jumps J must differ from
         the offsets by a boundary — vertex rows plus a row per homology generator), about a third of the rows;
-        same optimal objective (tested), faster (bench/RESULTS.md "swn-lp-speed"); ties may pick another optimum
+        same optimal objective (tested), ties may pick another optimum. Not the default: on the scaling case
+        (bench/RESULTS.md "swn-lp-speed", loaded machine) dual simplex was faster in cycle form (33k faces:
+        43 s vs 74 s) but interior point was not (35 s vs 29 s), and at 134k faces neither form finished in
+        240 s
 
     Attributes
     ----------
@@ -143,7 +146,7 @@ class SurfaceWindingNumbers:
     32
     """
 
-    def __init__(self, V, F, lp_form: str = "cycles"):
+    def __init__(self, V, F, lp_form: str = "faces"):
         if lp_form not in LP_FORMS:
             raise ValueError(f"lp_form: expected one of {LP_FORMS}, got {lp_form!r}")
         self.lp_form = lp_form
