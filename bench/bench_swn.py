@@ -38,12 +38,14 @@ Usage::
     PYTHONPATH=src python3 bench/bench_swn.py                # 924 cases (+ scaling + author data)
     PYTHONPATH=src python3 bench/bench_swn.py --breaking long   # the same 924 draws, few long gaps (cases only)
     PYTHONPATH=src python3 bench/bench_swn.py --topology simply # the 420 simply connected cases only (~1 min)
+    PYTHONPATH=src python3 bench/bench_swn.py --topology simply --endpoint-rule exclude   # ... with the old rule
     PYTHONPATH=src python3 bench/bench_swn.py --only scaling|author|cases
     PYTHONPATH=src python3 bench/bench_swn.py --only offsets    # solver offset vs oracle (50 fresh cases)
     PYTHONPATH=src python3 bench/bench_swn.py --only diagnose   # simply connected cases: where the error is
     PYTHONPATH=src python3 bench/bench_swn.py --only compare    # both schemes side by side, from the CSVs
 
-Per-case rows go to bench/swn_cases.csv (random) / bench/swn_cases_long.csv (long), ``_quick`` for --quick,
+Per-case rows go to bench/swn_cases.csv (random) / bench/swn_cases_long.csv (long), ``_simply`` for --topology
+simply, ``_quick`` for --quick, ``_exclude`` for --endpoint-rule exclude,
 appended as they finish (a rerun resumes; ``--fresh`` starts over); the summary goes to the sections "swn" /
 "swn-long" (+ "-quick", "-simply", "-diagnose", ...) of bench/RESULTS.md.
 """
@@ -466,7 +468,8 @@ def generate_cases_parts(mc, n, breaking="random"):
         yield c, f"{mc.name}:{c}", kind, truth, g, gb, frac, nb, parts
 
 
-def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", topology="all"):
+def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", topology="all",
+              endpoint_rule="auto"):
     global NEW_ROWS
     meshes = list(enumerate(mesh_list()))
     if quick:
@@ -499,7 +502,7 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", top
             row = {"case": cid, "mesh": name, "faces": mc.dec.n_faces, "b1": mc.swn.betti_1,
                    "boundary": int(not mc.closed), "region": kind, "broken": round(frac, 3),
                    "nonbounding": nb}
-            r0 = mc.swn.solve(gb, method="none")
+            r0 = mc.swn.solve(gb, method="none", endpoint_rule=endpoint_rule)
             row["endpoints"] = int(r0.endpoints.sum())
             row["err_none"] = mislabeled(r0.face_labels, truth, mc.area)
             row["t_none"] = r0.timings["total"]
@@ -507,7 +510,7 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", top
             status = "ok"
             for meth in ("lp", "reduced"):
                 try:
-                    r = mc.swn.solve(gb, method=meth, time_limit=time_limit)
+                    r = mc.swn.solve(gb, method=meth, time_limit=time_limit, endpoint_rule=endpoint_rule)
                     row[f"err_{meth}"] = mislabeled(r.face_labels, truth, mc.area)
                     row[f"t_{meth}_total" if meth == "reduced" else "t_lp_total"] = r.timings["total"]
                     row["t_lp_highs" if meth == "lp" else "t_reduced_lp"] = r.timings.get("lp", 0.0)
@@ -580,6 +583,36 @@ def summarize():
                 out.append(f"| {lab} | {len(rr)} | {a('err_lp'):.1f} % | {a('err_reduced'):.1f} % | "
                            f"{a('err_none'):.1f} % |")
         out.append("")
+    return "\n".join(out)
+
+
+def compare_endpoint_rules(n_worst=10):
+    """Simply connected cases under both endpoint rules of the jump solve (``--topology simply`` with
+    ``--endpoint-rule branch`` / ``exclude``): the same case ids, side by side, and the worst cases of the old
+    rule. Empty string unless both CSVs exist."""
+    paths = {r: os.path.join(HERE, "swn_cases_simply" + ("" if r == "branch" else "_exclude") + ".csv")
+             for r in ("exclude", "branch")}
+    if not all(os.path.exists(p) for p in paths.values()):
+        return ""
+    err = {}
+    for r, p in paths.items():
+        with open(p) as fh:
+            err[r] = {row["case"]: float(row["err_lp"]) for row in csv.DictReader(fh)}
+    ids = sorted(set(err["exclude"]) & set(err["branch"]))
+    a = {r: np.array([err[r][i] for i in ids]) for r in err}
+    out = ["| endpoint rule of the jump solve | cases | mean error | max error | cases < 0.5 % |", "|---|---|---|---|---|"]
+    names = {"exclude": "exclude (endpoints and their halfedges dropped, projective fill; before)",
+             "branch": "branch (discrete branch point, the default on simply connected surfaces now)"}
+    for r in ("exclude", "branch"):
+        out.append(f"| {names[r]} | {len(ids)} | {100 * a[r].mean():.3f} % | {100 * a[r].max():.2f} % | "
+                   f"{100 * (a[r] < 0.005).mean():.1f} % |")
+    out += ["", "Thesis: mean 0.14 %, max 5 %.", "", f"Worst {n_worst} cases of the old rule:", "",
+            "| case | exclude | branch |", "|---|---|---|"]
+    for k in np.argsort(-a["exclude"])[:n_worst]:
+        out.append(f"| {ids[k]} | {100 * a['exclude'][k]:.2f} % | {100 * a['branch'][k]:.2f} % |")
+    kb = np.argsort(-a["branch"])[:n_worst]
+    out += ["", f"Worst {n_worst} cases of the new rule: " + ", ".join(
+        f"{ids[k]} {100 * a['branch'][k]:.2f} % (was {100 * a['exclude'][k]:.2f} %)" for k in kb) + "."]
     return "\n".join(out)
 
 
@@ -808,12 +841,17 @@ def main():
     ap.add_argument("--topology", choices=["all", "simply"], default="all",
                     help="'simply': only the 10 simply connected meshes (fast; no LP)")
     ap.add_argument("--time-limit", type=float, default=120.0)
+    ap.add_argument("--endpoint-rule", choices=["auto", "branch", "exclude"], default="auto",
+                    help="interior endpoints in the jump solves (SurfaceWindingNumbers.solve endpoint_rule); "
+                         "'auto' (default): branch on simply connected meshes, exclude otherwise; 'exclude' is the "
+                         "rule before (per-case CSV tagged _exclude / _branch)")
     ap.add_argument("--fresh", action="store_true", help="discard this variant's per-case CSV first")
     a = ap.parse_args()
     if (a.topology == "simply" or a.breaking == "long") and a.only is None:
         a.only = "cases"                # the cases alone: scaling and author data do not depend on the breaking
     global CSV
-    tag = ("" if a.breaking == "random" else "_long") + ("_quick" if a.quick else "")
+    tag = ("" if a.breaking == "random" else "_long") + ("_simply" if a.topology == "simply" else "") + \
+        ("_quick" if a.quick else "") + ("" if a.endpoint_rule == "auto" else "_" + a.endpoint_rule)
     CSV = os.path.join(HERE, f"swn_cases{tag}.csv")
     if a.fresh and os.path.exists(CSV):
         os.remove(CSV)
@@ -822,7 +860,7 @@ def main():
     parts = {}
     if a.only in (None, "cases"):
         run_cases(a.per_mesh or (5 if a.quick else 42), a.quick, a.time_limit, breaking=a.breaking,
-                  topology=a.topology)
+                  topology=a.topology, endpoint_rule=a.endpoint_rule)
     if a.only in (None, "cases", "summary"):
         parts["cases"] = summarize()
     if a.only in (None, "scaling"):
@@ -842,7 +880,10 @@ def main():
             "", f"Breaking: {BREAKING_RULES[a.breaking]}.", ""]
     if "cases" in parts:
         text += ["### Generated cases" + (" (quick)" if a.quick else ""), "", parts["cases"], ""]
-        cmp_ = compare_breakings(a.quick)
+        cmp_ = compare_breakings(a.quick) if a.topology != "simply" else ""
+        if a.topology == "simply" and compare_endpoint_rules():
+            text += ["### Endpoint rule of the jump solve, old vs new (bench/swn_cases_simply*.csv)", "",
+                     compare_endpoint_rules(), ""]
         if cmp_:
             text += ["### Both breaking schemes (from bench/swn_cases*.csv)", "", cmp_, ""]
     if "scaling" in parts:
@@ -858,7 +899,7 @@ def main():
         text += ["### Both breaking schemes (from bench/swn_cases*.csv)", "", text_cmp, ""]
     name = "swn" + ("-long" if a.breaking == "long" else "") + ("-quick" if a.quick else "")
     if a.topology == "simply" and a.only == "cases":
-        name += "-simply"
+        name += "-simply" + ("" if a.endpoint_rule == "auto" else "-" + a.endpoint_rule)
     elif a.only and not (a.only == "cases" and a.breaking == "long"):
         name += "-" + a.only
     title = "## Surface winding numbers (issue 12)" + (", long gaps" if a.breaking == "long" else "")

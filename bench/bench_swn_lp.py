@@ -306,34 +306,40 @@ def summarize(rows):
 
 
 def speed(sizes, time_limit):
-    """Full-LP time on the scaling case of bench_swn.py (torus grid, a broken meridian + a broken band)."""
-    rows = ["| faces | step ① jump solve | HiGHS dual simplex | HiGHS interior point | reduced LP (LP / total) | "
-            "objectives agree |", "|---|---|---|---|---|---|"]
+    """Full-LP time on the scaling case of bench_swn.py (torus grid, a broken meridian + a broken band): the face
+    form (spec §1(b) ④, ``lp_form="faces"``, the only one before) and the cycle form (``lp_form="cycles"``,
+    gsdf.dec.cycle_lp), HiGHS dual simplex and interior point each; objectives must agree."""
+    rows = ["| faces | step ① jump solve | faces: dual simplex | faces: interior point | cycles: dual simplex | "
+            "cycles: interior point | reduced LP (LP / total) | objectives agree |",
+            "|---|---|---|---|---|---|---|---|"]
     for nu in sizes:
         nv = max(8, nu // 3)
         V, F = B.torus_grid(nu, nv)
-        swn = SurfaceWindingNumbers(V, F)
+        swn = {f: SurfaceWindingNumbers(V, F, lp_form=f) for f in ("faces", "cycles")}
+        s0 = swn["faces"]
         idx = np.arange(nu * nv).reshape(nu, nv)
         i0 = (F // nv).min(1)
         band = (i0 >= nu // 3) & (i0 < nu // 2)
-        g = np.rint(swn.dec.d1.T @ band.astype(float))
-        gap = (swn.dec.edges % nv < int(0.3 * nv)).all(axis=1)
+        g = np.rint(s0.dec.d1.T @ band.astype(float))
+        gap = (s0.dec.edges % nv < int(0.3 * nv)).all(axis=1)
         g[gap] = 0
-        g = g + swn.chain([idx[nu // 7, : int(0.8 * nv)]])
+        g = g + s0.chain([idx[nu // 7, : int(0.8 * nv)]])
         line = [f"| {len(F)} |"]
-        r0 = swn.solve(g, method="none")
+        r0 = s0.solve(g, method="none")
         line.append(f" {r0.timings['jump_solve']:.3f} s |")
         obj = []
-        for alg in ("highs-ds", "highs-ipm"):
-            try:
-                r = swn.solve(g, method="lp", time_limit=time_limit, lp_algorithm=alg)
-                line.append(f" {r.timings['lp']:.2f} s |")
-                obj.append(r.lp_objective)
-            except ValueError as exc:
-                line.append(f" > {time_limit:.0f} s ({'limit' if 'limit' in str(exc) else str(exc)[:30]}) |")
-        rr = swn.solve(g, method="reduced")
+        for form in ("faces", "cycles"):
+            for alg in ("highs-ds", "highs-ipm"):
+                try:
+                    r = swn[form].solve(g, method="lp", time_limit=time_limit, lp_algorithm=alg)
+                    line.append(f" {r.timings['lp']:.2f} s |")
+                    obj.append(r.lp_objective)
+                except ValueError as exc:
+                    line.append(f" > {time_limit:.0f} s ({'limit' if 'limit' in str(exc) else str(exc)[:30]}) |")
+        rr = s0.solve(g, method="reduced")
         line.append(f" {rr.timings['lp']:.3f} s / {rr.timings['total']:.2f} s |")
-        line.append(f" {'yes' if len(obj) == 2 and abs(obj[0] - obj[1]) < 1e-6 * max(1, abs(obj[0])) else '–'} |")
+        agree = len(obj) > 1 and max(obj) - min(obj) < 1e-6 * max(1, abs(obj[0]))
+        line.append(f" {'yes' if agree else '–'} ({len(obj)} solved) |")
         rows.append("".join(line))
         print(rows[-1], flush=True)
     return "\n".join(rows)
@@ -349,13 +355,16 @@ def main():
     ap.add_argument("--time-limit", type=float, default=300.0)
     ap.add_argument("--old", default="/work/main/bench/swn_cases.csv", help="--only versus: the old CSV")
     ap.add_argument("--new", default=os.path.join(HERE, "swn_cases.csv"), help="--only versus: the new CSV")
+    ap.add_argument("--sizes", default=None, help="comma-separated torus grid sizes nu for the speed run "
+                    "(faces = 2 nu max(8, nu//3); default 56,112,224,448: 2k to 134k faces)")
     a = ap.parse_args()
     load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     t0 = time.perf_counter()
     text = [f"Machine: {machine()}. Load at start: `{load}` (shared with other helpers; times are indicative).",
             f"Command: `PYTHONPATH=src python3 bench/bench_swn_lp.py{' --quick' if a.quick else ''}"
             f"{' --only ' + a.only if a.only else ''}{f' --per-mesh {a.per_mesh}' if a.per_mesh else ''} "
-            f"--breaking {a.breaking}{f' --time-limit {a.time_limit:g}' if a.time_limit != 300 else ''}`", ""]
+            f"--breaking {a.breaking}{f' --time-limit {a.time_limit:g}' if a.time_limit != 300 else ''}"
+            f"{f' --sizes {a.sizes}' if a.sizes else ''}`", ""]
     if a.only == "versus":
         text[1] = f"Command: `PYTHONPATH=src python3 bench/bench_swn_lp.py --only versus --old {a.old} --new {a.new}`"
         text += [versus(a.old, a.new), ""]
@@ -384,7 +393,7 @@ def main():
         text += [f"### Not simply connected cases, {a.breaking} breaking (up to {per} per mesh; rows in "
                  f"bench/{os.path.basename(path)})", "", summarize(rows), ""]
     if a.only in (None, "speed"):
-        sizes = [48, 112] if a.quick else [56, 112, 224, 448]
+        sizes = [int(x) for x in a.sizes.split(",")] if a.sizes else ([48, 112] if a.quick else [56, 112, 224, 448])
         text += ["### Full LP time vs faces (torus grid, one broken meridian + a 30 %-broken band boundary)", "",
                  speed(sizes, a.time_limit), ""]
     text[1] += f" ({time.perf_counter() - t0:.0f} s)."

@@ -5,8 +5,9 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
 
 0. classify: the surface is simply connected when its first Betti number is 0 (χ ∈ {1, 2} per component);
    interior endpoints are the interior vertices where the integer edge chain g of the curves does not close;
-1. jump Laplace solve ``u`` (jump g across the curves, harmonic elsewhere, endpoints excluded, projective
-   interpolation next to them) — :meth:`gsdf.dec.TriangleDEC.solve_jump`;
+1. jump Laplace solve ``u`` (jump g across the curves, harmonic elsewhere; at interior endpoints a discrete
+   branch point (default on simply connected surfaces), or the endpoints excluded with projective interpolation
+   next to them (``endpoint_rule="exclude"``, the default with an LP)) — :meth:`SurfaceWindingNumbers._jump_solve`;
 2. Darboux derivative ω = Du (du with the jumps removed);
 3. for open curves, the coexact part is removed by Hodge decomposition: γ = ω − ⋆1⁻¹d1ᵀβ (u harmonic: no exact
    part). γ is the harmonic part that nonbounding components leave behind;
@@ -65,6 +66,8 @@ HOMOLOGY = ("real", "integer")
 BOUNDING = ("subset", "fractional")
 MAX_PASSES = 3          # bounding="subset": decompositions of the remainder at most (bench: a third pass is rare)
 LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
+ENDPOINT_RULES = ("auto", "branch", "exclude")
+LP_FORMS = ("faces", "cycles")    # the full residual LP: face shifts (dual_graph_l1, default) or cycle form
 IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
                         # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
                         # 75 s vs 62 s; at load ≈ 9: 1.5 vs 2.1 s and 36 vs 16 s)
@@ -126,6 +129,14 @@ class SurfaceWindingNumbers:
     V : (n, 3) float
     F : (m, 3) int — a manifold, consistently oriented mesh (any genus, boundary allowed); a ValueError names
         the first non-manifold edge / vertex or misoriented edge otherwise.
+    lp_form : "faces" (default) or "cycles" — how the full residual LP (``method="lp"``) is written for HiGHS:
+        "faces" is the program of spec §1(b) ④ (a shift per face, :func:`gsdf.dec.lp.dual_graph_l1`); "cycles"
+        the same program without face unknowns (:class:`gsdf.dec.cycle_lp.CycleL1`: the jumps J must differ from
+        the offsets by a boundary — vertex rows plus a row per homology generator), about a third of the rows;
+        same optimal objective (tested), ties may pick another optimum. Not the default: on the scaling case
+        (bench/RESULTS.md "swn-lp-speed", loaded machine) dual simplex was faster in cycle form (33k faces:
+        43 s vs 74 s) but interior point was not (35 s vs 29 s), and at 134k faces neither form finished in
+        240 s
 
     Attributes
     ----------
@@ -145,7 +156,11 @@ class SurfaceWindingNumbers:
     32
     """
 
-    def __init__(self, V, F):
+    def __init__(self, V, F, lp_form: str = "faces"):
+        if lp_form not in LP_FORMS:
+            raise ValueError(f"lp_form: expected one of {LP_FORMS}, got {lp_form!r}")
+        self.lp_form = lp_form
+        self._cycle_lp = None
         self.dec = TriangleDEC(V, F)
         self.topology = self.dec.topology
         self.betti_1 = self.topology.betti_1()
@@ -222,7 +237,7 @@ class SurfaceWindingNumbers:
     # ----------------------------------------------------------------------------------------------- solve
     def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
               homology: str = "real", lp_algorithm: str = "auto", bounding: str = "subset", progress=None,
-              _final: str = "curves") -> SWNResult:
+              endpoint_rule: str = "auto", _final: str = "curves") -> SWNResult:
         """Surface winding numbers of ``curves``.
 
         Parameters
@@ -254,6 +269,14 @@ class SurfaceWindingNumbers:
             Simply connected surfaces and ``method="none"`` are unaffected.
         progress : callable(done, total), optional — the package's progress signature; called after each of the
             steps (jump solve, Darboux derivative, Hodge decomposition, residual LP, final solve)
+        endpoint_rule : "auto" (default), "branch" or "exclude" — how the jump solves (steps ① and ⑤) treat
+            interior endpoints: "branch" keeps them with a discrete branch point (an angular ramp of the corner
+            values around the endpoint, :meth:`gsdf.dec.TriangleDEC.branch_coordinates`); "exclude" drops them
+            and every halfedge touching them, with projective interpolation of their corners (the authors' rule;
+            its one-rings act as holes, see :meth:`_jump_solve`). "auto": "branch" on simply connected
+            surfaces, "exclude" otherwise — on 64 replayed not simply connected bench cases "branch" had the
+            same mean error (2.15 % vs 2.16 %) but 2 more cases over 0.5 % (73.4 % vs 76.6 % under), so the
+            surfaces with an LP keep the rule their LP was validated with
 
         Returns
         -------
@@ -270,6 +293,10 @@ class SurfaceWindingNumbers:
             raise ValueError(f"homology: expected one of {HOMOLOGY}, got {homology!r}")
         if not isinstance(bounding, str) or bounding not in BOUNDING:
             raise ValueError(f"bounding: expected one of {BOUNDING}, got {bounding!r}")
+        if endpoint_rule not in ENDPOINT_RULES:
+            raise ValueError(f"endpoint_rule: expected one of {ENDPOINT_RULES}, got {endpoint_rule!r}")
+        if endpoint_rule == "auto":
+            endpoint_rule = "branch" if self.simply_connected else "exclude"
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
         steps = iter(range(1, 6))
@@ -290,8 +317,7 @@ class SurfaceWindingNumbers:
 
         say("jump Laplace solve")
         t0 = time.perf_counter()
-        jc = dec.jump_coordinates(g, ends)
-        _, u = dec.solve_jump(jc)
+        u = self._jump_solve(g, ends, endpoint_rule)
         T["jump_solve"] = time.perf_counter() - t0
         nE = dec.n_edges
         zero = np.zeros(nE)
@@ -314,7 +340,7 @@ class SurfaceWindingNumbers:
             if k_pass:                       # ① again on the remainder (new endpoints where pieces were removed)
                 t0 = time.perf_counter()
                 ends_cur = ends | dec.chain_endpoints(cur, tol=1e-6)
-                _, u_cur = dec.solve_jump(dec.jump_coordinates(cur, ends_cur))
+                u_cur = self._jump_solve(cur, ends_cur, endpoint_rule)
                 T["jump_solve"] += time.perf_counter() - t0
             om_k, gamma_k, Jv_k, obj_k = self._decompose(u_cur, cur, ends_cur, method, homology, epsilon,
                                                          time_limit, lp_algorithm, T, say if k_pass == 0 else None)
@@ -348,7 +374,7 @@ class SurfaceWindingNumbers:
             bnd = np.where(g != 0, g - Jv, 0.0)
         ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
         if np.any(bnd != g):
-            _, w = dec.solve_jump(dec.jump_coordinates(bnd, ends2))
+            w = self._jump_solve(bnd, ends2, endpoint_rule)
         else:                                     # nothing nonbounding: w = u
             w = u
         T["final_solve"] = time.perf_counter() - t0
@@ -407,6 +433,27 @@ class SurfaceWindingNumbers:
         T["lp"] += lp_s
         T["residual"] += time.perf_counter() - t0
         return om, gamma, Jv, obj
+
+    def _jump_solve(self, chain: np.ndarray, ends: np.ndarray, rule: str = "branch") -> np.ndarray:
+        """Corner values (m, 3) of the jump Laplace solve (thesis Eq. 6.2, step ①) with jumps ``chain``.
+
+        ``rule="branch"``: interior endpoints keep their degree of freedom, with the angular ramp of a branch point
+        around them (thesis §2.3.3: the angle-valued u fails to be harmonic only at endpoints, a branch point;
+        §6.2: ω behaves like dθ there) — :meth:`gsdf.dec.TriangleDEC.branch_coordinates`. Nothing is removed
+        from the energy, and the Laplacian is the same for every curve set (one cached factorization).
+        ``rule="exclude"``: endpoints and their halfedges are dropped, their corners filled by projective
+        interpolation (spec §1(b) step ①, the authors' demo). The one-ring of an excluded endpoint is a hole
+        with zero-Neumann walls: on curves broken into runs of a few edges the holes leak (the far-field jump of
+        a broken leg loop, bench case dino:3, was 0.29 against 0.456 on the same curve on 4× and 16× refined
+        meshes, where the ramp gives 0.453), and neighbouring holes can wall a region off the solve entirely
+        (dino:37: w ≡ 0 on 7 % of the area; ramp 0.660 vs refined 0.659). Simply connected bench cases
+        (``bench/bench_swn.py --topology simply``, 420 cases): mean / max error 0.40 % / 13.5 % excluded,
+        0.32 % / 4.7 % branched.
+        """
+        dec = self.dec
+        if rule == "branch":
+            return dec.solve_jump(dec.branch_coordinates(chain, ends))[1]
+        return dec.solve_jump(dec.jump_coordinates(chain, ends))[1]
 
     def _finish(self, w, u, g, Jv, ends, om, gamma, method, T, bnd=None) -> SWNResult:
         dec, topo = self.dec, self.topology
@@ -483,7 +530,8 @@ class SurfaceWindingNumbers:
         d_hi = vinit[A, (sa + 1) % 3] - vinit[B, sb]
         return 0.5 * (d_lo + d_hi)
 
-    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
+    def _full_lp_terms(self, gamma, g, eps):
+        """The full residual LP's data (spec §1(b) ④): interior edges, offsets d, weights, bounds (k, 2)."""
         dec, topo = self.dec, self.topology
         interior = np.flatnonzero(topo.edge_face_count == 2)
         vinit = self._face_integrals(gamma)
@@ -494,10 +542,29 @@ class SurfaceWindingNumbers:
         # "no extra loops": 0 ≤ g·Jv ≤ g² on the input's edges
         lo = np.where(on, np.minimum(0.0, gi), -np.inf)
         hi = np.where(on, np.maximum(0.0, gi), np.inf)
+        return interior, d, w, np.column_stack([lo, hi])
+
+    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
+        if self.lp_form == "cycles":
+            return self._residual_cycles(gamma, g, eps, time_limit, algorithm)
+        dec, topo = self.dec, self.topology
+        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps)
         pairs = topo.edge_faces[interior]
-        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=np.column_stack([lo, hi]), time_limit=time_limit,
-                          algorithm=algorithm)
+        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=bounds, time_limit=time_limit, algorithm=algorithm)
         Jv = np.zeros(dec.n_edges)
+        Jv[interior] = r.jumps
+        return Jv, r.objective, r.seconds
+
+    def _residual_cycles(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
+        """The full residual LP in cycle form (:class:`gsdf.dec.cycle_lp.CycleL1`: the same program without face
+        unknowns — vertex conservation rows plus one row per homology generator; same optimum, built once)."""
+        from ..dec.cycle_lp import CycleL1
+
+        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps)
+        if self._cycle_lp is None:
+            self._cycle_lp = CycleL1(self.dec, interior)
+        r = self._cycle_lp.solve(d, w, bounds=bounds, time_limit=time_limit, algorithm=algorithm)
+        Jv = np.zeros(self.dec.n_edges)
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
 
@@ -598,7 +665,8 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
 
 def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
                            time_limit: float = 300.0, homology: str = "real",
-                           lp_algorithm: str = "auto", bounding: str = "subset") -> SWNResult:
+                           lp_algorithm: str = "auto", bounding: str = "subset",
+                           endpoint_rule: str = "auto") -> SWNResult:
     """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
     Examples
@@ -607,4 +675,5 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float =
     >>> res.face_labels                                                     # doctest: +SKIP
     """
     return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit,
-                                             homology=homology, lp_algorithm=lp_algorithm, bounding=bounding)
+                                             homology=homology, lp_algorithm=lp_algorithm, bounding=bounding,
+                                             endpoint_rule=endpoint_rule)

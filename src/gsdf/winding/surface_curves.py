@@ -4,7 +4,8 @@ Surface winding numbers need curves made of mesh edges (thesis §6.4; the author
 way). Nodes on edges become new vertices splitting their edge; a segment crossing a face between two of its
 edge points / corners becomes a new edge (a chord); every face touched is re-triangulated inside its own plane
 (the polygon of its corners and inserted boundary points, split along the chords, then ear-clipped without
-zero-area ears). Face-interior nodes are not supported (a ValueError says so). Segments joining two vertices
+zero-area ears). A face-interior node ('f') first splits the face piece containing it into three at the point
+(:func:`_split_at_face_points`); the segments from it then cross those pieces like chords. Segments joining two vertices
 that share an edge need no insertion. A curve consisting of one edge between two interior endpoints is split
 at its midpoint, or the endpoint exclusion of the jump solve would swallow it.
 
@@ -108,9 +109,14 @@ def insert_curves(V, F, curves):
         e = int(np.searchsorted(ekey, lo * n + hi))
         return e if e < len(ekey) and ekey[e] == lo * n + hi else -1
 
+    parent0 = None
+    if np.any(curves.kinds == "f"):
+        V, F, curves, parent0 = _split_at_face_points(V, F, curves)
+        n = len(V)
+        topo = MeshTopology(F, n)
+        E = topo.edges
+        ekey = E[:, 0] * n + E[:, 1]
     kinds, index, params, ev = curves.kinds, curves.index, curves.params, curves.edge_vertices
-    if np.any(kinds == "f"):
-        raise ValueError("curves: face-interior nodes ('f') are not supported; put curve nodes on vertices or edges")
     newV = [V]
     nv = n
     node_vertex = np.full(len(kinds), -1, dtype=np.int64)
@@ -253,5 +259,76 @@ def insert_curves(V, F, curves):
                 parent.append(f)
     F2 = np.concatenate([F[keep], np.array(newF, dtype=np.int64).reshape(-1, 3)])
     par = np.concatenate([np.flatnonzero(keep), np.array(parent, dtype=np.int64)])
+    if parent0 is not None:
+        par = parent0[par]
     S = np.array(out_segs, dtype=np.int64).reshape(-1, 2)
     return X, F2, S, par
+
+
+def _split_at_face_points(V, F, curves):
+    """Make every face-interior node ('f': face i, barycentric (a, b, c) of its corners F[i]) a vertex: the
+    triangle of the current mesh containing it (a piece of face i, all pieces lie in face i's plane) is split
+    into three at the point, geometry unchanged. Nodes with a barycentric coordinate ≈ 1 become vertex nodes,
+    with one ≈ 0 edge nodes (the segments from them are then inserted as for 'e' nodes). Returns
+    (V2, F2, curves with the interior nodes as 'v' nodes, parent (m2,) original face of every face)."""
+    from ..io.swn_curves import SWNCurves
+
+    m = len(F)
+    kinds = np.array(curves.kinds, dtype=object).copy()
+    index = np.asarray(curves.index, dtype=np.int64).copy()
+    params = np.asarray(curves.params, dtype=np.float64).copy()
+    ev = np.asarray(curves.edge_vertices, dtype=np.int64).copy()
+    Vl, Fl, parent = [V], [row for row in F.tolist()], list(range(m))
+    pieces: dict[int, list] = {}                                # original face -> indices into Fl
+    seen: dict = {}
+    nv = len(V)
+    for k in np.flatnonzero(kinds == "f"):
+        f = int(index[k])
+        if not 0 <= f < m:
+            raise ValueError(f"curves: node {k} names face {f}, out of range for {m} faces")
+        b = params[k]
+        if not np.isfinite(b).all() or b.min() < -1e-9 or abs(b.sum() - 1) > 1e-6:
+            raise ValueError(f"curves: node {k}: barycentric coordinates {b.tolist()} are not in face {f}")
+        b = np.clip(b, 0.0, None) / np.clip(b, 0.0, None).sum()
+        c = F[f]
+        big = b > 1 - SNAP
+        if big.any():                                          # at a corner
+            kinds[k], index[k], params[k] = "v", int(c[np.argmax(b)]), 0.0
+            continue
+        small = b < SNAP
+        if small.any():                                        # on a side: an edge node from corner i to j
+            z = int(np.argmax(small))
+            i, j = c[(z + 1) % 3], c[(z + 2) % 3]
+            kinds[k], ev[k] = "e", (int(i), int(j))
+            params[k] = (b[(z + 2) % 3], 0.0, 0.0)             # t from i towards j
+            continue
+        key = (f, *np.round(b, 12))
+        if key in seen:
+            kinds[k], index[k], params[k] = "v", seen[key], 0.0
+            continue
+        P = b @ V[c]
+        # the piece of face f containing P (barycentric coordinates in the piece's own plane)
+        best, best_min = None, -np.inf
+        for pi in pieces.get(f, [f]):
+            T = np.concatenate(Vl)[Fl[pi]]
+            e1, e2, r = T[1] - T[0], T[2] - T[0], P - T[0]
+            G = np.array([[e1 @ e1, e1 @ e2], [e1 @ e2, e2 @ e2]])
+            y, z2 = np.linalg.solve(G, [r @ e1, r @ e2])
+            lam = np.array([1 - y - z2, y, z2])
+            if lam.min() > best_min:
+                best, best_min, best_lam = pi, lam.min(), lam
+        if best_min < SNAP:
+            raise ValueError(f"curves: node {k} (face {f}) lies on a segment between other interior nodes of the "
+                             "face; give it as a vertex or edge node instead")
+        a0, a1, a2 = Fl[best]
+        Vl.append(P[None])
+        p = nv
+        nv += 1
+        Fl[best] = [a0, a1, p]
+        Fl += [[a1, a2, p], [a2, a0, p]]
+        parent += [f, f]
+        pieces.setdefault(f, [f]).extend([len(Fl) - 2, len(Fl) - 1])
+        seen[key] = p
+        kinds[k], index[k], params[k] = "v", p, 0.0
+    out = SWNCurves(np.array(kinds.tolist()), index, params, ev, np.asarray(curves.segments, dtype=np.int64))
+    return np.concatenate(Vl), np.array(Fl, dtype=np.int64), out, np.array(parent, dtype=np.int64)
