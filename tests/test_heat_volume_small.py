@@ -89,3 +89,34 @@ def test_small_cloud_volume_field_unchanged_by_the_fast_path():
     assert np.abs(fast - slow).max() <= 1e-4 * np.abs(slow).max()
     c = fast.shape[0] // 2
     assert fast[c, c, c] < -0.7  # the centre of the unit sphere
+
+
+def test_self_knn_matches_the_kd_tree():
+    """The cell-grid k nearest neighbours of point_areas: the k-d tree's sets (clustered cloud and an exact
+    lattice full of ties, where the k-th distances must agree), row ranges, degenerate and bad input."""
+    import pytest
+    from scipy.spatial import cKDTree
+
+    from gsdf.spatial.knn import SelfKNN, knn_self
+
+    rng = np.random.default_rng(5)
+    P = np.vstack([rng.normal(size=(400, 3)) * [1, 1, 0.01], rng.random((300, 3)) * 5 + 3])  # a sheet + a blob
+    for k in (1, 7, 161, 700):
+        ref = cKDTree(P).query(P, k)[1].reshape(len(P), k)
+        got = knn_self(P, k)
+        assert np.array_equal(np.sort(got, axis=1), np.sort(ref, axis=1))
+    assert np.array_equal(SelfKNN(P, 9).rows(100, 130), knn_self(P, 9)[100:130])
+    g = np.arange(7) * 0.5
+    G = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    d_ref = cKDTree(G).query(G, 19)[0]
+    got = knn_self(G, 19)
+    assert np.allclose(np.sort(np.linalg.norm(G[got] - G[:, None], axis=2), axis=1), d_ref)
+    assert all(len(set(r)) == 19 for r in got.tolist())
+    assert np.array_equal(knn_self(np.ones((5, 3)), 3), np.tile([0, 1, 2], (5, 1)))
+    for bad, k in ((P[:, :2], 3), (P, 0), (P, len(P) + 1), (P, True), (P, 2.5)):
+        with pytest.raises(ValueError):
+            knn_self(bad, k)
+    Q = P.copy()
+    Q[3, 1] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        knn_self(Q, 3)
