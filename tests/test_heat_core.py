@@ -21,7 +21,10 @@ def test_surface_core_matches_pre_core_solvers(name, build, curves, kw):
     phi = build().compute_distance(curves, **kw)
     ref = REF[name]
     scale = max(1.0, float(np.abs(ref).max()))
-    assert np.abs(phi - ref).max() <= 1e-8 * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
+    # the soft penalty is solved by preconditioned CG to a relative residual of 1e-5: agreement with the frozen
+    # run holds to that tolerance, not to rounding (the Step III preconditioner was reorganised, issue 17)
+    tol = 1e-5 if name == "grid_mesh_soft" else 1e-8
+    assert np.abs(phi - ref).max() <= tol * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
 
 
 # ------------------------------------------------------------------------------------------ typed sources
@@ -140,7 +143,10 @@ def test_volume_core_matches_pre_core_solvers(name, kw):
     phi = np.asarray(signed_heat_volume(**kw).values).ravel()
     ref = REF[name]
     scale = max(1.0, float(np.abs(ref).max()))
-    assert np.abs(phi - ref).max() <= 1e-8 * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
+    # the soft penalty is solved by preconditioned CG to a relative residual of 1e-5: agreement with the frozen
+    # run holds to that tolerance, not to rounding (the Step III preconditioner was reorganised, issue 17)
+    tol = 1e-5 if name == "grid_mesh_soft" else 1e-8
+    assert np.abs(phi - ref).max() <= tol * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
 
 
 def test_grid_multiple_and_hard_zero():
@@ -240,6 +246,7 @@ def test_grid_default_is_the_fast_penalty_and_none_is_hard():
 
     kw = dict(volume_cases())["grid_mesh_soft"]
     phi = np.asarray(signed_heat_volume(**kw).values).ravel()
-    assert np.abs(phi - REF["grid_mesh_soft"]).max() <= 1e-8 * max(1.0, float(np.abs(REF["grid_mesh_soft"]).max()))
+    # to the CG tolerance (relative residual 1e-5), see test_volume_core_matches_pre_core_solvers
+    assert np.abs(phi - REF["grid_mesh_soft"]).max() <= 1e-5 * max(1.0, float(np.abs(REF["grid_mesh_soft"]).max()))
     with pytest.raises(ValueError, match="soft_weight"):
         signed_heat_volume(**kw, soft_weight="bogus")

@@ -224,12 +224,15 @@ class YukawaTree:
         self._B = np.ascontiguousarray(B[o])
         self._W = np.ascontiguousarray(W[o])
         self._D = _moments(self.tree.start, self.tree.end, self._B, self._W)
-        self._kd = cKDTree(B)
+        self._src = B
+        self._kd = None  # built on first exact nearest-distance query (grids pass their own estimate)
         ext = B.max(axis=0) - B.min(axis=0)
         self._rmin = 1e-9 * max(float(ext.max()), 1e-300)
 
     def nearest_distance(self, Q) -> np.ndarray:
         """Distance from each query to the nearest source point (the reference distance d*)."""
+        if self._kd is None:
+            self._kd = cKDTree(self._src)
         return self._kd.query(Q, workers=-1)[0]
 
     def __call__(self, Q, dref=None, slack: float = 0.0, chunk: int = 1 << 16, progress=None) -> np.ndarray:

@@ -1,0 +1,222 @@
+"""The k nearest neighbours of every point of a cloud among the cloud itself, on a uniform cell grid.
+
+What :func:`gsdf.winding.point_areas` needs (k = 161 candidates per point): scipy's ``cKDTree.query`` keeps a
+sorted heap of k per query, and its cost grows with k (1.4k points: 25-45 ms for k = 161 against 3 ms for
+k = 21). Here the points are bucketed in cubic cells of about the typical k-th neighbour distance; each point
+scans rings of cells around its own (Chebyshev distance R = 0, 1, 2, ...) until at least k of the points seen
+are closer than the nearest face of the scanned cube (faces on the border of the grid do not count: nothing
+lies beyond them) — every unseen point is farther than that face, so those k are exact. The k smallest
+squared distances are then kept by a quickselect threshold; ties at the threshold go to the smallest indices.
+
+The rows come out in no particular order (the caller needs the set; sorting 161 entries per point would cost
+as much as the search). Cost: O(n log n) bucketing plus O(n m) for m ≈ 3-5 k candidates per point on a
+surface sample, on the calling thread.
+
+Example
+-------
+>>> import numpy as np
+>>> from gsdf.spatial.knn import knn_self
+>>> P = np.random.default_rng(0).random((500, 3))
+>>> idx = knn_self(P, 8)
+>>> from scipy.spatial import cKDTree
+>>> bool(np.array_equal(np.sort(idx, axis=1), np.sort(cKDTree(P).query(P, 8)[1], axis=1)))
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["SelfKNN", "knn_self"]
+
+MAX_CELLS = 1 << 22  # dense cell table; coarser cells above this
+CELL_FACTOR = 1.0  # cell / median k-th neighbour distance (0.4-2 measured on three CGAL clouds: 1 was fastest)
+
+
+class SelfKNN:
+    """The cell grid of a cloud ``P`` (n, 3) for its ``k`` nearest neighbours, queried in row ranges.
+
+    ``rows(s, e)`` gives (e − s, k) int64: the same sets as ``cKDTree(P).query(P[s:e], k)[1]`` (ties at the
+    k-th distance by smallest index), each row in no particular order, the point itself among them.
+    ``k`` must be in [1, n]. The kernel is serial: under 0.1 ms per 1k points a parallel launch does not pay
+    on a loaded machine (and compiles 5× longer).
+    """
+
+    def __init__(self, P, k: int):
+        P = np.ascontiguousarray(P, dtype=np.float64)
+        if P.ndim != 2 or P.shape[1] != 3:
+            raise ValueError(f"P: expected an (n, 3) array, got shape {P.shape}")
+        n = P.shape[0]
+        if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)) or not 1 <= int(k) <= n:
+            raise ValueError(f"k: must be an integer in [1, {n}] (the number of points), got {k!r}")
+        if not np.isfinite(P).all():
+            raise ValueError("P: contains NaN or inf")
+        self.P, self.n, self.k = P, n, int(k)
+        lo = P.min(axis=0)
+        ext = float((P.max(axis=0) - lo).max())
+        self.degenerate = ext == 0.0  # all points coincide: the k smallest indices
+        if self.degenerate:
+            return
+        # cell: the median k-th neighbour distance of ~32 sample points (brute force), bounded by the table size
+        sample = np.ascontiguousarray(P[:: max(1, n // 32)])
+        cell = max(CELL_FACTOR * _sample_kth(sample, P, self.k), ext / (MAX_CELLS ** (1.0 / 3.0) - 1.0), ext * 1e-12)
+        dims = np.floor((P.max(axis=0) - lo) / cell).astype(np.int64) + 1
+        c = np.minimum(np.floor((P - lo) / cell).astype(np.int64), dims - 1)
+        key = (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+        order = np.argsort(key, kind="stable").astype(np.int64)
+        ncell = int(np.prod(dims))
+        start = np.zeros(ncell + 1, np.int64)
+        np.cumsum(np.bincount(key, minlength=ncell), out=start[1:])
+        self._grid = (np.ascontiguousarray(P[order]), order, start, np.ascontiguousarray(c), dims, lo, float(cell))
+
+    def rows(self, s: int = 0, e: int | None = None) -> np.ndarray:
+        e = self.n if e is None else int(e)
+        if self.degenerate:
+            return np.tile(np.arange(self.k, dtype=np.int64), (e - s, 1))
+        out = np.empty((e - s, self.k), np.int64)
+        _knn_kernel(self.P, *self._grid, self.k, int(s), out)
+        return out
+
+
+def knn_self(P, k: int) -> np.ndarray:
+    """Indices (n, k) of the ``k`` nearest points of every row of ``P`` (n, 3) among ``P`` itself
+    (:class:`SelfKNN`; the same sets as ``cKDTree(P).query(P, k)[1]``, rows unordered)."""
+    return SelfKNN(P, k).rows()
+
+
+@njit(cache=True)
+def _sample_kth(S, P, k):
+    """Median over the sample points S of the distance to their k-th nearest point of P (brute force)."""
+    m, n = S.shape[0], P.shape[0]
+    d = np.empty(n)
+    kth = np.empty(m)
+    for a in range(m):
+        for j in range(n):
+            u, v, w = P[j, 0] - S[a, 0], P[j, 1] - S[a, 1], P[j, 2] - S[a, 2]
+            d[j] = u * u + v * v + w * w
+        kth[a] = np.sqrt(_select(d, n, k - 1))
+    return np.median(kth)
+
+
+@njit(cache=True)
+def _select(a, m, r):
+    """The r-th smallest (0-based) of a[:m], by quickselect (median-of-three pivots); reorders a[:m]."""
+    lo, hi = 0, m - 1
+    while hi > lo:
+        mid = (lo + hi) // 2
+        x, y, z = a[lo], a[mid], a[hi]
+        piv = max(min(x, y), min(max(x, y), z))
+        i, j = lo, hi
+        while i <= j:
+            while a[i] < piv:
+                i += 1
+            while a[j] > piv:
+                j -= 1
+            if i <= j:
+                a[i], a[j] = a[j], a[i]
+                i += 1
+                j -= 1
+        if r <= j:
+            hi = j
+        elif r >= i:
+            lo = i
+        else:
+            return a[r]
+    return a[r]
+
+
+@njit(cache=True)
+def _knn_kernel(P, Ps, order, start, cells, dims, lo, cell, k, s, out):
+    cap = 8 * k + 64
+    cd = np.empty(cap)
+    ci = np.empty(cap, np.int64)
+    tmp = np.empty(cap)
+    for r in range(out.shape[0]):
+        cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, s + r, r, cd, ci, tmp, out)
+
+
+@njit(cache=True)
+def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, cd, ci, tmp, out):
+    """The k nearest of point i into out[row]; returns the (possibly grown) scratch buffers."""
+    x, y, z = P[i, 0], P[i, 1], P[i, 2]
+    cx, cy, cz = cells[i, 0], cells[i, 1], cells[i, 2]
+    m = 0
+    R = 0
+    while True:
+        # the cells at Chebyshev distance exactly R from the point's own cell
+        x0, x1 = max(cx - R, 0), min(cx + R, dims[0] - 1)
+        y0, y1 = max(cy - R, 0), min(cy + R, dims[1] - 1)
+        z0, z1 = max(cz - R, 0), min(cz + R, dims[2] - 1)
+        for ax in range(x0, x1 + 1):
+            for ay in range(y0, y1 + 1):
+                shell = abs(ax - cx) == R or abs(ay - cy) == R
+                az = z0
+                while az <= z1:
+                    if not shell and abs(az - cz) != R:  # inside the cube scanned before
+                        az = cz + R
+                        continue
+                    cid = (ax * dims[1] + ay) * dims[2] + az
+                    s, e = start[cid], start[cid + 1]
+                    if m + (e - s) > cd.shape[0]:  # grow the scratch buffers
+                        cap = 2 * (m + e - s)
+                        cd2, ci2 = np.empty(cap), np.empty(cap, np.int64)
+                        cd2[:m] = cd[:m]
+                        ci2[:m] = ci[:m]
+                        cd, ci, tmp = cd2, ci2, np.empty(cap)
+                    for p in range(s, e):
+                        u, v, w = Ps[p, 0] - x, Ps[p, 1] - y, Ps[p, 2] - z
+                        cd[m] = u * u + v * v + w * w
+                        ci[m] = order[p]
+                        m += 1
+                    az += 1
+        # distance from the point to the nearest face of the scanned cube that has cells beyond it
+        reach = np.inf
+        if x0 > 0:
+            reach = min(reach, x - (lo[0] + x0 * cell))
+        if x1 < dims[0] - 1:
+            reach = min(reach, lo[0] + (x1 + 1) * cell - x)
+        if y0 > 0:
+            reach = min(reach, y - (lo[1] + y0 * cell))
+        if y1 < dims[1] - 1:
+            reach = min(reach, lo[1] + (y1 + 1) * cell - y)
+        if z0 > 0:
+            reach = min(reach, z - (lo[2] + z0 * cell))
+        if z1 < dims[2] - 1:
+            reach = min(reach, lo[2] + (z1 + 1) * cell - z)
+        if m >= k:
+            if reach == np.inf:
+                break  # every point has been seen
+            lim = reach * reach
+            cnt = 0
+            for q in range(m):
+                if cd[q] <= lim:
+                    cnt += 1
+            if cnt >= k:
+                break
+        R += 1
+    # the k smallest (d², index): a quickselect threshold, then the ties at it by smallest index
+    for q in range(m):
+        tmp[q] = cd[q]
+    thr = _select(tmp, m, k - 1)
+    c = 0
+    for q in range(m):
+        if cd[q] < thr:
+            out[row, c] = ci[q]
+            c += 1
+    if c < k:
+        nt = 0
+        for q in range(m):
+            if cd[q] == thr:
+                nt += 1
+        ties = np.empty(nt, np.int64)
+        nt = 0
+        for q in range(m):
+            if cd[q] == thr:
+                ties[nt] = ci[q]
+                nt += 1
+        ties.sort()
+        for t in range(k - c):
+            out[row, c] = ties[t]
+            c += 1
+    return cd, ci, tmp

@@ -1,0 +1,122 @@
+"""Small-grid speed path of the volume signed heat method (issue 17 goal 6): the Step III preconditioner that
+carries its residual through the stages, against a sparse direct solve and the stage-by-stage recomputation."""
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
+
+
+def _penalized_system(shape=(11, 9, 8), m=60, seed=4):
+    """L + P of the soft level-set penalty for m random sources on a small grid, and a right-hand side."""
+    from gsdf.heat.volume.grid import neumann_laplacian, trilinear_matrix
+
+    rng = np.random.default_rng(seed)
+    spacing = np.array([0.1, 0.1, 0.1])
+    lo = np.zeros(3)
+    B = lo + rng.uniform(0.15, 0.65, (m, 3)) * (np.array(shape) - 1) * spacing
+    T = trilinear_matrix(B, lo, spacing, shape)
+    P = (T.T @ sp.diags(rng.uniform(1, 3, m) * 10 / 0.1 ** 4) @ T).tocsr()
+    b = rng.normal(size=int(np.prod(shape)))
+    L = neumann_laplacian(shape, spacing)
+    return shape, spacing, L, P, b
+
+
+def test_carried_residual_preconditioner_solves_the_penalized_system():
+    from gsdf.heat.volume.grid import solve_poisson
+
+    shape, spacing, L, P, b = _penalized_system()
+    A = (L + P).tocsc()
+    ref = spsolve(A, b)
+    for block in (3, 4):
+        x = solve_poisson(b, shape, spacing, P, tol=1e-11, min_block=block)
+        assert np.abs(x - ref).max() <= 1e-8 * np.abs(ref).max()
+    x = solve_poisson(b, shape, spacing, P)  # default tolerance: relative residual 1e-5
+    assert np.linalg.norm(A @ x - b) <= 1.1e-5 * np.linalg.norm(b)
+
+
+def test_carried_residual_is_the_same_operator_as_recomputing_it():
+    """One preconditioner application of the fast path equals the stage-by-stage r − A x version."""
+    from scipy.sparse.linalg import LinearOperator
+
+    import gsdf.heat.volume.grid as G
+
+    shape, spacing, L, P, b = _penalized_system(seed=7)
+    seen = {}
+    real_pcg = G.pcg
+
+    def capture(A, rhs, M=None, **kw):
+        seen.setdefault("M", []).append(M)
+        return real_pcg(A, rhs, M=M, **kw)
+
+    G.pcg = capture
+    try:
+        G.solve_poisson(b, shape, spacing, P, min_block=3)
+        G._solve_poisson_reference(b, shape, spacing, P, block=3)
+    finally:
+        G.pcg = real_pcg
+    fast, slow = seen["M"]
+    assert isinstance(fast, LinearOperator) and isinstance(slow, LinearOperator)
+    r = np.random.default_rng(1).normal(size=L.shape[0])
+    zf, zs = fast.matvec(r), slow.matvec(r)
+    assert np.abs(zf - zs).max() <= 1e-9 * np.abs(zs).max()
+    # symmetric (CG needs it): <M r, s> = <r, M s>
+    s = np.random.default_rng(2).normal(size=L.shape[0])
+    assert abs(fast.matvec(r) @ s - r @ fast.matvec(s)) <= 1e-9 * abs(r @ fast.matvec(s))
+
+
+def test_small_cloud_volume_field_unchanged_by_the_fast_path():
+    """The whole soft-penalty grid run at 14³ against the reference preconditioner (same φ to CG tolerance)."""
+    import gsdf.heat.volume.grid as G
+    from gsdf.heat.volume import signed_heat_volume
+
+    i = np.arange(400) + 0.5
+    ph, th = np.arccos(1 - 2 * i / 400), np.pi * (1 + 5 ** 0.5) * i
+    S = np.column_stack([np.cos(th) * np.sin(ph), np.sin(th) * np.sin(ph), np.cos(ph)])
+    fast = signed_heat_volume(points=(S, S), resolution=14).values
+    real = G.solve_poisson
+    G.solve_poisson = lambda rhs, shape, spacing, penalty=None, **kw: (
+        real(rhs, shape, spacing) if penalty is None
+        else G._solve_poisson_reference(rhs, shape, spacing, penalty, tol=1e-10))
+    import gsdf.heat.domains.grid as D
+
+    old_ref = D.solve_poisson
+    D.solve_poisson = G.solve_poisson
+    try:
+        slow = signed_heat_volume(points=(S, S), resolution=14).values
+    finally:
+        G.solve_poisson = real
+        D.solve_poisson = old_ref
+    assert np.abs(fast - slow).max() <= 1e-4 * np.abs(slow).max()
+    c = fast.shape[0] // 2
+    assert fast[c, c, c] < -0.7  # the centre of the unit sphere
+
+
+def test_self_knn_matches_the_kd_tree():
+    """The cell-grid k nearest neighbours of point_areas: the k-d tree's sets (clustered cloud and an exact
+    lattice full of ties, where the k-th distances must agree), row ranges, degenerate and bad input."""
+    import pytest
+    from scipy.spatial import cKDTree
+
+    from gsdf.spatial.knn import SelfKNN, knn_self
+
+    rng = np.random.default_rng(5)
+    P = np.vstack([rng.normal(size=(400, 3)) * [1, 1, 0.01], rng.random((300, 3)) * 5 + 3])  # a sheet + a blob
+    for k in (1, 7, 161, 700):
+        ref = cKDTree(P).query(P, k)[1].reshape(len(P), k)
+        got = knn_self(P, k)
+        assert np.array_equal(np.sort(got, axis=1), np.sort(ref, axis=1))
+    assert np.array_equal(SelfKNN(P, 9).rows(100, 130), knn_self(P, 9)[100:130])
+    g = np.arange(7) * 0.5
+    G = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
+    d_ref = cKDTree(G).query(G, 19)[0]
+    got = knn_self(G, 19)
+    assert np.allclose(np.sort(np.linalg.norm(G[got] - G[:, None], axis=2), axis=1), d_ref)
+    assert all(len(set(r)) == 19 for r in got.tolist())
+    assert np.array_equal(knn_self(np.ones((5, 3)), 3), np.tile([0, 1, 2], (5, 1)))
+    for bad, k in ((P[:, :2], 3), (P, 0), (P, len(P) + 1), (P, True), (P, 2.5)):
+        with pytest.raises(ValueError):
+            knn_self(bad, k)
+    Q = P.copy()
+    Q[3, 1] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        knn_self(Q, 3)
