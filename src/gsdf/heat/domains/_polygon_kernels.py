@@ -59,11 +59,16 @@ def _jacobi3(S):
 
 
 @njit(cache=True)
-def _right_svd(A0, s):
-    """Singular values (3,) and right singular vectors (columns of a 3×3) of the s×3 matrix ``A0[:s]``, by
-    one-sided (Hestenes) Jacobi rotations of its columns."""
-    A = A0[:s].copy()
-    V = np.eye(3)
+def _right_svd(A, s, V, sig):
+    """Singular values ``sig`` (3,) and right singular vectors (columns of ``V``, 3×3) of the s×3 matrix
+    ``A[:s]``, by one-sided (Hestenes) Jacobi rotations of its columns; ``A[:s]`` is overwritten by A V."""
+    for i in range(3):
+        for j in range(3):
+            V[i, j] = 1.0 if i == j else 0.0
+    tot = 0.0
+    for i in range(s):
+        for j in range(3):
+            tot += A[i, j] * A[i, j]
     for _ in range(30):
         rotated = False
         for p, q in ((0, 1), (0, 2), (1, 2)):
@@ -74,7 +79,9 @@ def _right_svd(A0, s):
                 al += A[i, p] * A[i, p]
                 be += A[i, q] * A[i, q]
                 ga += A[i, p] * A[i, q]
-            if ga == 0.0 or abs(ga) <= 1e-17 * np.sqrt(al * be):
+            # converged pair: orthogonal to rounding, or one column negligible (σ < 1e-15 |A|, far below the
+            # 1e-10 cut-off of the callers)
+            if abs(ga) <= 1e-15 * np.sqrt(al * be) or min(al, be) <= 1e-30 * tot:
                 continue
             rotated = True
             zeta = (be - al) / (2.0 * ga)
@@ -91,45 +98,38 @@ def _right_svd(A0, s):
                 V[i, q] = sn * vip + c * viq
         if not rotated:
             break
-    sig = np.empty(3)
     for k in range(3):
         acc = 0.0
         for i in range(s):
             acc += A[i, k] * A[i, k]
         sig[k] = np.sqrt(acc)
-    return sig, V
 
 
 @njit(cache=True)
-def _min_eig3(H):
-    """Smallest eigenvalue of a symmetric 3×3 matrix, closed form (trigonometric); only used to choose between
-    a direct solve and a pseudo-inverse."""
-    q3 = (H[0, 0] + H[1, 1] + H[2, 2]) / 3.0
-    p1 = H[0, 1] ** 2 + H[0, 2] ** 2 + H[1, 2] ** 2
-    p2 = (H[0, 0] - q3) ** 2 + (H[1, 1] - q3) ** 2 + (H[2, 2] - q3) ** 2 + 2.0 * p1
+def _min_eig3(a, b, c, d, e, f):
+    """Smallest eigenvalue of the symmetric 3×3 matrix [[a, b, c], [b, d, e], [c, e, f]], closed form
+    (trigonometric); only used to choose between a direct solve and a pseudo-inverse."""
+    q3 = (a + d + f) / 3.0
+    p1 = b * b + c * c + e * e
+    p2 = (a - q3) ** 2 + (d - q3) ** 2 + (f - q3) ** 2 + 2.0 * p1
     p = np.sqrt(p2 / 6.0)
     if p == 0:
         return q3
-    B = (H - q3 * np.eye(3)) / p
-    r = 0.5 * (B[0, 0] * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1]) - B[0, 1] * (B[1, 0] * B[2, 2] - B[1, 2] * B[2, 0])
-               + B[0, 2] * (B[1, 0] * B[2, 1] - B[1, 1] * B[2, 0]))
+    a, d, f, b, c, e = (a - q3) / p, (d - q3) / p, (f - q3) / p, b / p, c / p, e / p
+    r = 0.5 * (a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c))
     r = min(1.0, max(-1.0, r))
     return q3 + 2.0 * p * np.cos(np.arccos(r) / 3.0 + 2.0 * np.pi / 3.0)
 
 
 @njit(cache=True)
-def _solve3(H, b):
-    """x = H⁻¹ b for a well-conditioned symmetric 3×3 H, by the adjugate."""
-    a, bb, c = H[0, 0], H[0, 1], H[0, 2]
-    d, e, f = H[1, 1], H[1, 2], H[2, 2]
+def _solve3(a, bb, c, d, e, f, b0, b1, b2):
+    """x = H⁻¹ b for a well-conditioned symmetric 3×3 H = [[a, bb, c], [bb, d, e], [c, e, f]], by the
+    adjugate."""
     A00, A01, A02 = d * f - e * e, c * e - bb * f, bb * e - c * d
     A11, A12, A22 = a * f - c * c, bb * c - a * e, a * d - bb * bb
     det = a * A00 + bb * A01 + c * A02
-    x = np.empty(3)
-    x[0] = (A00 * b[0] + A01 * b[1] + A02 * b[2]) / det
-    x[1] = (A01 * b[0] + A11 * b[1] + A12 * b[2]) / det
-    x[2] = (A02 * b[0] + A12 * b[1] + A22 * b[2]) / det
-    return x
+    return ((A00 * b0 + A01 * b1 + A02 * b2) / det, (A01 * b0 + A11 * b1 + A12 * b2) / det,
+            (A02 * b0 + A12 * b1 + A22 * b2) / det)
 
 
 @njit(cache=True)
@@ -155,6 +155,9 @@ def polygon_weights(X):
     q, s, _ = X.shape
     W = np.empty((q, s))
     A = np.empty((s, 3))
+    Asv = np.empty((s, 3))
+    Vsv = np.empty((3, 3))
+    sig = np.empty(3)
     for p in range(q):
         for j in range(3):
             c = 0.0
@@ -165,57 +168,68 @@ def polygon_weights(X):
                 A[i, j] = X[p, i, j] - c
         # (a - x) × (b - x) = a × b + [d]_× x with d = b - a: normal equations H x = rhs,
         # H = Σ (|d|² I − d dᵀ), rhs = Σ d × (a × b)
-        H = np.zeros((3, 3))
-        rhs = np.zeros(3)
+        h00 = h01 = h02 = h11 = h12 = h22 = 0.0
+        r0 = r1 = r2 = 0.0
+        g00 = g01 = g02 = g11 = g12 = g22 = 0.0
         for i in range(s):
             i1 = (i + 1) % s
-            d0, d1, d2 = A[i1, 0] - A[i, 0], A[i1, 1] - A[i, 1], A[i1, 2] - A[i, 2]
+            a0, a1, a2 = A[i, 0], A[i, 1], A[i, 2]
+            b0, b1, b2 = A[i1, 0], A[i1, 1], A[i1, 2]
+            d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
             dd = d0 * d0 + d1 * d1 + d2 * d2
-            dv = (d0, d1, d2)
-            for r in range(3):
-                for cc in range(3):
-                    H[r, cc] -= dv[r] * dv[cc]
-                H[r, r] += dd
-            c0 = A[i, 1] * A[i1, 2] - A[i, 2] * A[i1, 1]
-            c1 = A[i, 2] * A[i1, 0] - A[i, 0] * A[i1, 2]
-            c2 = A[i, 0] * A[i1, 1] - A[i, 1] * A[i1, 0]
-            rhs[0] += d1 * c2 - d2 * c1
-            rhs[1] += d2 * c0 - d0 * c2
-            rhs[2] += d0 * c1 - d1 * c0
-        scale = H[0, 0] + H[1, 1] + H[2, 2]
+            h00 += dd - d0 * d0
+            h11 += dd - d1 * d1
+            h22 += dd - d2 * d2
+            h01 -= d0 * d1
+            h02 -= d0 * d2
+            h12 -= d1 * d2
+            c0 = a1 * b2 - a2 * b1
+            c1 = a2 * b0 - a0 * b2
+            c2 = a0 * b1 - a1 * b0
+            r0 += d1 * c2 - d2 * c1
+            r1 += d2 * c0 - d0 * c2
+            r2 += d0 * c1 - d1 * c0
+            g00 += a0 * a0
+            g01 += a0 * a1
+            g02 += a0 * a2
+            g11 += a1 * a1
+            g12 += a1 * a2
+            g22 += a2 * a2
+        scale = h00 + h11 + h22
         ok = scale > 0
         floor = max(scale, 1e-300)
-        if _min_eig3(H) > 1e-6 * floor:
-            x = _solve3(H, rhs)
+        if _min_eig3(h00, h01, h02, h11, h12, h22) > 1e-6 * floor:
+            x0, x1, x2 = _solve3(h00, h01, h02, h11, h12, h22, r0, r1, r2)
         else:                                   # collinear corners: the pseudo-inverse (no unique minimizer)
-            x, allkept, _ = _pinv_apply(H, rhs, 1e-10, floor)
+            H = np.array([[h00, h01, h02], [h01, h11, h12], [h02, h12, h22]])
+            xv, allkept, _ = _pinv_apply(H, np.array([r0, r1, r2]), 1e-10, floor)
+            x0, x1, x2 = xv[0], xv[1], xv[2]
             ok = ok and allkept
         # minimum-norm affine weights w = K⁺ [x; 1], K = [Aᵀ; 1ᵀ]: A is centred, so K Kᵀ = diag(AᵀA, s) and
-        # w = A (AᵀA)⁺ x + 1/s, with pinv's cut-off on the singular values √λ(AᵀA) and √s of K
-        G = np.zeros((3, 3))
-        for i in range(s):
-            for r in range(3):
-                for cc in range(3):
-                    G[r, cc] += A[i, r] * A[i, cc]
-        gtr = G[0, 0] + G[1, 1] + G[2, 2]
-        gmin = _min_eig3(G)
+        # w = A (AᵀA)⁺ x + 1/s, with pinv's cut-off on the singular values of K (those of A, and √s)
+        gtr = g00 + g11 + g22
+        gmin = _min_eig3(g00, g01, g02, g11, g12, g22)
         cut = 1e-10 * np.sqrt(max(s, gtr))
         if gmin > 1e-6 * gtr and gmin > (1e4 * cut) ** 2:
-            y = _solve3(G, x)
+            y0, y1, y2 = _solve3(g00, g01, g02, g11, g12, g22, x0, x1, x2)
         else:                                   # planar and nearly planar polygons
             # singular values of A by one-sided Jacobi on A itself (accurate down to eps·|A|; those of AᵀA
             # would lose the small ones), cut like pinv: σ_k ≤ 1e-10 · max(σ_max(A), √s) count as zero
-            sig, Vt = _right_svd(A, s)
+            for i in range(s):
+                for j in range(3):
+                    Asv[i, j] = A[i, j]
+            _right_svd(Asv, s, Vsv, sig)
             smax = max(max(sig[0], max(sig[1], sig[2])), np.sqrt(float(s)))
-            y = np.zeros(3)
+            y0 = y1 = y2 = 0.0
             for k in range(3):
                 if sig[k] > 1e-10 * smax:
-                    vx = Vt[0, k] * x[0] + Vt[1, k] * x[1] + Vt[2, k] * x[2]
-                    for j in range(3):
-                        y[j] += vx / (sig[k] * sig[k]) * Vt[j, k]
+                    f = (Vsv[0, k] * x0 + Vsv[1, k] * x1 + Vsv[2, k] * x2) / (sig[k] * sig[k])
+                    y0 += f * Vsv[0, k]
+                    y1 += f * Vsv[1, k]
+                    y2 += f * Vsv[2, k]
         tot = 0.0
         for i in range(s):
-            W[p, i] = A[i, 0] * y[0] + A[i, 1] * y[1] + A[i, 2] * y[2] + 1.0 / s
+            W[p, i] = A[i, 0] * y0 + A[i, 1] * y1 + A[i, 2] * y2 + 1.0 / s
             tot += W[p, i]
             ok = ok and np.isfinite(W[p, i])
         if not ok or abs(tot - 1.0) >= 1e-6:
@@ -226,7 +240,7 @@ def polygon_weights(X):
 
 @njit(cache=True)
 def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
-    """Per-polygon Laplacian, mass and normals (module docs).
+    """Per-polygon Laplacian, mass and normals (module docs), and the fine triangles' data of steps II–III.
 
     Parameters
     ----------
@@ -237,13 +251,22 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
 
     Returns
     -------
-    rows, cols, vals : the Σ s² COO triplets of L; mass : (n,); An : (n, 3) area-weighted normal sums.
+    rows, cols, vals : the Σ s² COO triplets of L; mass : (n,); An : (n, 3) area-weighted normal sums;
+    good : (k,) bool, the fine triangles (triangles, then the fans polygon by polygon) that are kept;
+    fn : (k, 3) their unit normals; fG : (k, 3, 3) ``|f| ∇λ_c = ½ n × (v_{c+2} − v_{c+1})`` per corner c
+    (the divergence weights of :meth:`TriangleMeshOperators.divergence`).
     """
     m = len(start) - 1
     tot = 0
+    nfine = 0
     for p in range(m):
         s = start[p + 1] - start[p]
         tot += s * s
+        nfine += s if vid[p] >= 0 else 1
+    good = np.zeros(nfine, np.bool_)
+    fn = np.zeros((nfine, 3))
+    fG = np.zeros((nfine, 3, 3))
+    ft = -1
     rows = np.empty(tot, np.int64)
     cols = np.empty(tot, np.int64)
     vals = np.empty(tot)
@@ -269,6 +292,7 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
                 K[i, j] = 0.0
         ntri = s if refined else 1
         for t in range(ntri):
+            ft += 1
             if refined:
                 node[0], node[1], node[2] = 0, 1 + t, 1 + (t + 1) % s
             else:
@@ -279,19 +303,32 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
                 for j in range(3):
                     T[k, j] = Vr[g, j]
             # slot k: edge (k, k+1); the corner angle at k has cot (|e_{k-1}|² + |e_k|² − |e_{k+1}|²) / (4 area)
-            e0 = T[1] - T[0]
-            e1 = T[2] - T[1]
-            e2 = T[0] - T[2]
-            cx = e0[1] * (-e2[2]) - e0[2] * (-e2[1])
-            cy = e0[2] * (-e2[0]) - e0[0] * (-e2[2])
-            cz = e0[0] * (-e2[1]) - e0[1] * (-e2[0])
+            e00, e01, e02 = T[1, 0] - T[0, 0], T[1, 1] - T[0, 1], T[1, 2] - T[0, 2]
+            e10, e11, e12 = T[2, 0] - T[1, 0], T[2, 1] - T[1, 1], T[2, 2] - T[1, 2]
+            e20, e21, e22 = T[0, 0] - T[2, 0], T[0, 1] - T[2, 1], T[0, 2] - T[2, 2]
+            cx = e01 * (-e22) - e02 * (-e21)
+            cy = e02 * (-e20) - e00 * (-e22)
+            cz = e00 * (-e21) - e01 * (-e20)
             dbl = np.sqrt(cx * cx + cy * cy + cz * cz)
             if dbl <= thresh:
                 continue
             area = 0.5 * dbl
-            l0 = e0[0] * e0[0] + e0[1] * e0[1] + e0[2] * e0[2]
-            l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]
-            l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]
+            good[ft] = True
+            nx, ny, nz = cx / dbl, cy / dbl, cz / dbl
+            fn[ft, 0], fn[ft, 1], fn[ft, 2] = nx, ny, nz
+            # corner c: ½ n × e_{c+1} (e_{c+1} = the edge opposite c)
+            fG[ft, 0, 0] = 0.5 * (ny * e12 - nz * e11)
+            fG[ft, 0, 1] = 0.5 * (nz * e10 - nx * e12)
+            fG[ft, 0, 2] = 0.5 * (nx * e11 - ny * e10)
+            fG[ft, 1, 0] = 0.5 * (ny * e22 - nz * e21)
+            fG[ft, 1, 1] = 0.5 * (nz * e20 - nx * e22)
+            fG[ft, 1, 2] = 0.5 * (nx * e21 - ny * e20)
+            fG[ft, 2, 0] = 0.5 * (ny * e02 - nz * e01)
+            fG[ft, 2, 1] = 0.5 * (nz * e00 - nx * e02)
+            fG[ft, 2, 2] = 0.5 * (nx * e01 - ny * e00)
+            l0 = e00 * e00 + e01 * e01 + e02 * e02
+            l1 = e10 * e10 + e11 * e11 + e12 * e12
+            l2 = e20 * e20 + e21 * e21 + e22 * e22
             L2 = (l0, l1, l2)
             for k in range(3):
                 cot = (L2[(k + 2) % 3] + L2[k] - L2[(k + 1) % 3]) / (4.0 * area)
@@ -330,4 +367,98 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
                 cols[out] = corners[b0 + j]
                 vals[out] = val
                 out += 1
-    return rows, cols, vals, mass, An
+    return rows, cols, vals, mass, An, good, fn, fG
+
+
+@njit(cache=True)
+def coo_to_symmetric_csr(rows, cols, vals, n):
+    """CSR (indptr, indices, data) of n×n COO triplets, duplicates summed in input order per entry (a stable
+    counting sort by row, then by column): triplets that are symmetric polygon by polygon give an exactly
+    symmetric matrix, with sorted column indices."""
+    k = len(rows)
+    cnt = np.zeros(n + 1, np.int64)
+    for t in range(k):
+        cnt[rows[t] + 1] += 1
+    for i in range(n):
+        cnt[i + 1] += cnt[i]
+    pos = cnt[:-1].copy()
+    order = np.empty(k, np.int64)
+    for t in range(k):                                  # stable bucket by row
+        order[pos[rows[t]]] = t
+        pos[rows[t]] += 1
+    indptr = np.zeros(n + 1, np.int64)
+    indices = np.empty(k, np.int64)
+    data = np.empty(k)
+    out = 0
+    mark = np.full(n, -1, np.int64)                     # column -> its slot in the current row
+    for i in range(n):
+        start = out
+        for q in range(cnt[i], cnt[i + 1]):
+            t = order[q]
+            j = cols[t]
+            if mark[j] < start:
+                mark[j] = out
+                indices[out] = j
+                data[out] = vals[t]
+                out += 1
+            else:
+                data[mark[j]] += vals[t]
+        # sort the row's columns (insertion sort: rows are short)
+        for a in range(start + 1, out):
+            cj, cv = indices[a], data[a]
+            b = a - 1
+            while b >= start and indices[b] > cj:
+                indices[b + 1] = indices[b]
+                data[b + 1] = data[b]
+                b -= 1
+            indices[b + 1] = cj
+            data[b + 1] = cv
+        indptr[i + 1] = out
+    return indptr, indices[:out].copy(), data[:out].copy()
+
+
+@njit(cache=True)
+def connection_values(indptr, indices, data, N, e1, e2):
+    """Values of the vertex connection Laplacian on the pattern of a symmetric CSR Laplacian (sorted
+    columns and a symmetric pattern): for i < j, L_ij times the unit complex r_ij expressing e1_j in frame i
+    after the smallest rotation taking N_j to N_i (Rodrigues; antiparallel normals: no rotation) and, at (j, i),
+    L_ij times conj(r_ij) — exactly Hermitian; the diagonal unchanged."""
+    n = len(indptr) - 1
+    out = np.empty(len(data), np.complex128)
+    for i in range(n):
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if j == i:
+                out[p] = data[p]
+                continue
+            if j < i:
+                continue
+            a0, a1, a2 = N[j, 0], N[j, 1], N[j, 2]
+            b0, b1, b2 = N[i, 0], N[i, 1], N[i, 2]
+            v0, v1, v2 = e1[j, 0], e1[j, 1], e1[j, 2]
+            c = a0 * b0 + a1 * b1 + a2 * b2
+            w0, w1, w2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+            wv0, wv1, wv2 = w1 * v2 - w2 * v1, w2 * v0 - w0 * v2, w0 * v1 - w1 * v0
+            # R v = v + w × v + w × (w × v) / (1 + c)
+            if 1.0 + c > 1e-12:
+                inv = 1.0 / (1.0 + c)
+                r0 = v0 + wv0 + (w1 * wv2 - w2 * wv1) * inv
+                r1 = v1 + wv1 + (w2 * wv0 - w0 * wv2) * inv
+                r2 = v2 + wv2 + (w0 * wv1 - w1 * wv0) * inv
+            else:
+                r0, r1, r2 = v0 + wv0, v1 + wv1, v2 + wv2
+            zr = r0 * e1[i, 0] + r1 * e1[i, 1] + r2 * e1[i, 2]
+            zi = r0 * e2[i, 0] + r1 * e2[i, 1] + r2 * e2[i, 2]
+            mag = np.sqrt(zr * zr + zi * zi)
+            z = complex(zr / mag, zi / mag) if mag > 0 else complex(1.0, 0.0)
+            out[p] = data[p] * z
+            # the mirrored entry (j, i): binary search in row j
+            lo, hi = indptr[j], indptr[j + 1]
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if indices[mid] < i:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            out[lo] = data[p] * np.conj(z)
+    return out

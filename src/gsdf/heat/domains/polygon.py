@@ -43,7 +43,7 @@ import scipy.sparse as sp
 
 from ... import _checks
 from ..surface.operators import TriangleMeshOperators
-from ._polygon_kernels import polygon_assembly, polygon_weights
+from ._polygon_kernels import connection_values, coo_to_symmetric_csr, polygon_assembly, polygon_weights
 from .base import VertexSurfaceDomain, tangent_frames
 
 
@@ -89,7 +89,7 @@ def _parse_polygons(polygons, n: int) -> dict:
         k = int(np.searchsorted(start, np.flatnonzero(bad)[0], side="right") - 1)
         raise ValueError(f"polygons[{k}]: vertex index out of range for {n} vertices")
     out = {}
-    for s in np.unique(sizes):
+    for s in np.flatnonzero(np.bincount(sizes)):               # the degrees present, ascending
         sel = np.flatnonzero(sizes == s)
         Q = flat[start[sel][:, None] + np.arange(s)]
         S = np.sort(Q, axis=1)
@@ -193,13 +193,25 @@ def frame_transport(N, e1, e2, i, j) -> np.ndarray:
 
 def connection_laplacian(L: sp.spmatrix, N, e1, e2) -> sp.csr_matrix:
     """Vertex connection Laplacian: off-diagonal entries of the real Laplacian L times the frame rotations
-    r_ij (Eq. 9 / §8.3–8.4), the diagonal unchanged; Hermitian by construction (upper part, conjugated)."""
+    r_ij (Eq. 9 / §8.3–8.4), the diagonal unchanged; Hermitian by construction (upper part, conjugated).
+    On a symmetric pattern one numba pass over the upper entries writes both halves in L's own CSR layout
+    (:func:`~gsdf.heat.domains._polygon_kernels.connection_values`)."""
+    L = sp.csr_matrix(L)
+    L.sum_duplicates()
+    L.sort_indices()
+    n = L.shape[0]
+    Lt = L.T.tocsr()
+    Lt.sort_indices()
+    if np.array_equal(L.indptr, Lt.indptr) and np.array_equal(L.indices, Lt.indices):
+        N, e1, e2 = (np.ascontiguousarray(a, dtype=np.float64) for a in (N, e1, e2))
+        vals = connection_values(L.indptr.astype(np.int64), L.indices.astype(np.int64), L.data.astype(np.float64),
+                                 N, e1, e2)
+        return sp.csr_matrix((vals, L.indices, L.indptr), shape=(n, n))
     L = sp.coo_matrix(L)
     up = L.row < L.col
     i, j, v = L.row[up], L.col[up], L.data[up]
     r = frame_transport(N, e1, e2, i, j)
     d = L.diagonal()
-    n = L.shape[0]
     rows = np.concatenate([i, j, np.arange(n)])
     cols = np.concatenate([j, i, np.arange(n)])
     vals = np.concatenate([v * r, v * np.conj(r), d.astype(np.complex128)])
@@ -235,24 +247,24 @@ class PolygonDomain(VertexSurfaceDomain):
         polys = _parse_polygons(polygons, n)
         self.V_refined, F, self.P, start, corners, vid, wflat = _refine(V, polys)
         E = self._edges(polys)
-        self._edge_keys = np.unique(np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1]))
+        keys = np.sort(np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1]))
+        self._edge_keys = keys[np.concatenate([[True], keys[1:] != keys[:-1]])]
         ell = np.linalg.norm(V[self._edge_keys % n] - V[self._edge_keys // n], axis=1)   # unique polygon edges
         self.mean_edge = float(ell.mean())
-        # fan triangles of zero area (nonconvex / degenerate polygons) carry no stiffness or mass: dropped
+        # one kernel sums L = Pᵀ C_fan P (Bunge et al. 2020 §4), M = lump(Pᵀ M_fan P) = Pᵀ A_fan (rows of P sum
+        # to one, §4.2) and the normals per polygon, without forming the refined matrices; fan triangles of zero
+        # area (nonconvex / degenerate polygons) carry no stiffness or mass and are dropped
         thresh = 1e-12 * self.mean_edge ** 2
-        Vr = self.V_refined
-        dbl = np.linalg.norm(np.cross(Vr[F[:, 1]] - Vr[F[:, 0]], Vr[F[:, 2]] - Vr[F[:, 0]]), axis=1)
-        good = dbl > thresh
+        rows, cols, vals, self.M, An, good, fn, fG = polygon_assembly(self.V_refined, start, corners, vid, wflat, n,
+                                                                      thresh)
         if not good.any():
             raise ValueError("polygons: all polygons have zero area")
         self.F_refined = F[good]
-        # the fine vertex operators serve steps II–III (gather, divergence); L, M and the normals are summed per
-        # polygon by one kernel: L = Pᵀ C_fan P (Bunge et al. 2020 §4) and M = lump(Pᵀ M_fan P) = Pᵀ A_fan
-        # (rows of P sum to one, §4.2) without forming the refined matrices
-        self.fine_ops = TriangleMeshOperators(Vr, self.F_refined, edges=False)
-        rows, cols, vals, self.M, An = polygon_assembly(Vr, start, corners, vid, wflat, n, thresh)
-        L = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
-        L = (0.5 * (L + L.T)).tocsr()      # per polygon exactly symmetric; the duplicate sums' order may differ
+        self._fine_normals, self._fine_G = fn[good], fG[good]      # steps II–III on the fine triangles
+        self._fine_ops = None
+        # per polygon exactly symmetric, and duplicates summed in polygon order for (i, j) and (j, i) alike:
+        # L is exactly symmetric
+        L = sp.csr_matrix(coo_to_symmetric_csr(rows, cols, vals, n)[::-1], shape=(n, n))
         # vertex normals: area-weighted fine triangle normals (§8.3)
         nrm = np.linalg.norm(An, axis=1)
         An[nrm == 0] = [0, 0, 1.0]
@@ -265,19 +277,28 @@ class PolygonDomain(VertexSurfaceDomain):
     def _edges(groups) -> np.ndarray:
         return np.concatenate([np.stack([Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1) for Q in groups.values()])
 
+    @property
+    def fine_ops(self) -> TriangleMeshOperators:
+        """Vertex operators of the refined triangle mesh (built on first access; the solves use the kernel's
+        normals and divergence weights of the same triangles)."""
+        if self._fine_ops is None:
+            self._fine_ops = TriangleMeshOperators(self.V_refined, self.F_refined, edges=False)
+        return self._fine_ops
+
     def gather(self, X) -> np.ndarray:
         """§8.3: prolong the vertex vectors to the fine vertices (virtual vertex = Σ w_i X_i as 3D vectors), sum
         them over every fine triangle and project into its plane (normalized by the core)."""
-        ops = self.fine_ops
         Xf = self.P @ self.to_3d(X)                                      # (n + #virtual, 3)
-        F = ops.F
+        F, Nf = self.F_refined, self._fine_normals
         Y = Xf[F[:, 0]] + Xf[F[:, 1]] + Xf[F[:, 2]]                     # (a + b) + c, as .sum(axis=1) adds
-        Y -= ops.normals * np.einsum("fj,fj->f", Y, ops.normals)[:, None]
+        Y -= Nf * np.einsum("fj,fj->f", Y, Nf)[:, None]
         return Y
 
     def divergence(self, Y) -> np.ndarray:
-        """The fine divergence restricted by Pᵀ (Bunge et al. §4.5)."""
-        return self.P.T @ self.fine_ops.divergence(Y)
+        """The fine divergence (b_i = Σ_f |f| ∇λ_i · Y_f) restricted by Pᵀ (Bunge et al. §4.5)."""
+        contrib = np.einsum("fkj,fj->fk", self._fine_G, Y)
+        b = np.bincount(self.F_refined.ravel(), weights=contrib.ravel(), minlength=self.P.shape[0])
+        return self.P.T @ b
 
     def check_curve_edges(self, a, k):
         n = self.n_vertices
