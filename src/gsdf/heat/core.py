@@ -198,7 +198,7 @@ class FactorizedPoisson(PoissonSolver):
     :class:`gsdf.linalg.SPDSolver`, CG/AMG above a size).
     """
 
-    def __init__(self, L, Mv, spd=None, exact_gauge: bool = False):
+    def __init__(self, L, Mv, spd=None, exact_gauge: bool = False, renumber: bool = True):
         self.L = sp.csr_matrix(L).tocsc()
         self.Mv = np.asarray(Mv, np.float64)
         self.n = self.L.shape[0]
@@ -207,7 +207,9 @@ class FactorizedPoisson(PoissonSolver):
         self._active = self.L.diagonal() != 0 if exact_gauge else np.ones(self.n, bool)
         self._spd = spd or (lambda A: Factorization(sp.csc_matrix(A)))
         # the Dirichlet systems (no ε: well-conditioned) may take a bandwidth renumbering before the ordering
-        self._spd_dirichlet = (lambda A: Factorization(sp.csc_matrix(A), reorder=True)) if spd is None else self._spd
+        renumber = bool(renumber)
+        self._spd_dirichlet = (lambda A: Factorization(sp.csc_matrix(A), reorder=renumber)) if spd is None \
+            else self._spd
         self._cache: dict = {}
         self._last_fixed = None                      # (fixed array, key, free) of the last Dirichlet solve
 
@@ -342,7 +344,8 @@ class SignedHeatCore:
         if st["vec"] is None:
             form = self.domain.heat_form
             if form == "complex":
-                st["vec"] = HermitianFactorization(self.domain.vector_heat_matrix())
+                st["vec"] = HermitianFactorization(self.domain.vector_heat_matrix(),
+                                                   reorder=getattr(self.domain, "renumber", True))
             elif form == "real2":
                 st["vec"] = BlockHermitianFactorization(self.domain.vector_heat_matrix())
             else:
@@ -354,8 +357,8 @@ class SignedHeatCore:
         """The domain's Step III solver (its own, or :class:`FactorizedPoisson` of its Laplacian)."""
         st = self._state()
         if st["poisson"] is None:
-            st["poisson"] = self.domain.poisson_solver() or FactorizedPoisson(self.domain.laplacian(),
-                                                                              self.domain.mass())
+            st["poisson"] = self.domain.poisson_solver() or FactorizedPoisson(
+                self.domain.laplacian(), self.domain.mass(), renumber=getattr(self.domain, "renumber", True))
         return st["poisson"]
 
     def diffuse(self, S: Sources) -> np.ndarray:

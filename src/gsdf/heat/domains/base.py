@@ -100,6 +100,7 @@ class HeatDomain(ABC):
     difference_order: str = "first"
     shift_hard_zero: bool = True        # apply the shift of Alg. 13 after a hard "zero" constraint too
     cache_sources: bool = False         # sources depend only on the arguments: the core may reuse the last ones
+    renumber: bool = True               # RCM renumbering before SuperLU's ordering (bench --solver-rule)
 
     # ---- sources
     @abstractmethod

@@ -239,6 +239,10 @@ class PolygonDomain(VertexSurfaceDomain):
     (4, 4)
     """
 
+    # polygon meshes: SuperLU's minimum degree alone factorizes faster than after an RCM renumbering (1.2–2.4×
+    # on every polygon row of bench_heat_surface.py --solver-rule)
+    renumber = False
+
     def __init__(self, V, polygons, t_coef: float = 1.0):
         V = _checks.as_points(V, "V")
         t_coef = _checks.positive(t_coef, "t_coef")
