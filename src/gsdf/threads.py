@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 from contextlib import contextmanager
 
 ENV_VAR = "GSDF_NUM_THREADS"
@@ -289,8 +290,27 @@ def blas_region(n=None):
     ...     lu = scipy.sparse.linalg.splu(A)             # doctest: +SKIP
     """
     n = blas_solve_threads() if n is None else parse_num_threads(n)
-    with _blas_controller().limit(limits=n, user_api="blas"):
+    stack = _region_stack()
+    if stack and stack[-1] == n:          # nested in a block with the same limit: nothing to set or restore
         yield n
+        return
+    with _blas_controller().limit(limits=n, user_api="blas"):
+        stack.append(n)
+        try:
+            yield n
+        finally:
+            stack.pop()
+
+
+_LOCAL = threading.local()
+
+
+def _region_stack() -> list:
+    """The limits of the :func:`blas_region` blocks this thread is inside (innermost last)."""
+    st = getattr(_LOCAL, "stack", None)
+    if st is None:
+        st = _LOCAL.stack = []
+    return st
 
 
 _CONTROLLER = None

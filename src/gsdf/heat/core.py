@@ -54,6 +54,7 @@ import scipy.sparse as sp
 from .. import _checks
 from ..linalg import (BlockHermitianFactorization, Factorization, HermitianFactorization, cached_factorization,
                       saddle_matrix)
+from ..threads import blas_region
 from .domains.base import PoissonSolver
 from .sources import Sources, as_curves, as_point_sources
 
@@ -130,6 +131,62 @@ def curve_components(S: Sources, n: int) -> np.ndarray:
     return connected_components(G, directed=False)[1][:k]
 
 
+class _NoKey(Exception):
+    pass
+
+
+def source_key(curves, points, curve_signs, options):
+    """A content key (sha1 digest) of one call's source arguments, or None when they are not plain index arrays
+    and :class:`~gsdf.heat.sources.Curve` objects of vertices / edges (then the sources are assembled anew).
+
+    Two calls with equal keys get the same assembled sources: the key covers the container type, every array's
+    dtype, shape and bytes, each Curve's kind and sign, the points, the signs and the (all-None) options.
+    """
+    from .sources import Curve
+
+    h = hashlib.sha1()
+
+    def add(tag, a):
+        if not isinstance(a, np.ndarray) or a.dtype == object:
+            raise _NoKey
+        h.update(tag + a.dtype.str.encode() + str(a.shape).encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+
+    try:
+        if any(v is not None for v in options.values()):
+            raise _NoKey
+        if isinstance(curves, (np.ndarray, Curve)):
+            h.update(b"one")
+            items = [curves]
+        elif isinstance(curves, (list, tuple)):
+            h.update(b"list")
+            items = curves
+        else:
+            raise _NoKey
+        for c in items:
+            if isinstance(c, Curve):
+                if c.kind == "points":
+                    raise _NoKey
+                add(b"C" + c.kind.encode() + (b"+" if c.signed else b"-"), c.nodes)
+            else:
+                add(b"A", c)
+        if isinstance(points, np.ndarray):
+            add(b"P", points)
+        elif isinstance(points, (list, tuple)) and all(type(p) is int for p in points):
+            add(b"p", np.array(points, np.int64))
+        else:
+            raise _NoKey
+        if curve_signs is None:
+            h.update(b"S")
+        elif isinstance(curve_signs, (list, tuple)) and all(type(x) is bool for x in curve_signs):
+            h.update(b"s" + bytes(bytearray(curve_signs)))
+        else:
+            raise _NoKey
+    except _NoKey:
+        return None
+    return h.digest()
+
+
 class FactorizedPoisson(PoissonSolver):
     """Step III by sparse factorizations, kept per constraint set.
 
@@ -141,7 +198,7 @@ class FactorizedPoisson(PoissonSolver):
     :class:`gsdf.linalg.SPDSolver`, CG/AMG above a size).
     """
 
-    def __init__(self, L, Mv, spd=None, exact_gauge: bool = False):
+    def __init__(self, L, Mv, spd=None, exact_gauge: bool = False, renumber: bool = True):
         self.L = sp.csr_matrix(L).tocsc()
         self.Mv = np.asarray(Mv, np.float64)
         self.n = self.L.shape[0]
@@ -150,8 +207,11 @@ class FactorizedPoisson(PoissonSolver):
         self._active = self.L.diagonal() != 0 if exact_gauge else np.ones(self.n, bool)
         self._spd = spd or (lambda A: Factorization(sp.csc_matrix(A)))
         # the Dirichlet systems (no ε: well-conditioned) may take a bandwidth renumbering before the ordering
-        self._spd_dirichlet = (lambda A: Factorization(sp.csc_matrix(A), reorder=True)) if spd is None else self._spd
+        renumber = bool(renumber)
+        self._spd_dirichlet = (lambda A: Factorization(sp.csc_matrix(A), reorder=renumber)) if spd is None \
+            else self._spd
         self._cache: dict = {}
+        self._last_fixed = None                      # (fixed array, key, free) of the last Dirichlet solve
 
     def _cached(self, key, build):
         return cached_factorization(self._cache, key, build)
@@ -182,11 +242,18 @@ class FactorizedPoisson(PoissonSolver):
         return self._reduced("free", Pm, b)
 
     def dirichlet(self, fixed, b):
-        fixed = np.unique(np.asarray(fixed, np.int64))
-        mask = np.zeros(self.n, bool)
-        mask[fixed] = True
-        free = np.flatnonzero(~mask & self._active)
-        key = hash_key(np.array([0]), fixed)
+        last = self._last_fixed
+        if last is not None and last[0] is fixed:     # the same array again (cached sources): reuse its set
+            key, free = last[1], last[2]
+        else:
+            given = fixed
+            fixed = np.unique(np.asarray(fixed, np.int64))
+            mask = np.zeros(self.n, bool)
+            mask[fixed] = True
+            free = np.flatnonzero(~mask & self._active)
+            key = hash_key(np.array([0]), fixed)
+            self._last_fixed = (given, key, free) if isinstance(given, np.ndarray) and not given.flags.writeable \
+                else None
 
         def build():
             A = self.L[free][:, free]
@@ -256,6 +323,7 @@ class SignedHeatCore:
     def __init__(self, domain):
         self.domain = domain
         self._states: dict = {}
+        self._last_sources = None                 # (source_key, Sources) of the last call
 
     def _state(self) -> dict:
         """Factorizations of the domain's current operators (domains that switch triangulations, like the
@@ -276,7 +344,8 @@ class SignedHeatCore:
         if st["vec"] is None:
             form = self.domain.heat_form
             if form == "complex":
-                st["vec"] = HermitianFactorization(self.domain.vector_heat_matrix())
+                st["vec"] = HermitianFactorization(self.domain.vector_heat_matrix(),
+                                                   reorder=getattr(self.domain, "renumber", True))
             elif form == "real2":
                 st["vec"] = BlockHermitianFactorization(self.domain.vector_heat_matrix())
             else:
@@ -288,8 +357,8 @@ class SignedHeatCore:
         """The domain's Step III solver (its own, or :class:`FactorizedPoisson` of its Laplacian)."""
         st = self._state()
         if st["poisson"] is None:
-            st["poisson"] = self.domain.poisson_solver() or FactorizedPoisson(self.domain.laplacian(),
-                                                                              self.domain.mass())
+            st["poisson"] = self.domain.poisson_solver() or FactorizedPoisson(
+                self.domain.laplacian(), self.domain.mass(), renumber=getattr(self.domain, "renumber", True))
         return st["poisson"]
 
     def diffuse(self, S: Sources) -> np.ndarray:
@@ -316,7 +385,15 @@ class SignedHeatCore:
         lam = None if soft_weight is None else _checks.positive(soft_weight, "soft_weight")
         report = adapt_progress(progress)
         report("sources", 0.0)
-        S = self.sources(curves, points, curve_signs, **options)
+        # repeated calls with the same curves reuse the validated, assembled sources (domains whose sources do
+        # not depend on a changing state declare ``cache_sources``)
+        key = source_key(curves, points, curve_signs, options) if getattr(self.domain, "cache_sources", False) \
+            else None
+        if key is not None and self._last_sources is not None and self._last_sources[0] == key:
+            S = self._last_sources[1]
+        else:
+            S = self.sources(curves, points, curve_signs, **options)
+            self._last_sources = (key, S) if key is not None else None
         return self.solve(S, mode, lam, report)
 
     def solve(self, S: Sources, mode: str = "zero", lam=None, report=None) -> np.ndarray:
@@ -324,6 +401,10 @@ class SignedHeatCore:
         report = report or (lambda stage, fraction: None)
         if S.X0 is not None and not np.any(S.X0):
             raise ValueError("curves: the sources have zero total length / weight")
+        with blas_region():               # one BLAS limit for all factorizations and solves of the call
+            return self._solve(S, mode, lam, report)
+
+    def _solve(self, S: Sources, mode: str, lam, report) -> np.ndarray:
         report("heat (step I)", 0.0)
         X = self.diffuse(S)
         report("heat (step I)", 1.0)

@@ -353,7 +353,17 @@ class Sources:
         return self.B.min(axis=0), self.B.max(axis=0)
 
     def all_rows(self):
-        """(rows (k + p, n), vertex (k + p,)) of curve nodes and point sources together."""
+        """(rows (k + p, n), vertex (k + p,)) of curve nodes and point sources together (kept: a cached
+        :class:`Sources` serves repeated solves)."""
+        got = self.extra.get("all_rows")
+        if got is not None:
+            return got
+        got = self._all_rows()
+        got[1].flags.writeable = False                 # shared by later solves (gsdf.heat.core keys on it)
+        self.extra["all_rows"] = got
+        return got
+
+    def _all_rows(self):
         mats = [m for m in (self.node_rows, self.point_rows) if m is not None and m.shape[0]]
         vs = [v for m, v in ((self.node_rows, self.node_vertex), (self.point_rows, self.point_vertex))
               if m is not None and m.shape[0]]

@@ -114,6 +114,7 @@ class HermitianFactorization:
     2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved). Measured on the vector heat operators (bunny00 CR edges,
     113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2–3.5× faster (0.58 vs 1.14 s,
     0.15 vs 0.53 s) and solves as fast (bench/bench_solver_choices.py), so the 2n embedding is not worth it.
+    ``reorder``: the reverse Cuthill–McKee renumbering of :class:`Factorization` (default True).
 
     Example
     -------
@@ -125,7 +126,7 @@ class HermitianFactorization:
     """
 
     @_in_blas_region
-    def __init__(self, A, backend: str = "auto"):
+    def __init__(self, A, backend: str = "auto", reorder: bool = True):
         A = sp.coo_matrix(A)
         n = A.shape[0]
         self.n = n
@@ -145,7 +146,7 @@ class HermitianFactorization:
                                          np.ascontiguousarray(R.data), MatrixType.CSR)
             self.backend = "cholmod"
             return
-        self._lu = Factorization(A.astype(np.complex128), reorder=True)
+        self._lu = Factorization(A.astype(np.complex128), reorder=bool(reorder))
         self.backend = "superlu"
 
     @_in_blas_region

@@ -99,6 +99,8 @@ class HeatDomain(ABC):
     heat_form: str = "complex"
     difference_order: str = "first"
     shift_hard_zero: bool = True        # apply the shift of Alg. 13 after a hard "zero" constraint too
+    cache_sources: bool = False         # sources depend only on the arguments: the core may reuse the last ones
+    renumber: bool = True               # RCM renumbering before SuperLU's ordering (bench --solver-rule)
 
     # ---- sources
     @abstractmethod
@@ -187,6 +189,7 @@ class VertexSurfaceDomain(HeatDomain):
 
     heat_form = "complex"
     difference_order = "sorted"
+    cache_sources = True
 
     def __init__(self, X, L, M, Lconn, N, e1, e2, t):
         self.X = np.asarray(X, np.float64)

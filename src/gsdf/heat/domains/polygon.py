@@ -43,6 +43,7 @@ import scipy.sparse as sp
 
 from ... import _checks
 from ..surface.operators import TriangleMeshOperators
+from ._polygon_kernels import connection_values, coo_to_symmetric_csr, polygon_assembly, polygon_weights
 from .base import VertexSurfaceDomain, tangent_frames
 
 
@@ -88,7 +89,7 @@ def _parse_polygons(polygons, n: int) -> dict:
         k = int(np.searchsorted(start, np.flatnonzero(bad)[0], side="right") - 1)
         raise ValueError(f"polygons[{k}]: vertex index out of range for {n} vertices")
     out = {}
-    for s in np.unique(sizes):
+    for s in np.flatnonzero(np.bincount(sizes)):               # the degrees present, ascending
         sel = np.flatnonzero(sizes == s)
         Q = flat[start[sel][:, None] + np.arange(s)]
         S = np.sort(Q, axis=1)
@@ -105,7 +106,8 @@ def virtual_vertex_weights(X: np.ndarray) -> np.ndarray:
 
     The virtual vertex minimizes Σ_i |(x_i - x) × (x_{i+1} - x)|² (twice the squared fan-triangle areas, Bunge et
     al. 2020 §3): a 3×3 linear least-squares problem per polygon. Its weights are the minimum-norm affine ones
-    reproducing it (``Σ w = 1``, ``Σ w_i x_i = x``); degenerate polygons get uniform weights.
+    reproducing it (``Σ w = 1``, ``Σ w_i x_i = x``); degenerate polygons get uniform weights. One numba pass
+    over the polygons (:func:`gsdf.heat.domains._polygon_kernels.polygon_weights`).
 
     Example
     -------
@@ -113,75 +115,44 @@ def virtual_vertex_weights(X: np.ndarray) -> np.ndarray:
     >>> virtual_vertex_weights(X).round(6).tolist()
     [[0.25, 0.25, 0.25, 0.25]]
     """
-    q, s, _ = X.shape
-    c = X.mean(axis=1, keepdims=True)
-    A = X - c                                                   # centred corners (translation invariance)
-    B = np.roll(A, -1, axis=1)
-    D = B - A
-    # (a - x) × (b - x) = a × b - x × (b - a) = a × b + [d]_× x   (d = b - a); with [d]_×ᵀ[d]_× = |d|² I − d dᵀ
-    # the normal equations are H x = rhs, H = Σ (|d|² I − d dᵀ), rhs = −Σ [d]_×ᵀ (a × b) = Σ d × (a × b)
-    DD = np.einsum("qsi,qsj->qij", D, D)
-    H = np.einsum("qs,ij->qij", np.einsum("qsi,qsi->qs", D, D), np.eye(3)) - DD
-    rhs = np.cross(D, np.cross(A, B)).sum(axis=1)
-    scale = np.trace(H, axis1=1, axis2=2)
-    ok = scale > 0
-    # well-conditioned H (the usual case): x = H⁻¹ rhs by the adjugate; the others by the eigen-decomposition
-    # (a safe pseudo-inverse; collinear corners have no unique minimizer)
-    lmin = _sym3_min_eigenvalue(H)
-    fast = lmin > 1e-6 * np.maximum(scale, 1e-300)
-    x = np.zeros((q, 3))
-    x[fast] = _solve3(H[fast], rhs[fast])
-    slow = np.flatnonzero(~fast)
-    if len(slow):
-        lam, U = np.linalg.eigh(H[slow])                        # H is symmetric PSD
-        keep = lam > 1e-10 * np.maximum(scale[slow], 1e-300)[:, None]
-        inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
-        x[slow] = np.einsum("qij,qj,qkj,qk->qi", U, inv, U, rhs[slow])
-        ok[slow] &= keep.sum(1) == 3
-    # minimum-norm affine weights: w = K⁺ r with K = [Aᵀ; 1ᵀ] (4 × s), r = [x; 1]. A is centred, so the rows of
-    # K are orthogonal blocks and K⁺ r = A (AᵀA)⁻¹ x + 1/s when AᵀA is well-conditioned (non-planar polygons);
-    # planar and nearly planar ones (singular values near pinv's cutoff) take the SVD pseudo-inverse
-    G = np.einsum("qsi,qsj->qij", A, A)
-    gtr = np.trace(G, axis1=1, axis2=2)
-    gmin = _sym3_min_eigenvalue(G)
-    cut = 1e-10 * np.sqrt(np.maximum(s, gtr))                   # ≥ pinv's cutoff 1e-10 σ_max(K)
-    fastw = (gmin > 1e-6 * gtr) & (gmin > (1e4 * cut) ** 2)
-    w = np.empty((q, s))
-    w[fastw] = np.einsum("qsi,qi->qs", A[fastw], _solve3(G[fastw], x[fastw])) + 1.0 / s
-    slow = np.flatnonzero(~fastw)
-    if len(slow):
-        K = np.concatenate([np.transpose(A[slow], (0, 2, 1)), np.ones((len(slow), 1, s))], axis=1)
-        r = np.concatenate([x[slow], np.ones((len(slow), 1))], axis=1)
-        w[slow] = np.einsum("qij,qj->qi", np.linalg.pinv(K, rcond=1e-10), r)
-    ok &= np.isfinite(w).all(1) & (np.abs(w.sum(1) - 1) < 1e-6)
-    w[~ok] = 1.0 / s
-    return w
+    X = np.ascontiguousarray(X, dtype=np.float64)
+    if X.ndim != 3 or X.shape[2] != 3:
+        raise ValueError(f"X: expected shape (q, s, 3), got {X.shape}")
+    return polygon_weights(X)
 
 
-def _sym3_min_eigenvalue(H: np.ndarray) -> np.ndarray:
-    """Smallest eigenvalue of symmetric 3×3 matrices (q, 3, 3), closed form (trigonometric; absolute error a few
-    ulps of the largest eigenvalue — used only to choose between a direct solve and a pseudo-inverse)."""
-    q3 = np.trace(H, axis1=1, axis2=2) / 3.0
-    p1 = H[:, 0, 1] ** 2 + H[:, 0, 2] ** 2 + H[:, 1, 2] ** 2
-    p2 = (H[:, 0, 0] - q3) ** 2 + (H[:, 1, 1] - q3) ** 2 + (H[:, 2, 2] - q3) ** 2 + 2.0 * p1
-    p = np.sqrt(p2 / 6.0)
-    Bm = (H - q3[:, None, None] * np.eye(3)) / np.where(p > 0, p, 1.0)[:, None, None]
-    r = np.clip(0.5 * np.linalg.det(Bm), -1.0, 1.0)
-    phi = np.arccos(r) / 3.0
-    return np.where(p > 0, q3 + 2.0 * p * np.cos(phi + 2.0 * np.pi / 3.0), q3)
-
-
-def _solve3(H: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """x = H⁻¹ b for well-conditioned symmetric 3×3 matrices (q, 3, 3), by the adjugate."""
-    a, bb, c = H[:, 0, 0], H[:, 0, 1], H[:, 0, 2]
-    d, e, f = H[:, 1, 1], H[:, 1, 2], H[:, 2, 2]
-    A00, A01, A02 = d * f - e * e, c * e - bb * f, bb * e - c * d
-    A11, A12, A22 = a * f - c * c, bb * c - a * e, a * d - bb * bb
-    det = a * A00 + bb * A01 + c * A02
-    x0 = A00 * b[:, 0] + A01 * b[:, 1] + A02 * b[:, 2]
-    x1 = A01 * b[:, 0] + A11 * b[:, 1] + A12 * b[:, 2]
-    x2 = A02 * b[:, 0] + A12 * b[:, 1] + A22 * b[:, 2]
-    return np.stack([x0, x1, x2], 1) / det[:, None]
+def _refine(V: np.ndarray, groups: dict):
+    """The virtual-vertex refinement of validated polygon groups ({degree: (q, degree)}), and the flat polygon
+    layout the assembly kernel reads: ``(V_refined, F_refined, P, start, corners, vid, wflat)`` (polygons in
+    group order; ``vid`` = the virtual vertex of each polygon, -1 for triangles; ``wflat`` aligned with
+    ``corners``)."""
+    n = len(V)
+    newV, fans, prow, pcol, pval = [], [], [np.arange(n)], [np.arange(n)], [np.ones(n)]
+    tris = [groups[3]] if 3 in groups else []
+    flat, vids, wts = [], [], []
+    nv = n
+    for s, Q in groups.items():
+        flat.append(Q.ravel())
+        if s == 3:
+            vids.append(np.full(len(Q), -1, np.int64))
+            wts.append(np.zeros(Q.size))
+            continue
+        w = virtual_vertex_weights(V[Q])                                # (q, s) polygons of this degree
+        ids = nv + np.arange(len(Q))
+        nv += len(Q)
+        newV.append(np.einsum("qs,qsj->qj", w, V[Q]))
+        fans.append(np.stack([np.repeat(ids, s), Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1))
+        prow.append(np.repeat(ids, s))
+        pcol.append(Q.ravel())
+        pval.append(w.ravel())
+        vids.append(ids)
+        wts.append(w.ravel())
+    Vr = np.concatenate([V] + newV) if newV else V.copy()
+    Fr = np.concatenate(tris + fans) if (tris or fans) else np.zeros((0, 3), np.int64)
+    P = sp.csr_matrix((np.concatenate(pval), (np.concatenate(prow), np.concatenate(pcol))), shape=(nv, n))
+    sizes = np.concatenate([np.full(len(Q), s, np.int64) for s, Q in groups.items()])
+    start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    return Vr, Fr, P, start, np.concatenate(flat).astype(np.int64), np.concatenate(vids), np.concatenate(wts)
 
 
 def virtual_vertex_refinement(V: np.ndarray, polygons):
@@ -201,25 +172,7 @@ def virtual_vertex_refinement(V: np.ndarray, polygons):
     """
     V = np.asarray(V, dtype=np.float64)
     groups = polygons if isinstance(polygons, dict) else _parse_polygons(polygons, len(V))
-    n = len(V)
-    tris = [groups[3]] if 3 in groups else []
-    newV, fans, prow, pcol, pval = [], [], [np.arange(n)], [np.arange(n)], [np.ones(n)]
-    nv = n
-    for s, Q in groups.items():
-        if s == 3:
-            continue
-        w = virtual_vertex_weights(V[Q])                                # (q, s) polygons of this degree
-        ids = nv + np.arange(len(Q))
-        nv += len(Q)
-        newV.append(np.einsum("qs,qsj->qj", w, V[Q]))
-        fans.append(np.stack([np.repeat(ids, s), Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1))
-        prow.append(np.repeat(ids, s))
-        pcol.append(Q.ravel())
-        pval.append(w.ravel())
-    Vr = np.concatenate([V] + newV) if newV else V.copy()
-    Fr = np.concatenate(tris + fans) if (tris or fans) else np.zeros((0, 3), np.int64)
-    P = sp.csr_matrix((np.concatenate(pval), (np.concatenate(prow), np.concatenate(pcol))), shape=(nv, n))
-    return Vr, Fr, P
+    return _refine(V, groups)[:3]
 
 
 def frame_transport(N, e1, e2, i, j) -> np.ndarray:
@@ -240,13 +193,25 @@ def frame_transport(N, e1, e2, i, j) -> np.ndarray:
 
 def connection_laplacian(L: sp.spmatrix, N, e1, e2) -> sp.csr_matrix:
     """Vertex connection Laplacian: off-diagonal entries of the real Laplacian L times the frame rotations
-    r_ij (Eq. 9 / §8.3–8.4), the diagonal unchanged; Hermitian by construction (upper part, conjugated)."""
+    r_ij (Eq. 9 / §8.3–8.4), the diagonal unchanged; Hermitian by construction (upper part, conjugated).
+    On a symmetric pattern one numba pass over the upper entries writes both halves in L's own CSR layout
+    (:func:`~gsdf.heat.domains._polygon_kernels.connection_values`)."""
+    L = sp.csr_matrix(L)
+    L.sum_duplicates()
+    L.sort_indices()
+    n = L.shape[0]
+    Lt = L.T.tocsr()
+    Lt.sort_indices()
+    if np.array_equal(L.indptr, Lt.indptr) and np.array_equal(L.indices, Lt.indices):
+        N, e1, e2 = (np.ascontiguousarray(a, dtype=np.float64) for a in (N, e1, e2))
+        vals = connection_values(L.indptr.astype(np.int64), L.indices.astype(np.int64), L.data.astype(np.float64),
+                                 N, e1, e2)
+        return sp.csr_matrix((vals, L.indices, L.indptr), shape=(n, n))
     L = sp.coo_matrix(L)
     up = L.row < L.col
     i, j, v = L.row[up], L.col[up], L.data[up]
     r = frame_transport(N, e1, e2, i, j)
     d = L.diagonal()
-    n = L.shape[0]
     rows = np.concatenate([i, j, np.arange(n)])
     cols = np.concatenate([j, i, np.arange(n)])
     vals = np.concatenate([v * r, v * np.conj(r), d.astype(np.complex128)])
@@ -274,37 +239,37 @@ class PolygonDomain(VertexSurfaceDomain):
     (4, 4)
     """
 
+    # polygon meshes: SuperLU's minimum degree alone factorizes faster than after an RCM renumbering (1.2–2.4×
+    # on every polygon row of bench_heat_surface.py --solver-rule)
+    renumber = False
+
     def __init__(self, V, polygons, t_coef: float = 1.0):
         V = _checks.as_points(V, "V")
         t_coef = _checks.positive(t_coef, "t_coef")
         self.n_vertices = n = len(V)
         self.V = V
         polys = _parse_polygons(polygons, n)
-        self.V_refined, F, self.P = virtual_vertex_refinement(V, polys)
-        # fan triangles of zero area (nonconvex / degenerate polygons) carry no stiffness or mass: drop them
-        dbl = np.linalg.norm(np.cross(self.V_refined[F[:, 1]] - self.V_refined[F[:, 0]],
-                                      self.V_refined[F[:, 2]] - self.V_refined[F[:, 0]]), axis=1)
+        self.V_refined, F, self.P, start, corners, vid, wflat = _refine(V, polys)
         E = self._edges(polys)
-        self._edge_keys, first = np.unique(np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1]),
-                                           return_index=True)
-        ell = np.linalg.norm(V[E[first, 1]] - V[E[first, 0]], axis=1)      # unique polygon edges
+        keys = np.sort(np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1]))
+        self._edge_keys = keys[np.concatenate([[True], keys[1:] != keys[:-1]])]
+        ell = np.linalg.norm(V[self._edge_keys % n] - V[self._edge_keys // n], axis=1)   # unique polygon edges
         self.mean_edge = float(ell.mean())
-        good = dbl > 1e-12 * self.mean_edge ** 2
+        # one kernel sums L = Pᵀ C_fan P (Bunge et al. 2020 §4), M = lump(Pᵀ M_fan P) = Pᵀ A_fan (rows of P sum
+        # to one, §4.2) and the normals per polygon, without forming the refined matrices; fan triangles of zero
+        # area (nonconvex / degenerate polygons) carry no stiffness or mass and are dropped
+        thresh = 1e-12 * self.mean_edge ** 2
+        rows, cols, vals, self.M, An, good, fn, fG = polygon_assembly(self.V_refined, start, corners, vid, wflat, n,
+                                                                      thresh)
         if not good.any():
             raise ValueError("polygons: all polygons have zero area")
         self.F_refined = F[good]
-        ops = TriangleMeshOperators(self.V_refined, self.F_refined, edges=False)   # vertex operators only
-        self.fine_ops = ops
-        Pt = self.P.T.tocsr()
-        L = (Pt @ ops.cotan_laplacian() @ self.P).tocsr()               # Bunge et al. 2020 §4: L = Pᵀ L_fan P
-        L = (0.5 * (L + L.T)).tocsr()
-        self.M = Pt @ ops.vertex_mass()                                  # lumped Pᵀ M_fan P (rows of P sum to 1)
+        self._fine_normals, self._fine_G = fn[good], fG[good]      # steps II–III on the fine triangles
+        self._fine_ops = None
+        # per polygon exactly symmetric, and duplicates summed in polygon order for (i, j) and (j, i) alike:
+        # L is exactly symmetric
+        L = sp.csr_matrix(coo_to_symmetric_csr(rows, cols, vals, n)[::-1], shape=(n, n))
         # vertex normals: area-weighted fine triangle normals (§8.3)
-        # (the sum over the corners k = 0, 1, 2 in that order, as np.add.at did it, by one bincount per axis)
-        An = ops.normals * ops.areas[:, None]
-        idx = self.F_refined.T.ravel()
-        An = np.stack([np.bincount(idx, weights=np.tile(An[:, c], 3), minlength=len(self.V_refined))[:n]
-                       for c in range(3)], 1)
         nrm = np.linalg.norm(An, axis=1)
         An[nrm == 0] = [0, 0, 1.0]
         N = An / np.maximum(nrm, 1e-300)[:, None]
@@ -316,19 +281,28 @@ class PolygonDomain(VertexSurfaceDomain):
     def _edges(groups) -> np.ndarray:
         return np.concatenate([np.stack([Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1) for Q in groups.values()])
 
+    @property
+    def fine_ops(self) -> TriangleMeshOperators:
+        """Vertex operators of the refined triangle mesh (built on first access; the solves use the kernel's
+        normals and divergence weights of the same triangles)."""
+        if self._fine_ops is None:
+            self._fine_ops = TriangleMeshOperators(self.V_refined, self.F_refined, edges=False)
+        return self._fine_ops
+
     def gather(self, X) -> np.ndarray:
         """§8.3: prolong the vertex vectors to the fine vertices (virtual vertex = Σ w_i X_i as 3D vectors), sum
         them over every fine triangle and project into its plane (normalized by the core)."""
-        ops = self.fine_ops
         Xf = self.P @ self.to_3d(X)                                      # (n + #virtual, 3)
-        F = ops.F
+        F, Nf = self.F_refined, self._fine_normals
         Y = Xf[F[:, 0]] + Xf[F[:, 1]] + Xf[F[:, 2]]                     # (a + b) + c, as .sum(axis=1) adds
-        Y -= ops.normals * np.einsum("fj,fj->f", Y, ops.normals)[:, None]
+        Y -= Nf * np.einsum("fj,fj->f", Y, Nf)[:, None]
         return Y
 
     def divergence(self, Y) -> np.ndarray:
-        """The fine divergence restricted by Pᵀ (Bunge et al. §4.5)."""
-        return self.P.T @ self.fine_ops.divergence(Y)
+        """The fine divergence (b_i = Σ_f |f| ∇λ_i · Y_f) restricted by Pᵀ (Bunge et al. §4.5)."""
+        contrib = np.einsum("fkj,fj->fk", self._fine_G, Y)
+        b = np.bincount(self.F_refined.ravel(), weights=contrib.ravel(), minlength=self.P.shape[0])
+        return self.P.T @ b
 
     def check_curve_edges(self, a, k):
         n = self.n_vertices

@@ -91,6 +91,7 @@ class TriangleDomain(HeatDomain):
     """
 
     difference_order = "first"
+    cache_sources = True
 
     def __init__(self, V=None, F=None, t: float | None = None, connection: str = "auto", ops=None):
         self.ops = ops if ops is not None else TriangleMeshOperators(V, F)

@@ -51,9 +51,14 @@ class PolygonMeshSignedHeatSolver:
         self.core = SignedHeatCore(d)
         fr = self.frame  # attributes in input units (L, Lconn, P, frames are scale-free); fine_ops: frame units
         self.n_vertices, self.V, self.P = d.n_vertices, V, d.P
-        self.V_refined, self.F_refined, self.fine_ops = fr.point(d.V_refined), d.F_refined, d.fine_ops
+        self.V_refined, self.F_refined = fr.point(d.V_refined), d.F_refined
         self.L, self.M, self.Lconn, self.t = d.L, fr.area(d.M), d.Lconn, float(fr.area(d.t))
         self.N, self.e1, self.e2, self.mean_edge = d.N, d.e1, d.e2, float(fr.length(d.mean_edge))
+
+    @property
+    def fine_ops(self):
+        """Vertex operators of the refined triangle mesh (frame units; built on first access)."""
+        return self.domain.fine_ops
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint="zero",
                          soft_weight=None, progress=None):
