@@ -94,9 +94,16 @@ def test_far_queries_are_clamped_and_unrepresentable_ones_refused():
     d = gsdf.signed_distance(V, F, Qf)
     np.testing.assert_allclose(d, [1e200, 3e250], rtol=1e-14)
     assert FAR < 1e200
-    # a geometry 1e-300 across and a query at 1e300: the query's frame coordinate overflows float64
+    # a geometry 1e-300 across and a query at 1e300: the query's frame coordinate overflows float64; its
+    # winding number is still 0 (clamped like any far query), its distance is refused
+    np.testing.assert_allclose(gsdf.winding_number(V * 1e-300, F, [[1e300, 0, 0]]), 0.0, atol=1e-30)
+    np.testing.assert_allclose(gsdf.fast_winding_number(V * 1e-300, F, [[1e300, 0, 0]]), 0.0, atol=1e-30)
     with pytest.raises(ValueError, match="Q: row 0 cannot be represented"):
-        gsdf.winding_number(V * 1e-300, F, [[1e300, 0, 0]])
+        gsdf.unsigned_distance(V * 1e-300, F, [[1e300, 0, 0]])
+    # a vertex the faces do not use, beyond float64 range at the scale of the used ones: ignored
+    Vu = np.vstack([V * 1e-308, [[1.0, 0, 0]]])
+    np.testing.assert_allclose(gsdf.winding_number(Vu, F, [[0.0, 0, 0]]), gsdf.winding_number(V, F, [[0.0, 0, 0]]),
+                               atol=1e-12)
     with pytest.raises(ValueError, match="point areas overflow"):
         point_areas(P * 1e300, P)
 

@@ -102,13 +102,17 @@ def test_winding_number_invariances(mesh, Q, s, o, rnd):
     # queries on a face plane contribute a 0 solid angle there: keep queries off the geometry
     ws = gsdf.winding_number(V * s + o, F, Q * s + o, method="direct")
     tol = 1e-6 if o == 0 or s > 1e-3 else 1.0  # offsets much larger than the shape erase its digits
-    if tol < 1.0:
+    try:   # queries on the geometry (a face plane, an edge, a vertex) have no well-defined winding number
         near = gsdf.unsigned_distance(V, F, Q) < 1e-6
+    except ValueError as exc:    # a distance beyond float64 at the geometry's scale (subnormal V): refused
+        assert "cannot be represented" in str(exc)
+        near = np.zeros(len(Q), bool)
+    if tol < 1.0:
         np.testing.assert_allclose(ws[~near], w[~near], atol=tol)
     perm = list(range(len(F)))
     rnd.shuffle(perm)
-    np.testing.assert_allclose(gsdf.winding_number(V, F[perm], Q, method="direct"), w, atol=1e-9)
-    np.testing.assert_allclose(gsdf.winding_number(V, F, Q, method="hierarchical"), w, atol=1e-9)
+    np.testing.assert_allclose(gsdf.winding_number(V, F[perm], Q, method="direct")[~near], w[~near], atol=1e-9)
+    np.testing.assert_allclose(gsdf.winding_number(V, F, Q, method="hierarchical")[~near], w[~near], atol=1e-9)
 
 
 @given(closed_meshes(), queries(), SCALES)

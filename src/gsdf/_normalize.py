@@ -14,8 +14,9 @@ there and maps lengths back on output.
 * Queries farther than :data:`FAR` (2^64 frame units, i.e. 2^64 times the geometry's size) are moved
   radially onto that sphere: a winding number there is below 1e-38 and a distance grows exactly by the
   moved length up to a relative 2^-64 (:meth:`Frame.queries` returns that excess).
-* What cannot be represented after scaling (a query whose frame coordinates overflow float64) is refused
-  with a ValueError naming the argument.
+* A query whose frame coordinates overflow float64 is clamped like any far query when only its winding
+  number is asked for (it is 0); a distance there is not representable in frame units and is refused with a
+  ValueError naming the argument.
 
 Example
 -------
@@ -78,7 +79,9 @@ class Frame:
         used[F.ravel()] = True
         return cls.of(V[used])
 
-    def _map(self, X: np.ndarray, name: str, row0: int = 0) -> np.ndarray:
+    def _map(self, X: np.ndarray, name: str, row0: int = 0, far_ok: bool = False) -> np.ndarray:
+        """``(X − c) / s``; rows whose frame coordinates overflow are refused, or with ``far_ok`` put at
+        distance 2·FAR along their direction from the centre (farther than any clamp radius)."""
         if self.identity:
             return X
         e = self.exponent
@@ -96,14 +99,25 @@ class Frame:
             else:
                 Y = np.ldexp(X - self.centre, -e)
         if not np.isfinite(Y.sum()) and not np.isfinite(Y).all():
-            bad = int(np.argmax(~np.isfinite(Y).all(axis=1)))
+            over = ~np.isfinite(Y).all(axis=1)
+            if far_ok:
+                # the direction from the centre, computed in input units (halved: no overflow), then placed
+                # beyond FAR so that queries() clamps it like any other far query
+                D = 0.5 * np.asarray(X[over], dtype=np.float64) - 0.5 * self.centre
+                Z = D / np.max(np.abs(D), axis=1)[:, None]
+                Y = np.array(Y, dtype=np.float64, copy=True)
+                Y[over] = Z / np.linalg.norm(Z, axis=1)[:, None] * (2.0 * FAR)
+                return Y
+            bad = int(np.argmax(over))
             raise ValueError(f"{name}: row {row0 + bad} cannot be represented relative to the geometry (its distance "
                              f"from the geometry is beyond float64 range at the geometry's scale 2^{self.exponent})")
         return Y
 
     def geometry(self, X: np.ndarray, name: str = "V") -> np.ndarray:
-        """Geometry coordinates (n, d) in the frame."""
-        return np.ascontiguousarray(self._map(X, name))
+        """Geometry coordinates (n, d) in the frame. Rows beyond float64 range at the frame's scale can only be
+        vertices that the frame's geometry does not use (e.g. an unused 1.0 beside a face at 1e-309): they
+        are placed far away along their direction instead of refused."""
+        return np.ascontiguousarray(self._map(X, name, far_ok=True))
 
     def queries(self, Q: np.ndarray, name: str = "Q", want_excess: bool = False, row0: int = 0):
         """Query coordinates in the frame, far queries clamped onto the sphere of radius :data:`FAR`.
@@ -111,7 +125,9 @@ class Frame:
         Returns the (q, d) array, and with ``want_excess`` also the (q,) radial length removed by the
         clamp (frame units; zero for all but very far queries).
         """
-        Y = self._map(Q, name, row0)
+        # a query whose frame coordinates overflow is only clamped when no excess length is asked for (its
+        # winding number is 0); a distance there would not be representable in frame units: refused
+        Y = self._map(Q, name, row0, far_ok=not want_excess)
         excess = np.zeros(Y.shape[0]) if want_excess else None
         if Y.size and max(float(Y.max()), -float(Y.min())) > FAR:
             r = np.max(np.abs(Y), axis=1)
