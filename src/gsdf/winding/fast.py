@@ -47,7 +47,7 @@ from numba import njit, prange
 
 from .._checks import as_mesh, as_points, integer
 from .._normalize import Frame
-from ..spatial.bvh import BVH, build_bvh
+from ..spatial.bvh import BVH, build_bvh, build_volume_bvh
 from ..spatial.wide import widen
 from ._query import map_queries
 from .exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w
@@ -241,59 +241,171 @@ def _leaf_triangles(T, s, e, qx, qy, qz):
 
 
 @njit(parallel=True, cache=True)
-def _triangle_boxes(V, F):
-    """Corners (m, 9), centroids, box lows and highs (m, 3) of the triangles F of V, in one parallel pass."""
+def _triangle_elements(V, F):
+    """(m, 9) rows [centroid, box lo, box hi] of the triangles F of V: the input of the tree build."""
     m = F.shape[0]
-    T = np.empty((m, 9))
-    X = np.empty((m, 3))
-    lo = np.empty((m, 3))
-    hi = np.empty((m, 3))
+    E = np.empty((m, 9))
     for t in prange(m):
         for d in range(3):
             a, b, c = V[F[t, 0], d], V[F[t, 1], d], V[F[t, 2], d]
-            T[t, d], T[t, 3 + d], T[t, 6 + d] = a, b, c
-            X[t, d] = (a + b + c) / 3.0
-            lo[t, d] = min(a, min(b, c))
-            hi[t, d] = max(a, max(b, c))
-    return T, X, lo, hi
+            E[t, d] = (a + b + c) / 3.0
+            E[t, 3 + d] = min(a, min(b, c))
+            E[t, 6 + d] = max(a, max(b, c))
+    return E
+
+
+@njit(cache=True, inline="always")
+def _area_normal(T, j):
+    """Area-weighted normal n = ½ (b − a) × (c − a) of leaf row j of T (corners a, b, c)."""
+    e1x, e1y, e1z = T[j, 3] - T[j, 0], T[j, 4] - T[j, 1], T[j, 5] - T[j, 2]
+    e2x, e2y, e2z = T[j, 6] - T[j, 0], T[j, 7] - T[j, 1], T[j, 8] - T[j, 2]
+    return 0.5 * (e1y * e2z - e1z * e2y), 0.5 * (e1z * e2x - e1x * e2z), 0.5 * (e1x * e2y - e1y * e2x)
+
+
+# the 6 entries (a, b) of a symmetric 3×3 matrix in the order of the moment rows: xx yy zz xy xz yz
+_PA = (0, 1, 2, 0, 0, 1)
+_PB = (0, 1, 2, 1, 2, 2)
 
 
 @njit(parallel=True, cache=True)
-def _triangle_rows(T9, X, order):
-    """Per triangle in tree order: the leaf rows (corners, then 1.0, or 0.0 for a zero-area face), the
-    centroid, the area-weighted normal n = ½ (b − a) × (c − a) and the second moment C_t about the centroid
-    by Eq. 29 (⅓ Σ over the edge midpoints m of (m − x)(m − x)ᵀ; shifted to each node centre by the
-    parallel-axis theorem in _node_moments), as xx yy zz xy xz yz."""
+def _tree_moments(V, F, order, start, end, right, lo, hi):
+    """Leaf rows and Taylor moments of every node of a triangle tree, children before parents.
+
+    Returns T (m, 10): per triangle in tree order its 9 corner coordinates, then 1.0 (0.0 for a zero-area
+    face, see :func:`_leaf_triangles`); and D (k, NODE_WIDTH), the moments of :func:`_node_moments` about each
+    node's area-weighted centre p̃, with r² the farthest corner of the node's box from p̃.
+
+    A leaf sums its triangles (area-weighted normal n, centroid x, second moment C_t about x by the
+    edge-midpoint rule of Eq. 29). An internal node adds its two children's moments shifted from their
+    centres p_c to its own p̃ (δ = p_c − p̃, the parallel-axis theorem; Σ over the child's triangles):
+        c0 += c0_c,   C1_ab += C1_c,ab + δ_a c0_c,b,
+        S_ab,c += S_c,ab,c + δ_a C1_c,bc + δ_b C1_c,ac + δ_a δ_b c0_c,c      (S_ab,c = Σ (C_t + d dᵀ)_ab n_c)
+    so the build costs O(m + k) instead of the O(m log m) of summing every node's triangles.
+    """
     m = order.shape[0]
+    k = start.shape[0]
     T = np.empty((m, 10))
-    Xo = np.empty((m, 3))
-    AN = np.empty((m, 3))
-    M = np.zeros((m, 6))
-    for j in prange(m):
-        t = order[j]
-        for k in range(9):
-            T[j, k] = T9[t, k]
+    D = np.zeros((k, NODE_WIDTH))
+    W = np.empty((k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
+    for i in prange(k):
+        if right[i] >= 0:
+            continue
+        s, e = start[i], end[i]
+        A = ax = ay = az = ux = uy = uz = 0.0
+        for j in range(s, e):
+            f = order[j]
+            for c in range(3):
+                v = F[f, c]
+                T[j, 3 * c] = V[v, 0]
+                T[j, 3 * c + 1] = V[v, 1]
+                T[j, 3 * c + 2] = V[v, 2]
+            nx, ny, nz = _area_normal(T, j)
+            T[j, 9] = 1.0 if (nx != 0.0 or ny != 0.0 or nz != 0.0) else 0.0
+            a = np.sqrt(nx * nx + ny * ny + nz * nz)
+            x = (T[j, 0] + T[j, 3] + T[j, 6]) / 3.0
+            y = (T[j, 1] + T[j, 4] + T[j, 7]) / 3.0
+            z = (T[j, 2] + T[j, 5] + T[j, 8]) / 3.0
+            A += a
+            ax += a * x
+            ay += a * y
+            az += a * z
+            ux += x
+            uy += y
+            uz += z
+        W[i, 0], W[i, 1], W[i, 2], W[i, 3], W[i, 4], W[i, 5], W[i, 6] = A, ax, ay, az, ux, uy, uz
+        if A > 0.0:
+            cx, cy, cz = ax / A, ay / A, az / A
+        else:
+            cx, cy, cz = ux / (e - s), uy / (e - s), uz / (e - s)
+        D[i, 0], D[i, 1], D[i, 2] = cx, cy, cz
+        for j in range(s, e):
+            n0, n1, n2 = _area_normal(T, j)
+            x = (T[j, 0] + T[j, 3] + T[j, 6]) / 3.0
+            y = (T[j, 1] + T[j, 4] + T[j, 7]) / 3.0
+            z = (T[j, 2] + T[j, 5] + T[j, 8]) / 3.0
+            # C_t by Eq. 29: ⅓ Σ over the edge midpoints q of (q − x)(q − x)ᵀ
+            mxx = myy = mzz = mxy = mxz = myz = 0.0
+            for c in range(3):
+                c2 = (c + 1) % 3
+                qx = 0.5 * (T[j, 3 * c] + T[j, 3 * c2]) - x
+                qy = 0.5 * (T[j, 3 * c + 1] + T[j, 3 * c2 + 1]) - y
+                qz = 0.5 * (T[j, 3 * c + 2] + T[j, 3 * c2 + 2]) - z
+                mxx += qx * qx / 3.0
+                myy += qy * qy / 3.0
+                mzz += qz * qz / 3.0
+                mxy += qx * qy / 3.0
+                mxz += qx * qz / 3.0
+                myz += qy * qz / 3.0
+            d0, d1, d2 = x - cx, y - cy, z - cz
+            D[i, 4] += n0
+            D[i, 5] += n1
+            D[i, 6] += n2
+            D[i, 7] += d0 * n0
+            D[i, 8] += d0 * n1
+            D[i, 9] += d0 * n2
+            D[i, 10] += d1 * n0
+            D[i, 11] += d1 * n1
+            D[i, 12] += d1 * n2
+            D[i, 13] += d2 * n0
+            D[i, 14] += d2 * n1
+            D[i, 15] += d2 * n2
+            mxx += d0 * d0
+            myy += d1 * d1
+            mzz += d2 * d2
+            mxy += d0 * d1
+            mxz += d0 * d2
+            myz += d1 * d2
+            for c in range(3):
+                nc = n0 if c == 0 else (n1 if c == 1 else n2)
+                b = _S + 6 * c
+                D[i, b] += mxx * nc
+                D[i, b + 1] += myy * nc
+                D[i, b + 2] += mzz * nc
+                D[i, b + 3] += mxy * nc
+                D[i, b + 4] += mxz * nc
+                D[i, b + 5] += myz * nc
+    for i in range(k - 1, -1, -1):  # preorder: both children of i have larger ids
+        r = right[i]
+        if r < 0:
+            continue
+        l = i + 1
+        for q in range(7):
+            W[i, q] = W[l, q] + W[r, q]
+        if W[i, 0] > 0.0:
+            cx, cy, cz = W[i, 1] / W[i, 0], W[i, 2] / W[i, 0], W[i, 3] / W[i, 0]
+        else:
+            cnt = end[i] - start[i]
+            cx, cy, cz = W[i, 4] / cnt, W[i, 5] / cnt, W[i, 6] / cnt
+        D[i, 0], D[i, 1], D[i, 2] = cx, cy, cz
+        for h in range(2):
+            ch = l if h == 0 else r
+            dl0, dl1, dl2 = D[ch, 0] - cx, D[ch, 1] - cy, D[ch, 2] - cz
+            for a in range(3):
+                D[i, _C0 + a] += D[ch, _C0 + a]
+                da = dl0 if a == 0 else (dl1 if a == 1 else dl2)
+                for b in range(3):
+                    D[i, _C1 + 3 * a + b] += D[ch, _C1 + 3 * a + b] + da * D[ch, _C0 + b]
+            for q in range(6):
+                pa, pb = _PA[q], _PB[q]
+                da = dl0 if pa == 0 else (dl1 if pa == 1 else dl2)
+                db = dl0 if pb == 0 else (dl1 if pb == 1 else dl2)
+                for c in range(3):
+                    D[i, _S + 6 * c + q] += (D[ch, _S + 6 * c + q] + da * D[ch, _C1 + 3 * pb + c]
+                                             + db * D[ch, _C1 + 3 * pa + c] + da * db * D[ch, _C0 + c])
+    for i in prange(k):
+        # u_a = Σ_b S_ab,b and v_c = Σ_a S_aa,c (see the module docstring)
+        for c in range(3):
+            D[i, _VV + c] = D[i, _S + 6 * c] + D[i, _S + 6 * c + 1] + D[i, _S + 6 * c + 2]
+        D[i, _U] = D[i, _S] + D[i, _S + 6 + 3] + D[i, _S + 12 + 4]
+        D[i, _U + 1] = D[i, _S + 3] + D[i, _S + 6 + 1] + D[i, _S + 12 + 5]
+        D[i, _U + 2] = D[i, _S + 4] + D[i, _S + 6 + 5] + D[i, _S + 12 + 2]
+        # far-field radius: the farthest corner of the node's box from p̃ (see FastWindingNumber._build)
+        r2 = 0.0
         for d in range(3):
-            Xo[j, d] = X[t, d]
-        e1x, e1y, e1z = T9[t, 3] - T9[t, 0], T9[t, 4] - T9[t, 1], T9[t, 5] - T9[t, 2]
-        e2x, e2y, e2z = T9[t, 6] - T9[t, 0], T9[t, 7] - T9[t, 1], T9[t, 8] - T9[t, 2]
-        nx = 0.5 * (e1y * e2z - e1z * e2y)
-        ny = 0.5 * (e1z * e2x - e1x * e2z)
-        nz = 0.5 * (e1x * e2y - e1y * e2x)
-        AN[j, 0], AN[j, 1], AN[j, 2] = nx, ny, nz
-        T[j, 9] = 1.0 if (nx != 0.0 or ny != 0.0 or nz != 0.0) else 0.0
-        for k in range(3):
-            k2 = (k + 1) % 3
-            mx = 0.5 * (T9[t, 3 * k] + T9[t, 3 * k2]) - X[t, 0]
-            my = 0.5 * (T9[t, 3 * k + 1] + T9[t, 3 * k2 + 1]) - X[t, 1]
-            mz = 0.5 * (T9[t, 3 * k + 2] + T9[t, 3 * k2 + 2]) - X[t, 2]
-            M[j, 0] += mx * mx / 3.0
-            M[j, 1] += my * my / 3.0
-            M[j, 2] += mz * mz / 3.0
-            M[j, 3] += mx * my / 3.0
-            M[j, 4] += mx * mz / 3.0
-            M[j, 5] += my * mz / 3.0
-    return T, Xo, AN, M
+            g = max(abs(lo[i, d] - D[i, d]), abs(hi[i, d] - D[i, d]))
+            r2 += g * g
+        D[i, _R2] = r2
+    return T, D
 
 
 def _pack_nodes(D, tree):
@@ -314,7 +426,7 @@ WIDTH = 4
 _WF = 4 + COMPACT_WIDTH - 1  # fields per child slot: centre (3), β²r², the 23 compact coefficients
 
 
-def _pack_wide(D, C, tree, beta2, order, width=WIDTH):
+def _pack_wide(D, tree, beta2, order, width=WIDTH):
     """Per wide node, the far-field data of its children as (w, _WF, width) float64 (one lane per child, so
     the lane loop of :func:`_eval_triangles_wide` reads contiguous memory), plus the child links and the
     element ranges of the leaf children (w, width) int64."""
@@ -330,37 +442,37 @@ def _pack_wide(D, C, tree, beta2, order, width=WIDTH):
         top[0, 0] = 1
         child = np.vstack([top, np.where(child >= 0, child + 1, child)])
         depth += 1
-    rows = np.empty((D.shape[0], _WF))
-    rows[:, 0:3] = D[:, 0:3]
-    rows[:, 3] = beta2 * D[:, 3]
-    rows[:, 4:] = C[:, : COMPACT_WIDTH - 1]
-    if order < 2:   # the unused orders' coefficients are zero: one kernel evaluates every order
-        rows[:, 4 + 10:] = 0.0
-    if order < 1:
-        rows[:, 4 + 3:] = 0.0
-    # an empty slot is never far (β²r² = ∞) and never descended (child −2)
-    pad = np.zeros(_WF)
-    pad[3] = np.inf
-    W = _lanes(rows, kids, pad)
-    ok = kids >= 0
-    kk = np.where(ok, kids, 0)
-    LS = np.where(ok, tree.start[kk], 0)
-    LE = np.where(ok, tree.end[kk], 0)
+    # compact columns kept per order (the unused orders' coefficients are zero: one kernel evaluates every order)
+    keep = (3, 10, COMPACT_WIDTH - 1)[order]
+    W, LS, LE = _lanes(D, kids, tree.start, tree.end, beta2, keep, _FOLD_IN, _FOLD_OUT, _FOLD_VAL)
     return W, np.ascontiguousarray(child), LS, LE, depth * (width - 1) + 2
 
 
 @njit(parallel=True, cache=True)
-def _lanes(rows, kids, pad):
-    """(w, f, width) array whose lane c of node n is rows[kids[n, c]] (pad where kids is −1)."""
+def _lanes(D, kids, start, end, beta2, keep, fin, fout, val):
+    """(w, _WF, width) lanes: lane c of wide node n holds child kids[n, c]'s centre, β²r² and its compact
+    far-field row (the fold of :func:`_compact_moments`, columns < ``keep``), and (w, width) element ranges of
+    the children. An empty slot (kid −1) is never far (β²r² = ∞) and has an empty range."""
     w, width = kids.shape
-    f = rows.shape[1]
-    W = np.empty((w, f, width))
+    W = np.zeros((w, _WF, width))
+    LS = np.zeros((w, width), np.int64)
+    LE = np.zeros((w, width), np.int64)
     for n in prange(w):
         for c in range(width):
             b = kids[n, c]
-            for j in range(f):
-                W[n, j, c] = rows[b, j] if b >= 0 else pad[j]
-    return W
+            if b < 0:
+                W[n, 3, c] = np.inf
+                continue
+            W[n, 0, c] = D[b, 0]
+            W[n, 1, c] = D[b, 1]
+            W[n, 2, c] = D[b, 2]
+            W[n, 3, c] = beta2 * D[b, _R2]
+            for j in range(fin.shape[0]):
+                if fout[j] < keep:
+                    W[n, 4 + fout[j], c] += val[j] * D[b, fin[j]]
+            LS[n, c] = start[b]
+            LE[n, c] = end[b]
+    return W, LS, LE
 
 
 @njit(parallel=True, cache=True, fastmath=_FASTMATH)
@@ -528,20 +640,15 @@ class FastWindingNumber(_FastWindingBase):
 
     def _build(self, V, F, leaf_size):
         """Tree, leaf rows, node moments and the wide walk's lane data (in the normalised frame)."""
-        T, X, lo, hi = _triangle_boxes(np.ascontiguousarray(self._frame.geometry(V)), F)
-        self.tree = build_bvh(X, lo, hi, leaf_size, split="volume")
-        self._T, X, AN, M = _triangle_rows(T, X, self.tree.order)
-        # r² = 0 here (no element points passed): the box-corner radius set below bounds it anyway.
-        self._D = _node_moments(self.tree.start, self.tree.end, X, AN, M, np.empty((len(X), 0)), NODE_WIDTH)
-        # Far-field radius for triangles: the farthest corner of the node's box from p̃. It bounds the
-        # paper's r (farthest element point) and, measured on the CGAL meshes (bench/bench_winding.py),
-        # brings the RMS error at β = 2 from ~1.3e-3 to ~7e-4 — the paper's "β = 2 gives ~1e-3".
-        t = self.tree
-        far = np.maximum(np.abs(t.lo - self._D[:, :3]), np.abs(t.hi - self._D[:, :3]))
-        self._D[:, 3] = np.maximum(self._D[:, 3], (far ** 2).sum(axis=1))
+        V = np.ascontiguousarray(self._frame.geometry(V))
+        self.tree = t = build_volume_bvh(_triangle_elements(V, F), leaf_size)
+        # Far-field radius for triangles (set by _tree_moments): the farthest corner of the node's box from p̃.
+        # It bounds the paper's r (farthest element point) and, measured on the CGAL meshes
+        # (bench/bench_winding.py), brings the RMS error at β = 2 from ~1.3e-3 to ~7e-4 — the paper's
+        # "β = 2 gives ~1e-3".
+        self._T, self._D = _tree_moments(V, F, t.order, t.start, t.end, t.right, t.lo, t.hi)
         # the walk tests the WIDTH children of a node together (see _eval_triangles_wide)
-        self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(
-            self._D, _compact_moments(self._D), t, self.beta ** 2, self.order)
+        self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(self._D, t, self.beta ** 2, self.order)
 
     def _kernel(self, q, out):
         with _single_thread(q.shape[0] < SERIAL_QUERIES):
