@@ -28,8 +28,9 @@ Example
 
 from __future__ import annotations
 
+import numba
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 NBINS = 32
 #: Nodes with at most this many elements are split by an exhaustive sweep instead of bins (3 × 32 bins cost
@@ -37,6 +38,8 @@ NBINS = 32
 SMALL = 24
 MINBINS = 8
 BINDIV = 1
+#: Trees over more elements grow their lower subtrees in parallel when numba has more than one thread.
+PARALLEL_ELEMENTS = 20_000
 
 
 @njit(cache=True, inline="always")
@@ -230,37 +233,41 @@ def build_volume(cent, elo, ehi, leaf_size):
     E[:, 0:3] = cent
     E[:, 3:6] = elo
     E[:, 6:9] = ehi
-    return build_volume_rows(E, leaf_size)
+    return build_volume_rows(E, leaf_size, numba.get_num_threads())
 
 
 @njit(cache=True)
-def build_volume_rows(E, leaf_size):
-    """:func:`build_volume` on one (n, 9) float64 array of rows [centroid, box lo, box hi], which it reorders
-    in place (to tree order: row j is then element ``order[j]``)."""
-    n = E.shape[0]
-    order = np.arange(n)
-    root = np.empty(12)
-    for d in range(3):
-        root[d] = root[6 + d] = np.inf
-        root[3 + d] = root[9 + d] = -np.inf
-    for i in range(n):
-        for d in range(3):
-            c = E[i, d]
-            root[d] = min(root[d], E[i, 3 + d])
-            root[3 + d] = max(root[3 + d], E[i, 6 + d])
-            root[6 + d] = min(root[6 + d], c)
-            root[9 + d] = max(root[9 + d], c)
-    cap = 2 * n  # a binary tree whose leaves are nonempty has at most 2n − 1 nodes
-    start = np.empty(cap, np.int64)
-    end = np.empty(cap, np.int64)
-    right = np.full(cap, -1, np.int64)
-    lo = np.empty((cap, 3))
-    hi = np.empty((cap, 3))
+def _bigger(a, need):
+    """``a`` with its first axis grown (doubled) to hold at least ``need`` rows."""
+    cap = a.shape[0]
+    while cap < need:
+        cap *= 2
+    if cap == a.shape[0]:
+        return a
+    out = np.empty((cap,) + a.shape[1:], a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+@njit(cache=True)
+def _grow(E, order, s0, e0, b0, leaf_size, cutoff, cap):
+    """Split rows s0:e0 of E (node bounds ``b0``: box lo, hi, centroid lo, hi) top-down into a preorder
+    subtree with local node ids 0, 1, ... . A node of at most ``cutoff`` elements (cutoff > leaf_size; 0: none)
+    is not split but listed as a task (its subtree is grown later, possibly on another thread).
+
+    Returns (count, node_i (count, 4) int64 [start, end, right, task or −1], node_b (count, 6) box,
+    ntask, task_i (ntask, 3) [start, end, node], task_b (ntask, 12) bounds).
+    """
+    node_i = np.empty((cap, 4), np.int64)
+    node_b = np.empty((cap, 6))
+    task_i = np.empty((16, 3), np.int64)
+    task_b = np.empty((16, 12))
+    ntask = 0
     # stack of pending nodes: (start, end, parent that takes it as right child) and its 12 bounds
     st_i = np.empty((64, 3), np.int64)
     st_b = np.empty((64, 12))
-    st_i[0, 0], st_i[0, 1], st_i[0, 2] = 0, n, -1
-    st_b[0] = root
+    st_i[0, 0], st_i[0, 1], st_i[0, 2] = s0, e0, -1
+    st_b[0] = b0
     sp = 1
     count = 0
     bins = np.empty((3, NBINS, 7))
@@ -279,14 +286,27 @@ def build_volume_rows(E, leaf_size):
             b[d] = st_b[sp, d]
         node = count
         count += 1
-        start[node] = s
-        end[node] = e
-        for d in range(3):
-            lo[node, d] = b[d]
-            hi[node, d] = b[3 + d]
+        if count > node_i.shape[0]:
+            node_i = _bigger(node_i, count)
+            node_b = _bigger(node_b, count)
+        node_i[node, 0] = s
+        node_i[node, 1] = e
+        node_i[node, 2] = -1
+        node_i[node, 3] = -1
+        for d in range(6):
+            node_b[node, d] = b[d]
         if parent >= 0:
-            right[parent] = node
+            node_i[parent, 2] = node
         if e - s <= leaf_size:
+            continue
+        if e - s <= cutoff:
+            if ntask == task_i.shape[0]:
+                task_i = _bigger(task_i, ntask + 1)
+                task_b = _bigger(task_b, ntask + 1)
+            task_i[ntask, 0], task_i[ntask, 1], task_i[ntask, 2] = s, e, node
+            task_b[ntask] = b
+            node_i[node, 3] = ntask
+            ntask += 1
             continue
         if e - s <= SMALL:
             m = _split_sweep(E, order, s, e, perm, pre, tmp, tmpo, out)
@@ -305,11 +325,85 @@ def build_volume_rows(E, leaf_size):
         st_i[sp, 0], st_i[sp, 1], st_i[sp, 2] = s, m, -1
         st_b[sp] = out[0:12]
         sp += 1
-    k = count
+    return count, node_i, node_b, ntask, task_i, task_b
+
+
+@njit(cache=True, parallel=True)
+def build_volume_rows(E, leaf_size, threads=1):
+    """:func:`build_volume` on one (n, 9) float64 array of rows [centroid, box lo, box hi], which it reorders
+    in place (to tree order: row j is then element ``order[j]``).
+
+    With ``threads`` > 1 (numba's current thread count) the top of the tree is split on the calling thread down to nodes of about
+    n/64 elements, whose subtrees are then grown in parallel and spliced into the preorder arrays."""
+    n = E.shape[0]
+    order = np.arange(n)
+    root = np.empty(12)
+    for d in range(3):
+        root[d] = root[6 + d] = np.inf
+        root[3 + d] = root[9 + d] = -np.inf
+    for i in range(n):
+        for d in range(3):
+            c = E[i, d]
+            root[d] = min(root[d], E[i, 3 + d])
+            root[3 + d] = max(root[3 + d], E[i, 6 + d])
+            root[6 + d] = min(root[6 + d], c)
+            root[9 + d] = max(root[9 + d], c)
+    parallel = threads > 1 and n > PARALLEL_ELEMENTS
+    if not parallel:
+        k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, root, leaf_size, 0, 2 * n)
+        start = node_i[:k, 0].copy()
+        end = node_i[:k, 1].copy()
+        right = node_i[:k, 2].copy()
+        lo = node_b[:k, 0:3].copy()
+        hi = node_b[:k, 3:6].copy()
+    else:
+        cutoff = max(leaf_size + 1, n // 64)
+        kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, 0, n, root, leaf_size, cutoff, 256)
+        # the tasks' subtrees, in parallel (disjoint row ranges of E and order)
+        counts = np.empty(ntask, np.int64)
+        subs_i = [np.empty((0, 4), np.int64) for _ in range(ntask)]
+        subs_b = [np.empty((0, 6)) for _ in range(ntask)]
+        for t in prange(ntask):
+            s, e = task_i[t, 0], task_i[t, 1]
+            c, si, sb, _, _, _ = _grow(E, order, s, e, task_b[t], leaf_size, 0, 2 * (e - s))
+            counts[t] = c
+            subs_i[t] = si
+            subs_b[t] = sb
+        # final preorder ids: the top tree's nodes in order, each task node replaced by its subtree
+        final = np.empty(kt, np.int64)
+        k = 0
+        for i in range(kt):
+            final[i] = k
+            k += counts[top_i[i, 3]] if top_i[i, 3] >= 0 else 1
+        start = np.empty(k, np.int64)
+        end = np.empty(k, np.int64)
+        right = np.empty(k, np.int64)
+        lo = np.empty((k, 3))
+        hi = np.empty((k, 3))
+        for i in range(kt):
+            if top_i[i, 3] < 0:
+                f = final[i]
+                start[f], end[f] = top_i[i, 0], top_i[i, 1]
+                right[f] = final[top_i[i, 2]] if top_i[i, 2] >= 0 else -1
+                for d in range(3):
+                    lo[f, d] = top_b[i, d]
+                    hi[f, d] = top_b[i, 3 + d]
+        for t in prange(ntask):
+            base = final[task_i[t, 2]]
+            si = subs_i[t]
+            sb = subs_b[t]
+            for j in range(counts[t]):
+                f = base + j
+                start[f], end[f] = si[j, 0], si[j, 1]
+                right[f] = base + si[j, 2] if si[j, 2] >= 0 else -1
+                for d in range(3):
+                    lo[f, d] = sb[j, d]
+                    hi[f, d] = sb[j, 3 + d]
+    k = start.shape[0]
     size = np.ones(k, np.int64)
     for i in range(k - 1, -1, -1):
         r = right[i]
         if r >= 0:
             size[i] = 1 + size[i + 1] + size[r]
     skip = np.arange(k) + size
-    return order, start[:k].copy(), end[:k].copy(), right[:k].copy(), skip, lo[:k].copy(), hi[:k].copy()
+    return order, start, end, right, skip, lo, hi

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numba import njit
 
@@ -111,7 +112,7 @@ def build_volume_bvh(E: np.ndarray, leaf_size: int = 4) -> BVH:
         raise ValueError("cannot build a tree over zero elements")
     if leaf_size < 1:
         raise ValueError(f"leaf_size must be >= 1, got {leaf_size}")
-    return BVH(*build_volume_rows(E, int(leaf_size)))
+    return BVH(*build_volume_rows(E, int(leaf_size), numba.get_num_threads()))
 
 
 def build_point_bvh(P: np.ndarray, leaf_size: int = 8) -> BVH:

@@ -185,24 +185,53 @@ def _fold_moments(D):
     return C
 
 
-# the fold is linear in the moments: its (NODE_WIDTH, COMPACT_WIDTH) matrix has ~60 non-zeros
-_FOLD = _fold_moments(np.eye(NODE_WIDTH))
-_FOLD_IN, _FOLD_OUT = (a.astype(np.int64) for a in np.nonzero(_FOLD))
-_FOLD_VAL = _FOLD[_FOLD_IN, _FOLD_OUT]
-
-
 def _compact_moments(D):
     """Fold the (k, NODE_WIDTH) moments of :func:`_node_moments` into (k, COMPACT_WIDTH) rows for _far_field_c."""
-    return _apply_fold(np.ascontiguousarray(D), _FOLD_IN, _FOLD_OUT, _FOLD_VAL, COMPACT_WIDTH)
+    return _apply_fold(np.ascontiguousarray(D), COMPACT_WIDTH)
 
 
 @njit(parallel=True, cache=True)
-def _apply_fold(D, fin, fout, val, width):
+def _apply_fold(D, width):
     C = np.zeros((D.shape[0], width))
     for i in prange(D.shape[0]):
-        for j in range(fin.shape[0]):
-            C[i, fout[j]] += val[j] * D[i, fin[j]]
+        _fold_into(D, i, C[i, :], COMPACT_WIDTH - 1)
     return C
+
+
+@njit(cache=True, inline="always")
+def _fold_into(D, i, out, keep):
+    """out[0:23] = the compact row of node i (the map of :func:`_fold_moments`, written out term by term);
+    columns from ``keep`` on (orders not evaluated) are zero."""
+    g = INV_4PI
+    out[0] = g * D[i, 4]
+    out[1] = g * D[i, 5]
+    out[2] = g * D[i, 6]
+    out[3] = g * (D[i, 7] + D[i, 11] + D[i, 15])
+    h = -3.0 * g
+    out[4] = h * D[i, 7]
+    out[5] = h * D[i, 11]
+    out[6] = h * D[i, 15]
+    out[7] = h * (D[i, 8] + D[i, 10])
+    out[8] = h * (D[i, 9] + D[i, 13])
+    out[9] = h * (D[i, 12] + D[i, 14])
+    h2 = -1.5 * g
+    out[10] = h * D[i, 16] + h2 * D[i, 19]
+    out[11] = h * D[i, 17] + h2 * D[i, 20]
+    out[12] = h * D[i, 18] + h2 * D[i, 21]
+    a = 7.5 * g
+    b = 15.0 * g
+    out[13] = a * D[i, 22]
+    out[14] = a * D[i, 29]
+    out[15] = a * D[i, 36]
+    out[16] = b * D[i, 25] + a * D[i, 28]
+    out[17] = b * D[i, 26] + a * D[i, 34]
+    out[18] = a * D[i, 23] + b * D[i, 31]
+    out[19] = b * D[i, 33] + a * D[i, 35]
+    out[20] = a * D[i, 24] + b * D[i, 38]
+    out[21] = a * D[i, 30] + b * D[i, 39]
+    out[22] = b * (D[i, 27] + D[i, 32] + D[i, 37])
+    for j in range(keep, COMPACT_WIDTH - 1):
+        out[j] = 0.0
 
 
 @njit(cache=True, inline="always", fastmath=_FASTMATH)
@@ -443,16 +472,15 @@ def _pack_wide(D, tree, beta2, order, width=WIDTH):
         child = np.vstack([top, np.where(child >= 0, child + 1, child)])
         depth += 1
     # compact columns kept per order (the unused orders' coefficients are zero: one kernel evaluates every order)
-    keep = (3, 10, COMPACT_WIDTH - 1)[order]
-    W, LS, LE = _lanes(D, kids, tree.start, tree.end, beta2, keep, _FOLD_IN, _FOLD_OUT, _FOLD_VAL)
+    W, LS, LE = _lanes(D, kids, tree.start, tree.end, beta2, (3, 10, COMPACT_WIDTH - 1)[order])
     return W, np.ascontiguousarray(child), LS, LE, depth * (width - 1) + 2
 
 
 @njit(parallel=True, cache=True)
-def _lanes(D, kids, start, end, beta2, keep, fin, fout, val):
+def _lanes(D, kids, start, end, beta2, keep):
     """(w, _WF, width) lanes: lane c of wide node n holds child kids[n, c]'s centre, β²r² and its compact
-    far-field row (the fold of :func:`_compact_moments`, columns < ``keep``), and (w, width) element ranges of
-    the children. An empty slot (kid −1) is never far (β²r² = ∞) and has an empty range."""
+    far-field row (:func:`_fold_into`, columns < ``keep``), and (w, width) element ranges of the children.
+    An empty slot (kid −1) is never far (β²r² = ∞), has zero coefficients and an empty range."""
     w, width = kids.shape
     W = np.zeros((w, _WF, width))
     LS = np.zeros((w, width), np.int64)
@@ -467,9 +495,7 @@ def _lanes(D, kids, start, end, beta2, keep, fin, fout, val):
             W[n, 1, c] = D[b, 1]
             W[n, 2, c] = D[b, 2]
             W[n, 3, c] = beta2 * D[b, _R2]
-            for j in range(fin.shape[0]):
-                if fout[j] < keep:
-                    W[n, 4 + fout[j], c] += val[j] * D[b, fin[j]]
+            _fold_into(D, b, W[n, 4:, c], keep)
             LS[n, c] = start[b]
             LE[n, c] = end[b]
     return W, LS, LE
