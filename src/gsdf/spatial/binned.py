@@ -388,7 +388,7 @@ def build_volume_rows(E, leaf_size, threads=1):
                 for d in range(3):
                     lo[f, d] = top_b[i, d]
                     hi[f, d] = top_b[i, 3 + d]
-        for t in prange(ntask):
+        for t in range(ntask):  # a copy: serial, so the build is one parallel launch
             base = final[task_i[t, 2]]
             si = subs_i[t]
             sb = subs_b[t]

@@ -274,12 +274,12 @@ def _leaf_triangles(T, s, e, qx, qy, qz):
     return acc
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)  # serial: ~5 ns per face, less than a parallel launch
 def _triangle_elements(V, F):
     """(m, 9) rows [centroid, box lo, box hi] of the triangles F of V: the input of the tree build."""
     m = F.shape[0]
     E = np.empty((m, 9))
-    for t in prange(m):
+    for t in range(m):
         for d in range(3):
             a, b, c = V[F[t, 0], d], V[F[t, 1], d], V[F[t, 2], d]
             E[t, d] = (a + b + c) / 3.0
@@ -442,7 +442,7 @@ def _tree_moments(V, F, order, start, end, right, lo, hi):
                 for c in range(3):
                     D[i, _S + 6 * c + q] += (D[ch, _S + 6 * c + q] + da * D[ch, _C1 + 3 * pb + c]
                                              + db * D[ch, _C1 + 3 * pa + c] + da * db * D[ch, _C0 + c])
-    for i in prange(k):
+    for i in range(k):  # O(k), serial: one parallel launch per build step is enough
         # u_a = Σ_b S_ab,b and v_c = Σ_a S_aa,c (see the module docstring)
         for c in range(3):
             D[i, _VV + c] = D[i, _S + 6 * c] + D[i, _S + 6 * c + 1] + D[i, _S + 6 * c + 2]
@@ -617,7 +617,10 @@ def _check_params(beta, order):
 # Below these sizes the build kernels / the walk run on the calling thread: a numba parallel launch waits
 # for its worker threads, which on a loaded machine took 30-200 ms per launch (issue 17: measured the build
 # of rotor.off, 1200 faces, at 192 ms with 2 threads and 1 ms with one, at load 16).
-SERIAL_BUILD_FACES = 100_000  # faces (triangles) or points (clouds)
+SERIAL_BUILD_FACES = 100_000  # points (clouds)
+# Triangle builds use the threads from this size on: three parallel launches (the tree's lower subtrees,
+# the leaf moments, the lanes) against ~60 ms of serial work at 75k faces.
+PARALLEL_BUILD_FACES = 20_000
 SERIAL_QUERIES = 16_384
 
 
@@ -682,7 +685,7 @@ class FastWindingNumber(_FastWindingBase):
         self.beta, self.order = _check_params(beta, order)
         leaf_size = integer(leaf_size, "leaf_size", 1)
         self._frame = Frame.of_mesh(V, F)  # scale invariance: the tree lives in the normalised frame
-        with _single_thread(F.shape[0] < SERIAL_BUILD_FACES):
+        with _single_thread(F.shape[0] < PARALLEL_BUILD_FACES):
             self._build(V, F, leaf_size)
 
     def _build(self, V, F, leaf_size):
