@@ -5,7 +5,9 @@ Run in a Python that has gsdf and the anchors (``../shared/tools/install-anchors
     VENV/bin/python bench/bench_winding.py            # full run (~15 min on 2 cores)
     VENV/bin/python bench/bench_winding.py --quick    # fewer queries, no 100^3 voxel check
 
-Prints every table and writes them to bench/RESULTS.md (section "winding").
+Prints every table and writes them to bench/RESULTS.md (section "winding"; a run with --only gets
+"winding-PARTS", and one with --only and --queries other than 10^6 "winding-PARTS-qN", e.g.
+``--quick --queries 100000 --load --only triangles`` writes "winding-triangles-q100000").
 Speed is a ratio of medians of 3 runs in this process; accuracy is against exact winding numbers
 (gsdf's hierarchical exact evaluation, cross-checked against igl.winding_number).
 """
@@ -43,7 +45,12 @@ Triangle walk (src/gsdf/winding/fast.py): the binary tree (volume splits, leaves
 4 children at a time: per node the 4 children's far-field tests and order-2 expansions are evaluated
 together in one unrolled loop that LLVM turns into 4-lane SIMD (AVX2 doubles), the near children are
 descended. The query points of a chunk are grouped by a counting sort on coarse Morton cells, and small
-builds / query sets run on the calling thread (a parallel launch waits for workers under load)."""
+builds / query sets run on the calling thread (a parallel launch waits for workers under load).
+Build (src/gsdf/spatial/binned.py, winding/fast.py): the tree moves element rows instead of indexing them,
+bins all three axes in one pass and sweeps every split position in nodes of ≤ 24 triangles; the node
+moments are summed bottom-up (children shifted to the parent's centre), O(m + k) instead of O(m log m),
+and folded straight into the 4-wide lanes; from 20k faces the lower subtrees, leaf moments and lanes use
+the threads. "gsdf pre s" is this whole build."""
 
 
 def queries_in_box(X, n, rng, pad=0.1):
@@ -229,7 +236,11 @@ error of 1/2 and either method may flip a voxel. "ratio" is (gsdf precompute + q
 """
     text = text.replace("{reading}", READING if "triangles" in parts else "")
     # a partial run (--only) gets its own section, so the full tables of the last full run stay
-    write_section("winding" if not args.only else "winding-" + "-".join(sorted(parts)), text)
+    # (a query count other than the default 10^6 of a partial run gets its own section too: --queries 100000)
+    name = "winding" if not args.only else "winding-" + "-".join(sorted(parts))
+    if args.only and args.queries and args.queries != 1_000_000:
+        name += f"-q{args.queries}"
+    write_section(name, text)
     print(text)
 
 

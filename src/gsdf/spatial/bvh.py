@@ -13,8 +13,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numba import njit
+
+from .binned import build_volume, build_volume_rows
 
 
 @dataclass(frozen=True)
@@ -57,11 +60,20 @@ def build_bvh(centroids: np.ndarray, elem_lo: np.ndarray, elem_hi: np.ndarray, l
     """Build a BVH over elements with the given centroids and bounding boxes (all (n, 3) float64).
 
     ``split="median"`` halves each node at the median centroid of its longest centroid axis (balanced tree).
-    ``split="volume"`` picks, among 3 × 16 binned centroid planes, the one minimising
-    n_L·vol(box_L) + n_R·vol(box_R) (box = child's element bounding box, volume taken as the cube of its
-    half-diagonal so flat boxes still count). A node is opened by a uniformly distributed query with
+    ``split="volume"`` picks, among 3 × 32 binned centroid planes (every position of the sorted elements in
+    nodes of at most 24), the split minimising n_L·vol(box_L) + n_R·vol(box_R) (box = child's element
+    bounding box, volume taken as the cube of its half-diagonal so flat boxes still count); built by
+    :func:`gsdf.spatial.binned.build_volume`. A node is opened by a uniformly distributed query with
     probability ∝ the volume of its far-field ball, so this keeps the far-field walk short on thin or
     elongated shapes where median splits produce long, thin boxes.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> P = np.random.default_rng(0).random((100, 3))
+    >>> t = build_bvh(P, P, P, leaf_size=4, split="volume")
+    >>> t.n_elements, bool(t.skip[0] == t.n_nodes)
+    (100, True)
     """
     if split not in ("median", "volume"):
         raise ValueError(f"split must be 'median' or 'volume', got {split!r}")
@@ -70,14 +82,37 @@ def build_bvh(centroids: np.ndarray, elem_lo: np.ndarray, elem_hi: np.ndarray, l
         raise ValueError("cannot build a tree over zero elements")
     if leaf_size < 1:
         raise ValueError(f"leaf_size must be >= 1, got {leaf_size}")
-    arrays = _build(
-        np.ascontiguousarray(centroids, dtype=np.float64),
-        np.ascontiguousarray(elem_lo, dtype=np.float64),
-        np.ascontiguousarray(elem_hi, dtype=np.float64),
-        int(leaf_size),
-        split == "volume",
-    )
+    cent = np.ascontiguousarray(centroids, dtype=np.float64)
+    elo = np.ascontiguousarray(elem_lo, dtype=np.float64)
+    ehi = np.ascontiguousarray(elem_hi, dtype=np.float64)
+    if split == "volume":
+        arrays = build_volume(cent, elo, ehi, int(leaf_size))
+    else:
+        arrays = _build(cent, elo, ehi, int(leaf_size))
     return BVH(*arrays)
+
+
+def build_volume_bvh(E: np.ndarray, leaf_size: int = 4) -> BVH:
+    """Volume-split BVH (as ``build_bvh(..., split="volume")``) over elements given as one (n, 9) float64
+    C-contiguous array of rows [centroid, box lo, box hi]. ``E`` is reordered in place into tree order (row
+    ``j`` becomes element ``order[j]``), which saves the callers a gather.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> P = np.random.default_rng(0).random((50, 3))
+    >>> E = np.hstack([P, P, P])
+    >>> t = build_volume_bvh(E, 4)
+    >>> bool(np.array_equal(E[:, :3], P[t.order]))
+    True
+    """
+    if E.ndim != 2 or E.shape[1] != 9 or E.dtype != np.float64 or not E.flags.c_contiguous:
+        raise ValueError(f"E: expected a C-contiguous (n, 9) float64 array, got {E.dtype} {E.shape}")
+    if E.shape[0] == 0:
+        raise ValueError("cannot build a tree over zero elements")
+    if leaf_size < 1:
+        raise ValueError(f"leaf_size must be >= 1, got {leaf_size}")
+    return BVH(*build_volume_rows(E, int(leaf_size), numba.get_num_threads()))
 
 
 def build_point_bvh(P: np.ndarray, leaf_size: int = 8) -> BVH:
@@ -126,93 +161,8 @@ def _select(order, key, lo, hi, k):
             return
 
 
-NBINS = 32
-
-
-@njit(cache=True, inline="always")
-def _half_diag3(lx, ly, lz, hx, hy, hz):
-    dx, dy, dz = hx - lx, hy - ly, hz - lz
-    d2 = 0.25 * (dx * dx + dy * dy + dz * dz)
-    return d2 * np.sqrt(d2)
-
-
 @njit(cache=True)
-def _volume_split(order, cent, elo, ehi, s, e, c0, c1, c2, x0, x1, x2, bins):
-    """Binned split of order[s:e] minimising n_L r_L³ + n_R r_R³ (r = box half-diagonal); partitions
-    order[s:e] in place and returns the split index, or -1 when no plane separates the centroids."""
-    nb = bins.shape[0]
-    best = np.inf
-    best_axis = -1
-    best_bin = -1
-    left = np.empty((nb, 7), np.float64)
-    for axis in range(3):
-        ext = x0 if axis == 0 else (x1 if axis == 1 else x2)
-        if ext <= 0.0:
-            continue
-        cmin = c0 if axis == 0 else (c1 if axis == 1 else c2)
-        scale = nb / ext
-        for b in range(nb):
-            bins[b, 0] = 0.0
-            for d in range(3):
-                bins[b, 1 + d] = np.inf
-                bins[b, 4 + d] = -np.inf
-        for j in range(s, e):
-            t = order[j]
-            b = min(nb - 1, int((cent[t, axis] - cmin) * scale))
-            bins[b, 0] += 1.0
-            for d in range(3):
-                bins[b, 1 + d] = min(bins[b, 1 + d], elo[t, d])
-                bins[b, 4 + d] = max(bins[b, 4 + d], ehi[t, d])
-        # prefix (left) sweeps
-        for d in range(7):
-            left[0, d] = bins[0, d]
-        for b in range(1, nb):
-            left[b, 0] = left[b - 1, 0] + bins[b, 0]
-            for d in range(3):
-                left[b, 1 + d] = min(left[b - 1, 1 + d], bins[b, 1 + d])
-                left[b, 4 + d] = max(left[b - 1, 4 + d], bins[b, 4 + d])
-        rn = 0.0
-        rl0 = rl1 = rl2 = np.inf
-        rh0 = rh1 = rh2 = -np.inf
-        for b in range(nb - 1, 0, -1):  # right side = bins b..nb-1, left = 0..b-1
-            rn += bins[b, 0]
-            rl0 = min(rl0, bins[b, 1])
-            rl1 = min(rl1, bins[b, 2])
-            rl2 = min(rl2, bins[b, 3])
-            rh0 = max(rh0, bins[b, 4])
-            rh1 = max(rh1, bins[b, 5])
-            rh2 = max(rh2, bins[b, 6])
-            ln = left[b - 1, 0]
-            if ln == 0.0 or rn == 0.0:
-                continue
-            c = (ln * _half_diag3(left[b - 1, 1], left[b - 1, 2], left[b - 1, 3],
-                                  left[b - 1, 4], left[b - 1, 5], left[b - 1, 6])
-                 + rn * _half_diag3(rl0, rl1, rl2, rh0, rh1, rh2))
-            if c < best:
-                best = c
-                best_axis = axis
-                best_bin = b
-    if best_axis < 0:
-        return -1
-    cmin = c0 if best_axis == 0 else (c1 if best_axis == 1 else c2)
-    ext = x0 if best_axis == 0 else (x1 if best_axis == 1 else x2)
-    scale = nb / ext
-    i = s
-    j = e - 1
-    while i <= j:
-        t = order[i]
-        if min(nb - 1, int((cent[t, best_axis] - cmin) * scale)) < best_bin:
-            i += 1
-        else:
-            order[i], order[j] = order[j], order[i]
-            j -= 1
-    if i == s or i == e:
-        return -1
-    return i
-
-
-@njit(cache=True)
-def _build(cent, elo, ehi, leaf_size, volume):
+def _build(cent, elo, ehi, leaf_size):
     n = cent.shape[0]
     order = np.arange(n)
     cap = 2 * n + 1  # a binary tree whose leaves are nonempty has at most 2n - 1 nodes
@@ -230,7 +180,6 @@ def _build(cent, elo, ehi, leaf_size, volume):
     sp = 1
     count = 0
     key = np.empty(n, np.float64)
-    bins = np.empty((NBINS, 7), np.float64)
     while sp > 0:
         sp -= 1
         s = st_s[sp]
@@ -262,15 +211,11 @@ def _build(cent, elo, ehi, leaf_size, volume):
             axis = 1
         elif ext2 > ext0 and ext2 > ext1:
             axis = 2
-        m = -1
-        if volume:
-            m = _volume_split(order, cent, elo, ehi, s, e, cmin0, cmin1, cmin2, ext0, ext1, ext2, bins)
-        if m < 0:
-            for j in range(s, e):
-                t = order[j]
-                key[t] = cent[t, axis]
-            m = (s + e) // 2
-            _select(order, key, s, e, m)
+        for j in range(s, e):
+            t = order[j]
+            key[t] = cent[t, axis]
+        m = (s + e) // 2
+        _select(order, key, s, e, m)
         if sp + 2 > st_s.shape[0]:
             st_s = np.concatenate((st_s, np.empty(st_s.shape[0], np.int64)))
             st_e = np.concatenate((st_e, np.empty(st_e.shape[0], np.int64)))
