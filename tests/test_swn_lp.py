@@ -173,3 +173,23 @@ def test_subset_reading_stops_when_nothing_is_left_to_remove():
         swn.solve(g, bounding="all")
     with pytest.raises(ValueError, match="bounding"):
         swn.solve(g, bounding=True)
+
+
+def test_time_limit_bounds_the_lps_of_all_passes(monkeypatch):
+    """time_limit is one budget for the residual LPs of every pass: when the first pass's LP used it all, the
+    second pass is refused with the fallback named (before, each pass got the whole limit again)."""
+    swn, g, mer, R = _patch_and_broken_meridian([range(0, 6), range(9, 15), range(18, 22)])
+    calls = []
+    real = swn._residual_full
+
+    def slow(gamma, g_, eps, time_limit, algorithm="highs-ds"):
+        calls.append(time_limit)
+        Jv, obj, _ = real(gamma, g_, eps, time_limit, algorithm)
+        return Jv, obj, 0.75 * time_limit if len(calls) == 1 else 0.0   # the first LP takes 3/4 of the budget
+    monkeypatch.setattr(swn, "_residual_full", slow)
+    r = swn.solve(g, method="lp", time_limit=8.0)
+    assert calls == [8.0, 2.0] and r.passes >= 2                   # the second LP gets what is left
+    # the first LP takes the whole budget: the second is refused, naming the fallback
+    monkeypatch.setattr(swn, "_residual_full", lambda gm, g_, e, tl, alg="highs-ds": real(gm, g_, e, tl, alg)[:2] + (tl,))
+    with pytest.raises(ValueError, match=r"whole time_limit.*method='reduced'"):
+        swn.solve(g, method="lp", time_limit=8.0)

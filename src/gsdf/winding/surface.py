@@ -245,7 +245,8 @@ class SurfaceWindingNumbers:
         curves : list of vertex polylines along mesh edges, or an integer edge chain (nE,)
         method : "lp" (full residual LP, §6.1), "reduced" (reduced LP, §6.3) or "none" (naive rounding of u)
         epsilon : float in (0, 1], LP weight of jumps on the input's edges relative to gap-closing ones
-        time_limit : float, seconds HiGHS may take; beyond it a ValueError names ``method="reduced"``
+        time_limit : float, seconds HiGHS may take, summed over the passes; beyond it a ValueError names
+            ``method="reduced"``
         homology : "real" (default) or "integer" — the cohomology class of the harmonic part γ that the residual
             must integrate. "real": γ itself, as thesis §6.1.2 writes; a broken *bounding* curve then leaves a
             fractional class (the flux of the harmonic forms through its gaps) that the LP attributes to the
@@ -342,8 +343,9 @@ class SurfaceWindingNumbers:
                 ends_cur = ends | dec.chain_endpoints(cur, tol=1e-6)
                 u_cur = self._jump_solve(cur, ends_cur, endpoint_rule)
                 T["jump_solve"] += time.perf_counter() - t0
+            left = float(time_limit) - T["lp"]     # time_limit bounds the LPs of all passes together
             om_k, gamma_k, Jv_k, obj_k = self._decompose(u_cur, cur, ends_cur, method, homology, epsilon,
-                                                         time_limit, lp_algorithm, T, say if k_pass == 0 else None)
+                                                         left, lp_algorithm, T, say if k_pass == 0 else None)
             if k_pass == 0:
                 om, gamma = om_k, gamma_k
             Jv = Jv + Jv_k
@@ -418,6 +420,9 @@ class SurfaceWindingNumbers:
             Jv, obj, lp_s = np.zeros(dec.n_edges), 0.0, 0.0
         else:
             try:
+                if not time_limit > 0:
+                    raise ValueError(f"the residual LPs of the earlier passes took {T['lp']:.1f} s, the whole "
+                                     f"time_limit")
                 if method == "lp":
                     alg = lp_algorithm if lp_algorithm != "auto" else \
                         ("highs-ipm" if self.dec.n_faces >= IPM_FACES else "highs-ds")
