@@ -238,14 +238,14 @@ def build_volume(cent, elo, ehi, leaf_size):
 
 @njit(cache=True)
 def _bigger(a, need):
-    """``a`` with its first axis grown (doubled) to hold at least ``need`` rows."""
+    """The 2-d array ``a`` with its rows grown (doubled) to hold at least ``need`` rows."""
     cap = a.shape[0]
     while cap < need:
         cap *= 2
     if cap == a.shape[0]:
         return a
-    out = np.empty((cap,) + a.shape[1:], a.dtype)
-    out[: a.shape[0]] = a
+    out = np.empty((cap, a.shape[1]), a.dtype)
+    out[: a.shape[0], :] = a
     return out
 
 
@@ -316,8 +316,8 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, cap):
                 m = (s + e) // 2
                 _halves(E, s, m, e, out)
         if sp + 2 > st_i.shape[0]:
-            st_i = np.concatenate((st_i, np.empty_like(st_i)))
-            st_b = np.concatenate((st_b, np.empty_like(st_b)))
+            st_i = _bigger(st_i, sp + 2)
+            st_b = _bigger(st_b, sp + 2)
         # push right first so the left child is popped next and gets id node + 1 (preorder)
         st_i[sp, 0], st_i[sp, 1], st_i[sp, 2] = m, e, node
         st_b[sp] = out[12:24]
@@ -328,15 +328,23 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, cap):
     return count, node_i, node_b, ntask, task_i, task_b
 
 
-@njit(cache=True, parallel=True)
 def build_volume_rows(E, leaf_size, threads=1):
     """:func:`build_volume` on one (n, 9) float64 array of rows [centroid, box lo, box hi], which it reorders
     in place (to tree order: row j is then element ``order[j]``).
 
-    With ``threads`` > 1 (numba's current thread count) the top of the tree is split on the calling thread down to nodes of about
-    n/64 elements, whose subtrees are then grown in parallel and spliced into the preorder arrays."""
+    With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
+    of the tree is split on the calling thread down to nodes of about n/64 elements, whose subtrees are then
+    grown in parallel and spliced into the preorder arrays (the same tree as the serial build). The two are
+    separate kernels so that a small build never compiles the parallel one (about 20 s on first use)."""
+    if threads > 1 and E.shape[0] > PARALLEL_ELEMENTS:
+        return _build_rows_parallel(E, leaf_size)
+    return _build_rows_serial(E, leaf_size)
+
+
+@njit(cache=True)
+def _root_bounds(E):
+    """Box lo, hi and centroid lo, hi (12) of all rows of E."""
     n = E.shape[0]
-    order = np.arange(n)
     root = np.empty(12)
     for d in range(3):
         root[d] = root[6 + d] = np.inf
@@ -348,62 +356,79 @@ def build_volume_rows(E, leaf_size, threads=1):
             root[3 + d] = max(root[3 + d], E[i, 6 + d])
             root[6 + d] = min(root[6 + d], c)
             root[9 + d] = max(root[9 + d], c)
-    parallel = threads > 1 and n > PARALLEL_ELEMENTS
-    if not parallel:
-        k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, root, leaf_size, 0, 2 * n)
-        start = node_i[:k, 0].copy()
-        end = node_i[:k, 1].copy()
-        right = node_i[:k, 2].copy()
-        lo = node_b[:k, 0:3].copy()
-        hi = node_b[:k, 3:6].copy()
-    else:
-        cutoff = max(leaf_size + 1, n // 64)
-        kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, 0, n, root, leaf_size, cutoff, 256)
-        # the tasks' subtrees, in parallel (disjoint row ranges of E and order)
-        counts = np.empty(ntask, np.int64)
-        subs_i = [np.empty((0, 4), np.int64) for _ in range(ntask)]
-        subs_b = [np.empty((0, 6)) for _ in range(ntask)]
-        for t in prange(ntask):
-            s, e = task_i[t, 0], task_i[t, 1]
-            c, si, sb, _, _, _ = _grow(E, order, s, e, task_b[t], leaf_size, 0, 2 * (e - s))
-            counts[t] = c
-            subs_i[t] = si
-            subs_b[t] = sb
-        # final preorder ids: the top tree's nodes in order, each task node replaced by its subtree
-        final = np.empty(kt, np.int64)
-        k = 0
-        for i in range(kt):
-            final[i] = k
-            k += counts[top_i[i, 3]] if top_i[i, 3] >= 0 else 1
-        start = np.empty(k, np.int64)
-        end = np.empty(k, np.int64)
-        right = np.empty(k, np.int64)
-        lo = np.empty((k, 3))
-        hi = np.empty((k, 3))
-        for i in range(kt):
-            if top_i[i, 3] < 0:
-                f = final[i]
-                start[f], end[f] = top_i[i, 0], top_i[i, 1]
-                right[f] = final[top_i[i, 2]] if top_i[i, 2] >= 0 else -1
-                for d in range(3):
-                    lo[f, d] = top_b[i, d]
-                    hi[f, d] = top_b[i, 3 + d]
-        for t in range(ntask):  # a copy: serial, so the build is one parallel launch
-            base = final[task_i[t, 2]]
-            si = subs_i[t]
-            sb = subs_b[t]
-            for j in range(counts[t]):
-                f = base + j
-                start[f], end[f] = si[j, 0], si[j, 1]
-                right[f] = base + si[j, 2] if si[j, 2] >= 0 else -1
-                for d in range(3):
-                    lo[f, d] = sb[j, d]
-                    hi[f, d] = sb[j, 3 + d]
-    k = start.shape[0]
+    return root
+
+
+@njit(cache=True)
+def _skips(right):
+    """Preorder skip pointers: the node after node i's subtree."""
+    k = right.shape[0]
     size = np.ones(k, np.int64)
     for i in range(k - 1, -1, -1):
         r = right[i]
         if r >= 0:
             size[i] = 1 + size[i + 1] + size[r]
-    skip = np.arange(k) + size
-    return order, start, end, right, skip, lo, hi
+    return np.arange(k) + size
+
+
+@njit(cache=True)
+def _build_rows_serial(E, leaf_size):
+    n = E.shape[0]
+    order = np.arange(n)
+    k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, _root_bounds(E), leaf_size, 0, 2 * n)
+    start = node_i[:k, 0].copy()
+    end = node_i[:k, 1].copy()
+    right = node_i[:k, 2].copy()
+    lo = node_b[:k, 0:3].copy()
+    hi = node_b[:k, 3:6].copy()
+    return order, start, end, right, _skips(right), lo, hi
+
+
+@njit(cache=True, parallel=True)
+def _build_rows_parallel(E, leaf_size):
+    n = E.shape[0]
+    order = np.arange(n)
+    root = _root_bounds(E)
+    cutoff = max(leaf_size + 1, n // 64)
+    kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, 0, n, root, leaf_size, cutoff, 256)
+    # the tasks' subtrees, in parallel (disjoint row ranges of E and order)
+    counts = np.empty(ntask, np.int64)
+    subs_i = [np.empty((0, 4), np.int64) for _ in range(ntask)]
+    subs_b = [np.empty((0, 6)) for _ in range(ntask)]
+    for t in prange(ntask):
+        s, e = task_i[t, 0], task_i[t, 1]
+        c, si, sb, _, _, _ = _grow(E, order, s, e, task_b[t], leaf_size, 0, 2 * (e - s))
+        counts[t] = c
+        subs_i[t] = si
+        subs_b[t] = sb
+    # final preorder ids: the top tree's nodes in order, each task node replaced by its subtree
+    final = np.empty(kt, np.int64)
+    k = 0
+    for i in range(kt):
+        final[i] = k
+        k += counts[top_i[i, 3]] if top_i[i, 3] >= 0 else 1
+    start = np.empty(k, np.int64)
+    end = np.empty(k, np.int64)
+    right = np.empty(k, np.int64)
+    lo = np.empty((k, 3))
+    hi = np.empty((k, 3))
+    for i in range(kt):
+        if top_i[i, 3] < 0:
+            f = final[i]
+            start[f], end[f] = top_i[i, 0], top_i[i, 1]
+            right[f] = final[top_i[i, 2]] if top_i[i, 2] >= 0 else -1
+            for d in range(3):
+                lo[f, d] = top_b[i, d]
+                hi[f, d] = top_b[i, 3 + d]
+    for t in range(ntask):  # a copy: serial, so the build is one parallel launch
+        base = final[task_i[t, 2]]
+        si = subs_i[t]
+        sb = subs_b[t]
+        for j in range(counts[t]):
+            f = base + j
+            start[f], end[f] = si[j, 0], si[j, 1]
+            right[f] = base + si[j, 2] if si[j, 2] >= 0 else -1
+            for d in range(3):
+                lo[f, d] = sb[j, d]
+                hi[f, d] = sb[j, 3 + d]
+    return order, start, end, right, _skips(right), lo, hi
