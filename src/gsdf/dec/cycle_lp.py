@@ -42,13 +42,11 @@ Example
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
 
-from .lp import DualL1Result
+from .lp import DualL1Result, solve_highs
 from .triangle import TriangleDEC, forest_potentials
 
 __all__ = ["CycleL1"]
@@ -198,8 +196,6 @@ class CycleL1:
         DualL1Result — ``shifts`` per face (J − d integrated over T*, 0 at one face per component), ``jumps`` J,
         ``objective`` Σ w|J|, ``seconds`` (HiGHS)
         """
-        from scipy.optimize import linprog
-
         k = len(self.interior)
         d = np.asarray(offsets, dtype=np.float64)
         w = np.asarray(weights, dtype=np.float64)
@@ -221,23 +217,11 @@ class CycleL1:
         # J = s+ − s−, bounds on J as bounds on s± (as gsdf.dec.lp.dual_graph_l1 does)
         sp_lo, sp_hi = np.where(lo > 0, lo, 0.0), np.where(hi < 0, 0.0, hi)
         sm_lo, sm_hi = np.where(hi < 0, -hi, 0.0), np.where(lo > 0, 0.0, -lo)
-        t0 = time.perf_counter()
         if k == 0:
             return DualL1Result(np.zeros(self.dec.n_faces), np.zeros(0), 0.0, 0.0)
-        try:
-            res = linprog(np.concatenate([w, w]), A_eq=sp.hstack([self.C, -self.C]).tocsc(), b_eq=self.C @ d,
-                          bounds=np.column_stack([np.concatenate([sp_lo, sm_lo]), np.concatenate([sp_hi, sm_hi])]),
-                          method=algorithm, options={"time_limit": float(time_limit)})
-        except Exception as exc:  # pragma: no cover - HiGHS raising instead of reporting
-            raise ValueError(f"linear program: HiGHS failed ({exc})") from exc
-        secs = time.perf_counter() - t0
-        if res.status == 1:
-            raise ValueError(f"linear program: HiGHS hit its limit after {secs:.1f} s (time_limit={time_limit}): "
-                             f"{res.message}")
-        if res.status == 2:
-            raise ValueError(f"linear program: infeasible jump bounds ({res.message})")
-        if res.status != 0 or res.x is None:
-            raise ValueError(f"linear program: HiGHS failed with status {res.status}: {res.message}")
+        res, secs = solve_highs(np.concatenate([w, w]), sp.hstack([self.C, -self.C]).tocsc(), self.C @ d,
+                                np.column_stack([np.concatenate([sp_lo, sm_lo]), np.concatenate([sp_hi, sm_hi])]),
+                                algorithm, time_limit)
         J = res.x[:k] - res.x[k:]
         # shifts: x_A − x_B = J − d along the dual tree T*
         t = self._tree_links

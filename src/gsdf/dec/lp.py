@@ -68,6 +68,28 @@ def _check_1d(a, k, name, default=None):
     return A
 
 
+def solve_highs(cost, A_eq, b_eq, bounds, algorithm: str, time_limit: float):
+    """``scipy.optimize.linprog`` (HiGHS) of min cost·x, A_eq x = b_eq, bounds; returns (result, seconds).
+    A time limit hit, infeasible bounds or any other HiGHS failure is a ValueError saying which."""
+    from scipy.optimize import linprog
+
+    t0 = time.perf_counter()
+    try:
+        res = linprog(cost, A_eq=A_eq, b_eq=b_eq, bounds=bounds, method=algorithm,
+                      options={"time_limit": float(time_limit)})
+    except Exception as exc:  # pragma: no cover - HiGHS raising instead of reporting
+        raise ValueError(f"linear program: HiGHS failed ({exc})") from exc
+    secs = time.perf_counter() - t0
+    if res.status == 1:
+        raise ValueError(f"linear program: HiGHS hit its limit after {secs:.1f} s (time_limit={time_limit}): "
+                         f"{res.message}")
+    if res.status == 2:
+        raise ValueError(f"linear program: infeasible jump bounds ({res.message})")
+    if res.status != 0 or res.x is None:
+        raise ValueError(f"linear program: HiGHS failed with status {res.status}: {res.message}")
+    return res, secs
+
+
 def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit: float = 300.0,
                   gauge: str = "component", algorithm: str = "highs") -> DualL1Result:
     """Minimise ``Σ_k w_k |d_k + x_{A_k} - x_{B_k}|`` over per-cell shifts x with HiGHS.
@@ -99,8 +121,6 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
     >>> round(float(r.jumps[0]), 6), round(float(r.objective), 6)
     (1.0, 1.0)
     """
-    from scipy.optimize import linprog
-
     if isinstance(n_cells, (bool, np.bool_)) or not isinstance(n_cells, (int, np.integer)) or n_cells < 1:
         raise ValueError(f"n_cells: expected a positive integer, got {n_cells!r}")
     n = int(n_cells)
@@ -146,7 +166,6 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
         np.minimum.at(first, lab, np.arange(n))
         x_lo[first] = 0.0
         x_hi[first] = 0.0
-    t0 = time.perf_counter()
     if k == 0:
         return DualL1Result(np.zeros(n), np.zeros(0), 0.0, 0.0)
     r = np.arange(k)
@@ -156,19 +175,7 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
     A = sp.csr_matrix((vals, (rows, cols)), shape=(k, n + 2 * k))   # duplicates (A == B) sum to 0
     cost = np.concatenate([np.zeros(n), w, w])
     bnds = np.column_stack([np.concatenate([x_lo, sp_lo, sm_lo]), np.concatenate([x_hi, sp_hi, sm_hi])])
-    try:
-        res = linprog(cost, A_eq=A, b_eq=-d, bounds=bnds, method=algorithm,
-                      options={"time_limit": float(time_limit)})
-    except Exception as exc:  # pragma: no cover - HiGHS raising instead of reporting
-        raise ValueError(f"linear program: HiGHS failed ({exc})") from exc
-    secs = time.perf_counter() - t0
-    if res.status == 1:
-        raise ValueError(f"linear program: HiGHS hit its limit after {secs:.1f} s (time_limit={time_limit}): "
-                         f"{res.message}")
-    if res.status == 2:
-        raise ValueError(f"linear program: infeasible jump bounds ({res.message})")
-    if res.status != 0 or res.x is None:
-        raise ValueError(f"linear program: HiGHS failed with status {res.status}: {res.message}")
+    res, secs = solve_highs(cost, A, -d, bnds, algorithm, time_limit)
     x = res.x[:n]
     J = d + x[P[:, 0]] - x[P[:, 1]]
     return DualL1Result(x, J, float(np.dot(w, np.abs(J))), secs)
