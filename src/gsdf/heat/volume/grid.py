@@ -27,6 +27,8 @@ multiplier update; larger grids use the preconditioned CG per update, which is s
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
@@ -202,6 +204,29 @@ def _aggregation(shape, block: int) -> sp.csr_matrix:
     return sp.csr_matrix((np.ones(n), (agg, np.arange(n))), shape=(int(np.prod(coarse)), n))
 
 
+def _grid_operators(shape, spacing, block):
+    """(L, R, Rᵀ, L Rᵀ, R L Rᵀ) of a grid: its Neumann Laplacian, the block aggregation and the Laplacian's parts
+    of the coarse step of :func:`solve_poisson` — they depend only on the grid, not on the sources, so they are
+    built once per grid (kept for the last few grids of up to 2¹⁸ nodes; at 32³ building them took a few ms of
+    every solve). The matrices are shared: callers must not modify them."""
+    if int(np.prod(shape)) <= 1 << 18:
+        return _grid_operators_cached(tuple(shape), tuple(spacing), int(block))
+    return _build_grid_operators(shape, spacing, block)
+
+
+def _build_grid_operators(shape, spacing, block):
+    L = neumann_laplacian(shape, spacing)
+    R = _aggregation(shape, block)
+    RT = R.T.tocsr()
+    LR = (L @ RT).tocsr()
+    return L, R, RT, LR, (R @ LR).tocsr()
+
+
+@functools.lru_cache(maxsize=4)
+def _grid_operators_cached(shape, spacing, block):
+    return _build_grid_operators(shape, spacing, block)
+
+
 def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter: int = 300,
                   coarse_size: int = 4096, min_block: int = 3) -> np.ndarray:
     """Solve the Step III system.
@@ -237,7 +262,8 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
 
     n = int(np.prod(shape))
     penalty = sp.csr_matrix(penalty)
-    L = neumann_laplacian(shape, spacing)
+    block = max(int(min_block), int(np.ceil((n / coarse_size) ** (1.0 / 3.0))))
+    L, R, RT, LR, RLR = _grid_operators(shape, tuple(float(h) for h in spacing), block)
     A = (L + penalty).tocsr()
     delta = float(penalty.diagonal().sum()) / n
     lam = _dct_eigenvalues(shape, spacing, delta)
@@ -250,11 +276,9 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     upper = sp.triu(A_bb, format="csr")
     lower.sort_indices()
     upper.sort_indices()
-    block = max(int(min_block), int(np.ceil((n / coarse_size) ** (1.0 / 3.0))))
-    R = _aggregation(shape, block)
-    RT = R.T.tocsr()
-    AR = (A @ RT).tocsr()                           # A times the coarse basis: the coarse step's residual
-    coarse = Factorization((R @ AR).tocsc())        # SPD (P > 0): SuperLU's symmetric mode
+    PR = (penalty @ RT).tocsr()
+    AR = (LR + PR).tocsr()                          # A times the coarse basis: the coarse step's residual
+    coarse = Factorization((RLR + R @ PR).tocsc())  # R A Rᵀ, SPD (P > 0): SuperLU's symmetric mode
 
     def precondition(r):
         c = coarse.solve(R @ r)
