@@ -171,18 +171,58 @@ def dct_poisson(rhs, shape, spacing, shift: float = 0.0, lam=None) -> np.ndarray
     the separable DCT-II basis: one forward and one inverse transform, O(N log N). With ``shift = 0`` the
     constant mode is dropped (φ has zero mean; rhs must be orthogonal to constants).
     """
-    from scipy.fft import dctn, idctn
-
     if lam is None:
         lam = _dct_eigenvalues(shape, spacing, shift)
-    workers = _fft_workers(int(np.prod(shape)))
-    c = dctn(np.asarray(rhs, float).reshape(shape), type=2, norm="ortho", workers=workers)
+    c = dct3(np.asarray(rhs, float).reshape(shape))
     if shift == 0.0:
         c[0, 0, 0] = 0.0
         lam = lam.copy()
         lam[0, 0, 0] = 1.0
     c /= lam
-    return idctn(c, type=2, norm="ortho", workers=workers).ravel()
+    return dct3(c, inverse=True).ravel()
+
+
+#: Grids whose three node counts sum to at most this are transformed by dense DCT matrices (below).
+DCT_MATRIX_MAX_SUM = 100
+
+
+@functools.lru_cache(maxsize=16)
+def _dct_matrix(n: int) -> np.ndarray:
+    """The orthonormal DCT-II matrix of size n: C[k, j] = s_k cos(π k (2j + 1) / 2n), s_0 = √(1/n), else √(2/n)."""
+    k = np.arange(n)[:, None]
+    C = np.cos(np.pi * k * (2 * np.arange(n)[None, :] + 1) / (2 * n)) * np.sqrt(2.0 / n)
+    C[0] /= np.sqrt(2.0)
+    C.setflags(write=False)
+    return C
+
+
+def dct3(X, inverse: bool = False) -> np.ndarray:
+    """Orthonormal 3D DCT-II of X (n0, n1, n2) (``inverse``: its inverse, the DCT-III), as scipy's
+    ``dctn(X, type=2, norm="ortho")`` / ``idctn``.
+
+    Small grids (n0 + n1 + n2 ≤ :data:`DCT_MATRIX_MAX_SUM`) apply the dense n_a × n_a DCT matrix along each axis
+    (three matrix products, 2 N Σ n_a flops, in BLAS): at 32³-sized grids that is 2-3× faster than pocketfft,
+    whose odd and prime lengths (23, 27, …, the cubic-cell grids of a box) are its slow case — (23, 32, 27):
+    0.12 vs 0.31 ms, (32, 32, 32): 0.18 vs 0.37 ms; at 48³ and 64³ pocketfft is faster (1.2 vs 2.1 ms,
+    3.8 vs 6.0 ms) and is used. The two agree to ~3e-14 of the values.
+    """
+    X = np.asarray(X, np.float64)
+    shape = X.shape
+    if sum(shape) > DCT_MATRIX_MAX_SUM:
+        from scipy.fft import dctn, idctn
+
+        workers = _fft_workers(int(np.prod(shape)))
+        return (idctn if inverse else dctn)(X, type=2, norm="ortho", workers=workers)
+    from ...threads import blas_region
+
+    n0, n1, n2 = shape
+    C0, C1, C2 = (_dct_matrix(n) for n in shape)
+    if inverse:
+        C0, C1, C2 = C0.T, C1.T, C2.T
+    with blas_region():   # one BLAS thread (or gsdf's setting): these products take a tenth of a millisecond
+        Y = (C0 @ X.reshape(n0, n1 * n2)).reshape(n0, n1, n2)
+        Y = np.matmul(C1, Y)
+        return (Y.reshape(n0 * n1, n2) @ C2.T).reshape(n0, n1, n2)
 
 
 def _fft_workers(n: int) -> int:
