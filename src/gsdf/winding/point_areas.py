@@ -248,12 +248,14 @@ KD_TREE_MAX_K = 64
 
 
 class _KDRows:
-    """The ``rows(s, e)`` interface of :class:`SelfKNN` over ``cKDTree.query`` (one thread up to 50k points:
-    a few ms of work, where starting threads on a loaded machine costs more)."""
+    """The ``rows(s, e)`` interface of :class:`SelfKNN` over ``cKDTree.query`` (gsdf's thread count from 2,000
+    points: scipy's query threads are joined, never spin, so they do not stall under load; below, one)."""
 
     def __init__(self, P, k):
+        from ..threads import get_num_threads
+
         self.tree, self.P, self.k = cKDTree(P), P, k
-        self.workers = 1 if len(P) <= 50_000 else -1
+        self.workers = 1 if len(P) < 2000 else get_num_threads()
 
     def rows(self, s, e):
         idx = self.tree.query(self.P[s:e], k=self.k, workers=self.workers)[1]
