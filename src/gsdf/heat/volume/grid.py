@@ -312,10 +312,7 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     A_cols = A_b.T.tocsr()
     A_bb = A_b[:, band]
     P_bb = penalty[band][:, band]
-    lower = sp.tril(A_bb, format="csr")
-    upper = sp.triu(A_bb, format="csr")
-    lower.sort_indices()
-    upper.sort_indices()
+    A_bb.sort_indices()                            # the sweeps read its lower / upper triangle in place
     PR = (penalty @ RT).tocsr()
     AR = (LR + PR).tocsr()                          # A times the coarse basis: the coarse step's residual
     coarse = Factorization((RLR + R @ PR).tocsc())  # R A Rᵀ, SPD (P > 0): SuperLU's symmetric mode
@@ -324,14 +321,14 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
         c = coarse.solve(R @ r)
         x = RT @ c
         res = r - AR @ c
-        d = _triangular_solve(lower.indptr, lower.indices, lower.data, res[band], True)
+        d = _triangular_solve(A_bb.indptr, A_bb.indices, A_bb.data, res[band], True)
         x[band] += d
         res -= A_cols @ d
         y = dct_poisson(res, shape, spacing, delta, lam)
         x += y
         res = delta * y                            # r − A y, as (L + δI) y = r exactly
         res[band] -= P_bb @ y[band]
-        d = _triangular_solve(upper.indptr, upper.indices, upper.data, res[band], False)
+        d = _triangular_solve(A_bb.indptr, A_bb.indices, A_bb.data, res[band], False)
         x[band] += d
         res -= A_cols @ d
         x += RT @ coarse.solve(R @ res)
@@ -378,8 +375,9 @@ def _solve_poisson_reference(rhs, shape, spacing, penalty, tol: float = 1e-5, ma
 
 @njit(cache=True)
 def _triangular_solve(indptr, indices, data, b, lower):
-    """Solve T x = b for a CSR triangular T with sorted indices (the Gauss–Seidel sweeps of
-    :func:`solve_poisson`): forward substitution when ``lower``, else backward. Serial by nature."""
+    """Solve T x = b, T the lower (``lower``) or upper triangle of a CSR matrix — entries of the other triangle
+    are skipped, so the whole matrix can be passed (the Gauss–Seidel sweeps of :func:`solve_poisson`):
+    forward substitution when ``lower``, else backward. Serial by nature."""
     n = b.shape[0]
     x = np.empty(n)
     for k in range(n):
@@ -390,7 +388,7 @@ def _triangular_solve(indptr, indices, data, b, lower):
             j = indices[p]
             if j == i:
                 diag = data[p]
-            else:
+            elif (j < i) == lower:
                 acc -= data[p] * x[j]
         x[i] = acc / diag
     return x
