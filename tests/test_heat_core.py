@@ -133,10 +133,17 @@ VOLUME = volume_cases()
 
 
 @pytest.mark.parametrize("name,kw", VOLUME, ids=[c[0] for c in VOLUME])
-def test_volume_core_matches_pre_core_solvers(name, kw):
+def test_volume_core_matches_pre_core_solvers(name, kw, monkeypatch):
+    import gsdf.heat.volume as hv
     from gsdf.heat.volume import signed_heat_volume
 
     kw = dict(kw)
+    if "points" in kw:
+        # the frozen run estimated cloud areas from 8·k candidates; the default is 2·k since issue 17 (lower
+        # error on the benchmark clouds): the default stays within 1e-4, the old areas reproduce the run exactly
+        phi = np.asarray(signed_heat_volume(**kw).values).ravel()
+        assert np.abs(phi - REF[name]).max() <= 1e-4 * max(1.0, float(np.abs(REF[name]).max()))
+        monkeypatch.setattr(hv, "point_sources", lambda P, N: hv.sources.point_sources(P, N, candidates=8))
     if name in _NEW_SPELLING:
         kw.pop("constraint", None)
         kw.update(_NEW_SPELLING[name])

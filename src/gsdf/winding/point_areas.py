@@ -241,6 +241,33 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
 # ----------------------------------------------------------------------------------------------
 
 
+#: Candidate counts up to this use scipy's k-d tree, above it the cell grid of :class:`SelfKNN` (measured on
+#: the CGAL clouds oni / kitten / hippo1, 1.4k-6k points: the k-d tree is 1.2-2.5x faster at k = 21-41, the
+#: cell grid 1.5-2x faster at k = 161).
+KD_TREE_MAX_K = 64
+
+
+class _KDRows:
+    """The ``rows(s, e)`` interface of :class:`SelfKNN` over ``cKDTree.query`` (gsdf's thread count from 2,000
+    points: scipy's query threads are joined, never spin, so they do not stall under load; below, one)."""
+
+    def __init__(self, P, k):
+        from ..threads import get_num_threads
+
+        self.tree, self.P, self.k = cKDTree(P), P, k
+        self.workers = 1 if len(P) < 2000 else get_num_threads()
+
+    def rows(self, s, e):
+        idx = self.tree.query(self.P[s:e], k=self.k, workers=self.workers)[1]
+        return np.ascontiguousarray(idx.reshape(e - s, self.k), dtype=np.int64)
+
+
+def _candidate_search(P, k):
+    """The k nearest of every point (itself included) by the faster structure for this k
+    (:data:`KD_TREE_MAX_K`)."""
+    return _KDRows(P, k) if k <= KD_TREE_MAX_K else SelfKNN(P, k)
+
+
 def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) -> np.ndarray:
     """Voronoi area of every point of an oriented point cloud (Barill et al. 2018, §3.1).
 
@@ -307,7 +334,8 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     (8) to within 1 %
     (``bench/bench_winding.py`` prints the figure). On a clean sphere both are within 0.1 %.
 
-    Cost: one k-nearest-neighbour search on a cell grid (:class:`gsdf.spatial.knn.SelfKNN`) plus
+    Cost: one k-nearest-neighbour search (scipy's k-d tree up to 64 candidates, the cell grid of
+    :class:`gsdf.spatial.knn.SelfKNN` above) plus
     O(n (candidates k + k^2)) work in a parallel numba kernel.
 
     Examples
@@ -336,7 +364,7 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     frame = Frame.of(P)
     P = frame.geometry(P, "P")
     N = N / np.maximum(np.abs(N).max(axis=1, keepdims=True), np.finfo(float).tiny)
-    knn = SelfKNN(P, kc + 1)  # the kc + 1 nearest (itself included); a cell grid, 1.5-2x a k-d tree at k = 161
+    knn = _candidate_search(P, kc + 1)  # the kc + 1 nearest, itself included
     out = np.zeros(n)
     chunk = max(1, (1 << 22) // (kc + 1))  # bounded memory: ~32 MB of neighbour indices at a time
     for s in range(0, n, chunk):
@@ -350,6 +378,49 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     if not np.isfinite(a).all():
         raise ValueError(f"P: point areas overflow float64 at this scale (cloud half-size 2^{frame.exponent})")
     return a
+
+
+@njit(cache=True)
+def _smallest_eigenvector3(C):
+    """Eigenvector of the smallest eigenvalue of a symmetric 3×3 matrix ``C`` (overwritten). Cyclic Jacobi
+    rotations (each zeroes one off-diagonal entry; the off-diagonal mass falls quadratically, so a few sweeps reach rounding level): as accurate as LAPACK's
+    ``eigh`` on a 3×3 and, called once per point, much cheaper than the LAPACK call from numba. Returns
+    ``(w_mid, w_max, vx, vy, vz)``."""
+    V = np.eye(3)
+    for _sweep in range(12):
+        off = C[0, 1] * C[0, 1] + C[0, 2] * C[0, 2] + C[1, 2] * C[1, 2]
+        diag = C[0, 0] * C[0, 0] + C[1, 1] * C[1, 1] + C[2, 2] * C[2, 2]
+        if off <= 1e-36 * diag or off == 0.0:
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            apq = C[p, q]
+            if apq == 0.0:
+                continue
+            # the rotation angle that zeroes C[p, q]: t = tan θ, the smaller root of t² + 2τt − 1 = 0
+            tau = (C[q, q] - C[p, p]) / (2.0 * apq)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + np.sqrt(1.0 + tau * tau))
+            c = 1.0 / np.sqrt(1.0 + t * t)
+            sn = t * c
+            for r in range(3):  # C ← C J (columns p, q)
+                crp, crq = C[r, p], C[r, q]
+                C[r, p] = c * crp - sn * crq
+                C[r, q] = sn * crp + c * crq
+            for r in range(3):  # C ← Jᵀ C (rows p, q)
+                cpr, cqr = C[p, r], C[q, r]
+                C[p, r] = c * cpr - sn * cqr
+                C[q, r] = sn * cpr + c * cqr
+            C[p, q] = C[q, p] = 0.0
+            for r in range(3):  # V ← V J: its columns are the eigenvectors
+                vrp, vrq = V[r, p], V[r, q]
+                V[r, p] = c * vrp - sn * vrq
+                V[r, q] = sn * vrp + c * vrq
+    a, b, d = C[0, 0], C[1, 1], C[2, 2]
+    lo = 0 if (a <= b and a <= d) else (1 if b <= d else 2)
+    hi = 0 if (a > b and a > d) else (1 if b > d else 2)
+    if lo == hi:  # all equal
+        hi = 2 if lo != 2 else 1
+    mid = 3 - lo - hi
+    return C[mid, mid], C[hi, hi], V[0, lo], V[1, lo], V[2, lo]
 
 
 @njit(parallel=True, cache=True)
@@ -412,9 +483,9 @@ def _tangent_row(P, N, cand, offset, k, sel, plane, row):
         C[1, 0] = C[0, 1]
         C[2, 0] = C[0, 2]
         C[2, 1] = C[1, 2]
-        w, U = np.linalg.eigh(C)
-        if w[1] > 0.0:  # a real plane (not collinear or coincident points)
-            vx, vy, vz = U[0, 0], U[1, 0], U[2, 0]
+        w1, w2, ux, uy, uz = _smallest_eigenvector3(C)
+        if w1 > 1e-12 * w2:  # a real plane (not collinear or coincident points, up to rounding)
+            vx, vy, vz = ux, uy, uz
             if vx * nx + vy * ny + vz * nz < 0.0:
                 vx, vy, vz = -vx, -vy, -vz
     plane[row, 0], plane[row, 1], plane[row, 2] = vx, vy, vz

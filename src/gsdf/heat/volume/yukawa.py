@@ -89,9 +89,9 @@ def _moments(start, end, B, W):
 
 
 @njit(parallel=True, cache=True, fastmath=True)
-def _tree_kernel(Q, dref, B, W, D, lo, hi, right, skip, start, end, lam, theta, band, rmin, out):
+def _tree_kernel(Q, dref, B, W, D, erho, lo, hi, right, skip, start, end, lam, theta, band, rmin, out):
     k = D.shape[0]
-    log_theta3 = 3.0 * np.log(max(theta, 1e-300))
+    theta3 = theta * theta * theta
     for qi in prange(Q.shape[0]):
         qx, qy, qz = Q[qi, 0], Q[qi, 1], Q[qi, 2]
         d0 = dref[qi]
@@ -113,17 +113,21 @@ def _tree_kernel(Q, dref, B, W, D, lo, hi, right, skip, start, end, lam, theta, 
             r = np.sqrt(ux * ux + uy * uy + uz * uz)
             rho = D[i, 3]
             # accept the cluster when its Taylor remainder, ~E³ e^{λρ}/6 times the cluster's weight
-            # e^{−λ(r − d*)} relative to the nearest source, is below θ³/6 (E = ρ(λ + 1/r))
+            # e^{−λ(r − d*)} relative to the nearest source, is below θ³/6 (E = ρ(λ + 1/r)): written as
+            # E³ e^{−λ(r − d*)} < θ³ e^{−λρ}, so the one exponential serves the test and the expansion
+            # (erho = e^{−λρ} per tree node; no logarithm per visited node)
             accept = False
-            if r > 2.0 * rho:
+            decay = 0.0
+            if r > 2.0 * rho and theta > 0.0:
                 E = rho * (lam + 1.0 / r)
-                if theta > 0.0 and (E == 0.0 or 3.0 * np.log(E) + lam * (rho - r + d0) < log_theta3):
+                decay = np.exp(-lam * (r - d0))
+                if E == 0.0 or E * E * E * decay < theta3 * erho[i]:
                     accept = True
             if accept:
                 ux /= r
                 uy /= r
                 uz /= r
-                g = np.exp(-lam * (r - d0)) * INV_4PI / r
+                g = decay * INV_4PI / r
                 g1 = -g * (1.0 + lam * r) / r
                 g2 = g * (lam * lam * r * r + 2.0 * lam * r + 2.0) / (r * r)
                 a2 = 0.5 * (g2 - g1 / r)
@@ -224,6 +228,7 @@ class YukawaTree:
         self._B = np.ascontiguousarray(B[o])
         self._W = np.ascontiguousarray(W[o])
         self._D = _moments(self.tree.start, self.tree.end, self._B, self._W)
+        self._erho = np.exp(-self.lam * self._D[:, 3])  # e^{−λρ} of every tree node (the acceptance test)
         self._src = B
         self._kd = None  # built on first exact nearest-distance query (grids pass their own estimate)
         ext = B.max(axis=0) - B.min(axis=0)
@@ -250,7 +255,7 @@ class YukawaTree:
         for s in range(0, len(Q), chunk):
             q = Q[s:s + chunk]
             d = self.nearest_distance(q) if dref is None else dref[s:s + chunk]
-            _tree_kernel(q, d, self._B, self._W, self._D, t.lo, t.hi, t.right, t.skip, t.start, t.end,
+            _tree_kernel(q, d, self._B, self._W, self._D, self._erho, t.lo, t.hi, t.right, t.skip, t.start, t.end,
                          self.lam, self.theta, band, self._rmin, out[s:s + chunk])
             if progress is not None:
                 progress(len(q))
