@@ -17,7 +17,8 @@ truth: ours must still be one sphere), and time / peak memory vs point count 1K 
 
 Run: ``PYTHONPATH=src /work/anchors/bin/python bench/bench_recon.py [--quick] [--relocation]``.  ``--quick`` runs
 a subset and ASSERTS the topology promise (CC = 1, genus 0, closed manifold) on every case of ours;
-``--relocation`` adds a before / after table of the vertex relocation (same clouds, with SPSR).
+``--relocation`` adds a before / after table of the vertex relocation (same clouds, with SPSR); ``--meshes
+bull,camel --table2-only`` runs the Table-2 cases of those meshes only (section ``recon-subset``).
 """
 
 from __future__ import annotations
@@ -232,7 +233,7 @@ def relocation_table(rng):
 
 
 # ------------------------------------------------------------------------------------------- main
-def main(quick: bool, relocation: bool = False, only_relocation: bool = False):
+def main(quick: bool, relocation: bool = False, only_relocation: bool = False, only_meshes=None, table2_only: bool = False):
     rng = np.random.default_rng(0)
     up = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     print(machine(), "\n", up, flush=True)
@@ -240,9 +241,10 @@ def main(quick: bool, relocation: bool = False, only_relocation: bool = False):
     lines = [f"Machine: {machine()}. Load at start: `{up}` (2 cores shared by ~8 helpers: absolute times are "
              "inflated; compare methods within a row). Command: `PYTHONPATH=src /work/anchors/bin/python "
              f"bench/bench_recon.py{' --quick' if quick else ''}"
+             f"{' --meshes ' + ','.join(only_meshes) if only_meshes else ''}{' --table2-only' if table2_only else ''}"
              f"{(' --only-relocation' if only_relocation else ' --relocation') if relocation else ''}`.", ""]
 
-    section = "recon" + ("-quick" if quick else "")
+    section = "recon" + ("-quick" if quick else "") + ("-subset" if only_meshes else "")
     title = "## recon: guaranteed simply connected reconstruction" + (" (quick)" if quick else "")
 
     def flush(extra):
@@ -268,6 +270,8 @@ def main(quick: bool, relocation: bool = False, only_relocation: bool = False):
 
     # ---------------- Table 2
     meshes = ["bunny00.off", "armadillo.off"] if quick else MESHES
+    if only_meshes:
+        meshes = [m for m in meshes if m.replace(".off", "") in only_meshes]
     rows = []
     for mname in meshes:
         V0, F0 = gsdf.read_mesh(os.path.join(data_dir(), "meshes", mname))
@@ -314,6 +318,12 @@ def main(quick: bool, relocation: bool = False, only_relocation: bool = False):
               table(T2_HEADER, rows), ""]
     flush([])
 
+    if table2_only:
+        lines.append(f"Topology promise on every Table-2 case of ours: {'HELD' if not failures else 'FAILED on ' + ', '.join(failures)}.")
+        flush([])
+        if failures:
+            raise SystemExit(f"topology promise broken on: {failures}")
+        return
     # ---------------- thin tubes
     Vt, Ft = vessel_mesh()
     GTt, _ = sample_surface(Vt, Ft, 100_000, rng)
@@ -379,9 +389,14 @@ if __name__ == "__main__":
     ap.add_argument("--relocation", action="store_true",
                     help="also: the before/after table of the vertex relocation on 13 Table-2 clouds")
     ap.add_argument("--only-relocation", action="store_true", help="only that table (into the section of the mode)")
+    ap.add_argument("--meshes", default=None,
+                    help="comma list of Table-2 meshes (bunny00,armadillo,bull,camel,fandisk,homer); the clouds come "
+                         "from one rng stream, so they differ from the full run's; written to section recon-subset")
+    ap.add_argument("--table2-only", action="store_true", help="skip tubes, torus and time vs size")
     ap.add_argument("--size-worker", type=int, default=None)
     a = ap.parse_args()
     if a.size_worker is not None:
         _size_worker(a.size_worker)
     else:
-        main(a.quick, a.relocation or a.only_relocation, a.only_relocation)
+        main(a.quick, a.relocation or a.only_relocation, a.only_relocation,
+             a.meshes.split(",") if a.meshes else None, a.table2_only)

@@ -27,7 +27,7 @@ from scipy.spatial import cKDTree
 
 from .._checks import as_faces, as_points, integer, nonnegative, positive
 
-__all__ = ["local_surface", "relocate_vertices"]
+__all__ = ["local_surface", "relocate_vertices", "subdivide_onto_samples"]
 
 
 def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False, tree=None,
@@ -222,3 +222,100 @@ def relocate_vertices(V, F, S, spacing: float, *, fixed=None, rounds: int = 3, s
     report.update(moved=int((shift > 0).sum()), reverted=int(ever_reverted.sum()), damped=int(ever_damped.sum()),
                   mean_shift=float(shift.mean()))
     return (V, report) if return_report else V
+
+
+def subdivide_onto_samples(V, F, S, spacing: float, *, levels: int = 1, k: int = 12, fit_tol: float = 0.2,
+                           max_step: float = 1.0, return_report: bool = False):
+    """Split every triangle into four and move the new edge midpoints onto the local surface of the samples.
+
+    The output of the guarantee layer interpolates the samples with flat triangles, so between samples it
+    cuts the chord of the curved surface (an error of about κ·ℓ²/8 for an edge of length ℓ on curvature κ).
+    One 1-to-4 split puts a vertex on each edge midpoint; each moves along the normal of its
+    moving-least-squares quadric (:func:`local_surface`) onto it, at most ``max_step`` × ``spacing``, and not at
+    all where that fit's rms residual exceeds ``fit_tol`` × ``spacing`` (the samples there are not one smooth
+    sheet: a crease, or both sides of a thin part).  A midpoint whose move would turn one of its six new
+    faces by more than 90° against its parent face stays at the midpoint.  The split of a closed, edge- and
+    vertex-manifold mesh is again one (each edge becomes two, each face four, χ = V − E + F is unchanged), so
+    the topology is the input's by construction; only positions of the new vertices are fitted.
+
+    Parameters
+    ----------
+    V : (v, 3) float; F : (f, 3) int — a triangle mesh (kept vertices stay where they are).
+    S : (s, 3) float — samples (s ≥ 3); spacing : float > 0 — their typical spacing.
+    levels : int ≥ 0 — how many splits; k, fit_tol, max_step — as in :func:`relocate_vertices`.
+    return_report : bool — also return ``{"midpoints": n, "projected": n, "kept_flat": n}`` (summed).
+
+    Returns
+    -------
+    V2 : (v + e, 3) float64 — the input vertices first, then one vertex per edge; F2 : (4 f, 3) int64 — same
+    orientation as F.  With ``return_report``: (V2, F2, report).
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> from gsdf.recon.relocate import subdivide_onto_samples
+    >>> t = (1 + 5 ** 0.5) / 2                                        # icosahedron on the unit sphere
+    >>> V = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t],
+    ...               [0, 1, -t], [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], float)
+    >>> V /= np.linalg.norm(V, axis=1)[:, None]
+    >>> F = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
+    ...               [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
+    ...               [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]])
+    >>> rng = np.random.default_rng(0)
+    >>> S = rng.normal(size=(20000, 3)); S /= np.linalg.norm(S, axis=1)[:, None]
+    >>> V2, F2 = subdivide_onto_samples(V, F, S, 0.2)
+    >>> len(V2), len(F2), bool(np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-3)
+    (42, 80, True)
+    """
+    V = as_points(V, "V")
+    F = as_faces(F, len(V), "F")
+    S = as_points(S, "S")
+    spacing = positive(spacing, "spacing")
+    levels = integer(levels, "levels", lo=0)
+    k = integer(k, "k", lo=3)
+    fit_tol = positive(fit_tol, "fit_tol")
+    max_step = positive(max_step, "max_step")
+    if len(S) < 3:
+        raise ValueError(f"S: needs at least 3 samples for a local surface, got {len(S)}")
+    tree = cKDTree(S)
+    report = {"midpoints": 0, "projected": 0, "kept_flat": 0}
+    V = V.copy()
+    F = F.astype(np.int64, copy=True)
+    for _ in range(levels):
+        if len(F) == 0:
+            break
+        H = np.concatenate([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]])     # edge opposite corner 0, 1, 2
+        key = np.sort(H, axis=1)
+        uniq, inv = np.unique(key, axis=0, return_inverse=True)
+        inv = inv.ravel()
+        m = len(V) + inv.reshape(3, len(F)).T                             # (f, 3) midpoint id opposite each corner
+        M = 0.5 * (V[uniq[:, 0]] + V[uniq[:, 1]])
+        foot, _, _, rms = local_surface(M, S, spacing, k=k, tree=tree, return_fit=True)
+        step = foot - M
+        step[rms > fit_tol * spacing] = 0.0
+        L = np.linalg.norm(step, axis=1)
+        step *= np.minimum(1.0, max_step * spacing / np.maximum(L, 1e-300))[:, None]
+        a, b, c = F[:, 0], F[:, 1], F[:, 2]
+        ma, mb, mc = m[:, 0], m[:, 1], m[:, 2]
+        F2 = np.concatenate([np.stack([a, mc, mb], 1), np.stack([mc, b, ma], 1), np.stack([mb, ma, c], 1),
+                             np.stack([ma, mb, mc], 1)])
+        parent = np.tile(_face_normals(V, F), (4, 1))
+        moved = np.linalg.norm(step, axis=1) > 0
+        W = np.concatenate([V, M + step])
+        for _attempt in range(len(M) + 1):                 # each pass only reverts moves: terminates
+            Nn = _face_normals(W, F2)
+            bad = np.einsum("fx,fx->f", Nn, parent) <= 0
+            if not bad.any():
+                break
+            ids = np.unique(F2[bad]) - len(V)
+            ids = ids[ids >= 0]
+            ids = ids[moved[ids]]
+            if ids.size == 0:
+                break
+            W[len(V) + ids] = M[ids]
+            moved[ids] = False
+        report["midpoints"] += len(M)
+        report["projected"] += int(moved.sum())
+        report["kept_flat"] += int(len(M) - moved.sum())
+        V, F = W, F2
+    return (V, F, report) if return_report else (V, F)
