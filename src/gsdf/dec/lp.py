@@ -17,6 +17,7 @@ a network matrix with two nonzeros per column block. Bounds on J become bounds o
 ``lo ≥ 0`` the negative part is fixed at 0 and ``s⁺ ∈ [lo, hi]``; mirrored for ``hi ≤ 0``; otherwise
 ``s⁺ ≤ hi`` and ``s⁻ ≤ -lo``. One shift per connected component of the dual graph is fixed at 0 (the gauge),
 so the answer is deterministic up to LP ties. HiGHS failure, infeasibility or its time limit raise ValueError.
+``algorithm="network"`` solves the LP dual instead, a pure min-cost circulation (:mod:`gsdf.dec.netflow`).
 
 Example
 -------
@@ -36,7 +37,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-__all__ = ["DualL1Result", "dual_graph_l1"]
+__all__ = ["DualL1Result", "dual_graph_l1", "ALGORITHMS"]
+
+ALGORITHMS = ("highs", "highs-ds", "highs-ipm", "network")
 
 
 @dataclass
@@ -90,37 +93,9 @@ def solve_highs(cost, A_eq, b_eq, bounds, algorithm: str, time_limit: float):
     return res, secs
 
 
-def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit: float = 300.0,
-                  gauge: str = "component", algorithm: str = "highs") -> DualL1Result:
-    """Minimise ``Σ_k w_k |d_k + x_{A_k} - x_{B_k}|`` over per-cell shifts x with HiGHS.
-
-    Parameters
-    ----------
-    n_cells : int
-        Number of cells (unknown shifts).
-    pairs : (k, 2) int
-        ``(A_k, B_k)`` cells of each dual edge.
-    offsets : (k,) float
-        ``d_k``, the jump when both shifts are 0.
-    weights : (k,) float, ≥ 0
-    bounds : (k, 2) float, optional
-        ``[lo_k, hi_k]`` bounds on the jump ``J_k`` (±inf allowed); ``lo ≤ hi``.
-    time_limit : float
-        Seconds HiGHS may use; reaching it raises ValueError.
-    gauge : "component" | "none"
-        Fix one shift per connected component of the dual graph at 0 (default), or leave all free.
-    algorithm : "highs" (HiGHS picks), "highs-ds" (dual simplex) or "highs-ipm" (interior point + crossover)
-
-    Returns
-    -------
-    DualL1Result
-
-    Example
-    -------
-    >>> r = dual_graph_l1(2, [[0, 1]], [0.5], [1.0], bounds=[[1.0, 2.0]])
-    >>> round(float(r.jumps[0]), 6), round(float(r.objective), 6)
-    (1.0, 1.0)
-    """
+def _checked_terms(n_cells, pairs, offsets, weights, bounds, time_limit, gauge):
+    """Validated data of the L1 program: (n, pairs (k, 2), d, w, lo, hi, gauge cells or None, component label
+    per cell or None). ValueError naming the argument otherwise."""
     if isinstance(n_cells, (bool, np.bool_)) or not isinstance(n_cells, (int, np.integer)) or n_cells < 1:
         raise ValueError(f"n_cells: expected a positive integer, got {n_cells!r}")
     n = int(n_cells)
@@ -148,22 +123,66 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
             raise ValueError("bounds: need lo <= hi without NaN")
     if gauge not in ("component", "none"):
         raise ValueError(f"gauge: expected 'component' or 'none', got {gauge!r}")
-    if algorithm not in ("highs", "highs-ds", "highs-ipm"):
-        raise ValueError(f"algorithm: expected 'highs', 'highs-ds' or 'highs-ipm', got {algorithm!r}")
     if not isinstance(time_limit, (int, float)) or isinstance(time_limit, bool) or not time_limit > 0:
         raise ValueError(f"time_limit: expected a positive number of seconds, got {time_limit!r}")
 
+    first = lab = None
+    if gauge == "component":
+        G = sp.coo_matrix((np.ones(k), (P[:, 0], P[:, 1])), shape=(n, n))
+        nc, lab = connected_components(G, directed=False)
+        first = np.full(nc, n, dtype=np.int64)
+        np.minimum.at(first, lab, np.arange(n))
+    return n, P, d, w, lo, hi, first, lab
+
+
+def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit: float = 300.0,
+                  gauge: str = "component", algorithm: str = "highs") -> DualL1Result:
+    """Minimise ``Σ_k w_k |d_k + x_{A_k} - x_{B_k}|`` over per-cell shifts x with HiGHS.
+
+    Parameters
+    ----------
+    n_cells : int
+        Number of cells (unknown shifts).
+    pairs : (k, 2) int
+        ``(A_k, B_k)`` cells of each dual edge.
+    offsets : (k,) float
+        ``d_k``, the jump when both shifts are 0.
+    weights : (k,) float, ≥ 0
+    bounds : (k, 2) float, optional
+        ``[lo_k, hi_k]`` bounds on the jump ``J_k`` (±inf allowed); ``lo ≤ hi``.
+    time_limit : float
+        Seconds HiGHS may use; reaching it raises ValueError.
+    gauge : "component" | "none"
+        Fix one shift per connected component of the dual graph at 0 (default), or leave all free.
+    algorithm : "highs" (HiGHS picks), "highs-ds" (dual simplex), "highs-ipm" (interior point + crossover) or
+        "network" (the dual min-cost circulation by a network simplex, :mod:`gsdf.dec.netflow`; same optimum)
+
+    Returns
+    -------
+    DualL1Result
+
+    Example
+    -------
+    >>> r = dual_graph_l1(2, [[0, 1]], [0.5], [1.0], bounds=[[1.0, 2.0]])
+    >>> round(float(r.jumps[0]), 6), round(float(r.objective), 6)
+    (1.0, 1.0)
+    """
+    if algorithm not in ALGORITHMS:
+        raise ValueError(f"algorithm: expected one of {ALGORITHMS}, got {algorithm!r}")
+    if algorithm == "network":
+        from .netflow import dual_graph_l1_network
+
+        return dual_graph_l1_network(n_cells, pairs, offsets, weights, bounds=bounds, time_limit=time_limit,
+                                     gauge=gauge)
+    n, P, d, w, lo, hi, first, _ = _checked_terms(n_cells, pairs, offsets, weights, bounds, time_limit, gauge)
+    k = len(P)
     # bounds of s+ and s-
     sp_lo = np.where(lo > 0, lo, 0.0)
     sp_hi = np.where(hi < 0, 0.0, hi)
     sm_lo = np.where(hi < 0, -hi, 0.0)
     sm_hi = np.where(lo > 0, 0.0, -lo)
     x_lo, x_hi = np.full(n, -np.inf), np.full(n, np.inf)
-    if gauge == "component":
-        G = sp.coo_matrix((np.ones(k), (P[:, 0], P[:, 1])), shape=(n, n))
-        nc, lab = connected_components(G, directed=False)
-        first = np.full(nc, n, dtype=np.int64)
-        np.minimum.at(first, lab, np.arange(n))
+    if first is not None:
         x_lo[first] = 0.0
         x_hi[first] = 0.0
     if k == 0:

@@ -65,7 +65,7 @@ METHODS = ("lp", "reduced", "none")
 HOMOLOGY = ("real", "integer")
 BOUNDING = ("subset", "fractional")
 MAX_PASSES = 3          # bounding="subset": decompositions of the remainder at most (bench: a third pass is rare)
-LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
+LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm", "network")   # network: gsdf.dec.netflow
 ENDPOINT_RULES = ("auto", "branch", "exclude")
 LP_FORMS = ("faces", "cycles")    # the full residual LP: face shifts (dual_graph_l1, default) or cycle form
 IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
@@ -256,7 +256,9 @@ class SurfaceWindingNumbers:
             closed form with the rounding error as periods (the LP only sees the class: exact parts are absorbed
             by the face shifts). A class that rounds to 0 needs no LP at all; otherwise Jv is an integer chain.
         lp_algorithm : "auto" (default: interior point from 12k faces on, dual simplex below), "highs",
-            "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP
+            "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP — or "network": the same
+            face-form program solved as its dual min-cost circulation by a network simplex
+            (:func:`gsdf.dec.netflow.dual_graph_l1_network`; face form only)
         bounding : "subset" (default) or "fractional" — how step ⑤ reads the bounding part "Γ ∖ Jv" (§6.1.2)
             off the residual. "subset": as a *subset* of the input, the thesis' words ("the bounding components
             of Γ are … the complement of the nonbounding components, taken as a subset of Γ"): an input edge
@@ -551,6 +553,8 @@ class SurfaceWindingNumbers:
 
     def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
         if self.lp_form == "cycles":
+            if algorithm == "network":
+                raise ValueError("lp_algorithm='network' solves the face form (lp_form='faces') only")
             return self._residual_cycles(gamma, g, eps, time_limit, algorithm)
         dec, topo = self.dec, self.topology
         interior, d, w, bounds = self._full_lp_terms(gamma, g, eps)
