@@ -56,7 +56,7 @@ from .lp import DualL1Result
 
 __all__ = ["network_simplex", "dual_graph_l1_network"]
 
-_CHUNK = 200_000        # pivots between two time-limit checks
+_CHUNK = 20_000         # pivots between two time-limit checks
 
 
 @nb.njit(cache=True)
@@ -379,6 +379,39 @@ def network_simplex(n_nodes: int, tail, head, cap, cost, time_limit: float = 300
     return flow[:m].copy(), pi[:n].copy(), total
 
 
+def _l1_by_circulation(n, P, d, w, lo, hi, time_limit):
+    """The circulation of the module docstring, solved: (shifts x = −π, flow f per dual edge (A → B positive),
+    optimum of the L1 program by strong duality). ValueError on infeasible bounds or the time limit."""
+    k = len(P)
+    a_lo = np.where(lo > 0, lo, 0.0)               # s+ ∈ [a_lo, a_hi], s- ∈ [b_lo, b_hi] (as dual_graph_l1)
+    a_hi = np.where(hi < 0, 0.0, hi)
+    b_lo = np.where(hi < 0, -hi, 0.0)
+    b_hi = np.where(lo > 0, 0.0, -lo)
+    lin = -d + a_lo - b_lo
+    A, B = P[:, 0], P[:, 1]
+    ea = np.flatnonzero(np.isfinite(a_hi))
+    eb = np.flatnonzero(np.isfinite(b_hi))
+    edge = np.concatenate([np.arange(k), np.arange(k), ea, eb])
+    sign = np.concatenate([np.ones(k), -np.ones(k), np.ones(len(ea)), -np.ones(len(eb))])
+    tail = np.concatenate([A, B, A[ea], B[eb]])
+    head = np.concatenate([B, A, B[ea], A[eb]])
+    cap = np.concatenate([w, w, np.full(len(ea) + len(eb), np.inf)])
+    cost = np.concatenate([lin, -lin, lin[ea] + (a_hi - a_lo)[ea], -lin[eb] + (b_hi - b_lo)[eb]])
+    keep = (cap > 0) & (tail != head)              # zero-weight links carry nothing; A == B has J = d fixed
+    try:
+        flow, pi, _ = network_simplex(n, tail[keep], head[keep], cap[keep], cost[keep], time_limit=time_limit)
+    except ValueError as exc:
+        if "unbounded" in str(exc):
+            raise ValueError("linear program: infeasible jump bounds (network simplex: unbounded dual)") from exc
+        raise ValueError(f"linear program: {exc}") from exc
+    f = np.bincount(edge[keep], weights=sign[keep] * flow, minlength=k)
+    # strong duality: minus the circulation's cost, plus the fixed jumps of links with A == B (J = d there)
+    loop = A == B
+    flow_obj = -(float(np.dot(cost[keep], flow)) - float(np.dot(w[~loop], (a_lo + b_lo)[~loop]))) + \
+        float(np.dot(w[loop], np.abs(d[loop])))
+    return -pi, f, flow_obj
+
+
 def dual_graph_l1_network(n_cells: int, pairs, offsets, weights, bounds=None, time_limit: float = 300.0,
                           gauge: str = "component") -> DualL1Result:
     """The program of :func:`gsdf.dec.lp.dual_graph_l1` solved as its dual min-cost circulation (module docstring).
@@ -400,40 +433,18 @@ def dual_graph_l1_network(n_cells: int, pairs, offsets, weights, bounds=None, ti
     k = len(P)
     if k == 0:
         return DualL1Result(np.zeros(n), np.zeros(0), 0.0, 0.0)
-    a_lo = np.where(lo > 0, lo, 0.0)               # s+ ∈ [a_lo, a_hi], s- ∈ [b_lo, b_hi] (as dual_graph_l1)
-    a_hi = np.where(hi < 0, 0.0, hi)
-    b_lo = np.where(hi < 0, -hi, 0.0)
-    b_hi = np.where(lo > 0, 0.0, -lo)
-    lin = -d + a_lo - b_lo
-    A, B = P[:, 0], P[:, 1]
-    ea = np.flatnonzero(np.isfinite(a_hi))
-    eb = np.flatnonzero(np.isfinite(b_hi))
-    tail = np.concatenate([A, B, A[ea], B[eb]])
-    head = np.concatenate([B, A, B[ea], A[eb]])
-    cap = np.concatenate([w, w, np.full(len(ea) + len(eb), np.inf)])
-    cost = np.concatenate([lin, -lin, lin[ea] + (a_hi - a_lo)[ea], -lin[eb] + (b_hi - b_lo)[eb]])
-    keep = (cap > 0) & (tail != head)              # zero-weight links carry nothing; A == B has J = d fixed
     t0 = time.perf_counter()
-    try:
-        flow, pi, _ = network_simplex(n, tail[keep], head[keep], cap[keep], cost[keep], time_limit=time_limit)
-    except ValueError as exc:
-        if "unbounded" in str(exc):
-            raise ValueError("linear program: infeasible jump bounds (network simplex: unbounded dual)") from exc
-        raise ValueError(f"linear program: {exc}") from exc
+    x, f, flow_obj = _l1_by_circulation(n, P, d, w, lo, hi, time_limit)
     secs = time.perf_counter() - t0
-    x = -pi
     if gauge_cells is not None:                    # the gauge: 0 at the first cell of every component
         x = x - x[gauge_cells][labels]
+    A, B = P[:, 0], P[:, 1]
     J = d + x[A] - x[B]
     scale = max(1.0, float(np.abs(d).max()))
     if (J < lo - 1e-7 * scale).any() or (J > hi + 1e-7 * scale).any():
         raise ValueError("linear program: network simplex result violates the jump bounds (numerical trouble)")
     J = np.clip(J, lo, hi)
     obj = float(np.dot(w, np.abs(J)))
-    # strong duality: minus the circulation's cost, plus the fixed jumps of links with A == B (J = d there)
-    loop = A == B
-    flow_obj = -(float(np.dot(cost[keep], flow)) - float(np.dot(w[~loop], (a_lo + b_lo)[~loop]))) + \
-        float(np.dot(w[loop], np.abs(d[loop])))
     if abs(obj - flow_obj) > 1e-7 * max(1.0, abs(obj), float(np.dot(w, np.abs(d)))):
         raise ValueError(f"linear program: network simplex duality gap {obj - flow_obj:.3g} (numerical trouble)")
     return DualL1Result(x, J, obj, secs)
