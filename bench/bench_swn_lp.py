@@ -155,7 +155,7 @@ def _lp_without(swn, forbid):
     """The full residual LP of ``swn`` with the jump forced to 0 on the edges ``forbid`` (diagnosis only)."""
     from gsdf.dec.lp import dual_graph_l1
 
-    def residual(gamma, g, eps, time_limit, algorithm="highs-ds"):
+    def residual(gamma, g, eps, time_limit, algorithm="highs-ds", ends=None):
         dec, topo = swn.dec, swn.topology
         inter = np.flatnonzero(topo.edge_face_count == 2)
         d = swn._edge_offsets(swn._face_integrals(gamma), inter)

@@ -113,3 +113,89 @@ def test_network_bad_input(monkeypatch):
     V, F, idx = torus(16, 8)
     with pytest.raises(ValueError, match="face form"):
         SurfaceWindingNumbers(V, F, lp_form="cycles").solve([idx[3, :5]], lp_algorithm="network")
+
+
+# ------------------------------------------------------------------------------------------------ banded LP
+from gsdf.dec.band_lp import banded_l1, certify  # noqa: E402
+
+
+@pytest.mark.parametrize("name,V,F,curves", list(cases()), ids=lambda x: x if isinstance(x, str) else "")
+def test_band_residual_lp_equals_face_form(name, V, F, curves):
+    swn = SurfaceWindingNumbers(V, F)
+    for eps in (1e-2, 0.5):
+        kw = dict(method="lp", epsilon=eps, bounding="fractional")        # one pass: the same LP data
+        rh = swn.solve(curves, lp_algorithm="highs-ds", **kw)
+        rb = swn.solve(curves, lp_algorithm="band", **kw)
+        assert rh.lp_objective > 1e-6
+        assert abs(rh.lp_objective - rb.lp_objective) <= 1e-7 * max(1.0, rh.lp_objective), (name, eps)
+
+
+def test_band_is_proven_on_a_small_band():
+    # torus with a broken meridian: the band starts thin (rings=1) and is proven before it covers the surface
+    V, F, idx = torus(40, 20)
+    swn = SurfaceWindingNumbers(V, F)
+    curves = [idx[5, :15]]
+    g = swn.chain(curves)
+    gamma = swn.solve(curves, method="lp", bounding="fractional").gamma
+    interior, d, w, bounds = swn._full_lp_terms(gamma, g, 1e-2)
+    pairs = swn.topology.edge_faces[interior]
+    seeds = np.unique(pairs[g[interior] != 0])
+    info = {}
+    rb = banded_l1(swn.dec.n_faces, pairs, d, w, bounds=bounds, seeds=seeds, rings=1, _info=info)
+    rh = dual_graph_l1(swn.dec.n_faces, pairs, d, w, bounds=bounds)
+    assert info["proven"] and "fallback" not in info
+    assert info["band_cells"][-1] < swn.dec.n_faces
+    assert abs(rb.objective - rh.objective) <= 1e-7 * max(1.0, rh.objective)
+    assert np.all(rb.jumps >= bounds[:, 0] - 1e-7) and np.all(rb.jumps <= bounds[:, 1] + 1e-7)
+    assert certify(swn.dec.n_faces, pairs, rh.jumps, w, bounds[:, 0], bounds[:, 1])[0]
+
+
+def test_certificate_accepts_the_optimum_only():
+    # a cycle of three cells, period 1: optimal on the cheapest link (w = 1), not on the others
+    P = np.array([[0, 1], [1, 2], [2, 0]])
+    w = np.array([2.0, 1.0, 5.0])
+    inf = np.full(3, np.inf)
+    assert certify(3, P, np.array([0.0, 1.0, 0.0]), w, -inf, inf)[0]
+    ok, reach = certify(3, P, np.array([1.0, 0.0, 0.0]), w, -inf, inf)
+    assert not ok and reach is not None
+    assert not certify(3, P, np.array([0.0, 0.0, 1.0]), w, -inf, inf)[0]
+    # with J ≤ 0.5 on the cheap link the optimum splits 0.5 / 0.5 between the two cheapest links
+    hi = np.array([np.inf, 0.5, np.inf])
+    assert certify(3, P, np.array([0.5, 0.5, 0.0]), w, -inf, hi)[0]
+    assert not certify(3, P, np.array([0.0, 0.5, 0.5]), w, -inf, hi)[0]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_band_matches_highs_on_random_graphs(seed):
+    rng = np.random.default_rng(40 + seed)
+    n = 60
+    a, b = _random_graph(rng, n, 60)
+    P = np.stack([a, b], 1)
+    k = len(P)
+    d = rng.normal(size=k) * (rng.random(k) < 0.3)
+    w = rng.uniform(0.1, 2.0, k)
+    info = {}
+    r1 = dual_graph_l1(n, P, d, w)
+    r2 = banded_l1(n, P, d, w, seeds=[0, 1], rings=1, _info=info)
+    assert abs(r1.objective - r2.objective) <= 1e-7 * max(1.0, r1.objective)
+
+
+def test_band_bad_input():
+    P = [[0, 1], [1, 2], [2, 0]]
+    with pytest.raises(ValueError, match="rings"):
+        banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], rings=-1)
+    with pytest.raises(ValueError, match="rings"):
+        banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], rings=True)
+    with pytest.raises(ValueError, match="max_rounds"):
+        banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], max_rounds=0)
+    with pytest.raises(ValueError, match="fallback"):
+        banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], fallback="simplex")
+    with pytest.raises(ValueError, match="seeds"):
+        banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], seeds=[5])
+    with pytest.raises(ValueError, match="seeds"):
+        banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], seeds=np.ones(2, bool))
+    with pytest.raises(ValueError, match="offsets"):
+        banded_l1(3, P, [np.nan, 0, 0], [1.0, 1, 1])
+    V, F, idx = torus(16, 8)
+    with pytest.raises(ValueError, match="face form"):
+        SurfaceWindingNumbers(V, F, lp_form="cycles").solve([idx[3, :5]], lp_algorithm="band")

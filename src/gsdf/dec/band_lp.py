@@ -9,7 +9,8 @@ gaps. Solving it on all cells costs simplex pivots that only route the dual flow
 1. **band**: the seed cells (e.g. the faces along the curves and along the reduced LP's completion paths, §6.3)
    grown by ``rings`` rings of neighbours; outside it, J = 0 is imposed: every connected piece of the outside is
    integrated once (``x_B − x_A = d`` along a spanning forest) and becomes a single cell. If d is not exact on
-   a piece (a link inside it would get a jump), the band grows over that link and step 1 repeats;
+   a piece (a non-forest link inside it would get a jump: the piece has a loop with a period), the cells of
+   such links (the forest's seam) join the band and step 1 repeats;
 2. **restricted solve** of the contracted program (band cells + one cell per outside piece) by the network simplex
    (:mod:`gsdf.dec.netflow`) — a restriction of the full program (J = 0 outside), so its optimum is ≥ the full
    one, and equal when some full optimum has no jump outside the band;
@@ -54,6 +55,16 @@ def _grow(band, G, rings):
     for _ in range(int(rings)):
         band = band | (G @ band.astype(np.float64) > 0)
     return band
+
+
+def _integrate(n, a, b, d):
+    """x with x_b − x_a = d along a spanning forest of the links a–b (one link per cell pair)."""
+    if len(a) == 0:
+        return np.zeros(n)
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    _, first = np.unique(lo * n + hi, return_index=True)
+    a, b, d = a[first], b[first], d[first]
+    return forest_potentials(n, np.concatenate([a, b]), np.concatenate([b, a]), np.concatenate([d, -d]))
 
 
 def certify(n, P, J, w, lo, hi, tol=1e-9):
@@ -124,7 +135,8 @@ def banded_l1(n_cells: int, pairs, offsets, weights, bounds=None, seeds=None, ri
     n_cells, pairs, offsets, weights, bounds, time_limit, gauge : as :func:`gsdf.dec.lp.dual_graph_l1`
     seeds : (s,) int or (n_cells,) bool, the cells where jumps are expected (default: the cells of links with a
         bound that excludes 0 or a weight below a tenth of the median — cheap links)
-    rings : int ≥ 0, neighbour rings added to the seeds (doubled, plus 1, after each failed proof)
+    rings : int ≥ 0, neighbour rings added to the seeds; after a failed proof the band grows by ``rings`` rings
+        around the links of the certificate's minimum cut (where the better shifts jump) and one ring everywhere
     max_rounds : int ≥ 1
     fallback : "network", "highs", "highs-ds" or "highs-ipm"
 
@@ -185,8 +197,7 @@ def banded_l1(n_cells: int, pairs, offsets, weights, bounds=None, seeds=None, ri
         for _ in range(20):
             out = ~band
             oo = np.flatnonzero(out[A] & out[B] & (A != B))
-            x = forest_potentials(n, np.concatenate([A[oo], B[oo]]), np.concatenate([B[oo], A[oo]]),
-                                  np.concatenate([d[oo], -d[oo]])) if len(oo) else np.zeros(n)
+            x = _integrate(n, A[oo], B[oo], d[oo])
             x[band] = 0.0
             bad = oo[np.abs(d[oo] + x[A[oo]] - x[B[oo]]) > tol]
             if len(bad) == 0:
@@ -230,7 +241,8 @@ def banded_l1(n_cells: int, pairs, offsets, weights, bounds=None, seeds=None, ri
             info["proven"] = True
             if gauge_cells is not None:
                 xf = xf - xf[gauge_cells][labels]
-            return DualL1Result(xf, d + xf[A] - xf[B], float(np.dot(w, np.abs(J))), time.perf_counter() - t_start)
+            Jr = d + xf[A] - xf[B]
+            return DualL1Result(xf, Jr, float(np.dot(w, np.abs(Jr))), time.perf_counter() - t_start)
         # grow the band over the links of the minimum cut (where the next jumps go), and a little everywhere
         across = reach[A] != reach[B]
         grow = np.zeros(n, dtype=bool)
