@@ -436,7 +436,8 @@ class SurfaceWindingNumbers:
                         ("highs-ipm" if self.dec.n_faces >= IPM_FACES else "highs-ds")
                     if lp_algorithm == "auto" and self.lp_form == "faces" and self.dec.n_faces >= BAND_FACES:
                         alg = "band"
-                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit, alg, ends)
+                    extra = (ends,) if alg == "band" else ()          # the band's seeds need the endpoints
+                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit, alg, *extra)
                 else:
                     Jv, obj, lp_s = self._residual_reduced(gamma_lp, g, ends, time_limit)
             except ValueError as exc:
