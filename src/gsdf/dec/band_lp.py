@@ -43,7 +43,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import breadth_first_order, connected_components, maximum_flow
 
-from .lp import DualL1Result, _checked_terms, dual_graph_l1
+from .l1_terms import DualL1Result, _checked_terms
+from .lp import dual_graph_l1
 from .netflow import _l1_by_circulation
 from .triangle import forest_potentials
 

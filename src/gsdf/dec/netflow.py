@@ -52,7 +52,7 @@ import time
 import numba as nb
 import numpy as np
 
-from .lp import DualL1Result
+from .l1_terms import DualL1Result
 
 __all__ = ["network_simplex", "dual_graph_l1_network"]
 
@@ -426,7 +426,7 @@ def dual_graph_l1_network(n_cells: int, pairs, offsets, weights, bounds=None, ti
     >>> round(float(r.jumps[0]), 6), round(float(r.objective), 6)
     (1.0, 1.0)
     """
-    from .lp import _checked_terms
+    from .l1_terms import _checked_terms
 
     n, P, d, w, lo, hi, gauge_cells, labels = _checked_terms(n_cells, pairs, offsets, weights, bounds, time_limit,
                                                              gauge)
