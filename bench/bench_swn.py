@@ -642,7 +642,8 @@ def compare_breakings(quick=False):
 
 # ----------------------------------------------------------------------------------------------- scaling
 def scaling(time_limit, sizes):
-    rows = ["| faces | step ① jump solve | full LP: HiGHS / total | reduced LP: LP / total | errors lp / reduced |",
+    rows = ["| faces | step ① jump solve | full LP (lp_algorithm auto): LP / total | reduced LP: LP / total | "
+            "errors lp / reduced |",
             "|---|---|---|---|---|"]
     for nu in sizes:
         nv = max(8, nu // 3)

@@ -14,13 +14,15 @@ bench/bench_swn.py, with its ``--breaking`` scheme) and scores, on the same case
 
 For every method the error with the solver's rounding offset and, for naive and lp, with the best offset in
 hindsight (an oracle that reads the truth: how much is the offset rule, how much the labels). The speed part
-times the full LP (HiGHS dual simplex vs interior point) on the scaling case of bench_swn.py.
+(``--only speed``, section "swn-lp-scaling") times the full LP per form (banded LP, network simplex, HiGHS on the
+face and cycle forms) and the linear solves, 2k → 326k faces, on the scaling case of bench_swn.py.
 
 Usage::
 
     PYTHONPATH=src python3 bench/bench_swn_lp.py --quick           # 4 cases per mesh (48), small speed run
     PYTHONPATH=src python3 bench/bench_swn_lp.py                   # 42 per mesh (all 504), speed to 134k faces
-    PYTHONPATH=src python3 bench/bench_swn_lp.py --only speed|cases [--breaking long|random]
+    PYTHONPATH=src python3 bench/bench_swn_lp.py --only speed [--quick] [--sizes 56,112] [--max-faces N]
+    PYTHONPATH=src python3 bench/bench_swn_lp.py --only cases [--breaking long|random]
     PYTHONPATH=src python3 bench/bench_swn_lp.py --only summary    # the table of a partial run's CSV
     PYTHONPATH=src python3 bench/bench_swn_lp.py --only ns-diagnose [--quick]   # causes of the misses with
                                                                    # broken nonbounding loops (section swn-ns-diagnose)
@@ -155,7 +157,7 @@ def _lp_without(swn, forbid):
     """The full residual LP of ``swn`` with the jump forced to 0 on the edges ``forbid`` (diagnosis only)."""
     from gsdf.dec.lp import dual_graph_l1
 
-    def residual(gamma, g, eps, time_limit, algorithm="highs-ds"):
+    def residual(gamma, g, eps, time_limit, algorithm="highs-ds", ends=None):
         dec, topo = swn.dec, swn.topology
         inter = np.flatnonzero(topo.edge_face_count == 2)
         d = swn._edge_offsets(swn._face_integrals(gamma), inter)
@@ -305,13 +307,31 @@ def summarize(rows):
     return "\n".join(out)
 
 
-def speed(sizes, time_limit):
-    """Full-LP time on the scaling case of bench_swn.py (torus grid, a broken meridian + a broken band): the face
-    form (spec §1(b) ④, ``lp_form="faces"``, the only one before) and the cycle form (``lp_form="cycles"``,
-    gsdf.dec.cycle_lp), HiGHS dual simplex and interior point each; objectives must agree."""
-    rows = ["| faces | step ① jump solve | faces: dual simplex | faces: interior point | cycles: dual simplex | "
-            "cycles: interior point | reduced LP (LP / total) | objectives agree |",
-            "|---|---|---|---|---|---|---|---|"]
+FORMS = {  # column -> (lp_form, lp_algorithm, largest face count run by default)
+    "band": ("faces", "band", 10**9),
+    "faces: network simplex": ("faces", "network", 40_000),
+    "faces: HiGHS dual simplex": ("faces", "highs-ds", 40_000),
+    "faces: HiGHS interior point": ("faces", "highs-ipm", 40_000),
+    "cycles: HiGHS dual simplex": ("cycles", "highs-ds", 10_000),
+    "cycles: HiGHS interior point": ("cycles", "highs-ipm", 10_000),
+}
+
+
+def speed(sizes, time_limit, max_faces=None):
+    """Full-LP time vs faces on the scaling case of bench_swn.py (torus grid, a broken meridian + a broken band),
+    one decomposition (``bounding="fractional"``: every form solves the same LP): per form the LP time, and the
+    linear solves (step ① jump solve + Hodge decomposition + step ⑤ final solve) once per size. Forms slower
+    than a few minutes at 134k faces in earlier runs are skipped above their size cap (``--max-faces`` lifts it);
+    objectives must agree to 1e-7 (relative)."""
+    from gsdf.dec.band_lp import banded_l1
+    from gsdf.dec.lp import dual_graph_l1
+
+    dual_graph_l1(2, [[0, 1]], [0.5], [1.0], algorithm="network")        # load the numba kernels once
+    banded_l1(3, [[0, 1], [1, 2], [2, 0]], [1.0, 0.0, 0.0], [2.0, 1.0, 5.0], seeds=[0])
+    cols = list(FORMS)
+    rows = ["| faces | linear solves (① + Hodge + ⑤) | " + " | ".join(f"LP: {c}" for c in cols) +
+            " | reduced LP (LP / total) | objectives agree |",
+            "|---|---|" + "---|" * len(cols) + "---|---|"]
     for nu in sizes:
         nv = max(8, nu // 3)
         V, F = B.torus_grid(nu, nv)
@@ -325,24 +345,41 @@ def speed(sizes, time_limit):
         g[gap] = 0
         g = g + s0.chain([idx[nu // 7, : int(0.8 * nv)]])
         line = [f"| {len(F)} |"]
-        r0 = s0.solve(g, method="none")
-        line.append(f" {r0.timings['jump_solve']:.3f} s |")
-        obj = []
-        for form in ("faces", "cycles"):
-            for alg in ("highs-ds", "highs-ipm"):
-                try:
-                    r = swn[form].solve(g, method="lp", time_limit=time_limit, lp_algorithm=alg)
-                    line.append(f" {r.timings['lp']:.2f} s |")
-                    obj.append(r.lp_objective)
-                except ValueError as exc:
-                    line.append(f" > {time_limit:.0f} s ({'limit' if 'limit' in str(exc) else str(exc)[:30]}) |")
-        rr = s0.solve(g, method="reduced")
+        obj, lin = [], None
+        cells = []
+        for c in cols:
+            form, alg, cap = FORMS[c]
+            if len(F) > (max_faces or cap):
+                cells.append(" skipped |")
+                continue
+            try:
+                r = swn[form].solve(g, method="lp", time_limit=time_limit, lp_algorithm=alg, bounding="fractional")
+                cells.append(f" {r.timings['lp']:.2f} s |")
+                obj.append(r.lp_objective)
+                if lin is None:
+                    T = r.timings
+                    lin = T["jump_solve"] + T["hodge"] + T["final_solve"]
+            except ValueError as exc:
+                cells.append(f" > {time_limit:.0f} s ({'limit' if 'limit' in str(exc) else str(exc)[:30]}) |")
+            print(len(F), c, cells[-1], flush=True)
+        line.append(f" {lin:.2f} s |" if lin is not None else " – |")
+        line += cells
+        rr = s0.solve(g, method="reduced", bounding="fractional")
         line.append(f" {rr.timings['lp']:.3f} s / {rr.timings['total']:.2f} s |")
-        agree = len(obj) > 1 and max(obj) - min(obj) < 1e-6 * max(1, abs(obj[0]))
-        line.append(f" {'yes' if agree else '–'} ({len(obj)} solved) |")
+        agree = len(obj) > 1 and max(obj) - min(obj) <= 1e-7 * max(1, abs(obj[0]))
+        line.append(f" {'yes' if agree else ('–' if len(obj) < 2 else 'NO')} ({len(obj)} solved) |")
         rows.append("".join(line))
         print(rows[-1], flush=True)
     return "\n".join(rows)
+
+
+SPEED_NOTES = """One decomposition per solve (`bounding="fractional"`), so that every form solves the same LP; the
+default `bounding="subset"` runs up to three (bench_swn.py `--only scaling` times those). "band" (the default from
+12k faces on, `lp_algorithm="auto"`): gsdf.dec.band_lp — the face-form LP on a band of faces around the curves and
+their shortest-path completions, every outside piece one cell, then a proof of optimality on all faces (a maximum
+flow: a circulation satisfying complementary slackness exists), growing the band over the certificate's minimum
+cut until proven. "network simplex": the face-form LP's dual min-cost circulation on all faces (gsdf.dec.netflow).
+The objectives are compared to 1e-7 (relative)."""
 
 
 def main():
@@ -356,7 +393,9 @@ def main():
     ap.add_argument("--old", default="/work/main/bench/swn_cases.csv", help="--only versus: the old CSV")
     ap.add_argument("--new", default=os.path.join(HERE, "swn_cases.csv"), help="--only versus: the new CSV")
     ap.add_argument("--sizes", default=None, help="comma-separated torus grid sizes nu for the speed run "
-                    "(faces = 2 nu max(8, nu//3); default 56,112,224,448: 2k to 134k faces)")
+                    "(faces = 2 nu max(8, nu//3); default 56,112,224,448,700: 2k to 326k faces; --quick 56,112,224)")
+    ap.add_argument("--max-faces", type=int, default=None, help="speed run: run every form up to this many faces "
+                    "(default: per-form caps, FORMS)")
     a = ap.parse_args()
     load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     t0 = time.perf_counter()
@@ -393,10 +432,18 @@ def main():
         text += [f"### Not simply connected cases, {a.breaking} breaking (up to {per} per mesh; rows in "
                  f"bench/{os.path.basename(path)})", "", summarize(rows), ""]
     if a.only in (None, "speed"):
-        sizes = [int(x) for x in a.sizes.split(",")] if a.sizes else ([48, 112] if a.quick else [56, 112, 224, 448])
+        sizes = [int(x) for x in a.sizes.split(",")] if a.sizes else \
+            ([56, 112, 224] if a.quick else [56, 112, 224, 448, 700])
         text += ["### Full LP time vs faces (torus grid, one broken meridian + a 30 %-broken band boundary)", "",
-                 speed(sizes, a.time_limit), ""]
+                 SPEED_NOTES, "", speed(sizes, a.time_limit, a.max_faces), ""]
     text[1] += f" ({time.perf_counter() - t0:.0f} s)."
+    if a.only == "speed":
+        text[1] += f"{f' --max-faces {a.max_faces}' if a.max_faces else ''}"
+        write_section("swn-lp-scaling" + ("-quick" if a.quick else ""),
+                      "## Surface winding numbers: full residual LP time vs faces, by form (issue 12)\n\n" +
+                      "\n".join(text))
+        print("\n".join(text))
+        return
     name = "swn-lp" + ("-quick" if a.quick else "") + ("-speed" if a.only == "speed" else "") + \
         ("-long" if a.breaking == "long" and a.only != "speed" else "")
     write_section(name, "## Surface winding numbers, not simply connected: residual LP (issue 12)\n\n" +

@@ -7,6 +7,8 @@ triangle : d0, d1, diagonal Hodge stars (cotan, clamped), jump ("reduced") coord
 hodge    : Hodge decomposition of a 1-form on any cell complex given d0, d1 and positive diagonal stars
            (exact, coexact, harmonic parts) and a harmonic basis (dimension = first Betti number).
 lp       : the L1 linear program on a dual graph (per-cell shifts, least weighted L1 jump), solved by HiGHS.
+netflow  : network simplex for min-cost circulations; the L1 program through its dual circulation.
+band_lp  : the L1 program on a band of cells, proven optimal on all cells by a max-flow certificate.
 
 Names are imported lazily (PEP 562) so ``import gsdf.dec.lp`` does not pay for the others.
 """

@@ -17,6 +17,7 @@ a network matrix with two nonzeros per column block. Bounds on J become bounds o
 ``lo ≥ 0`` the negative part is fixed at 0 and ``s⁺ ∈ [lo, hi]``; mirrored for ``hi ≤ 0``; otherwise
 ``s⁺ ≤ hi`` and ``s⁻ ≤ -lo``. One shift per connected component of the dual graph is fixed at 0 (the gauge),
 so the answer is deterministic up to LP ties. HiGHS failure, infeasibility or its time limit raise ValueError.
+``algorithm="network"`` solves the LP dual instead, a pure min-cost circulation (:mod:`gsdf.dec.netflow`).
 
 Example
 -------
@@ -30,42 +31,15 @@ Example
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
-__all__ = ["DualL1Result", "dual_graph_l1"]
+from .l1_terms import DualL1Result, _checked_terms
 
+__all__ = ["DualL1Result", "dual_graph_l1", "ALGORITHMS"]
 
-@dataclass
-class DualL1Result:
-    """Solution of :func:`dual_graph_l1`.
-
-    Attributes
-    ----------
-    shifts : (n_cells,) the per-cell shifts x (0 at each component's gauge cell)
-    jumps : (k,) J = d + x_A - x_B per dual edge
-    objective : Σ w |J|
-    seconds : wall time of HiGHS
-    """
-
-    shifts: np.ndarray
-    jumps: np.ndarray
-    objective: float
-    seconds: float
-
-
-def _check_1d(a, k, name, default=None):
-    if a is None:
-        return default
-    A = np.asarray(a, dtype=np.float64) if not (np.asarray(a).dtype == bool) else None
-    if A is None:
-        raise ValueError(f"{name}: expected real numbers, got booleans")
-    if A.shape != (k,):
-        raise ValueError(f"{name}: expected shape ({k},), got {A.shape}")
-    return A
+ALGORITHMS = ("highs", "highs-ds", "highs-ipm", "network")
 
 
 def solve_highs(cost, A_eq, b_eq, bounds, algorithm: str, time_limit: float):
@@ -109,7 +83,8 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
         Seconds HiGHS may use; reaching it raises ValueError.
     gauge : "component" | "none"
         Fix one shift per connected component of the dual graph at 0 (default), or leave all free.
-    algorithm : "highs" (HiGHS picks), "highs-ds" (dual simplex) or "highs-ipm" (interior point + crossover)
+    algorithm : "highs" (HiGHS picks), "highs-ds" (dual simplex), "highs-ipm" (interior point + crossover) or
+        "network" (the dual min-cost circulation by a network simplex, :mod:`gsdf.dec.netflow`; same optimum)
 
     Returns
     -------
@@ -121,49 +96,22 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
     >>> round(float(r.jumps[0]), 6), round(float(r.objective), 6)
     (1.0, 1.0)
     """
-    if isinstance(n_cells, (bool, np.bool_)) or not isinstance(n_cells, (int, np.integer)) or n_cells < 1:
-        raise ValueError(f"n_cells: expected a positive integer, got {n_cells!r}")
-    n = int(n_cells)
-    P = np.asarray(pairs)
-    if P.dtype == bool or not (np.issubdtype(P.dtype, np.integer) or P.size == 0):
-        raise ValueError(f"pairs: expected an integer (k, 2) array, got dtype {P.dtype}")
-    P = P.reshape(-1, 2).astype(np.int64) if P.size else np.zeros((0, 2), np.int64)
-    if P.size and (P.min() < 0 or P.max() >= n):
-        raise ValueError(f"pairs: cell index out of range for {n} cells")
-    k = len(P)
-    d = _check_1d(offsets, k, "offsets")
-    w = _check_1d(weights, k, "weights")
-    if not (np.isfinite(d).all() and np.isfinite(w).all()):
-        raise ValueError("offsets/weights: contain NaN or infinite values")
-    if (w < 0).any():
-        raise ValueError("weights: must be nonnegative")
-    if bounds is None:
-        lo, hi = np.full(k, -np.inf), np.full(k, np.inf)
-    else:
-        B = np.asarray(bounds, dtype=np.float64)
-        if B.shape != (k, 2):
-            raise ValueError(f"bounds: expected shape ({k}, 2), got {B.shape}")
-        lo, hi = B[:, 0], B[:, 1]
-        if np.isnan(B).any() or (lo > hi).any():
-            raise ValueError("bounds: need lo <= hi without NaN")
-    if gauge not in ("component", "none"):
-        raise ValueError(f"gauge: expected 'component' or 'none', got {gauge!r}")
-    if algorithm not in ("highs", "highs-ds", "highs-ipm"):
-        raise ValueError(f"algorithm: expected 'highs', 'highs-ds' or 'highs-ipm', got {algorithm!r}")
-    if not isinstance(time_limit, (int, float)) or isinstance(time_limit, bool) or not time_limit > 0:
-        raise ValueError(f"time_limit: expected a positive number of seconds, got {time_limit!r}")
+    if algorithm not in ALGORITHMS:
+        raise ValueError(f"algorithm: expected one of {ALGORITHMS}, got {algorithm!r}")
+    if algorithm == "network":
+        from .netflow import dual_graph_l1_network
 
+        return dual_graph_l1_network(n_cells, pairs, offsets, weights, bounds=bounds, time_limit=time_limit,
+                                     gauge=gauge)
+    n, P, d, w, lo, hi, first, _ = _checked_terms(n_cells, pairs, offsets, weights, bounds, time_limit, gauge)
+    k = len(P)
     # bounds of s+ and s-
     sp_lo = np.where(lo > 0, lo, 0.0)
     sp_hi = np.where(hi < 0, 0.0, hi)
     sm_lo = np.where(hi < 0, -hi, 0.0)
     sm_hi = np.where(lo > 0, 0.0, -lo)
     x_lo, x_hi = np.full(n, -np.inf), np.full(n, np.inf)
-    if gauge == "component":
-        G = sp.coo_matrix((np.ones(k), (P[:, 0], P[:, 1])), shape=(n, n))
-        nc, lab = connected_components(G, directed=False)
-        first = np.full(nc, n, dtype=np.int64)
-        np.minimum.at(first, lab, np.arange(n))
+    if first is not None:
         x_lo[first] = 0.0
         x_hi[first] = 0.0
     if k == 0:

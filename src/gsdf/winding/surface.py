@@ -65,12 +65,14 @@ METHODS = ("lp", "reduced", "none")
 HOMOLOGY = ("real", "integer")
 BOUNDING = ("subset", "fractional")
 MAX_PASSES = 3          # bounding="subset": decompositions of the remainder at most (bench: a third pass is rare)
-LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm")
+LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm", "network", "band")   # gsdf.dec.netflow / .band_lp
 ENDPOINT_RULES = ("auto", "branch", "exclude")
 LP_FORMS = ("faces", "cycles")    # the full residual LP: face shifts (dual_graph_l1, default) or cycle form
 IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
                         # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
                         # 75 s vs 62 s; at load ≈ 9: 1.5 vs 2.1 s and 36 vs 16 s)
+BAND_FACES = 12_000     # "auto": the banded LP (gsdf.dec.band_lp) from this many faces on (torus case of
+                        # bench/bench_swn_lp.py --only speed, loaded machine: 33k faces 3 s vs 14-29 s HiGHS)
 NEXT = np.array([1, 2, 0])
 
 
@@ -256,7 +258,13 @@ class SurfaceWindingNumbers:
             closed form with the rounding error as periods (the LP only sees the class: exact parts are absorbed
             by the face shifts). A class that rounds to 0 needs no LP at all; otherwise Jv is an integer chain.
         lp_algorithm : "auto" (default: interior point from 12k faces on, dual simplex below), "highs",
-            "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP
+            "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP — or "network": the same
+            face-form program solved as its dual min-cost circulation by a network simplex
+            (:func:`gsdf.dec.netflow.dual_graph_l1_network`; face form only) — or "band": the face-form program on
+            a band of faces around the curves and their §6.3 completion paths, proven optimal for all faces by
+            a maximum-flow certificate, grown until proven (:func:`gsdf.dec.band_lp.banded_l1`; HiGHS interior
+            point on all faces if no band is proven; face form only). "auto" uses "band" from ``BAND_FACES``
+            faces on (face form)
         bounding : "subset" (default) or "fractional" — how step ⑤ reads the bounding part "Γ ∖ Jv" (§6.1.2)
             off the residual. "subset": as a *subset* of the input, the thesis' words ("the bounding components
             of Γ are … the complement of the nonbounding components, taken as a subset of Γ"): an input edge
@@ -426,7 +434,10 @@ class SurfaceWindingNumbers:
                 if method == "lp":
                     alg = lp_algorithm if lp_algorithm != "auto" else \
                         ("highs-ipm" if self.dec.n_faces >= IPM_FACES else "highs-ds")
-                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit, alg)
+                    if lp_algorithm == "auto" and self.lp_form == "faces" and self.dec.n_faces >= BAND_FACES:
+                        alg = "band"
+                    extra = (ends,) if alg == "band" else ()          # the band's seeds need the endpoints
+                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit, alg, *extra)
                 else:
                     Jv, obj, lp_s = self._residual_reduced(gamma_lp, g, ends, time_limit)
             except ValueError as exc:
@@ -549,13 +560,24 @@ class SurfaceWindingNumbers:
         hi = np.where(on, np.maximum(0.0, gi), np.inf)
         return interior, d, w, np.column_stack([lo, hi])
 
-    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
+    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds", ends=None):
         if self.lp_form == "cycles":
+            if algorithm in ("network", "band"):
+                raise ValueError(f"lp_algorithm={algorithm!r} solves the face form (lp_form='faces') only")
             return self._residual_cycles(gamma, g, eps, time_limit, algorithm)
         dec, topo = self.dec, self.topology
         interior, d, w, bounds = self._full_lp_terms(gamma, g, eps)
         pairs = topo.edge_faces[interior]
-        r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=bounds, time_limit=time_limit, algorithm=algorithm)
+        if algorithm == "band":
+            from ..dec.band_lp import banded_l1
+
+            # seeds: the faces along the curves and along their shortest-path completions (§6.3)
+            path = (g != 0) | (self._complete_chain(g, ends) != 0) if ends is not None else (g != 0)
+            seeds = np.unique(topo.edge_faces[path & (topo.edge_face_count == 2)])
+            r = banded_l1(dec.n_faces, pairs, d, w, bounds=bounds, seeds=seeds, time_limit=time_limit,
+                          fallback="highs-ipm")
+        else:
+            r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=bounds, time_limit=time_limit, algorithm=algorithm)
         Jv = np.zeros(dec.n_edges)
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
