@@ -321,87 +321,80 @@ def _nearest_kernel(Q, perm, D, order, start, end, right, lo, hi, out_d2, out_fa
     nq = perm.shape[0]
     nblocks = (nq + _BLOCK - 1) // _BLOCK
     for blk in prange(nblocks):
-        i0 = np.int64(blk) * _BLOCK  # int64, not the unsigned prange index: one compiled _nearest_block
-        _nearest_block(Q, perm, D, order, start, end, right, lo, hi, out_d2, out_face, out_c, out_bary, i0,
-                       min(nq, i0 + _BLOCK))
-
-
-@njit(cache=True)
-def _nearest_block(Q, perm, D, order, start, end, right, lo, hi, out_d2, out_face, out_c, out_bary, i0, i1):
-    """:func:`_nearest_kernel` for the queries perm[i0:i1], in order (a kernel of its own: the parallel loop
-    that calls it stays small, so it compiles in a fraction of the time)."""
-    stack = np.empty(_STACK, np.int64)
-    stack_d = np.empty(_STACK, np.float64)
-    bj = -1
-    for k in range(i0, i1):
-        qi = perm[k]
-        px = Q[qi, 0]
-        py = Q[qi, 1]
-        pz = Q[qi, 2]
-        best = np.inf
-        if bj >= 0:  # warm start from the previous query's nearest triangle
-            best = _tri_d2(px, py, pz, D, bj)
-        sp = 0
-        node = 0
-        if _box_d2(px, py, pz, lo, hi, np.int64(0)) >= best:  # not the literal 0: one specialisation
-            node = -1
-        while node >= 0:
-            r = right[node]
-            if r < 0:
-                for j in range(start[node], end[node]):
-                    # cheap lower bounds first: the triangle's box, then its plane
-                    if _tri_box_d2(px, py, pz, D, j) >= best:
-                        continue
-                    n2 = D[j, 12]
-                    if n2 > 0.0:
-                        s = (px - D[j, 0]) * D[j, 9] + (py - D[j, 1]) * D[j, 10] + (pz - D[j, 2]) * D[j, 11]
-                        if s * s >= best * n2:
-                            continue
-                    d2 = _tri_d2(px, py, pz, D, j)
-                    if d2 < best:
-                        best = d2
-                        bj = j
+        stack = np.empty(_STACK, np.int64)
+        stack_d = np.empty(_STACK, np.float64)
+        i0 = blk * _BLOCK
+        i1 = min(nq, i0 + _BLOCK)
+        bj = -1
+        for k in range(i0, i1):
+            qi = perm[k]
+            px = Q[qi, 0]
+            py = Q[qi, 1]
+            pz = Q[qi, 2]
+            best = np.inf
+            if bj >= 0:  # warm start from the previous query's nearest triangle
+                best = _tri_d2(px, py, pz, D, bj)
+            sp = 0
+            node = 0
+            if _box_d2(px, py, pz, lo, hi, np.int64(0)) >= best:  # not the literal 0: one specialisation
                 node = -1
-            else:
-                left = node + 1
-                dl = _box_d2(px, py, pz, lo, hi, left)
-                dr = _box_d2(px, py, pz, lo, hi, r)
-                if dl <= dr:
-                    near = left
-                    far = r
-                    dn = dl
-                    dfar = dr
-                else:
-                    near = r
-                    far = left
-                    dn = dr
-                    dfar = dl
-                if dfar < best:
-                    stack[sp] = far
-                    stack_d[sp] = dfar
-                    sp += 1
-                if dn < best:
-                    node = near
-                else:
+            while node >= 0:
+                r = right[node]
+                if r < 0:
+                    for j in range(start[node], end[node]):
+                        # cheap lower bounds first: the triangle's box, then its plane
+                        if _tri_box_d2(px, py, pz, D, j) >= best:
+                            continue
+                        n2 = D[j, 12]
+                        if n2 > 0.0:
+                            s = (px - D[j, 0]) * D[j, 9] + (py - D[j, 1]) * D[j, 10] + (pz - D[j, 2]) * D[j, 11]
+                            if s * s >= best * n2:
+                                continue
+                        d2 = _tri_d2(px, py, pz, D, j)
+                        if d2 < best:
+                            best = d2
+                            bj = j
                     node = -1
-            if node < 0:
-                # pop the next box that can still hold something closer
-                while sp > 0:
-                    sp -= 1
-                    if stack_d[sp] < best:
-                        node = stack[sp]
-                        break
-        res = _closest_point_triangle(
-            px, py, pz, D[bj, 0], D[bj, 1], D[bj, 2], D[bj, 3], D[bj, 4], D[bj, 5], D[bj, 6], D[bj, 7], D[bj, 8]
-        )
-        out_d2[qi] = res[0]
-        out_face[qi] = order[bj]
-        out_c[qi, 0] = res[1]
-        out_c[qi, 1] = res[2]
-        out_c[qi, 2] = res[3]
-        out_bary[qi, 0] = res[4]
-        out_bary[qi, 1] = res[5]
-        out_bary[qi, 2] = res[6]
+                else:
+                    left = node + 1
+                    dl = _box_d2(px, py, pz, lo, hi, left)
+                    dr = _box_d2(px, py, pz, lo, hi, r)
+                    if dl <= dr:
+                        near = left
+                        far = r
+                        dn = dl
+                        dfar = dr
+                    else:
+                        near = r
+                        far = left
+                        dn = dr
+                        dfar = dl
+                    if dfar < best:
+                        stack[sp] = far
+                        stack_d[sp] = dfar
+                        sp += 1
+                    if dn < best:
+                        node = near
+                    else:
+                        node = -1
+                if node < 0:
+                    # pop the next box that can still hold something closer
+                    while sp > 0:
+                        sp -= 1
+                        if stack_d[sp] < best:
+                            node = stack[sp]
+                            break
+            res = _closest_point_triangle(
+                px, py, pz, D[bj, 0], D[bj, 1], D[bj, 2], D[bj, 3], D[bj, 4], D[bj, 5], D[bj, 6], D[bj, 7], D[bj, 8]
+            )
+            out_d2[qi] = res[0]
+            out_face[qi] = order[bj]
+            out_c[qi, 0] = res[1]
+            out_c[qi, 1] = res[2]
+            out_c[qi, 2] = res[3]
+            out_bary[qi, 0] = res[4]
+            out_bary[qi, 1] = res[5]
+            out_bary[qi, 2] = res[6]
 
 
 @njit(cache=True)

@@ -349,7 +349,8 @@ def build_volume_rows(E, leaf_size, threads=1):
     With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
     of the tree is split on the calling thread down to nodes of about n/64 elements, whose subtrees are then
     grown in parallel and spliced into the preorder arrays (the same tree as the serial build). The two are
-    separate kernels so that a small build never compiles the parallel one (about 20 s on first use)."""
+    separate kernels so that a small build never compiles the parallel one; the parallel one is a serial top
+    (:func:`_grow`), one small parallel loop (:func:`_grow_tasks`) and a serial splice, sharing :func:`_grow`."""
     if threads > 1 and E.shape[0] > PARALLEL_ELEMENTS:
         return _build_rows_parallel(E, leaf_size)
     return _build_rows_serial(E, leaf_size)

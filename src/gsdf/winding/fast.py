@@ -577,98 +577,66 @@ def _lanes(D, kids, start, end, beta2, keep):
     return W, LS, LE
 
 
+# The walks stay one parallel kernel each, with the per-query loop inside the prange body: moved to a
+# serial kernel of its own (called per chunk) the same loop ran 1.3-2x slower (measured on bunny00 and rotor,
+# one and two threads), for no compile time saved.
+@njit(parallel=True, cache=True, fastmath=_FASTMATH)
 def _eval_triangles_wide(Q, T, W, CH, LS, LE, stack_size, out):
-    """Winding numbers at Q into ``out``: chunks of 256 queries on the threads, or all on the calling thread
-    when numba has one (then the parallel driver is never compiled)."""
-    if numba.get_num_threads() > 1 and Q.shape[0] > _CHUNK:
-        _walk_triangles_parallel(Q, T, W, CH, LS, LE, stack_size, out)
-    else:
-        _walk_triangles(Q, T, W, CH, LS, LE, np.empty(stack_size, np.int64), np.int64(0), np.int64(Q.shape[0]), out)
-
-
-_CHUNK = 256
-
-
-@njit(parallel=True, cache=True)
-def _walk_triangles_parallel(Q, T, W, CH, LS, LE, stack_size, out):
     n = Q.shape[0]
-    nchunks = (n + _CHUNK - 1) // _CHUNK
+    chunk = 256
+    nchunks = (n + chunk - 1) // chunk
     for ch in prange(nchunks):
-        q0 = np.int64(ch) * _CHUNK
-        _walk_triangles(Q, T, W, CH, LS, LE, np.empty(stack_size, np.int64), q0, min(n, q0 + _CHUNK), out)
+        stack = np.empty(stack_size, np.int64)
+        for qi in range(ch * chunk, min(n, (ch + 1) * chunk)):
+            qx, qy, qz = Q[qi, 0], Q[qi, 1], Q[qi, 2]
+            acc = 0.0
+            stack[0] = 0
+            sp = 1
+            while sp > 0:
+                sp -= 1
+                nd = stack[sp]
+                near = 0
+                # the children's order-2 far fields, one SIMD lane each: Barill et al. 2018 §3.2 Eq. 13 with
+                # the App. A derivatives (Eqs. 22-24) and the §3.3 / App. B triangle moments, folded into the
+                # 23 per-node numbers of _compact_moments: w = (A + (B + C/d²)/d²)/d³
+                for c in range(WIDTH):
+                    rx = W[nd, 0, c] - qx
+                    ry = W[nd, 1, c] - qy
+                    rz = W[nd, 2, c] - qz
+                    d2 = rx * rx + ry * ry + rz * rz
+                    far = d2 > W[nd, 3, c]
+                    if not far:
+                        near |= 1 << c
+                        d2 = 1.0
+                    inv_d2 = 1.0 / d2
+                    inv_d3 = np.sqrt(inv_d2) * inv_d2
+                    xx, yy, zz = rx * rx, ry * ry, rz * rz
+                    a = W[nd, 4, c] * rx + W[nd, 5, c] * ry + W[nd, 6, c] * rz + W[nd, 7, c]
+                    b = (W[nd, 8, c] * xx + W[nd, 9, c] * yy + W[nd, 10, c] * zz
+                         + W[nd, 11, c] * (rx * ry) + W[nd, 12, c] * (rx * rz) + W[nd, 13, c] * (ry * rz)
+                         + W[nd, 14, c] * rx + W[nd, 15, c] * ry + W[nd, 16, c] * rz)
+                    cc = (rx * (W[nd, 17, c] * xx + W[nd, 20, c] * (rx * ry) + W[nd, 21, c] * (rx * rz)
+                                + W[nd, 22, c] * yy + W[nd, 24, c] * zz + W[nd, 26, c] * (ry * rz))
+                          + ry * (W[nd, 18, c] * yy + W[nd, 23, c] * (ry * rz) + W[nd, 25, c] * zz)
+                          + rz * (W[nd, 19, c] * zz))
+                    v = (a + (b + cc * inv_d2) * inv_d2) * inv_d3
+                    acc += v if far else 0.0
+                if near:
+                    for c in range(WIDTH - 1, -1, -1):
+                        if (near >> c) & 1:
+                            cw = CH[nd, c]
+                            if cw >= 0:
+                                stack[sp] = cw
+                                sp += 1
+                            elif cw == -1:
+                                acc += _leaf_triangles(T, LS[nd, c], LE[nd, c], qx, qy, qz)
+            out[qi] = acc
 
 
-@njit(cache=True, fastmath=_FASTMATH)
-def _walk_triangles(Q, T, W, CH, LS, LE, stack, q0, q1, out):
-    """The wide walk (see the module docstring) for queries q0..q1−1; one kernel shared by both drivers."""
-    for qi in range(q0, q1):
-        qx, qy, qz = Q[qi, 0], Q[qi, 1], Q[qi, 2]
-        acc = 0.0
-        stack[0] = 0
-        sp = 1
-        while sp > 0:
-            sp -= 1
-            nd = stack[sp]
-            near = 0
-            # the children's order-2 far fields, one SIMD lane each: Barill et al. 2018 §3.2 Eq. 13 with
-            # the App. A derivatives (Eqs. 22-24) and the §3.3 / App. B triangle moments, folded into the
-            # 23 per-node numbers of _compact_moments: w = (A + (B + C/d²)/d²)/d³
-            for c in range(WIDTH):
-                rx = W[nd, 0, c] - qx
-                ry = W[nd, 1, c] - qy
-                rz = W[nd, 2, c] - qz
-                d2 = rx * rx + ry * ry + rz * rz
-                far = d2 > W[nd, 3, c]
-                if not far:
-                    near |= 1 << c
-                    d2 = 1.0
-                inv_d2 = 1.0 / d2
-                inv_d3 = np.sqrt(inv_d2) * inv_d2
-                xx, yy, zz = rx * rx, ry * ry, rz * rz
-                a = W[nd, 4, c] * rx + W[nd, 5, c] * ry + W[nd, 6, c] * rz + W[nd, 7, c]
-                b = (W[nd, 8, c] * xx + W[nd, 9, c] * yy + W[nd, 10, c] * zz
-                     + W[nd, 11, c] * (rx * ry) + W[nd, 12, c] * (rx * rz) + W[nd, 13, c] * (ry * rz)
-                     + W[nd, 14, c] * rx + W[nd, 15, c] * ry + W[nd, 16, c] * rz)
-                cc = (rx * (W[nd, 17, c] * xx + W[nd, 20, c] * (rx * ry) + W[nd, 21, c] * (rx * rz)
-                            + W[nd, 22, c] * yy + W[nd, 24, c] * zz + W[nd, 26, c] * (ry * rz))
-                      + ry * (W[nd, 18, c] * yy + W[nd, 23, c] * (ry * rz) + W[nd, 25, c] * zz)
-                      + rz * (W[nd, 19, c] * zz))
-                v = (a + (b + cc * inv_d2) * inv_d2) * inv_d3
-                acc += v if far else 0.0
-            if near:
-                for c in range(WIDTH - 1, -1, -1):
-                    if (near >> c) & 1:
-                        cw = CH[nd, c]
-                        if cw >= 0:
-                            stack[sp] = cw
-                            sp += 1
-                        elif cw == -1:
-                            acc += _leaf_triangles(T, LS[nd, c], LE[nd, c], qx, qy, qz)
-        out[qi] = acc
-
-
+@njit(parallel=True, cache=True, fastmath=_FASTMATH)
 def _eval_points(Q, P, NA, N, C, beta2, order, out):
-    """Winding numbers of the point tree at Q into ``out``: chunks of 256 queries on the threads, or all on the
-    calling thread when numba has one (then the parallel driver is never compiled)."""
-    if numba.get_num_threads() > 1 and Q.shape[0] > _CHUNK:
-        _walk_points_parallel(Q, P, NA, N, C, beta2, order, out)
-    else:
-        _walk_points(Q, P, NA, N, C, beta2, order, np.int64(0), np.int64(Q.shape[0]), out)
-
-
-@njit(parallel=True, cache=True)
-def _walk_points_parallel(Q, P, NA, N, C, beta2, order, out):
-    n = Q.shape[0]
-    for ch in prange((n + _CHUNK - 1) // _CHUNK):
-        q0 = np.int64(ch) * _CHUNK
-        _walk_points(Q, P, NA, N, C, beta2, order, q0, min(n, q0 + _CHUNK), out)
-
-
-@njit(cache=True, fastmath=_FASTMATH)
-def _walk_points(Q, P, NA, N, C, beta2, order, q0, q1, out):
-    """Algorithm 1 (stackless preorder walk: far → expansion and skip, leaf → dipoles) for queries q0..q1−1."""
     k = N.shape[0]
-    for qi in range(q0, q1):
+    for qi in prange(Q.shape[0]):
         qx, qy, qz = Q[qi, 0], Q[qi, 1], Q[qi, 2]
         acc = 0.0
         i = 0
