@@ -26,15 +26,20 @@ class BackgroundWarmup:
         from ..threads import get_num_threads
 
         self.jobs, self.proc = list(jobs), None
-        if get_num_threads() >= 2:
-            install_compile_notice()
-            on_first_compile(self._start)
+        if self.jobs and get_num_threads() >= 2:
+            if install_compile_notice().printed:  # a kernel compiled already (cold cache): start now
+                self._start()
+            else:
+                on_first_compile(self._start)
 
     def _start(self):
         import subprocess
 
-        cmd = [sys.executable, "-m", "gsdf.cli.main", "--threads", "1", "warmup", "--only", ",".join(self.jobs),
-               "--jobs", "1"]
+        from ..threads import get_num_threads
+
+        # this process's thread count: kernels that pick a serial or a parallel driver by it pick the same
+        cmd = [sys.executable, "-m", "gsdf.cli.main", "--threads", str(get_num_threads()), "warmup", "--only",
+               ",".join(self.jobs), "--jobs", "1"]
         try:
             self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                          stdin=subprocess.DEVNULL)

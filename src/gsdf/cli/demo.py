@@ -42,7 +42,8 @@ def demo(output_dir, resolution):
 
     if os.path.exists(output_dir) and not os.path.isdir(output_dir):
         raise ValueError(f"{output_dir}: exists and is not a folder")
-    # cold cache, >= 2 threads: the cloud half's kernels compile in a second process meanwhile
+    # cold cache, >= 2 threads: a second process compiles the distance kernels and the cloud half's
+    # meanwhile (this one compiles the fast winding numbers of triangles first)
     background = BackgroundWarmup(["demo-cloud"])
     written = []
     t0 = time.perf_counter()
@@ -77,6 +78,9 @@ def demo(output_dir, resolution):
     written.append((f"{len(zs)} closed print slices ({sum(map(len, contours))} contours)", "soup_slices.svg"))
 
     # --- the point cloud -------------------------------------------------------------------------------
+    # cold cache: the background process is compiling (or has compiled) this half's kernels; wait for it
+    # rather than compile the same kernels here a second time
+    background.close()
     P, N = read_points(data.path("torus_cloud.xyz"))
     cloud = Geometry(P, N=N, path=data.path("torus_cloud.xyz"))
     click.echo(f"[cloud] {cloud.describe()}")

@@ -62,7 +62,12 @@ def sdf(input, output, resolution, pad, sign, png, surface_out, beta, estimate_n
     check_output(png, (".png",), "--png")
     check_output(surface_out, MESH_WRITE_FORMATS, "--surface")
     geo = load_geometry(input, estimate_normals)
-    field = signed_distance_grid(geo, resolution, pad, sign, beta, quiet)
+    from ._background import BackgroundWarmup
+
+    # cold cache, >= 2 threads, winding sign of a mesh: the distance kernels compile in a second process while
+    # this one compiles the fast winding numbers (computed first for this reason)
+    with BackgroundWarmup(["distance"] if geo.is_mesh and sign == "winding" else []):
+        field = signed_distance_grid(geo, resolution, pad, sign, beta, quiet)
     with output_file(output) as tmp:
         field.save(tmp)
     click.echo(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")

@@ -134,16 +134,17 @@ def signed_distance_grid(V, F=None, *, points=None, resolution: int = 64, bbox_m
     from .signed import _pseudonormal_sign
     from .triangles import TriangleDistance
 
-    td = TriangleDistance(V, F)
     if sign == "pseudonormal":
-        d, face, closest, bary = td.query_barycentric(Q)
+        d, face, closest, bary = TriangleDistance(V, F).query_barycentric(Q)
         sgn = _pseudonormal_sign(V, F, Q, closest, face, bary)
         s = sgn * d
     else:
         from ..winding import FastWindingNumber
 
-        d, face, closest = td.query(Q)
+        # the winding numbers first: on a cold cache `gsdf sdf` compiles the distance kernels in a background
+        # process meanwhile (gsdf.cli._background), which are then ready when the distance is reached
         w = FastWindingNumber(V, F, beta=positive(2.0 if beta is None else beta, "beta"))(Q, progress=progress)
+        d, face, closest = TriangleDistance(V, F).query(Q)
         s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
     S = GridField(s.reshape(shape), lo, hi)
     if not return_closest:

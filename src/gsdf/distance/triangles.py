@@ -336,7 +336,7 @@ def _nearest_kernel(Q, perm, D, order, start, end, right, lo, hi, out_d2, out_fa
                 best = _tri_d2(px, py, pz, D, bj)
             sp = 0
             node = 0
-            if _box_d2(px, py, pz, lo, hi, 0) >= best:
+            if _box_d2(px, py, pz, lo, hi, np.int64(0)) >= best:  # not the literal 0: one specialisation
                 node = -1
             while node >= 0:
                 r = right[node]

@@ -238,28 +238,41 @@ def build_volume(cent, elo, ehi, leaf_size):
 
 @njit(cache=True)
 def _bigger(a, need):
-    """The 2-d array ``a`` with its rows grown (doubled) to hold at least ``need`` rows."""
+    """The 2-d array ``a`` with its rows grown (doubled) to hold at least ``need`` rows.
+
+    The copy is an explicit loop: a slice assignment would compile numba's shape-mismatch error path
+    (message formatting, ~3 s of a cold build)."""
     cap = a.shape[0]
     while cap < need:
         cap *= 2
     if cap == a.shape[0]:
         return a
     out = np.empty((cap, a.shape[1]), a.dtype)
-    out[: a.shape[0], :] = a
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            out[i, j] = a[i, j]
     return out
 
 
+@njit(cache=True, inline="always")
+def _put(dst, i, src, o, n):
+    """dst[i, 0:n] = src[o:o + n] as a loop (no slice assignment, see :func:`_bigger`)."""
+    for d in range(n):
+        dst[i, d] = src[o + d]
+
+
 @njit(cache=True)
-def _grow(E, order, s0, e0, b0, leaf_size, cutoff, cap):
+def _grow(E, order, s0, e0, b0, leaf_size, cutoff, node_i, node_b, base):
     """Split rows s0:e0 of E (node bounds ``b0``: box lo, hi, centroid lo, hi) top-down into a preorder
     subtree with local node ids 0, 1, ... . A node of at most ``cutoff`` elements (cutoff > leaf_size; 0: none)
     is not split but listed as a task (its subtree is grown later, possibly on another thread).
 
-    Returns (count, node_i (count, 4) int64 [start, end, right, task or −1], node_b (count, 6) box,
-    ntask, task_i (ntask, 3) [start, end, node], task_b (ntask, 12) bounds).
+    Node ``j`` is written to row ``base + j`` of ``node_i`` (int64 [start, end, right, task or −1]) and
+    ``node_b`` (box); both are grown (copies returned) if too short. A subtree over n elements has at most
+    2n − 1 nodes, so rows base .. base + 2n − 1 always suffice and a task grown into them never reallocates.
+
+    Returns (count, node_i, node_b, ntask, task_i (ntask, 3) [start, end, node], task_b (ntask, 12) bounds).
     """
-    node_i = np.empty((cap, 4), np.int64)
-    node_b = np.empty((cap, 6))
     task_i = np.empty((16, 3), np.int64)
     task_b = np.empty((16, 12))
     ntask = 0
@@ -267,7 +280,7 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, cap):
     st_i = np.empty((64, 3), np.int64)
     st_b = np.empty((64, 12))
     st_i[0, 0], st_i[0, 1], st_i[0, 2] = s0, e0, -1
-    st_b[0] = b0
+    _put(st_b, 0, b0, 0, 12)
     sp = 1
     count = 0
     bins = np.empty((3, NBINS, 7))
@@ -286,17 +299,18 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, cap):
             b[d] = st_b[sp, d]
         node = count
         count += 1
-        if count > node_i.shape[0]:
-            node_i = _bigger(node_i, count)
-            node_b = _bigger(node_b, count)
-        node_i[node, 0] = s
-        node_i[node, 1] = e
-        node_i[node, 2] = -1
-        node_i[node, 3] = -1
+        row = base + node
+        if row >= node_i.shape[0]:
+            node_i = _bigger(node_i, row + 1)
+            node_b = _bigger(node_b, row + 1)
+        node_i[row, 0] = s
+        node_i[row, 1] = e
+        node_i[row, 2] = -1
+        node_i[row, 3] = -1
         for d in range(6):
-            node_b[node, d] = b[d]
+            node_b[row, d] = b[d]
         if parent >= 0:
-            node_i[parent, 2] = node
+            node_i[base + parent, 2] = node
         if e - s <= leaf_size:
             continue
         if e - s <= cutoff:
@@ -304,8 +318,8 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, cap):
                 task_i = _bigger(task_i, ntask + 1)
                 task_b = _bigger(task_b, ntask + 1)
             task_i[ntask, 0], task_i[ntask, 1], task_i[ntask, 2] = s, e, node
-            task_b[ntask] = b
-            node_i[node, 3] = ntask
+            _put(task_b, ntask, b, 0, 12)
+            node_i[row, 3] = ntask
             ntask += 1
             continue
         if e - s <= SMALL:
@@ -320,10 +334,10 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, cap):
             st_b = _bigger(st_b, sp + 2)
         # push right first so the left child is popped next and gets id node + 1 (preorder)
         st_i[sp, 0], st_i[sp, 1], st_i[sp, 2] = m, e, node
-        st_b[sp] = out[12:24]
+        _put(st_b, sp, out, 12, 12)
         sp += 1
         st_i[sp, 0], st_i[sp, 1], st_i[sp, 2] = s, m, -1
-        st_b[sp] = out[0:12]
+        _put(st_b, sp, out, 0, 12)
         sp += 1
     return count, node_i, node_b, ntask, task_i, task_b
 
@@ -335,7 +349,8 @@ def build_volume_rows(E, leaf_size, threads=1):
     With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
     of the tree is split on the calling thread down to nodes of about n/64 elements, whose subtrees are then
     grown in parallel and spliced into the preorder arrays (the same tree as the serial build). The two are
-    separate kernels so that a small build never compiles the parallel one (about 20 s on first use)."""
+    separate kernels so that a small build never compiles the parallel one; the parallel one is a serial top
+    (:func:`_grow`), one small parallel loop (:func:`_grow_tasks`) and a serial splice, sharing :func:`_grow`."""
     if threads > 1 and E.shape[0] > PARALLEL_ELEMENTS:
         return _build_rows_parallel(E, leaf_size)
     return _build_rows_serial(E, leaf_size)
@@ -375,7 +390,10 @@ def _skips(right):
 def _build_rows_serial(E, leaf_size):
     n = E.shape[0]
     order = np.arange(n)
-    k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, _root_bounds(E), leaf_size, 0, 2 * n)
+    node_i = np.empty((2 * n, 4), np.int64)
+    node_b = np.empty((2 * n, 6))
+    zero = np.int64(0)  # not the literal 0: one compiled _grow for every caller (see _grow_tasks)
+    k, node_i, node_b, _, _, _ = _grow(E, order, zero, n, _root_bounds(E), leaf_size, zero, node_i, node_b, zero)
     start = node_i[:k, 0].copy()
     end = node_i[:k, 1].copy()
     right = node_i[:k, 2].copy()
@@ -384,24 +402,45 @@ def _build_rows_serial(E, leaf_size):
     return order, start, end, right, _skips(right), lo, hi
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def _build_rows_parallel(E, leaf_size):
+    """The top of the tree here, its lower subtrees by :func:`_grow_tasks` on the threads, then spliced."""
     n = E.shape[0]
     order = np.arange(n)
-    root = _root_bounds(E)
     cutoff = max(leaf_size + 1, n // 64)
-    kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, 0, n, root, leaf_size, cutoff, 256)
-    # the tasks' subtrees, in parallel (disjoint row ranges of E and order)
+    zero = np.int64(0)
+    kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, zero, n, _root_bounds(E), leaf_size, cutoff,
+                                                    np.empty((256, 4), np.int64), np.empty((256, 6)), zero)
+    # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
+    sub_i = np.empty((2 * n, 4), np.int64)
+    sub_b = np.empty((2 * n, 6))
     counts = np.empty(ntask, np.int64)
-    subs_i = [np.empty((0, 4), np.int64) for _ in range(ntask)]
-    subs_b = [np.empty((0, 6)) for _ in range(ntask)]
-    for t in prange(ntask):
-        s, e = task_i[t, 0], task_i[t, 1]
-        c, si, sb, _, _, _ = _grow(E, order, s, e, task_b[t], leaf_size, 0, 2 * (e - s))
-        counts[t] = c
-        subs_i[t] = si
-        subs_b[t] = sb
-    # final preorder ids: the top tree's nodes in order, each task node replaced by its subtree
+    _grow_tasks(E, order, task_i, task_b, leaf_size, sub_i, sub_b, counts)
+    return _splice(order, kt, top_i, top_b, task_i, counts, sub_i, sub_b)
+
+
+@njit(cache=True, parallel=True)
+def _grow_tasks(E, order, task_i, task_b, leaf_size, sub_i, sub_b, counts):
+    """The subtrees of the tasks of :func:`_grow`, in parallel (disjoint rows of E, order, sub_i, sub_b). The
+    only parallel kernel of the build, and a small one: the loop body is one call (:func:`_grow_task`).
+
+    Integer arguments of the kernels called here are int64 variables, never literals or the unsigned prange
+    index: numba compiles one specialisation per distinct argument type (Literal[int](0) and uint64 each
+    cost another ~3 s of compilation)."""
+    for t in prange(counts.shape[0]):
+        counts[t] = _grow_task(E, order, task_i, task_b, np.int64(t), leaf_size, sub_i, sub_b)
+
+
+@njit(cache=True)
+def _grow_task(E, order, task_i, task_b, t, leaf_size, sub_i, sub_b):
+    s, e = task_i[t, 0], task_i[t, 1]
+    c, _, _, _, _, _ = _grow(E, order, s, e, task_b[t], leaf_size, np.int64(0), sub_i, sub_b, 2 * s)
+    return c
+
+
+@njit(cache=True)
+def _splice(order, kt, top_i, top_b, task_i, counts, sub_i, sub_b):
+    """Final preorder arrays: the top tree's nodes in order, each task node replaced by its subtree."""
     final = np.empty(kt, np.int64)
     k = 0
     for i in range(kt):
@@ -420,15 +459,14 @@ def _build_rows_parallel(E, leaf_size):
             for d in range(3):
                 lo[f, d] = top_b[i, d]
                 hi[f, d] = top_b[i, 3 + d]
-    for t in range(ntask):  # a copy: serial, so the build is one parallel launch
+    for t in range(counts.shape[0]):
         base = final[task_i[t, 2]]
-        si = subs_i[t]
-        sb = subs_b[t]
+        r0 = 2 * task_i[t, 0]
         for j in range(counts[t]):
             f = base + j
-            start[f], end[f] = si[j, 0], si[j, 1]
-            right[f] = base + si[j, 2] if si[j, 2] >= 0 else -1
+            start[f], end[f] = sub_i[r0 + j, 0], sub_i[r0 + j, 1]
+            right[f] = base + sub_i[r0 + j, 2] if sub_i[r0 + j, 2] >= 0 else -1
             for d in range(3):
-                lo[f, d] = sb[j, d]
-                hi[f, d] = sb[j, 3 + d]
+                lo[f, d] = sub_b[r0 + j, d]
+                hi[f, d] = sub_b[r0 + j, 3 + d]
     return order, start, end, right, _skips(right), lo, hi
