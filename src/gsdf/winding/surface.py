@@ -257,14 +257,14 @@ class SurfaceWindingNumbers:
             input is an integer chain, so its nonbounding part is an integer class — and γ is corrected by the
             closed form with the rounding error as periods (the LP only sees the class: exact parts are absorbed
             by the face shifts). A class that rounds to 0 needs no LP at all; otherwise Jv is an integer chain.
-        lp_algorithm : "auto" (default: interior point from 12k faces on, dual simplex below), "highs",
+        lp_algorithm : "auto" (default: HiGHS dual simplex below ``BAND_FACES`` = 12k faces; from there "band"
+            in the face form, HiGHS interior point in the cycle form), "highs",
             "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP — or "network": the same
             face-form program solved as its dual min-cost circulation by a network simplex
             (:func:`gsdf.dec.netflow.dual_graph_l1_network`; face form only) — or "band": the face-form program on
             a band of faces around the curves and their §6.3 completion paths, proven optimal for all faces by
             a maximum-flow certificate, grown until proven (:func:`gsdf.dec.band_lp.banded_l1`; HiGHS interior
-            point on all faces if no band is proven; face form only). "auto" uses "band" from ``BAND_FACES``
-            faces on (face form)
+            point on all faces if no band is proven; face form only)
         bounding : "subset" (default) or "fractional" — how step ⑤ reads the bounding part "Γ ∖ Jv" (§6.1.2)
             off the residual. "subset": as a *subset* of the input, the thesis' words ("the bounding components
             of Γ are … the complement of the nonbounding components, taken as a subset of Γ"): an input edge
