@@ -70,3 +70,18 @@ def test_not_positive_definite_raises_and_callers_fall_back():
         LDLFactorization(sp.csr_matrix(np.ones((2, 3))))
     with pytest.raises(ValueError, match="shape"):
         LDLFactorization(sp.identity(3, format="csr")).solve(np.ones(4))
+
+
+def test_coo_to_csr_matches_scipy_real_and_complex():
+    from gsdf.linalg.assembly import coo_to_csr
+
+    rng = np.random.default_rng(3)
+    r, c = rng.integers(0, 40, 500), rng.integers(0, 30, 500)
+    for v in (rng.normal(size=500), rng.normal(size=500) + 1j * rng.normal(size=500)):
+        A = coo_to_csr(r, c, v, (40, 30))
+        B = sp.csr_matrix((v, (r, c)), shape=(40, 30))
+        assert A.has_canonical_format and np.all(np.diff(A.indices[A.indptr[0]:A.indptr[1]]) > 0)
+        np.testing.assert_allclose(A.toarray(), B.toarray(), rtol=1e-13, atol=1e-14)
+    ops = _ops()
+    np.testing.assert_allclose(ops.cr_vector_heat_matrix(0.1).toarray(),
+                               (ops.cr_mass() + 0.1 * ops.cr_connection_laplacian()).toarray(), atol=1e-15)

@@ -67,6 +67,15 @@ def _parse_polygons(polygons, n: int) -> dict:
                 raise ValueError(f"polygons: vertex indices must be integers, got dtype {arr.dtype}")
         sizes = np.full(len(arr), arr.shape[1], np.int64)
         flat = arr.astype(np.int64).ravel()
+    elif isinstance(polygons, (list, tuple)) and polygons and all(
+            type(p) is np.ndarray and p.ndim == 1 and p.dtype != object for p in polygons):
+        # a ragged list of 1-D index arrays (gsdf.read_mesh(triangulate=False)): one concatenation
+        sizes = np.fromiter(map(len, polygons), np.int64, count=len(polygons))
+        flat = np.concatenate(polygons)
+        if flat.size and not np.issubdtype(flat.dtype, np.integer):
+            if not (np.issubdtype(flat.dtype, np.number) and np.all(flat == np.round(flat))):
+                raise ValueError(f"polygons: vertex indices must be integers, got dtype {flat.dtype}")
+        flat = flat.astype(np.int64)
     else:
         try:
             polygons = [np.asarray(p).ravel() if isinstance(p, np.ndarray) else p for p in polygons]
