@@ -918,7 +918,7 @@ def speed(quick=False, load=False, small=False):
 #: a first measurement but corrupted the heap (glibc "corrupted size vs. prev_size", LLVM assertions later in
 #: the process), so gsdf keeps SuperLU's defaults.
 SUPERLU_OPTIONS = [("MMD", "MMD_AT_PLUS_A", False),
-                   ("RCM + MMD (gsdf)", "MMD_AT_PLUS_A", True),
+                   ("RCM + MMD (gsdf > 50k)", "MMD_AT_PLUS_A", True),
                    ("COLAMD", "COLAMD", False),
                    ("RCM + COLAMD", "COLAMD", True)]
 
@@ -953,7 +953,7 @@ def solver_rule(names, repeat=3):
     import scipy.sparse.linalg as spla
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-    from gsdf.linalg import CholeskyFactorization, HermitianFactorization
+    from gsdf.linalg import CholeskyFactorization, HermitianFactorization, LDLFactorization
     from gsdf.threads import blas_region
 
     def best(fn):
@@ -979,6 +979,7 @@ def solver_rule(names, repeat=3):
                             B = sp.csc_matrix(M[p][:, p])
                         spla.splu(B, permc_spec=spec, diag_pivot_thresh=0.0, options={"SymmetricMode": True})
                     t[olab] = best(run)
+            t["LDLᴴ, nested dissection"] = best(lambda: LDLFactorization(M))
             if M.dtype == np.complex128:
                 t["CHOLMOD (2n real form)"] = best(lambda: HermitianFactorization(M, backend="cholmod"))
                 D = sp.identity(2 * M.shape[0], format="csr")
@@ -994,7 +995,7 @@ def solver_rule(names, repeat=3):
                         + [f"{t[k]:.3f}" + (f" ({t[k] / ref:.2f})" if k != SUPERLU_OPTIONS[0][0] else "")
                            for k in t] + [win])
             print("rule", rows[-1], os.getloadavg()[0], flush=True)
-    hdr = (["mesh", "system", "unknowns", "nonzeros"] + [o[0] for o in SUPERLU_OPTIONS] + ["CHOLMOD",
+    hdr = (["mesh", "system", "unknowns", "nonzeros"] + [o[0] for o in SUPERLU_OPTIONS] + ["LDLᴴ, ND", "CHOLMOD",
            "CHOLMOD of I (overhead)"] + ["fastest"])
     return table(hdr, rows), wins
 
@@ -1022,7 +1023,9 @@ def main():
                "of the --speed cases: the vector heat operator M + tL∇ (complex Hermitian; CR edges on triangle "
                "meshes, vertices on polygon meshes) and the Poisson operator with the curve vertices eliminated "
                "(real SPD). SuperLU in symmetric mode with one BLAS thread (gsdf.threads.blas_region); CHOLMOD = "
-               "cholespy (the complex system as its 2n real form). Fastest per system: "
+               "cholespy (the complex system as its 2n real form); LDLᴴ, ND = gsdf.linalg.ldl (serial numba, BFS "
+               "nested dissection), which gsdf uses up to gsdf.linalg.LDL_MAX_UNKNOWNS unknowns (SuperLU with the "
+               "RCM + MMD ordering above; polygon meshes: MMD alone). Fastest per system: "
                + "; ".join(f"{lab}: " + ", ".join(f"{k} {n}×" for k, n in c.items()) for lab, c in count.items())
                + ".\n\n" + tab + "\n")
         print(txt)

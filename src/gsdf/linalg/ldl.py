@@ -113,13 +113,13 @@ def _nested_dissection(indptr, indices, n, leaf):
         counts = np.zeros(nlev, np.int64)
         for r in range(reached):
             counts[level[queue[r]]] += 1
-        # the smallest level whose cumulative count lies in the middle 40 % of the subset (ties: nearest half)
+        # the smallest level whose cumulative count lies in the middle 60 % of the subset (ties: nearest half)
         best, best_score = -1, 1e300
         below = 0
         for L in range(nlev):
             if L > 0 and L < nlev - 1:
                 frac = (below + 0.5 * counts[L]) / size
-                if 0.3 <= frac <= 0.7:
+                if 0.2 <= frac <= 0.8:
                     score = counts[L] * (1.0 + 2.0 * abs(frac - 0.5))
                     if score < best_score:
                         best, best_score = L, score
