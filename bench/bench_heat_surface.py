@@ -918,7 +918,7 @@ def speed(quick=False, load=False, small=False):
 #: a first measurement but corrupted the heap (glibc "corrupted size vs. prev_size", LLVM assertions later in
 #: the process), so gsdf keeps SuperLU's defaults.
 SUPERLU_OPTIONS = [("MMD", "MMD_AT_PLUS_A", False),
-                   ("RCM + MMD (gsdf > 50k)", "MMD_AT_PLUS_A", True),
+                   ("RCM + MMD (gsdf above the LDL size)", "MMD_AT_PLUS_A", True),
                    ("COLAMD", "COLAMD", False),
                    ("RCM + COLAMD", "COLAMD", True)]
 
@@ -1024,7 +1024,7 @@ def main():
                "meshes, vertices on polygon meshes) and the Poisson operator with the curve vertices eliminated "
                "(real SPD). SuperLU in symmetric mode with one BLAS thread (gsdf.threads.blas_region); CHOLMOD = "
                "cholespy (the complex system as its 2n real form); LDLᴴ, ND = gsdf.linalg.ldl (serial numba, BFS "
-               "nested dissection), which gsdf uses up to gsdf.linalg.LDL_MAX_UNKNOWNS unknowns (SuperLU with the "
+               "nested dissection), which gsdf uses up to gsdf.linalg.LDL_MAX_UNKNOWNS real unknowns (complex count 2; SuperLU with the "
                "RCM + MMD ordering above; polygon meshes: MMD alone). Fastest per system: "
                + "; ".join(f"{lab}: " + ", ".join(f"{k} {n}×" for k, n in c.items()) for lab, c in count.items())
                + ".\n\n" + tab + "\n")

@@ -3,8 +3,8 @@
 The only module of gsdf that wraps a sparse factorization (with :mod:`.iterative`, which falls back to it).
 
 * :class:`Factorization` — SuperLU LU of a square real or complex matrix (symmetric mode first);
-* :class:`HermitianFactorization` — complex Hermitian positive definite (numba LDLᴴ up to ``LDL_MAX_UNKNOWNS``,
-  else SuperLU; or CHOLMOD on the 2n real form);
+* :class:`HermitianFactorization` — complex Hermitian positive definite (numba LDLᴴ up to ``LDL_MAX_UNKNOWNS`` / 2
+  unknowns, else SuperLU; or CHOLMOD on the 2n real form);
 * :func:`spd_factorization` — real SPD: numba LDLᵀ up to ``LDL_MAX_UNKNOWNS``, else :class:`Factorization`;
 * :class:`BlockHermitianFactorization` — a complex operator given as its real 2n×2n SPD block matrix
   (``[[Re, -Im], [Im, Re]]`` per entry, or any real 2×2 blocks such as reflections): CHOLMOD, SuperLU fallback;
@@ -43,12 +43,18 @@ def _in_blas_region(method):
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
            "cholesky", "cached_factorization", "spd_factorization", "LDL_MAX_UNKNOWNS"]
 
-#: Size rule of the factorization backend (bench_heat_surface.py --solver-rule, issue 17): up to this many
-#: unknowns the numba LDLᴴ of :mod:`gsdf.linalg.ldl` (nested dissection) factorizes faster than SuperLU, whose
-#: fixed costs dominate small systems (7.4k complex unknowns: 7.8 vs 17.5 ms; 29k: 66 vs 100 ms; 37k real:
-#: 136 vs 179 ms); above it SuperLU's supernodes and its minimum-degree fill win (113k complex: 655 vs
-#: 1086 ms).
-LDL_MAX_UNKNOWNS = 50_000
+#: Size rule of the factorization backend (bench_heat_surface.py --solver-rule / --speed, issue 17), in real
+#: unknowns (a complex unknown counts 2): up to this size the numba LDLᴴ of :mod:`gsdf.linalg.ldl` (nested
+#: dissection) factorizes faster than SuperLU, whose fixed costs dominate small systems (7.4k complex unknowns:
+#: 7.8 vs 17.5 ms; 29k complex: 66 vs 100 ms, first solve of camel.off 0.13 vs 0.18 s CPU; 37k real: 136 vs
+#: 179 ms); above it SuperLU's supernodes and its minimum-degree fill win (39k complex, mannequin-devil.off:
+#: first solve 0.25–0.35 s CPU with SuperLU vs 0.41–0.55 s; 113k complex: 655 vs 1086 ms).
+LDL_MAX_UNKNOWNS = 64_000
+
+
+def _ldl_size(A) -> int:
+    """Size of ``A`` in real unknowns for :data:`LDL_MAX_UNKNOWNS` (complex unknowns count 2)."""
+    return A.shape[0] * (2 if np.iscomplexobj(A.data if sp.issparse(A) else A) else 1)
 
 
 def _ldl_or_none(A):
@@ -63,7 +69,7 @@ def _ldl_or_none(A):
 
 def spd_factorization(A, reorder: bool = True):
     """A factorization of the real symmetric positive definite ``A`` with ``solve(b)``: LDLᵀ (numba, nested
-    dissection) up to :data:`LDL_MAX_UNKNOWNS` unknowns, else (or when a pivot is not positive) SuperLU's
+    dissection) up to :data:`LDL_MAX_UNKNOWNS` (real) unknowns, else (or when a pivot is not positive) SuperLU's
     :class:`Factorization` (``reorder`` = its RCM renumbering).
 
     Example
@@ -72,7 +78,7 @@ def spd_factorization(A, reorder: bool = True):
     >>> spd_factorization(sp.diags([2.0, 4.0]).tocsr()).solve(np.array([2.0, 2.0]))
     array([1. , 0.5])
     """
-    if A.shape[0] <= LDL_MAX_UNKNOWNS:
+    if _ldl_size(A) <= LDL_MAX_UNKNOWNS:
         f = _ldl_or_none(A)
         if f is not None:
             return f
@@ -146,7 +152,8 @@ class Factorization:
 class HermitianFactorization:
     """Factorization of a sparse Hermitian positive definite complex matrix, reused across solves.
 
-    ``backend="auto"`` (the default): ``"ldl"`` up to :data:`LDL_MAX_UNKNOWNS` unknowns, else ``"superlu"``.
+    ``backend="auto"`` (the default): ``"ldl"`` up to :data:`LDL_MAX_UNKNOWNS` / 2 complex unknowns, else
+    ``"superlu"``.
     ``backend="ldl"``: the numba LDLᴴ of :mod:`gsdf.linalg.ldl` (SuperLU when a pivot is not positive).
     ``backend="superlu"``: SciPy's SuperLU on the complex matrix in symmetric mode.
     ``backend="cholmod"``: CHOLMOD through ``cholespy`` on the equivalent real symmetric system of size 2n (the
@@ -171,7 +178,7 @@ class HermitianFactorization:
         self._chol = self._ldl = None
         if backend not in ("auto", "superlu", "cholmod", "ldl"):
             raise ValueError(f"backend: expected 'auto', 'ldl', 'superlu' or 'cholmod', got {backend!r}")
-        if backend == "ldl" or (backend == "auto" and n <= LDL_MAX_UNKNOWNS):
+        if backend == "ldl" or (backend == "auto" and 2 * n <= LDL_MAX_UNKNOWNS):
             self._ldl = _ldl_or_none(sp.csr_matrix(A, dtype=np.complex128))
             if self._ldl is not None:
                 self.backend = "ldl"
