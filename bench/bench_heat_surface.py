@@ -786,6 +786,25 @@ def _time_first_repeat(make, solve, repeat):
     return first, rep, peak, out
 
 
+#: Cases whose first solve takes less than FAST_CASE_S seconds are timed over FAST_ROUNDS fresh solvers (and
+#: FAST_REPEAT repeated solves each) instead of ``rounds`` / 3: millisecond timings on a shared machine need
+#: more samples for a stable median.
+FAST_CASE_S, FAST_ROUNDS, FAST_REPEAT = 0.1, 7, 7
+
+
+def _interleaved(runs, res, rounds):
+    """Time both libraries ``rounds`` times in one process, interleaved with alternating order (gsdf first on
+    even rounds); after the first round, cases under FAST_CASE_S get FAST_ROUNDS rounds and FAST_REPEAT repeated
+    solves (more samples, same quantities)."""
+    r, total, repeat = 0, rounds, 3
+    while r < total:
+        for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
+            res[lib].append(_time_first_repeat(*runs[lib], repeat=repeat))
+        if r == 0 and max(res["gsdf"][0][0], res["pp3d"][0][0]) < FAST_CASE_S:
+            total, repeat = max(rounds, FAST_ROUNDS), FAST_REPEAT
+        r += 1
+
+
 def speed_table(names, rounds=3, label="idle"):
     """Per mesh: gsdf vs potpourri3d, first (constructor + first solve) and repeated solve, medians over
     ``rounds`` fresh solvers each (the libraries interleaved, the order alternating), constraint "zero" =
@@ -798,9 +817,7 @@ def speed_table(names, rounds=3, label="idle"):
         res = {"gsdf": [], "pp3d": []}
         runs = {"gsdf": (lambda: SurfaceSignedHeatSolver(V, F), lambda s: s.compute_distance(loops)),
                 "pp3d": (lambda: pp3d.MeshSignedHeatSolver(V, F), lambda s: s.compute_distance(pp_loops))}
-        for r in range(rounds):
-            for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
-                res[lib].append(_time_first_repeat(*runs[lib], repeat=3))
+        _interleaved(runs, res, rounds)
         med = {k: [float(np.median([x[i] for x in v])) for i in range(3)] for k, v in res.items()}
         p, q = res["gsdf"][-1][3], -res["pp3d"][-1][3]
         d = float(np.linalg.norm(p - q) / np.linalg.norm(q))
@@ -833,6 +850,13 @@ def speed(quick=False, load=False, small=False):
     lv = region_boundary_curves(Fw, Vw[Fw].mean(1)[:, 2] < 0)
     SurfaceSignedHeatSolver(Vw, Fw).compute_distance(lv)
     pp3d.MeshSignedHeatSolver(Vw, Fw).compute_distance([[(int(v), []) for v in c] for c in lv])
+    from gsdf.heat import PolygonMeshSignedHeatSolver              # the polygon kernels too (numba cache load)
+
+    Vq, Q = _cube_sphere(4)
+    cq = np.array([Vq[q].mean(0) for q in Q])
+    lq = _poly_region_loops(Vq, Q, cq[:, 1] < np.median(cq[:, 1]))
+    PolygonMeshSignedHeatSolver(Vq, Q).compute_distance(lq)
+    pp3d.PolygonMeshHeatSolver(Vq, np.asarray(Q)).compute_signed_distance([list(map(int, c)) for c in lq])
     pnames = POLY_QUICK if quick else POLY_SPEED
     start = uptime()
     t_idle, r_idle = speed_table(names, rounds, "idle")
@@ -880,7 +904,8 @@ def speed(quick=False, load=False, small=False):
            "process, same mesh and curves (the boundary loops of {y < median} along edges), constraint \"zero\" = "
            "potpourri3d's default `ZeroSet` (both: φ = 0 at the curve vertices). first = constructor + first "
            "solve; repeat = median of 3 further solves with the same curves; each the median over "
-           f"{rounds} fresh solvers, the libraries interleaved with alternating order. Peak RSS = growth of the "
+           f"{rounds} fresh solvers, the libraries interleaved with alternating order (cases whose first solve "
+           f"is under {FAST_CASE_S} s: {FAST_ROUNDS} fresh solvers and {FAST_REPEAT} repeated solves each). Peak RSS = growth of the "
            "process's VmHWM over the RSS before the case (median). Ratios = gsdf / potpourri3d (goal: first ≤ 1.0, "
            "repeat ≤ 0.5, loaded ratio within 1.25× of the idle one).\n\n" + summ + "\n\n" + "\n\n".join(parts)
            + "\n")
@@ -893,7 +918,7 @@ def speed(quick=False, load=False, small=False):
 #: a first measurement but corrupted the heap (glibc "corrupted size vs. prev_size", LLVM assertions later in
 #: the process), so gsdf keeps SuperLU's defaults.
 SUPERLU_OPTIONS = [("MMD", "MMD_AT_PLUS_A", False),
-                   ("RCM + MMD (gsdf)", "MMD_AT_PLUS_A", True),
+                   ("RCM + MMD (gsdf above the LDL size)", "MMD_AT_PLUS_A", True),
                    ("COLAMD", "COLAMD", False),
                    ("RCM + COLAMD", "COLAMD", True)]
 
@@ -928,7 +953,7 @@ def solver_rule(names, repeat=3):
     import scipy.sparse.linalg as spla
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-    from gsdf.linalg import CholeskyFactorization, HermitianFactorization
+    from gsdf.linalg import CholeskyFactorization, HermitianFactorization, LDLFactorization
     from gsdf.threads import blas_region
 
     def best(fn):
@@ -954,6 +979,7 @@ def solver_rule(names, repeat=3):
                             B = sp.csc_matrix(M[p][:, p])
                         spla.splu(B, permc_spec=spec, diag_pivot_thresh=0.0, options={"SymmetricMode": True})
                     t[olab] = best(run)
+            t["LDLᴴ, nested dissection"] = best(lambda: LDLFactorization(M))
             if M.dtype == np.complex128:
                 t["CHOLMOD (2n real form)"] = best(lambda: HermitianFactorization(M, backend="cholmod"))
                 D = sp.identity(2 * M.shape[0], format="csr")
@@ -969,7 +995,7 @@ def solver_rule(names, repeat=3):
                         + [f"{t[k]:.3f}" + (f" ({t[k] / ref:.2f})" if k != SUPERLU_OPTIONS[0][0] else "")
                            for k in t] + [win])
             print("rule", rows[-1], os.getloadavg()[0], flush=True)
-    hdr = (["mesh", "system", "unknowns", "nonzeros"] + [o[0] for o in SUPERLU_OPTIONS] + ["CHOLMOD",
+    hdr = (["mesh", "system", "unknowns", "nonzeros"] + [o[0] for o in SUPERLU_OPTIONS] + ["LDLᴴ, ND", "CHOLMOD",
            "CHOLMOD of I (overhead)"] + ["fastest"])
     return table(hdr, rows), wins
 
@@ -997,7 +1023,9 @@ def main():
                "of the --speed cases: the vector heat operator M + tL∇ (complex Hermitian; CR edges on triangle "
                "meshes, vertices on polygon meshes) and the Poisson operator with the curve vertices eliminated "
                "(real SPD). SuperLU in symmetric mode with one BLAS thread (gsdf.threads.blas_region); CHOLMOD = "
-               "cholespy (the complex system as its 2n real form). Fastest per system: "
+               "cholespy (the complex system as its 2n real form); LDLᴴ, ND = gsdf.linalg.ldl (serial numba, BFS "
+               "nested dissection), which gsdf uses up to gsdf.linalg.LDL_MAX_UNKNOWNS real unknowns (complex count 2; SuperLU with the "
+               "RCM + MMD ordering above; polygon meshes: MMD alone). Fastest per system: "
                + "; ".join(f"{lab}: " + ", ".join(f"{k} {n}×" for k, n in c.items()) for lab, c in count.items())
                + ".\n\n" + tab + "\n")
         print(txt)
@@ -1357,9 +1385,7 @@ def poly_speed_table(names, rounds=3, label="idle"):
         runs = {"gsdf": (lambda: PolygonMeshSignedHeatSolver(V, polys), lambda s: s.compute_distance(loops)),
                 "pp3d": (lambda: pp3d.PolygonMeshHeatSolver(V, pp_polys),
                          lambda s: s.compute_signed_distance(pp_loops))}
-        for r in range(rounds):
-            for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
-                res[lib].append(_time_first_repeat(*runs[lib], repeat=3))
+        _interleaved(runs, res, rounds)
         med = {k: [float(np.median([x[i] for x in v])) for i in range(3)] for k, v in res.items()}
         p, q = res["gsdf"][-1][3], res["pp3d"][-1][3]
         d = float(np.linalg.norm(p - q) / np.linalg.norm(q))

@@ -17,9 +17,12 @@ def test_hermitian_backends_agree():
     b = np.random.default_rng(0).normal(size=A.shape[0]) * (1 + 1j)
     x1 = HermitianFactorization(A, backend="superlu").solve(b)
     x2 = HermitianFactorization(A, backend="cholmod").solve(b)
-    assert HermitianFactorization(A).backend == "superlu"  # the default: measured faster (linalg docstring)
+    x3 = HermitianFactorization(A, backend="ldl").solve(b)
+    # the default: LDLᴴ below LDL_MAX_UNKNOWNS, SuperLU above (measured, gsdf.linalg.direct)
+    assert HermitianFactorization(A).backend == "ldl"
     np.testing.assert_allclose(A @ x1, b, atol=1e-10)
     np.testing.assert_allclose(x1, x2, atol=1e-10)
+    np.testing.assert_allclose(x1, x3, atol=1e-10)
     with pytest.raises(ValueError, match="backend"):
         HermitianFactorization(A, backend="mumps")
 

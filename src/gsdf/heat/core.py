@@ -53,7 +53,7 @@ import scipy.sparse as sp
 
 from .. import _checks
 from ..linalg import (BlockHermitianFactorization, Factorization, HermitianFactorization, cached_factorization,
-                      saddle_matrix)
+                      saddle_matrix, spd_factorization)
 from ..threads import blas_region
 from .domains.base import PoissonSolver
 from .sources import Sources, as_curves, as_point_sources
@@ -208,8 +208,7 @@ class FactorizedPoisson(PoissonSolver):
         self._spd = spd or (lambda A: Factorization(sp.csc_matrix(A)))
         # the Dirichlet systems (no ε: well-conditioned) may take a bandwidth renumbering before the ordering
         renumber = bool(renumber)
-        self._spd_dirichlet = (lambda A: Factorization(sp.csc_matrix(A), reorder=renumber)) if spd is None \
-            else self._spd
+        self._spd_dirichlet = (lambda A: spd_factorization(A, reorder=renumber)) if spd is None else self._spd
         self._cache: dict = {}
         self._last_fixed = None                      # (fixed array, key, free) of the last Dirichlet solve
 

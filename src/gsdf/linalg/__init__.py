@@ -1,8 +1,9 @@
 """Sparse linear algebra — the only place in gsdf that factorizes: factorize once, solve many.
 
 * :mod:`.direct` — SuperLU (symmetric mode) and CHOLMOD via cholespy: :class:`Factorization` (real/complex LU),
-  :class:`HermitianFactorization`, :class:`BlockHermitianFactorization` (complex operators in real 2×2-block
+  :class:`HermitianFactorization`, :func:`spd_factorization`, :class:`BlockHermitianFactorization` (complex operators in real 2×2-block
   form), :class:`CholeskyFactorization` / :func:`cholesky`, :func:`cached_factorization`;
+* :mod:`.ldl` — :class:`LDLFactorization`, numba LDLᴴ with nested dissection (small and mid-size SPD / HPD);
 * :mod:`.iterative` — :class:`SPDSolver` (factorize small, CG with AMG/Jacobi large), :func:`pcg`,
   :func:`amg_preconditioner`;
 * :mod:`.saddle` — :func:`saddle_matrix` of equality-constrained least squares (Eq. 14);
@@ -19,11 +20,12 @@ array([1., 1.])
 """
 
 from .direct import (BlockHermitianFactorization, CholeskyFactorization, Factorization, HermitianFactorization,
-                     cached_factorization, cholesky)
+                     LDL_MAX_UNKNOWNS, cached_factorization, cholesky, spd_factorization)
+from .ldl import LDLFactorization
 from .iterative import SPDSolver, amg_preconditioner, pcg
 from .lp import solve_lp
 from .saddle import saddle_matrix
 
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
            "cholesky", "cached_factorization", "saddle_matrix", "solve_lp", "SPDSolver", "pcg",
-           "amg_preconditioner"]
+           "amg_preconditioner", "spd_factorization", "LDLFactorization", "LDL_MAX_UNKNOWNS"]

@@ -3,7 +3,9 @@
 The only module of gsdf that wraps a sparse factorization (with :mod:`.iterative`, which falls back to it).
 
 * :class:`Factorization` — SuperLU LU of a square real or complex matrix (symmetric mode first);
-* :class:`HermitianFactorization` — complex Hermitian positive definite (SuperLU, or CHOLMOD on the 2n real form);
+* :class:`HermitianFactorization` — complex Hermitian positive definite (numba LDLᴴ up to ``LDL_MAX_UNKNOWNS`` / 2
+  unknowns, else SuperLU; or CHOLMOD on the 2n real form);
+* :func:`spd_factorization` — real SPD: numba LDLᵀ up to ``LDL_MAX_UNKNOWNS``, else :class:`Factorization`;
 * :class:`BlockHermitianFactorization` — a complex operator given as its real 2n×2n SPD block matrix
   (``[[Re, -Im], [Im, Re]]`` per entry, or any real 2×2 blocks such as reflections): CHOLMOD, SuperLU fallback;
   solves take and return complex vectors;
@@ -39,7 +41,48 @@ def _in_blas_region(method):
     return wrapper
 
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
-           "cholesky", "cached_factorization"]
+           "cholesky", "cached_factorization", "spd_factorization", "LDL_MAX_UNKNOWNS"]
+
+#: Size rule of the factorization backend (bench_heat_surface.py --solver-rule / --speed, issue 17), in real
+#: unknowns (a complex unknown counts 2): up to this size the numba LDLᴴ of :mod:`gsdf.linalg.ldl` (nested
+#: dissection) factorizes faster than SuperLU, whose fixed costs dominate small systems (7.4k complex unknowns:
+#: 7.8 vs 17.5 ms; 29k complex: 66 vs 100 ms, first solve of camel.off 0.13 vs 0.18 s CPU; 37k real: 136 vs
+#: 179 ms); above it SuperLU's supernodes and its minimum-degree fill win (39k complex, mannequin-devil.off:
+#: first solve 0.25–0.35 s CPU with SuperLU vs 0.41–0.55 s; 113k complex: 655 vs 1086 ms).
+LDL_MAX_UNKNOWNS = 64_000
+
+
+def _ldl_size(A) -> int:
+    """Size of ``A`` in real unknowns for :data:`LDL_MAX_UNKNOWNS` (complex unknowns count 2)."""
+    return A.shape[0] * (2 if np.iscomplexobj(A.data if sp.issparse(A) else A) else 1)
+
+
+def _ldl_or_none(A):
+    """:class:`~gsdf.linalg.ldl.LDLFactorization` of ``A``, or None when it is not positive definite."""
+    from .ldl import LDLFactorization
+
+    try:
+        return LDLFactorization(A)
+    except ValueError:
+        return None
+
+
+def spd_factorization(A, reorder: bool = True):
+    """A factorization of the real symmetric positive definite ``A`` with ``solve(b)``: LDLᵀ (numba, nested
+    dissection) up to :data:`LDL_MAX_UNKNOWNS` (real) unknowns, else (or when a pivot is not positive) SuperLU's
+    :class:`Factorization` (``reorder`` = its RCM renumbering).
+
+    Example
+    -------
+    >>> import numpy as np, scipy.sparse as sp
+    >>> spd_factorization(sp.diags([2.0, 4.0]).tocsr()).solve(np.array([2.0, 2.0]))
+    array([1. , 0.5])
+    """
+    if _ldl_size(A) <= LDL_MAX_UNKNOWNS:
+        f = _ldl_or_none(A)
+        if f is not None:
+            return f
+    return Factorization(sp.csc_matrix(A), reorder=reorder)
 
 
 class Factorization:
@@ -109,7 +152,10 @@ class Factorization:
 class HermitianFactorization:
     """Factorization of a sparse Hermitian positive definite complex matrix, reused across solves.
 
-    ``backend="superlu"`` (the default, ``"auto"``): SciPy's SuperLU on the complex matrix in symmetric mode.
+    ``backend="auto"`` (the default): ``"ldl"`` up to :data:`LDL_MAX_UNKNOWNS` / 2 complex unknowns, else
+    ``"superlu"``.
+    ``backend="ldl"``: the numba LDLᴴ of :mod:`gsdf.linalg.ldl` (SuperLU when a pivot is not positive).
+    ``backend="superlu"``: SciPy's SuperLU on the complex matrix in symmetric mode.
     ``backend="cholmod"``: CHOLMOD through ``cholespy`` on the equivalent real symmetric system of size 2n (the
     2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved). Measured on the vector heat operators (bunny00 CR edges,
     113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2–3.5× faster (0.58 vs 1.14 s,
@@ -127,12 +173,17 @@ class HermitianFactorization:
 
     @_in_blas_region
     def __init__(self, A, backend: str = "auto", reorder: bool = True):
-        A = sp.coo_matrix(A)
         n = A.shape[0]
         self.n = n
-        self._chol = None
-        if backend not in ("auto", "superlu", "cholmod"):
-            raise ValueError(f"backend: expected 'auto', 'superlu' or 'cholmod', got {backend!r}")
+        self._chol = self._ldl = None
+        if backend not in ("auto", "superlu", "cholmod", "ldl"):
+            raise ValueError(f"backend: expected 'auto', 'ldl', 'superlu' or 'cholmod', got {backend!r}")
+        if backend == "ldl" or (backend == "auto" and 2 * n <= LDL_MAX_UNKNOWNS):
+            self._ldl = _ldl_or_none(sp.csr_matrix(A, dtype=np.complex128))
+            if self._ldl is not None:
+                self.backend = "ldl"
+                return
+        A = sp.coo_matrix(A)
         if backend == "cholmod":
             from cholespy import CholeskySolverD, MatrixType
 
@@ -153,6 +204,8 @@ class HermitianFactorization:
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solve ``A x = b`` for a complex right-hand side (n,)."""
         b = np.asarray(b, dtype=np.complex128)
+        if self._ldl is not None:
+            return self._ldl.solve(b)
         if self._chol is None:
             return self._lu.solve(b)
         rb = np.empty(2 * self.n)

@@ -60,6 +60,14 @@ def _parse_polygons(polygons, n: int) -> dict:
             stacked = None
         if stacked is not None and stacked.ndim == 2 and stacked.dtype != object:
             polygons = stacked
+    ragged = None
+    if isinstance(polygons, (list, tuple)) and polygons and all(type(p) is np.ndarray for p in polygons):
+        try:
+            ragged = np.concatenate(polygons)
+        except (ValueError, TypeError):                       # mixed dimensions or dtypes: the general path
+            ragged = None
+        if ragged is not None and (ragged.ndim != 1 or ragged.dtype == object):
+            ragged = None
     if isinstance(polygons, np.ndarray) and polygons.ndim == 2 and polygons.dtype != object:
         arr = polygons
         if not np.issubdtype(arr.dtype, np.integer):
@@ -67,6 +75,14 @@ def _parse_polygons(polygons, n: int) -> dict:
                 raise ValueError(f"polygons: vertex indices must be integers, got dtype {arr.dtype}")
         sizes = np.full(len(arr), arr.shape[1], np.int64)
         flat = arr.astype(np.int64).ravel()
+    elif ragged is not None:
+        # a ragged list of 1-D index arrays (gsdf.read_mesh(triangulate=False)): one concatenation
+        sizes = np.fromiter(map(len, polygons), np.int64, count=len(polygons))
+        flat = ragged
+        if flat.size and not np.issubdtype(flat.dtype, np.integer):
+            if not (np.issubdtype(flat.dtype, np.number) and np.all(flat == np.round(flat))):
+                raise ValueError(f"polygons: vertex indices must be integers, got dtype {flat.dtype}")
+        flat = flat.astype(np.int64)
     else:
         try:
             polygons = [np.asarray(p).ravel() if isinstance(p, np.ndarray) else p for p in polygons]

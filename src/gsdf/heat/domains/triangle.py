@@ -100,7 +100,7 @@ class TriangleDomain(HeatDomain):
         self.connection = connection
         real = connection == "real" or (connection == "auto" and not self.ops.consistent)
         self.heat_form = "real2" if real else "complex"
-        self.C = self.ops.cotan_laplacian().tocsc()
+        self.C = self.ops.cotan_laplacian().tocsc()   # symmetric: the CSR arrays (transposed, exact copy)
         Mv = self.ops.vertex_mass()
         self._Mv = np.where(Mv > 0, Mv, Mv.mean())              # unreferenced vertices: keep the system regular
 
@@ -109,7 +109,7 @@ class TriangleDomain(HeatDomain):
         if self.heat_form == "real2":
             M = self.ops.cr_mass().diagonal()
             return sp.diags(np.repeat(M, 2)) + self.t * self.ops.cr_connection_laplacian_real()
-        return self.ops.cr_mass() + self.t * self.ops.cr_connection_laplacian()
+        return self.ops.cr_vector_heat_matrix(self.t)
 
     def gather(self, X):
         """Edge vectors averaged onto the faces (Alg. 3), (m, 3)."""

@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ...linalg.assembly import coo_to_csr
 from ...mesh.connectivity import unique_edges
 
 NEXT = np.array([1, 2, 0])
@@ -132,6 +133,20 @@ class TriangleMeshOperators:
         diagonal += w, and L[e_a, e_b] = -w ρ̄_a ρ_b, where ρ is the direction of each edge's real axis in a
         common face frame (the rotation r of Eq. 8, including the orientation sign s).
         """
+        rows, cols, vals = self._cr_connection_triplets()
+        return coo_to_csr(rows, cols, vals, (self.n_edges, self.n_edges))
+
+    def cr_vector_heat_matrix(self, t: float) -> sp.csr_matrix:
+        """``M + t L∇`` (Eq. 12: CR mass, Eq. 7, plus t times the complex connection Laplacian) assembled in
+        one pass (the triplets of both, summed), complex (|E|, |E|)."""
+        rows, cols, vals = self._cr_connection_triplets()
+        nE = self.n_edges
+        d = np.arange(nE)
+        mass = np.bincount(self.face_edges.ravel(), weights=np.repeat(self.areas / 3.0, 3), minlength=nE)
+        return coo_to_csr(np.concatenate([d, rows]), np.concatenate([d, cols]),
+                          np.concatenate([mass.astype(np.complex128), t * vals]), (nE, nE))
+
+    def _cr_connection_triplets(self):
         a = np.arange(3)
         b = NEXT
         w = 2.0 * self.cot[:, b]                                # angle at the shared vertex v_{a+1}
@@ -140,8 +155,7 @@ class TriangleMeshOperators:
         rows = np.concatenate([ea.ravel(), eb.ravel(), ea.ravel(), eb.ravel()])
         cols = np.concatenate([ea.ravel(), eb.ravel(), eb.ravel(), ea.ravel()])
         vals = np.concatenate([w.ravel(), w.ravel(), off.ravel(), np.conj(off).ravel()]).astype(np.complex128)
-        nE = self.n_edges
-        return sp.csr_matrix((vals, (rows, cols)), shape=(nE, nE))
+        return rows, cols, vals
 
     def cr_connection_laplacian_real(self) -> sp.csr_matrix:
         """Real symmetric PSD CR connection Laplacian (2|E|, 2|E|) of 2×2 blocks, for any orientation.
@@ -185,7 +199,7 @@ class TriangleMeshOperators:
         cols = np.concatenate([j, i, i, j])
         vals = np.concatenate([-w, -w, w, w])
         n = self.n_vertices
-        return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+        return coo_to_csr(rows, cols, vals, (n, n))
 
     def vertex_mass(self) -> np.ndarray:
         """Barycentric vertex areas A_i = ⅓ Σ |ijk| (§9.1), shape (n,)."""

@@ -354,10 +354,14 @@ def _signed_vertex_polylines(ops, parsed, signs, curve_normals):
     mw = np.zeros((len(a), 6))
     mw[:, :2] = 0.5
     mid = np.stack([a, b, a, b, a, b], 1)
-    node_rows = list(zip(np.split(ids, cuts_nodes), np.split(w, cuts_nodes)))
+    def split(a, cuts):                                         # np.split without its per-piece overhead
+        b = [0, *cuts.tolist(), len(a)]
+        return [a[i:j] for i, j in zip(b[:-1], b[1:])]
+
+    node_rows = list(zip(split(ids, cuts_nodes), split(w, cuts_nodes)))
     node_is_vertex = [v.copy() for v in vs_list]
-    seg_len = np.split(ln, cuts_segs)
-    seg_mid = list(zip(np.split(mid, cuts_segs), np.split(mw, cuts_segs)))
+    seg_len = split(ln, cuts_segs)
+    seg_mid = list(zip(split(mid, cuts_segs), split(mw, cuts_segs)))
     return e, val, node_rows, node_is_vertex, seg_len, seg_mid
 
 

@@ -1,0 +1,87 @@
+"""gsdf.linalg.ldl: nested-dissection LDLᴴ against dense solves and SuperLU; orderings; non-PD input."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from gsdf.heat.surface.meshes import grid_mesh, sphere_mesh
+from gsdf.heat.surface.operators import TriangleMeshOperators
+from gsdf.linalg import Factorization, HermitianFactorization, LDLFactorization, spd_factorization
+from gsdf.linalg.ldl import nested_dissection
+
+
+def _ops():
+    V, F = sphere_mesh(2)
+    return TriangleMeshOperators(V, F)
+
+
+def test_complex_hermitian_matches_dense_solve():
+    ops = _ops()
+    A = (ops.cr_mass() + ops.h ** 2 * ops.cr_connection_laplacian()).tocsr()
+    b = np.random.default_rng(1).normal(size=(A.shape[0], 2)) @ np.array([1.0, 1j])
+    f = LDLFactorization(A)
+    x = f.solve(b)
+    np.testing.assert_allclose(x, np.linalg.solve(A.toarray(), b), rtol=1e-10, atol=1e-12)
+    # the same from the CSC arrays (read as Aᵀ = conj(A)), and several right-hand sides at once
+    np.testing.assert_allclose(LDLFactorization(A.tocsc()).solve(b), x, rtol=1e-12, atol=1e-14)
+    B = np.stack([b, 2 * b], axis=1)
+    np.testing.assert_allclose(f.solve(B)[:, 1], 2 * x, rtol=1e-12, atol=1e-14)
+
+
+def test_real_spd_matches_superlu_and_complex_rhs():
+    ops = _ops()
+    C = ops.cotan_laplacian()
+    free = np.arange(5, C.shape[0])
+    A = (C[free][:, free]).tocsr()                                # Dirichlet-reduced: SPD
+    b = np.random.default_rng(2).normal(size=A.shape[0])
+    x = LDLFactorization(A).solve(b)
+    np.testing.assert_allclose(x, Factorization(A.tocsc()).solve(b), rtol=1e-10, atol=1e-12)
+    z = LDLFactorization(A).solve(b + 2j * b)                     # complex b of a real matrix: two solves
+    np.testing.assert_allclose(z, x + 2j * x, rtol=1e-12, atol=1e-13)
+    assert type(spd_factorization(A)).__name__ == "LDLFactorization"
+
+
+def test_nested_dissection_is_a_permutation_with_less_fill_than_natural():
+    V, F = grid_mesh(30)
+    L = TriangleMeshOperators(V, F).cotan_laplacian().tocsr()
+    p = nested_dissection(L)
+    assert sorted(p.tolist()) == list(range(L.shape[0]))
+    A = (L + sp.identity(L.shape[0])).tocsr()
+    f = LDLFactorization(A)
+    natural = np.linalg.cholesky(A.toarray())                    # grid numbering: banded fill
+    assert f.nnz < 0.6 * (np.count_nonzero(np.abs(natural) > 1e-14) - A.shape[0])
+    # disconnected graphs (two blocks) and a path (separator = middle node)
+    D = sp.block_diag([A, A]).tocsr()
+    np.testing.assert_allclose(LDLFactorization(D).solve(np.ones(D.shape[0])), np.tile(f.solve(np.ones(A.shape[0])), 2),
+                               rtol=1e-12)
+    P = sp.diags([1, 1, 1], [-1, 0, 1], shape=(7, 7)).tocsr()
+    assert int(nested_dissection(P, leaf=1)[-1]) == 3
+
+
+def test_not_positive_definite_raises_and_callers_fall_back():
+    A = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]]))         # indefinite
+    with pytest.raises(ValueError, match="positive definite"):
+        LDLFactorization(A)
+    x = spd_factorization(A).solve(np.array([3.0, 3.0]))          # SuperLU instead
+    np.testing.assert_allclose(x, [1.0, 1.0])
+    Ac = sp.csr_matrix(np.array([[1.0, 2j], [-2j, 1.0]]))
+    assert HermitianFactorization(Ac).backend == "superlu"
+    with pytest.raises(ValueError, match="square"):
+        LDLFactorization(sp.csr_matrix(np.ones((2, 3))))
+    with pytest.raises(ValueError, match="shape"):
+        LDLFactorization(sp.identity(3, format="csr")).solve(np.ones(4))
+
+
+def test_coo_to_csr_matches_scipy_real_and_complex():
+    from gsdf.linalg.assembly import coo_to_csr
+
+    rng = np.random.default_rng(3)
+    r, c = rng.integers(0, 40, 500), rng.integers(0, 30, 500)
+    for v in (rng.normal(size=500), rng.normal(size=500) + 1j * rng.normal(size=500)):
+        A = coo_to_csr(r, c, v, (40, 30))
+        B = sp.csr_matrix((v, (r, c)), shape=(40, 30))
+        assert A.has_canonical_format and np.all(np.diff(A.indices[A.indptr[0]:A.indptr[1]]) > 0)
+        np.testing.assert_allclose(A.toarray(), B.toarray(), rtol=1e-13, atol=1e-14)
+    ops = _ops()
+    np.testing.assert_allclose(ops.cr_vector_heat_matrix(0.1).toarray(),
+                               (ops.cr_mass() + 0.1 * ops.cr_connection_laplacian()).toarray(), atol=1e-15)
