@@ -196,6 +196,23 @@ def time_vs_size(sizes):
                   "CC / genus / manifold"], rows)
 
 
+def _uptime():
+    return subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
+
+
+def only_sizes(sizes):
+    """The time-vs-size table alone (a quiet-machine rerun of the timings), into section recon-time."""
+    load0, t0 = _uptime(), time.perf_counter()
+    tab = time_vs_size(sizes)
+    text = ["## recon: time and peak memory vs point count (issue 13)", "",
+            f"Machine: {machine()}. Load at start: `{load0}`; at end: `{_uptime()}`. Command: "
+            f"`PYTHONPATH=src /work/anchors/bin/python bench/bench_recon.py --only-sizes {','.join(map(str, sizes))}` "
+            f"({time.perf_counter() - t0:.0f} s). bunny00 surface samples, no outliers, one process per size, "
+            "default options (reach=True, subdivide=1).", "", tab]
+    write_section("recon-time", "\n".join(text))
+    print("\n".join(text))
+
+
 # ------------------------------------------------------------------------------------------- relocation
 RELOC_CASES = [("bunny00.off", 2000, 200), ("bunny00.off", 2000, 400)] + [
     (m, n, k) for m in MESHES for (n, k) in ((4000, 400), (2000, 400))
@@ -394,9 +411,14 @@ if __name__ == "__main__":
                          "from one rng stream, so they differ from the full run's; written to section recon-subset")
     ap.add_argument("--table2-only", action="store_true", help="skip tubes, torus and time vs size")
     ap.add_argument("--size-worker", type=int, default=None)
+    ap.add_argument("--only-sizes", default=None, metavar="N,N,...",
+                    help="only the time / peak memory vs point count table for these sizes (one process each), "
+                         "written to section recon-time")
     a = ap.parse_args()
     if a.size_worker is not None:
         _size_worker(a.size_worker)
+    elif a.only_sizes:
+        only_sizes([int(n) for n in a.only_sizes.split(",")])
     else:
         main(a.quick, a.relocation or a.only_relocation, a.only_relocation,
              a.meshes.split(",") if a.meshes else None, a.table2_only)
