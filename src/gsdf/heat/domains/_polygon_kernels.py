@@ -371,53 +371,6 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
 
 
 @njit(cache=True)
-def coo_to_symmetric_csr(rows, cols, vals, n):
-    """CSR (indptr, indices, data) of n×n COO triplets, duplicates summed in input order per entry (a stable
-    counting sort by row, then by column): triplets that are symmetric polygon by polygon give an exactly
-    symmetric matrix, with sorted column indices."""
-    k = len(rows)
-    cnt = np.zeros(n + 1, np.int64)
-    for t in range(k):
-        cnt[rows[t] + 1] += 1
-    for i in range(n):
-        cnt[i + 1] += cnt[i]
-    pos = cnt[:-1].copy()
-    order = np.empty(k, np.int64)
-    for t in range(k):                                  # stable bucket by row
-        order[pos[rows[t]]] = t
-        pos[rows[t]] += 1
-    indptr = np.zeros(n + 1, np.int64)
-    indices = np.empty(k, np.int64)
-    data = np.empty(k)
-    out = 0
-    mark = np.full(n, -1, np.int64)                     # column -> its slot in the current row
-    for i in range(n):
-        start = out
-        for q in range(cnt[i], cnt[i + 1]):
-            t = order[q]
-            j = cols[t]
-            if mark[j] < start:
-                mark[j] = out
-                indices[out] = j
-                data[out] = vals[t]
-                out += 1
-            else:
-                data[mark[j]] += vals[t]
-        # sort the row's columns (insertion sort: rows are short)
-        for a in range(start + 1, out):
-            cj, cv = indices[a], data[a]
-            b = a - 1
-            while b >= start and indices[b] > cj:
-                indices[b + 1] = indices[b]
-                data[b + 1] = data[b]
-                b -= 1
-            indices[b + 1] = cj
-            data[b + 1] = cv
-        indptr[i + 1] = out
-    return indptr, indices[:out].copy(), data[:out].copy()
-
-
-@njit(cache=True)
 def connection_values(indptr, indices, data, N, e1, e2):
     """Values of the vertex connection Laplacian on the pattern of a symmetric CSR Laplacian (sorted
     columns and a symmetric pattern): for i < j, L_ij times the unit complex r_ij expressing e1_j in frame i

@@ -43,7 +43,8 @@ import scipy.sparse as sp
 
 from ... import _checks
 from ..surface.operators import TriangleMeshOperators
-from ._polygon_kernels import connection_values, coo_to_symmetric_csr, polygon_assembly, polygon_weights
+from ...linalg.assembly import coo_to_csr
+from ._polygon_kernels import connection_values, polygon_assembly, polygon_weights
 from .base import VertexSurfaceDomain, tangent_frames
 
 
@@ -282,9 +283,9 @@ class PolygonDomain(VertexSurfaceDomain):
         self.F_refined = F[good]
         self._fine_normals, self._fine_G = fn[good], fG[good]      # steps II–III on the fine triangles
         self._fine_ops = None
-        # per polygon exactly symmetric, and duplicates summed in polygon order for (i, j) and (j, i) alike:
-        # L is exactly symmetric
-        L = sp.csr_matrix(coo_to_symmetric_csr(rows, cols, vals, n)[::-1], shape=(n, n))
+        # per polygon exactly symmetric, and coo_to_csr sums duplicates in input (polygon) order for (i, j) and
+        # (j, i) alike: L is exactly symmetric
+        L = coo_to_csr(rows, cols, vals, (n, n))
         # vertex normals: area-weighted fine triangle normals (§8.3)
         nrm = np.linalg.norm(An, axis=1)
         An[nrm == 0] = [0, 0, 1.0]
