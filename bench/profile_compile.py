@@ -9,6 +9,12 @@ compiles in this process and shows up in the table.
 
     PYTHONPATH=src python3 bench/profile_compile.py demo            # top 15 kernels of `gsdf demo`
     PYTHONPATH=src python3 bench/profile_compile.py sdf --top 30    # `gsdf sdf` on bunny00.off
+    PYTHONPATH=src python3 bench/profile_compile.py demo-cloud      # the demo's background process alone
+    PYTHONPATH=src python3 bench/profile_compile.py demo-soup       # the demo's main process alone (its
+                                                                    # background job's kernels cached first)
+
+``demo-cloud`` + ``demo-soup`` split ``demo``'s compile into its two processes (the critical path of a cold
+demo on >= 2 cores is the longer of the two).
 
 Prints only (the cold-start section of RESULTS.md is bench_cold_start.py's).
 """
@@ -26,7 +32,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("command", choices=["demo", "sdf", "winding"], help="what to run cold")
+    ap.add_argument("command", choices=["demo", "sdf", "winding", "demo-cloud", "demo-soup"], help="what to run cold")
     ap.add_argument("--top", type=int, default=15)
     a = ap.parse_args(argv)
     cache = tempfile.mkdtemp(prefix="numba-profile-")
@@ -53,6 +59,11 @@ def main(argv=None):
             if stack:
                 stack[-1][2] += dt
 
+    if a.command == "demo-soup":  # the background job's kernels compiled (and cached) in another process first
+        import subprocess
+
+        subprocess.run([sys.executable, "-m", "gsdf.cli.main", "warmup", "--only", "demo-cloud", "--jobs", "1"],
+                       check=True, stdout=subprocess.DEVNULL, env=dict(os.environ, NUMBA_CACHE_DIR=cache))
     event.register("numba:compile", Timer())
     import gsdf.cli._background as bg
 
@@ -63,6 +74,7 @@ def main(argv=None):
 
     out = tempfile.mkdtemp(prefix="gsdf-profile-out-")
     args = {"demo": ["demo", "-o", os.path.join(out, "demo")],
+            "demo-soup": ["demo", "-o", os.path.join(out, "demo")],
             "sdf": ["sdf", os.path.join(data_dir(), "meshes", "bunny00.off"), "-o", os.path.join(out, "s.npz"),
                     "-q"]}
     if a.command == "winding":
@@ -75,6 +87,13 @@ def main(argv=None):
         t = time.perf_counter()
         V, F = read_mesh(data.path("broken_soup.obj"))
         FastWindingNumber(V, F)(np.random.default_rng(0).random((2000, 3)))
+    elif a.command == "demo-cloud":
+        from gsdf.cli.warmup import warm
+
+        t = time.perf_counter()
+        [(_, _, err)] = warm(["demo-cloud"], processes=1)
+        if err:
+            raise SystemExit(err)
     else:
         t = time.perf_counter()
         res = CliRunner().invoke(cli, args[a.command], catch_exceptions=False)

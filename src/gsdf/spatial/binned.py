@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 NBINS = 32
 #: Nodes with at most this many elements are split by an exhaustive sweep instead of bins (3 × 32 bins cost
@@ -261,7 +261,7 @@ def _put(dst, i, src, o, n):
         dst[i, d] = src[o + d]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # nogil: build_volume_rows grows subtrees on Python threads
 def _grow(E, order, s0, e0, b0, leaf_size, cutoff, node_i, node_b, base):
     """Split rows s0:e0 of E (node bounds ``b0``: box lo, hi, centroid lo, hi) top-down into a preorder
     subtree with local node ids 0, 1, ... . A node of at most ``cutoff`` elements (cutoff > leaf_size; 0: none)
@@ -348,12 +348,39 @@ def build_volume_rows(E, leaf_size, threads=1):
 
     With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
     of the tree is split on the calling thread down to nodes of about n/64 elements, whose subtrees are then
-    grown in parallel and spliced into the preorder arrays (the same tree as the serial build). The two are
-    separate kernels so that a small build never compiles the parallel one; the parallel one is a serial top
-    (:func:`_grow`), one small parallel loop (:func:`_grow_tasks`) and a serial splice, sharing :func:`_grow`."""
-    if threads > 1 and E.shape[0] > PARALLEL_ELEMENTS:
-        return _build_rows_parallel(E, leaf_size)
-    return _build_rows_serial(E, leaf_size)
+    grown on ``threads`` Python threads (:func:`_grow` releases the GIL; the subtrees own disjoint rows) and
+    spliced into the preorder arrays by :func:`_splice` (the same tree as the serial build). Both builds are
+    the one compiled kernel :func:`_grow` driven from here: no parallel numba kernel (a parfor over the tasks
+    cost ~6 s of compilation on a cold start, issue 17, for a build of 0.05-0.3 s)."""
+    n = E.shape[0]
+    order = np.arange(n, dtype=np.int64)
+    root = _root_bounds(E)
+    if threads > 1 and n > PARALLEL_ELEMENTS:
+        cutoff = max(leaf_size + 1, n // 64)
+        kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, 0, n, root, leaf_size, cutoff,
+                                                        np.empty((256, 4), np.int64), np.empty((256, 6)), 0)
+        # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
+        sub_i = np.empty((2 * n, 4), np.int64)
+        sub_b = np.empty((2 * n, 6))
+        counts = np.empty(ntask, np.int64)
+
+        def grow_task(t):
+            s, e = task_i[t, 0], task_i[t, 1]
+            counts[t] = _grow(E, order, s, e, task_b[t], leaf_size, 0, sub_i, sub_b, 2 * s)[0]
+
+        from concurrent.futures import ThreadPoolExecutor
+
+        # largest subtrees first, so the threads finish together
+        todo = np.argsort(task_i[:ntask, 0] - task_i[:ntask, 1], kind="stable")
+        with ThreadPoolExecutor(max_workers=threads) as pool:
+            list(pool.map(grow_task, todo))
+        start, end, right, lo, hi = _splice(kt, top_i, top_b, task_i[:ntask], counts, sub_i, sub_b)
+    else:
+        k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, root, leaf_size, 0, np.empty((2 * n, 4), np.int64),
+                                           np.empty((2 * n, 6)), 0)
+        start, end, right = (node_i[:k, c].copy() for c in range(3))
+        lo, hi = node_b[:k, 0:3].copy(), node_b[:k, 3:6].copy()
+    return order, start, end, right, _skips(start, end, right), lo, hi
 
 
 @njit(cache=True)
@@ -374,99 +401,37 @@ def _root_bounds(E):
     return root
 
 
-@njit(cache=True)
-def _skips(right):
-    """Preorder skip pointers: the node after node i's subtree."""
-    k = right.shape[0]
-    size = np.ones(k, np.int64)
-    for i in range(k - 1, -1, -1):
-        r = right[i]
-        if r >= 0:
-            size[i] = 1 + size[i + 1] + size[r]
-    return np.arange(k) + size
+def _skips(start, end, right):
+    """Preorder skip pointers: the node after node i's subtree, i + (its node count). Every internal node has
+    two children and every leaf elements, so a subtree with L leaves has 2L − 1 nodes, and its leaves are
+    those whose first element lies in its range (leaves appear in element order in preorder)."""
+    first = start[right < 0]
+    leaves = np.searchsorted(first, end) - np.searchsorted(first, start)
+    return np.arange(start.shape[0]) + 2 * leaves - 1
 
 
-@njit(cache=True)
-def _build_rows_serial(E, leaf_size):
-    n = E.shape[0]
-    order = np.arange(n)
-    node_i = np.empty((2 * n, 4), np.int64)
-    node_b = np.empty((2 * n, 6))
-    zero = np.int64(0)  # not the literal 0: one compiled _grow for every caller (see _grow_tasks)
-    k, node_i, node_b, _, _, _ = _grow(E, order, zero, n, _root_bounds(E), leaf_size, zero, node_i, node_b, zero)
-    start = node_i[:k, 0].copy()
-    end = node_i[:k, 1].copy()
-    right = node_i[:k, 2].copy()
-    lo = node_b[:k, 0:3].copy()
-    hi = node_b[:k, 3:6].copy()
-    return order, start, end, right, _skips(right), lo, hi
-
-
-@njit(cache=True)
-def _build_rows_parallel(E, leaf_size):
-    """The top of the tree here, its lower subtrees by :func:`_grow_tasks` on the threads, then spliced."""
-    n = E.shape[0]
-    order = np.arange(n)
-    cutoff = max(leaf_size + 1, n // 64)
-    zero = np.int64(0)
-    kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, zero, n, _root_bounds(E), leaf_size, cutoff,
-                                                    np.empty((256, 4), np.int64), np.empty((256, 6)), zero)
-    # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
-    sub_i = np.empty((2 * n, 4), np.int64)
-    sub_b = np.empty((2 * n, 6))
-    counts = np.empty(ntask, np.int64)
-    _grow_tasks(E, order, task_i, task_b, leaf_size, sub_i, sub_b, counts)
-    return _splice(order, kt, top_i, top_b, task_i, counts, sub_i, sub_b)
-
-
-@njit(cache=True, parallel=True)
-def _grow_tasks(E, order, task_i, task_b, leaf_size, sub_i, sub_b, counts):
-    """The subtrees of the tasks of :func:`_grow`, in parallel (disjoint rows of E, order, sub_i, sub_b). The
-    only parallel kernel of the build, and a small one: the loop body is one call (:func:`_grow_task`).
-
-    Integer arguments of the kernels called here are int64 variables, never literals or the unsigned prange
-    index: numba compiles one specialisation per distinct argument type (Literal[int](0) and uint64 each
-    cost another ~3 s of compilation)."""
-    for t in prange(counts.shape[0]):
-        counts[t] = _grow_task(E, order, task_i, task_b, np.int64(t), leaf_size, sub_i, sub_b)
-
-
-@njit(cache=True)
-def _grow_task(E, order, task_i, task_b, t, leaf_size, sub_i, sub_b):
-    s, e = task_i[t, 0], task_i[t, 1]
-    c, _, _, _, _, _ = _grow(E, order, s, e, task_b[t], leaf_size, np.int64(0), sub_i, sub_b, 2 * s)
-    return c
-
-
-@njit(cache=True)
-def _splice(order, kt, top_i, top_b, task_i, counts, sub_i, sub_b):
-    """Final preorder arrays: the top tree's nodes in order, each task node replaced by its subtree."""
-    final = np.empty(kt, np.int64)
-    k = 0
-    for i in range(kt):
-        final[i] = k
-        k += counts[top_i[i, 3]] if top_i[i, 3] >= 0 else 1
-    start = np.empty(k, np.int64)
-    end = np.empty(k, np.int64)
-    right = np.empty(k, np.int64)
-    lo = np.empty((k, 3))
-    hi = np.empty((k, 3))
-    for i in range(kt):
-        if top_i[i, 3] < 0:
-            f = final[i]
-            start[f], end[f] = top_i[i, 0], top_i[i, 1]
-            right[f] = final[top_i[i, 2]] if top_i[i, 2] >= 0 else -1
-            for d in range(3):
-                lo[f, d] = top_b[i, d]
-                hi[f, d] = top_b[i, 3 + d]
-    for t in range(counts.shape[0]):
-        base = final[task_i[t, 2]]
-        r0 = 2 * task_i[t, 0]
-        for j in range(counts[t]):
-            f = base + j
-            start[f], end[f] = sub_i[r0 + j, 0], sub_i[r0 + j, 1]
-            right[f] = base + sub_i[r0 + j, 2] if sub_i[r0 + j, 2] >= 0 else -1
-            for d in range(3):
-                lo[f, d] = sub_b[r0 + j, d]
-                hi[f, d] = sub_b[r0 + j, 3 + d]
-    return order, start, end, right, _skips(right), lo, hi
+def _splice(kt, top_i, top_b, task_i, counts, sub_i, sub_b):
+    """Final preorder arrays (start, end, right, lo, hi): the top tree's ``kt`` nodes in order, each task
+    node replaced by its subtree (task t's ``counts[t]`` nodes at rows 2·start_t … of sub_i / sub_b)."""
+    task = top_i[:kt, 3]
+    size = np.where(task >= 0, counts[np.maximum(task, 0)], 1)
+    final = np.concatenate(([0], np.cumsum(size)[:-1]))  # where each top node's subtree starts
+    k = int(size.sum())
+    start, end, right = np.empty(k, np.int64), np.empty(k, np.int64), np.empty(k, np.int64)
+    lo, hi = np.empty((k, 3)), np.empty((k, 3))
+    own = np.flatnonzero(task < 0)  # top nodes that stay
+    f = final[own]
+    start[f], end[f] = top_i[own, 0], top_i[own, 1]
+    r = top_i[own, 2]
+    right[f] = np.where(r >= 0, final[np.maximum(r, 0)], -1)
+    lo[f], hi[f] = top_b[own, 0:3], top_b[own, 3:6]
+    # the subtrees: node j of task t goes to final[node of t] + j, from row 2·start_t + j
+    base = np.repeat(final[task_i[:, 2]], counts)
+    j = np.arange(base.shape[0]) - np.repeat(np.cumsum(counts) - counts, counts)
+    f = base + j
+    rows = np.repeat(2 * task_i[:, 0], counts) + j
+    start[f], end[f] = sub_i[rows, 0], sub_i[rows, 1]
+    r = sub_i[rows, 2]
+    right[f] = np.where(r >= 0, base + r, -1)
+    lo[f], hi[f] = sub_b[rows, 0:3], sub_b[rows, 3:6]
+    return start, end, right, lo, hi

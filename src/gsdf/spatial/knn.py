@@ -96,7 +96,8 @@ def _sample_kth(S, P, k):
             u, v, w = P[j, 0] - S[a, 0], P[j, 1] - S[a, 1], P[j, 2] - S[a, 2]
             d[j] = u * u + v * v + w * w
         kth[a] = np.sqrt(_select(d, n, k - 1))
-    return np.median(kth)
+    # the (upper) median by the same quickselect: np.median would compile numba's sort (~1.5 s cold)
+    return _select(kth, m, m // 2)
 
 
 @njit(cache=True)
@@ -161,8 +162,9 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, cd, ci, tmp,
                     if m + (e - s) > cd.shape[0]:  # grow the scratch buffers
                         cap = 2 * (m + e - s)
                         cd2, ci2 = np.empty(cap), np.empty(cap, np.int64)
-                        cd2[:m] = cd[:m]
-                        ci2[:m] = ci[:m]
+                        for q in range(m):  # a loop, not a slice assignment (whose shape-mismatch error
+                            cd2[q] = cd[q]  # path costs ~2 s of a cold compile)
+                            ci2[q] = ci[q]
                         cd, ci, tmp = cd2, ci2, np.empty(cap)
                     for p in range(s, e):
                         u, v, w = Ps[p, 0] - x, Ps[p, 1] - y, Ps[p, 2] - z
@@ -198,7 +200,7 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, cd, ci, tmp,
     # the k smallest (d², index): a quickselect threshold, then the ties at it by smallest index
     for q in range(m):
         tmp[q] = cd[q]
-    thr = _select(tmp, m, k - 1)
+    thr = _select(tmp, np.int64(m), k - 1)  # int64, not Literal[int](0): one specialisation
     c = 0
     for q in range(m):
         if cd[q] < thr:
@@ -215,7 +217,13 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, cd, ci, tmp,
             if cd[q] == thr:
                 ties[nt] = ci[q]
                 nt += 1
-        ties.sort()
+        for a in range(1, nt):  # insertion sort (few ties; ndarray.sort would compile numba's quicksort)
+            v = ties[a]
+            b = a
+            while b > 0 and ties[b - 1] > v:
+                ties[b] = ties[b - 1]
+                b -= 1
+            ties[b] = v
         for t in range(k - c):
             out[row, c] = ties[t]
             c += 1
