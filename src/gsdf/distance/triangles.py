@@ -325,7 +325,7 @@ def _nearest_kernel(Q, perm, D, order, start, end, right, lo, hi, out_d2, out_fa
         stack_d = np.empty(_STACK, np.float64)
         i0 = blk * _BLOCK
         i1 = min(nq, i0 + _BLOCK)
-        bj = -1
+        bj = np.int64(-1)  # not the literal -1: one compiled _tri_d2
         for k in range(i0, i1):
             qi = perm[k]
             px = Q[qi, 0]

@@ -8,19 +8,20 @@ where ``a_i`` is the (geodesic) Voronoi area of ``p_i`` on the sampled surface. 
 acquisition does not provide the areas, §3.1 estimates them by projecting each point and its
 ``k`` nearest neighbours (dropping neighbours with opposite normals) onto a plane through the
 point and taking the area of the point's 2D Voronoi cell.  :func:`point_areas` does exactly that
-in a parallel numba kernel; :func:`estimate_normals` gives PCA normals for unoriented clouds
+in numba kernels run on threads; :func:`estimate_normals` gives PCA normals for unoriented clouds
 ("for unoriented point clouds we can also use the plane to define normals", §3.1).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 from scipy.spatial import cKDTree
 
 from .._checks import as_normals, as_points, integer
 from .._normalize import Frame
 from ..spatial.knn import SelfKNN
+from ..threads import run_ranges
 
 __all__ = ["point_areas", "estimate_normals"]
 
@@ -117,21 +118,19 @@ def _convex_hull(pts, m, hull):
     return h
 
 
-@njit(parallel=True, cache=True)
-def _voronoi_areas(P, N, plane, idx, offset, clip_hull, out):
-    """Cell areas of points offset + r for the rows r of ``idx`` (neighbours), ``plane`` (projection normals)."""
-    n = idx.shape[0]
+@njit(cache=True, nogil=True)
+def _voronoi_areas(P, N, plane, idx, offset, clip_hull, out, r0, r1):
+    """Cell areas of points offset + r for the rows r0 <= r < r1 of ``idx`` (neighbours), ``plane``
+    (projection normals). Serial and GIL-free: :func:`point_areas` runs row ranges on threads
+    (:func:`gsdf.threads.run_ranges`; a numba parallel loop here cost ~1 s more to compile on a cold start)."""
     m = idx.shape[1]
-    block = 256  # points per task: scratch buffers are allocated once per block
-    nblocks = (n + block - 1) // block
-    for bi in prange(nblocks):
-        cap = 2 * m + 16
-        Q = np.empty((m + 1, 2))
-        A0 = np.empty((cap, 2))
-        B0 = np.empty((cap, 2))
-        H = np.empty((2 * m + 4, 2))
-        for r in range(bi * block, min(n, (bi + 1) * block)):
-            out[r] = _cell_area(P, N, plane, idx, offset + r, r, clip_hull, Q, A0, B0, H)
+    cap = 2 * m + 16  # scratch buffers, allocated once per range
+    Q = np.empty((m + 1, 2))
+    A0 = np.empty((cap, 2))
+    B0 = np.empty((cap, 2))
+    H = np.empty((2 * m + 4, 2))
+    for r in range(r0, r1):
+        out[r] = _cell_area(P, N, plane, idx, offset + r, r, clip_hull, Q, A0, B0, H)
 
 
 @njit(cache=True)
@@ -198,7 +197,7 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
     A[2, 1] = R
     A[3, 0] = -R
     A[3, 1] = R
-    k = 4
+    k = np.int64(4)  # not the literal 4: one compiled _clip_halfplane
     ndup = 0
     for s in range(cnt):
         qx = Q[s, 0]
@@ -336,7 +335,7 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
 
     Cost: one k-nearest-neighbour search (scipy's k-d tree up to 64 candidates, the cell grid of
     :class:`gsdf.spatial.knn.SelfKNN` above) plus
-    O(n (candidates k + k^2)) work in a parallel numba kernel.
+    O(n (candidates k + k^2)) work in numba kernels on the threads.
 
     Examples
     --------
@@ -372,8 +371,9 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
         cand = knn.rows(s, e)
         sel = np.full((e - s, kk + 1), -1, np.int64)
         plane = np.zeros((e - s, 3))
-        _tangent_neighbours(P, N, cand, s, kk, sel, plane)
-        _voronoi_areas(P, N, plane, sel, s, boundary == "hull", out[s:e])
+        part = out[s:e]
+        run_ranges(lambda r0, r1: _tangent_neighbours(P, N, cand, s, kk, sel, plane, r0, r1), e - s)
+        run_ranges(lambda r0, r1: _voronoi_areas(P, N, plane, sel, s, boundary == "hull", part, r0, r1), e - s)
     a = frame.area(out)
     if not np.isfinite(a).all():
         raise ValueError(f"P: point areas overflow float64 at this scale (cloud half-size 2^{frame.exponent})")
@@ -386,7 +386,8 @@ def _smallest_eigenvector3(C):
     rotations (each zeroes one off-diagonal entry; the off-diagonal mass falls quadratically, so a few sweeps reach rounding level): as accurate as LAPACK's
     ``eigh`` on a 3×3 and, called once per point, much cheaper than the LAPACK call from numba. Returns
     ``(w_mid, w_max, vx, vy, vz)``."""
-    V = np.eye(3)
+    V = np.zeros((3, 3))  # the identity (np.eye compiles one more overload)
+    V[0, 0] = V[1, 1] = V[2, 2] = 1.0
     for _sweep in range(12):
         off = C[0, 1] * C[0, 1] + C[0, 2] * C[0, 2] + C[1, 2] * C[1, 2]
         diag = C[0, 0] * C[0, 0] + C[1, 1] * C[1, 1] + C[2, 2] * C[2, 2]
@@ -423,23 +424,24 @@ def _smallest_eigenvector3(C):
     return C[mid, mid], C[hi, hi], V[0, lo], V[1, lo], V[2, lo]
 
 
-@njit(parallel=True, cache=True)
-def _tangent_neighbours(P, N, cand, offset, k, sel, plane):
-    """Per point: the best-fit (PCA) plane of its same-side candidates and their k nearest in that plane.
+@njit(cache=True, nogil=True)
+def _tangent_neighbours(P, N, cand, offset, k, sel, plane, r0, r1):
+    """Per point (rows r0 <= row < r1): the best-fit (PCA) plane of its same-side candidates and their k
+    nearest in that plane.
 
-    Writes the plane normal (oriented like n_i) to ``plane[i]`` and the chosen neighbour indices to
-    ``sel[i]`` (padded with -1). With a thin sample these are the k nearest neighbours of §3.1; in a
+    Writes the plane normal (oriented like n_i) to ``plane[row]`` and the chosen neighbour indices to
+    ``sel[row]`` (padded with -1). With a thin sample these are the k nearest neighbours of §3.1; in a
     noisy shell thicker than the spacing they are the points whose *projections* are nearest, which keeps
-    the projected density equal to the surface density.
+    the projected density equal to the surface density. Serial and GIL-free, run on threads like
+    :func:`_voronoi_areas`.
     """
-    m = cand.shape[1]
-    for row in prange(cand.shape[0]):
-        _tangent_row(P, N, cand, offset, k, sel, plane, np.int64(row))
+    for row in range(r0, r1):
+        _tangent_row(P, N, cand, offset, k, sel, plane, row)
 
 
 @njit(cache=True)
 def _tangent_row(P, N, cand, offset, k, sel, plane, row):
-    """One row of :func:`_tangent_neighbours` (kept out of the parallel loop: shorter parfor compilation)."""
+    """One row of :func:`_tangent_neighbours`."""
     m = cand.shape[1]
     i = offset + row
     nx, ny, nz = N[i, 0], N[i, 1], N[i, 2]
