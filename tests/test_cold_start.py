@@ -146,3 +146,27 @@ def test_background_warmup_withdrawn_on_close(fresh_listener):
     bg = BackgroundWarmup(["demo-cloud"])
     bg.close()  # nothing compiled in between: nothing started, and the callback is gone
     assert bg.proc is None and bg._start not in _jit._first_compile_callbacks
+
+
+def test_background_wait_for_returns_when_its_job_is_reported(fresh_listener):
+    import subprocess
+    import time
+
+    from gsdf.cli._background import BackgroundWarmup
+
+    bg = BackgroundWarmup(["demo-cloud", "distance"])
+    with pytest.raises(ValueError, match="job"):
+        bg.wait_for("soup")
+    bg.wait_for("distance")  # nothing started (warm / no compile yet): returns at once
+    # a stand-in for the warm-up process: reports demo-cloud, then keeps running
+    bg.proc = subprocess.Popen([sys.executable, "-c", "import time; print('compiling ...', flush=True); "
+                                "print('  demo-cloud     1.0 s  the cloud', flush=True); time.sleep(60)"],
+                               stdout=subprocess.PIPE, text=True)
+    t = time.perf_counter()
+    bg.wait_for("demo-cloud")
+    assert time.perf_counter() - t < 30 and bg.proc.poll() is None and bg.done == {"demo-cloud"}
+    bg.proc.kill()
+    bg.wait_for("distance")  # the process ended without reporting it: return, the caller compiles it
+    assert bg.done == {"demo-cloud", "distance"}
+    bg.close()
+    assert bg.proc is None

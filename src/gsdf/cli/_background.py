@@ -12,20 +12,21 @@ class BackgroundWarmup:
 
     On a cold cache and with >= 2 threads, the background process compiles (and caches) the kernels of
     ``jobs`` while this process compiles its own; when this process reaches them they load from the cache.
-    On a warm cache nothing is started. :meth:`close` waits for the process (it is short-lived), or stops
-    it after ``timeout`` seconds.
+    On a warm cache nothing is started. The jobs run one after the other; :meth:`wait_for` waits until one
+    of them is done (the process prints a line per finished job), :meth:`close` waits for the process (it is
+    short-lived), or stops it after ``timeout`` seconds.
 
     Example
     -------
-    >>> with BackgroundWarmup(["demo-cloud"]):           # doctest: +SKIP
-    ...     run_the_soup_part(); run_the_cloud_part()
+    >>> with BackgroundWarmup(["demo-cloud", "distance"]) as bg:     # doctest: +SKIP
+    ...     run_the_soup_part(); bg.wait_for("demo-cloud"); run_the_cloud_part()
     """
 
     def __init__(self, jobs):
         from .._jit import install_compile_notice, on_first_compile
         from ..threads import get_num_threads
 
-        self.jobs, self.proc = list(jobs), None
+        self.jobs, self.proc, self.done = list(jobs), None, set()
         if self.jobs and get_num_threads() >= 2:
             if install_compile_notice().printed:  # a kernel compiled already (cold cache): start now
                 self._start()
@@ -41,10 +42,25 @@ class BackgroundWarmup:
         cmd = [sys.executable, "-m", "gsdf.cli.main", "--threads", str(get_num_threads()), "warmup", "--only",
                ",".join(self.jobs), "--jobs", "1"]
         try:
-            self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                         stdin=subprocess.DEVNULL)
+            self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                         stdin=subprocess.DEVNULL, text=True)
         except OSError:  # pragma: no cover - no subprocesses here: compile in this process only
             self.proc = None
+
+    def wait_for(self, job: str) -> None:
+        """Return once background job ``job`` has finished (or the process has ended; at once if none runs).
+
+        :func:`gsdf.cli.warmup.warm` prints one line per finished job, starting with its name."""
+        if job not in self.jobs:
+            raise ValueError(f"job: {job!r} is not one of this background process's jobs {self.jobs}")
+        while self.proc is not None and job not in self.done:
+            line = self.proc.stdout.readline()
+            if not line:  # the process ended (every job done, or it failed): the caller compiles what is left
+                self.done.update(self.jobs)
+                break
+            words = line.split()
+            if words and words[0] in self.jobs:
+                self.done.add(words[0])
 
     def close(self, timeout: float = 120.0):
         from .._jit import cancel_first_compile
@@ -55,10 +71,10 @@ class BackgroundWarmup:
         import subprocess
 
         try:
-            self.proc.wait(timeout=timeout)
+            self.proc.communicate(timeout=timeout)  # reads what is left of its output, then waits
         except subprocess.TimeoutExpired:  # pragma: no cover
             self.proc.kill()
-            self.proc.wait()
+            self.proc.communicate()
         self.proc = None
 
     def __enter__(self):

@@ -42,10 +42,11 @@ def demo(output_dir, resolution):
 
     if os.path.exists(output_dir) and not os.path.isdir(output_dir):
         raise ValueError(f"{output_dir}: exists and is not a folder")
-    # cold cache, >= 2 threads: a second process compiles the distance kernels and the cloud half's
-    # meanwhile (this one compiles the fast winding numbers of triangles first)
-    background = BackgroundWarmup(["demo-cloud"])
-    written = []
+    # cold cache, >= 2 threads: a second process compiles the cloud half's kernels, then the distance kernels,
+    # while this one compiles the fast winding numbers of triangles; so the soup's signed distance grid (which
+    # needs the distance kernels) is computed last (the outputs and what is printed are the same in any order)
+    background = BackgroundWarmup(["demo-cloud", "distance"])
+    written = {}
     t0 = time.perf_counter()
 
     # --- the triangle soup -----------------------------------------------------------------------------
@@ -58,29 +59,23 @@ def demo(output_dir, resolution):
     Q = rng.uniform(lo, hi, (2000, 3))
     w_fast, w_exact = fwn(Q), winding_number(V, F, Q, method="direct")  # 2000 x 2715 solid angles: ~0.05 s
     save("soup_winding_samples.npz", lambda p: np.savez(p, queries=Q, winding_fast=w_fast, winding_exact=w_exact))
-    written.append(("winding numbers at 2000 random points (fast and exact)", "soup_winding_samples.npz"))
+    written["samples"] = ("winding numbers at 2000 random points (fast and exact)", "soup_winding_samples.npz")
     click.echo(f"        fast vs exact winding number on 2000 points: RMS {np.sqrt(np.mean((w_fast - w_exact)**2)):.2e},"
                f" inside/outside agree on {np.mean((w_fast > 0.5) == (w_exact > 0.5)) * 100:.2f} %")
 
-    field = signed_distance_grid(soup, resolution, 0.05)
-    save("soup_sdf.npz", field.save)
-    written.append((f"signed distance grid {field.shape} (negative inside)", "soup_sdf.npz"))
-    save("soup_sdf_slice.png", lambda p: write_field_slice_png(p, field))
-    written.append(("PNG of the middle z slice of the signed distance, zero contour in black", "soup_sdf_slice.png"))
-
     Vs, Fs = extract_isosurface(fwn, lo, hi, resolution=resolution, level=0.5, bisection_steps=10)
     save("soup_surface.ply", lambda p: write_mesh(p, Vs, Fs))
-    written.append((f"watertight surface of the soup (w = 1/2), {len(Fs)} triangles", "soup_surface.ply"))
+    written["surface"] = (f"watertight surface of the soup (w = 1/2), {len(Fs)} triangles", "soup_surface.ply")
 
     zs = list(np.linspace(lo[2], hi[2], 12)[1:-1])
     contours = slice_contours(fwn, zs, lo, hi, resolution=192)
     save("soup_slices.svg", lambda p: write_svg(p, contours, z_values=zs, layout="stack"))
-    written.append((f"{len(zs)} closed print slices ({sum(map(len, contours))} contours)", "soup_slices.svg"))
+    written["slices"] = (f"{len(zs)} closed print slices ({sum(map(len, contours))} contours)", "soup_slices.svg")
 
     # --- the point cloud -------------------------------------------------------------------------------
     # cold cache: the background process is compiling (or has compiled) this half's kernels; wait for it
     # rather than compile the same kernels here a second time
-    background.close()
+    background.wait_for("demo-cloud")
     P, N = read_points(data.path("torus_cloud.xyz"))
     cloud = Geometry(P, N=N, path=data.path("torus_cloud.xyz"))
     click.echo(f"[cloud] {cloud.describe()}")
@@ -92,7 +87,7 @@ def demo(output_dir, resolution):
     plo, phi = bbox_of(P, 0.05)
     Vc, Fc = extract_isosurface(fwp, plo, phi, resolution=resolution, level=0.5, bisection_steps=10)
     save("cloud_surface.ply", lambda p: write_mesh(p, Vc, Fc))
-    written.append((f"point-set surface of the cloud (w = 1/2), {len(Fc)} triangles", "cloud_surface.ply"))
+    written["cloud"] = (f"point-set surface of the cloud (w = 1/2), {len(Fc)} triangles", "cloud_surface.ply")
     # winding number on the z = 0 plane
     n = 256
     xs = np.linspace(plo[0], phi[0], n)
@@ -100,9 +95,18 @@ def demo(output_dir, resolution):
     X, Y = np.meshgrid(xs, ys, indexing="xy")
     W = fwp(np.column_stack([X.ravel(), Y.ravel(), np.zeros(n * n)])).reshape(n, n)
     save("cloud_winding_slice.png", lambda p: write_png(p, field_to_rgb(np.flipud(-(W - 0.5)), zero_level=0.0)))
-    written.append(("PNG of the cloud's winding number on z = 0 (1/2 contour in black)", "cloud_winding_slice.png"))
+    written["cloud_png"] = ("PNG of the cloud's winding number on z = 0 (1/2 contour in black)",
+                            "cloud_winding_slice.png")
 
+    # --- the soup's signed distance (its distance kernels were compiled last in the background) ----------
     background.close()
+    field = signed_distance_grid(soup, resolution, 0.05)
+    save("soup_sdf.npz", field.save)
+    written["sdf"] = (f"signed distance grid {field.shape} (negative inside)", "soup_sdf.npz")
+    save("soup_sdf_slice.png", lambda p: write_field_slice_png(p, field))
+    written["sdf_png"] = ("PNG of the middle z slice of the signed distance, zero contour in black", "soup_sdf_slice.png")
+
     click.echo(f"\nDone in {time.perf_counter() - t0:.1f} s. Outputs in {os.path.abspath(output_dir)}:")
-    for what, name in written:
+    for key in ("samples", "sdf", "sdf_png", "surface", "slices", "cloud", "cloud_png"):
+        what, name = written[key]
         click.echo(f"  {name:28s} {what}")

@@ -32,7 +32,7 @@ JOBS = {
 
 
 # jobs that other commands start in the background (not part of a full warm-up: a subset of "cloud")
-_PARTIAL = {"demo-cloud": "the distance kernels and the point-cloud half of gsdf demo",
+_PARTIAL = {"demo-cloud": "the point-cloud half of gsdf demo",
             "distance": "the unsigned-distance kernels (gsdf sdf of a mesh)"}
 
 
@@ -78,10 +78,8 @@ def _job_commands(name: str, f: dict) -> list[list[str]]:
                 ["sdf", f["soup"], "-o", o("sp.npz"), "--resolution", "8", "--sign", "pseudonormal", "-q"],
                 ["slice", f["soup"], "-o", o("s.svg"), "--layers", "2", "--resolution", "16"]]
     if name == "demo-cloud":
-        # the distance first (gsdf demo needs it second, after the fast winding numbers it compiles itself),
-        # then the cloud at a resolution whose 28³ grid takes the parallel walk, as the demo's 64³ one does
-        return [["@distance", f["soup"]],
-                ["surface", f["cloud"], "-o", o("c.ply"), "--resolution", "28"]]
+        # the cloud at a resolution whose 28³ grid takes the parallel walk, as the demo's 64³ one does
+        return [["surface", f["cloud"], "-o", o("c.ply"), "--resolution", "28"]]
     if name == "distance":
         return [["@distance", f["soup"]]]
     if name == "cloud":

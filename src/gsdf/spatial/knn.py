@@ -96,8 +96,15 @@ def _sample_kth(S, P, k):
             u, v, w = P[j, 0] - S[a, 0], P[j, 1] - S[a, 1], P[j, 2] - S[a, 2]
             d[j] = u * u + v * v + w * w
         kth[a] = np.sqrt(_select(d, n, k - 1))
-    # the (upper) median by the same quickselect: np.median would compile numba's sort (~1.5 s cold)
-    return _select(kth, m, m // 2)
+    # the median by the same quickselect (np.median would compile numba's sort, ~1.5 s cold): after selecting
+    # rank m // 2 the smaller half lies before it, so for even m the other middle value is that half's largest
+    hi = _select(kth, m, m // 2)
+    if m % 2 == 1:
+        return hi
+    lo = kth[0]
+    for a in range(1, m // 2):
+        lo = max(lo, kth[a])
+    return (lo + hi) / 2.0
 
 
 @njit(cache=True)

@@ -54,6 +54,7 @@ from .._checks import as_mesh, as_points, integer
 from .._normalize import Frame
 from ..spatial.bvh import BVH, build_bvh, build_volume_bvh
 from ..spatial.wide import widen
+from ..threads import run_ranges
 from ._query import map_queries
 from .exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w
 
@@ -72,35 +73,29 @@ def _node_moments(start, end, X, AN, M, R, width):
     X (m,3) expansion points of elements (centroids), AN (m,3) area-weighted normals, M (m,6) second
     moments about the element's own centroid (0 for points; for triangles the edge-midpoint C_t about the
     centroid), R (m,k*3) points whose distance bounds the node radius. All arrays in tree order, float64.
-    Runs on the threads from :data:`SERIAL_BUILD_FACES` elements (the parallel driver is then compiled).
+    Runs on the threads from :data:`SERIAL_BUILD_FACES` elements (node ranges on Python threads, the kernel
+    releases the GIL: :func:`gsdf.threads.run_ranges`).
     """
     conv = [np.ascontiguousarray(a, dtype=np.float64) for a in (X, AN, M, R)]
     start = np.ascontiguousarray(start, dtype=np.int64)
     end = np.ascontiguousarray(end, dtype=np.int64)
     D = np.zeros((start.shape[0], width))
     if X.shape[0] >= SERIAL_BUILD_FACES and numba.get_num_threads() > 1:
-        _node_moments_parallel(start, end, *conv, D)
+        run_ranges(lambda i0, i1: _node_moments_range(start, end, *conv, D, i0, i1), start.shape[0], 2048)
     else:
-        _node_moments_serial(start, end, *conv, D)
+        _node_moments_range(start, end, *conv, D, 0, start.shape[0])
     return D
 
 
-@njit(cache=True)
-def _node_moments_serial(start, end, X, AN, M, R, D):
-    for i in range(start.shape[0]):
+@njit(cache=True, nogil=True)  # one serial, GIL-free kernel for both drivers (no parallel loop to compile)
+def _node_moments_range(start, end, X, AN, M, R, D, i0, i1):
+    for i in range(i0, i1):
         _node_moment(start[i], end[i], X, AN, M, R, D, i)
-
-
-@njit(cache=True, parallel=True)
-def _node_moments_parallel(start, end, X, AN, M, R, D):
-    for i in prange(start.shape[0]):  # np.int64: the prange index is unsigned, one compiled body for both drivers
-        _node_moment(start[i], end[i], X, AN, M, R, D, np.int64(i))
 
 
 @njit(cache=True)
 def _node_moment(s, e, X, AN, M, R, D, i):
-    """Row i of :func:`_node_moments` (node of elements s..e−1); a kernel of its own, so the serial and the
-    parallel driver share one compiled body."""
+    """Row i of :func:`_node_moments` (node of elements s..e−1)."""
     nr = R.shape[1] // 3
     A = 0.0
     cx = cy = cz = 0.0
@@ -345,32 +340,25 @@ def _tree_moments(V, F, order, start, end, right, lo, hi):
     T = np.empty((m, 10))
     D = np.zeros((k, NODE_WIDTH))
     W = np.empty((k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
-    if m >= PARALLEL_BUILD_FACES and numba.get_num_threads() > 1:
-        _leaf_moments_parallel(V, F, order, start, end, right, T, D, W)
+    if m >= PARALLEL_BUILD_FACES and numba.get_num_threads() > 1:  # node ranges on Python threads
+        run_ranges(lambda i0, i1: _leaf_moments(V, F, order, start, end, right, T, D, W, i0, i1), k, 2048)
     else:
-        _leaf_moments_serial(V, F, order, start, end, right, T, D, W)
+        _leaf_moments(V, F, order, start, end, right, T, D, W, 0, k)
     _parent_moments(start, end, right, lo, hi, D, W)
     return T, D
 
 
-@njit(cache=True)
-def _leaf_moments_serial(V, F, order, start, end, right, T, D, W):
-    for i in range(start.shape[0]):
+@njit(cache=True, nogil=True)  # one serial, GIL-free kernel for both drivers (no parallel loop to compile)
+def _leaf_moments(V, F, order, start, end, right, T, D, W, i0, i1):
+    for i in range(i0, i1):
         if right[i] < 0:
             _leaf_moment(V, F, order, start[i], end[i], T, D, W, i)
-
-
-@njit(cache=True, parallel=True)
-def _leaf_moments_parallel(V, F, order, start, end, right, T, D, W):
-    for i in prange(start.shape[0]):
-        if right[i] < 0:  # np.int64: the prange index is unsigned, one compiled body for both drivers
-            _leaf_moment(V, F, order, start[i], end[i], T, D, W, np.int64(i))
 
 
 @njit(cache=True)
 def _leaf_moment(V, F, order, s, e, T, D, W, i):
     """Leaf i of :func:`_tree_moments` (triangles s..e−1 in tree order): its rows of T, its moments (row i
-    of D) and its sums of W. One kernel shared by the serial and the parallel driver."""
+    of D) and its sums of W."""
     A = ax = ay = az = ux = uy = uz = 0.0
     for j in range(s, e):
         f = order[j]
