@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import machine, table, write_section  # noqa: E402
 
 import bench_heat_surface as bhs  # noqa: E402
-from gsdf.linalg.direct import LDL_MAX_UNKNOWNS  # noqa: E402
+from gsdf.linalg.direct import LDL_MAX_UNKNOWNS, Factorization  # noqa: E402
 from gsdf.linalg.ldl import LDLFactorization, fill_count  # noqa: E402
 from gsdf.linalg.ordering import order_csr  # noqa: E402
 
@@ -58,30 +58,38 @@ def measure(names, repeat=3):
                 res[meth] = (t_ord, t_fac, t_sol, f.nnz)
             lu = spla.splu(sp.csc_matrix(M), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                            options={"SymmetricMode": True})
+            t_slu, lu_g = best(lambda: Factorization(sp.csc_matrix(M), reorder=True), repeat)
+            t_slu_s, _ = best(lambda: lu_g.solve(b), repeat)
             pmmd = np.empty(n, np.int64)
             pmmd[lu.perm_c] = np.arange(n)                # perm_c[j] = the position of column j
             mmd = fill_count(M, pmmd)
             a, d = res["amd"], res["nd"]
             tot_a, tot_d = a[0] + a[1], d[0] + d[1]
             win = "amd" if tot_a <= tot_d else "nd"
-            summary.append((name, lab, real_unknowns, win, tot_a / tot_d, a[3] / d[3], a[3] / mmd))
+            summary.append((name, lab, real_unknowns, win, tot_a / tot_d, a[3] / d[3], a[3] / mmd, tot_a / t_slu,
+                            a[2] / t_slu_s))
             rows.append([name.replace("shm:", "").replace("poly:", "polygon "), lab, n, real_unknowns <= LDL_MAX_UNKNOWNS,
                          f"{a[0] * 1e3:.1f} / {d[0] * 1e3:.1f}", f"{a[1] * 1e3:.1f} / {d[1] * 1e3:.1f}",
                          f"{tot_a * 1e3:.1f} / {tot_d * 1e3:.1f} ({tot_a / tot_d:.2f})",
                          f"{a[2] * 1e3:.2f} / {d[2] * 1e3:.2f}", f"{a[3]} / {d[3]} ({a[3] / d[3]:.2f})",
-                         f"{mmd} ({a[3] / mmd:.3f})", win])
+                         f"{mmd} ({a[3] / mmd:.3f})", win, f"{t_slu * 1e3:.1f} ({tot_a / t_slu:.2f})",
+                         f"{t_slu_s * 1e3:.2f} ({a[2] / t_slu_s:.2f})"])
             print(rows[-1], f"load {os.getloadavg()[0]:.1f}", flush=True)
     hdr = ["mesh", "system", "unknowns", "LDL used (≤ 64k real)", "ordering ms AMD / ND", "factorize ms AMD / ND",
            "ordering + factorize ms AMD / ND (ratio)", "solve ms AMD / ND", "nnz(L) AMD / ND (ratio)",
-           "nnz(L) SuperLU MMD (AMD / MMD)", "faster"]
+           "nnz(L) SuperLU MMD (AMD / MMD)", "faster", "SuperLU factorize ms (LDL-AMD / SuperLU)",
+           "SuperLU solve ms (LDL-AMD / SuperLU)"]
     return table(hdr, rows), summary
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="6 + 3 meshes, no RESULTS.md update")
+    ap.add_argument("--only", help="comma-separated mesh names (as in bench_heat_surface.py; no RESULTS.md update)")
     args = ap.parse_args()
     names = bhs.SPEED_QUICK + bhs.POLY_QUICK if args.quick else bhs.SPEED_MESHES + bhs.POLY_SPEED
+    if args.only:
+        names = args.only.split(",")
     start = os.popen("uptime").read().strip()
     # compile first (not timed)
     LDLFactorization(sp.identity(3, format="csr"), ordering="amd")
@@ -99,9 +107,13 @@ def main():
             f"factorizes (≤ {LDL_MAX_UNKNOWNS} real unknowns); ordering + factorization AMD/ND ratio "
             f"{min(s[4] for s in used):.2f}–{max(s[4] for s in used):.2f}, fill AMD/ND "
             f"{min(s[5] for s in used):.2f}–{max(s[5] for s in used):.2f}, fill AMD/MMD "
-            f"{min(s[6] for s in summary):.3f}–{max(s[6] for s in summary):.3f}.\n\n" + tab)
+            f"{min(s[6] for s in summary):.3f}–{max(s[6] for s in summary):.3f}. LDL (AMD, ordering + factorization) / "
+            f"SuperLU factorization on all systems: {min(s[7] for s in summary):.2f}–{max(s[7] for s in summary):.2f}"
+            f" (above {LDL_MAX_UNKNOWNS} real unknowns: "
+            + ", ".join(f"{s[0].replace('shm:', '')} {s[1]} {s[7]:.2f}" for s in summary if s[2] > LDL_MAX_UNKNOWNS)
+            + f"); solves {min(s[8] for s in summary):.2f}–{max(s[8] for s in summary):.2f}.\n\n" + tab)
     print(text)
-    if not args.quick:
+    if not (args.quick or args.only):
         write_section("ldl-ordering", "## LDL orderings: approximate minimum degree vs nested dissection "
                       "(16 + 6 meshes)\n\n" + text)
 

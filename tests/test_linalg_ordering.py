@@ -107,3 +107,36 @@ def test_bad_orderings_raise():
         approximate_minimum_degree(sp.csr_matrix(np.ones((2, 3))))
     with pytest.raises(ValueError, match="ordering"):
         fill_count(A, np.arange(3))
+
+
+def _flop_count(f):
+    c = np.diff(f._lp).astype(float)
+    return float(c @ c)
+
+
+def test_auto_rule_keeps_the_cheaper_ordering():
+    from gsdf.linalg.ldl import AUTO_ND_FLOPS, AUTO_ND_MAX_N
+
+    def periodic(m):
+        T = sp.diags([1.0, 1.0, 1.0], [-1, 0, 1], shape=(m, m)).tolil()
+        T[0, m - 1] = T[m - 1, 0] = 1.0
+        return T.tocsr()
+
+    # a quad torus (9-point stencil, periodic) cut along two rings: a flop-heavy factor where ND has fewer flops
+    a, b = 96, 48
+    G = sp.kron(periodic(a), periodic(b)).tocsr()
+    keep = np.ones(a * b, bool)
+    keep[np.r_[(a // 4) * b:(a // 4 + 1) * b, (3 * a // 4) * b:(3 * a // 4 + 1) * b]] = False
+    k = np.flatnonzero(keep)
+    torus = (sp.diags(np.full(a * b, 20.0)) - 0.1 * G).tocsr()[k][:, k].tocsr()
+    for A in (torus, _delaunay_laplacian(3000, 6)):
+        assert A.shape[0] <= AUTO_ND_MAX_N
+        f_auto, f_amd, f_nd = (LDLFactorization(A, ordering=o) for o in ("auto", "amd", "nd"))
+        heavy = _flop_count(f_amd) >= AUTO_ND_FLOPS * A.nnz * np.log2(A.shape[0])
+        expect = f_nd if heavy and _flop_count(f_nd) < 0.9 * _flop_count(f_amd) else f_amd
+        assert np.array_equal(f_auto.perm, expect.perm)
+        b_ = np.ones(A.shape[0])
+        np.testing.assert_allclose(f_auto.solve(b_), f_amd.solve(b_), rtol=1e-12)
+    assert np.array_equal(LDLFactorization(torus).perm, LDLFactorization(torus, ordering="nd").perm)
+    D = _delaunay_laplacian(3000, 6)
+    assert np.array_equal(LDLFactorization(D).perm, LDLFactorization(D, ordering="amd").perm)

@@ -6,8 +6,9 @@ vector heat operator of a 2.8k-vertex scan (7.4k unknowns, L with 47k entries) t
 the arithmetic is ~10⁵ multiply-adds (issue 17: first solves on small meshes were slower than potpourri3d,
 whose Eigen ``SimplicialLDLT`` does exactly this). Here:
 
-* **ordering** — a fill-reducing permutation from :mod:`.ordering` (approximate minimum degree by default,
-  nested dissection on request, or one given by the caller);
+* **ordering** — a fill-reducing permutation from :mod:`.ordering`: by default approximate minimum degree,
+  and on small systems whose AMD factor is flop-heavy also nested dissection, keeping the one with fewer
+  flops (:data:`AUTO_ND_MAX_N`, :data:`AUTO_ND_FLOPS`); or one named or given by the caller;
 * **symbolic** — elimination tree and column counts of L (Davis, "Algorithm 849: LDL", 2005);
 * **numeric** — up-looking LDLᴴ: row k of L from a sparse triangular solve along the elimination tree,
   ``l_k = conj(y) / D``, ``D_k = a_kk − Σ l_ki y_i`` (no pivoting: the matrix must be positive definite;
@@ -33,7 +34,22 @@ from numba import njit
 
 from .ordering import ORDERING_NAMES, nested_dissection, order_csr
 
-__all__ = ["LDLFactorization", "nested_dissection", "fill_count"]
+__all__ = ["LDLFactorization", "nested_dissection", "fill_count", "AUTO_ND_MAX_N", "AUTO_ND_FLOPS"]
+
+#: The ``ordering="auto"`` rule (bench/bench_ldl_ordering.py, RESULTS section "ldl-ordering", 16 + 6 meshes):
+#: AMD's fill is 0.5–0.9× nested dissection's on the triangle-mesh systems and its ordering 1.5–4× faster, so
+#: AMD is the default. Nested dissection has fewer flops only on regular grids (the quad meshes of the polygon
+#: benchmark, 0.57–0.96×, and one CAD part); there the factor is flop-heavy: Σ_j c_j² ≥ AUTO_ND_FLOPS ·
+#: nnz(A) · log2 n (c_j = entries of column j of L). Up to AUTO_ND_MAX_N unknowns, when the AMD factor is that
+#: heavy, nested dissection is computed too (its ordering and symbolic pass cost ≤ ~10 % of such a
+#: factorization) and kept when its flop count is below AUTO_ND_GAIN × AMD's. Above that size an ND attempt
+#: (up to 160 ms on bunny00) costs more than it can save.
+AUTO_ND_MAX_N = 10_000
+AUTO_ND_FLOPS = 12.0
+AUTO_ND_GAIN = 0.9
+
+#: The orderings :class:`LDLFactorization` takes by name.
+LDL_ORDERINGS = ("auto",) + ORDERING_NAMES
 
 
 # ------------------------------------------------------------------------------------------ factorization
@@ -159,7 +175,7 @@ def _check_perm(perm, n):
     """``perm`` as an int64 permutation of range(n), or ValueError."""
     p = np.asarray(perm)
     if p.shape != (n,) or p.dtype.kind not in "iu":
-        raise ValueError(f"ordering: expected a name in {ORDERING_NAMES} or an integer permutation of shape ({n},), "
+        raise ValueError(f"ordering: expected a name in {LDL_ORDERINGS} or an integer permutation of shape ({n},), "
                          f"got {p.dtype} array of shape {p.shape}")
     p = p.astype(np.int64)
     seen = np.zeros(n, bool)
@@ -171,14 +187,34 @@ def _check_perm(perm, n):
     return p
 
 
-def _pattern(A, perm):
-    """(colptr, rows, src, parent, lp): the reordered upper pattern of ``A`` (CSR) and its symbolic factor."""
-    n = A.shape[0]
+def _pattern(indptr, indices, n, perm):
+    """(colptr, rows, src, parent, lp): the upper pattern of P A Pᵀ (A's int64 CSR arrays) and its symbolic
+    factor."""
     pinv = np.empty(n, np.int64)
     pinv[perm] = np.arange(n)
-    colptr, rows, src = _upper_csc(A.indptr.astype(np.int64), A.indices.astype(np.int64), n, pinv)
+    colptr, rows, src = _upper_csc(indptr, indices, n, pinv)
     parent, lp = _symbolic(colptr, rows, n)
     return colptr, rows, src, parent, lp
+
+
+def _flops(lp) -> float:
+    """Σ_j c_j² over the column counts c_j of L (the multiply-adds of the factorization, up to a factor)."""
+    c = np.diff(lp).astype(np.float64)
+    return float(c @ c)
+
+
+def _auto_pattern(indptr, indices, n):
+    """The ``ordering="auto"`` rule (:data:`AUTO_ND_MAX_N`): (perm, pattern)."""
+    perm = order_csr(indptr, indices, n, "amd")
+    pat = _pattern(indptr, indices, n, perm)
+    if 2 < n <= AUTO_ND_MAX_N:
+        f_amd = _flops(pat[4])
+        if f_amd >= AUTO_ND_FLOPS * len(indices) * np.log2(n):
+            perm_nd = order_csr(indptr, indices, n, "nd")
+            pat_nd = _pattern(indptr, indices, n, perm_nd)
+            if _flops(pat_nd[4]) < AUTO_ND_GAIN * f_amd:
+                return perm_nd, pat_nd
+    return perm, pat
 
 
 def fill_count(A, perm) -> int:
@@ -193,7 +229,8 @@ def fill_count(A, perm) -> int:
     (3, 2)
     """
     A = sp.csr_matrix(A)
-    return int(_pattern(A, _check_perm(perm, A.shape[0]))[4][-1])
+    n = A.shape[0]
+    return int(_pattern(A.indptr.astype(np.int64), A.indices.astype(np.int64), n, _check_perm(perm, n))[4][-1])
 
 
 class LDLFactorization:
@@ -205,8 +242,9 @@ class LDLFactorization:
         Only the pattern's symmetry and the values of the upper triangle of the reordered matrix are used (A is
         assumed Hermitian; nothing checks it).
     ordering : {"auto", "amd", "nd"} or int array (n,)
-        The fill-reducing ordering (:func:`gsdf.linalg.ordering.fill_reducing_ordering`), or a permutation
-        (``ordering[k]`` = the unknown eliminated k-th). The factors are those of ``A``, whatever the ordering.
+        The fill-reducing ordering: ``"auto"`` the measured rule (module docs, :data:`AUTO_ND_MAX_N`), a
+        name of :func:`gsdf.linalg.ordering.fill_reducing_ordering`, or a permutation (``ordering[k]`` = the
+        unknown eliminated k-th). The factors are those of ``A``, whatever the ordering.
 
     Raises
     ------
@@ -235,14 +273,17 @@ class LDLFactorization:
             data = np.conj(data)             # CSC arrays read as CSR are Aᵀ = conj(A) for a Hermitian A
         indptr, indices = A.indptr.astype(np.int64), A.indices.astype(np.int64)
         self.n, self.dtype = n, data.dtype
-        if isinstance(ordering, str):
-            self.perm = order_csr(indptr, indices, n, ordering)
+        if isinstance(ordering, str) and ordering == "auto":
+            self.perm, pat = _auto_pattern(indptr, indices, n)
         else:
-            self.perm = _check_perm(ordering, n)
-        pinv = np.empty(n, np.int64)
-        pinv[self.perm] = np.arange(n)
-        colptr, rows, src = _upper_csc(indptr, indices, n, pinv)
-        parent, self._lp = _symbolic(colptr, rows, n)
+            if isinstance(ordering, str):
+                if ordering not in LDL_ORDERINGS:
+                    raise ValueError(f"ordering: expected one of {LDL_ORDERINGS} or a permutation, got {ordering!r}")
+                self.perm = order_csr(indptr, indices, n, ordering)
+            else:
+                self.perm = _check_perm(ordering, n)
+            pat = _pattern(indptr, indices, n, self.perm)
+        colptr, rows, src, parent, self._lp = pat
         self._li, self._lx, self._d, bad = _numeric(colptr, rows, data[src], n, parent, self._lp)
         if bad >= 0:
             raise ValueError(f"matrix: not positive definite (pivot {int(bad)} of the LDL factorization ≤ 0)")

@@ -19,8 +19,8 @@
   vertex separator (thinned: separator nodes without a neighbour on the far side move to the near side); the
   two sides recurse, the separator is numbered last. O(nnz log n); disconnected subgraphs split into
   components for free.
-* :func:`fill_reducing_ordering` — the one :class:`~gsdf.linalg.ldl.LDLFactorization` uses, by name
-  (``"amd"``, ``"nd"``, ``"auto"``: the rule measured by bench/bench_ldl_ordering.py).
+* :func:`fill_reducing_ordering` — either, by name (:class:`~gsdf.linalg.ldl.LDLFactorization` chooses
+  between them by the rule measured in bench/bench_ldl_ordering.py).
 
 Example
 -------
@@ -39,7 +39,7 @@ from numba import njit
 __all__ = ["approximate_minimum_degree", "nested_dissection", "fill_reducing_ordering", "order_csr", "ORDERING_NAMES"]
 
 #: The orderings :func:`fill_reducing_ordering` knows.
-ORDERING_NAMES = ("auto", "amd", "nd")
+ORDERING_NAMES = ("amd", "nd")
 
 
 # ------------------------------------------------------------------------------------------ minimum degree
@@ -571,11 +571,8 @@ def approximate_minimum_degree(A) -> np.ndarray:
     return _amd(indptr, indices, n)
 
 
-def fill_reducing_ordering(A, method: str = "auto") -> np.ndarray:
+def fill_reducing_ordering(A, method: str = "amd") -> np.ndarray:
     """The ordering ``method`` (one of :data:`ORDERING_NAMES`) of the symmetric pattern of ``A`` (n, n).
-
-    ``"auto"`` is :func:`approximate_minimum_degree` (the rule measured in bench/RESULTS.md, section
-    "LDL orderings": on all 22 benchmark meshes AMD's smaller fill pays for its longer ordering time).
 
     Example
     -------
@@ -587,7 +584,7 @@ def fill_reducing_ordering(A, method: str = "auto") -> np.ndarray:
     return order_csr(indptr, indices, n, method)
 
 
-def order_csr(indptr, indices, n: int, method: str = "auto") -> np.ndarray:
+def order_csr(indptr, indices, n: int, method: str = "amd") -> np.ndarray:
     """:func:`fill_reducing_ordering` from the int64 CSR (or CSC) index arrays of a symmetric pattern (no
     conversion: the entry point of :class:`~gsdf.linalg.ldl.LDLFactorization`)."""
     if not isinstance(method, str) or method not in ORDERING_NAMES:
