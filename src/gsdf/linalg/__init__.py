@@ -3,7 +3,8 @@
 * :mod:`.direct` — SuperLU (symmetric mode) and CHOLMOD via cholespy: :class:`Factorization` (real/complex LU),
   :class:`HermitianFactorization`, :func:`spd_factorization`, :class:`BlockHermitianFactorization` (complex operators in real 2×2-block
   form), :class:`CholeskyFactorization` / :func:`cholesky`, :func:`cached_factorization`;
-* :mod:`.ldl` — :class:`LDLFactorization`, numba LDLᴴ with nested dissection (small and mid-size SPD / HPD);
+* :mod:`.ldl` — :class:`LDLFactorization`, numba LDLᴴ (SPD / HPD up to ``LDL_MAX_UNKNOWNS``);
+* :mod:`.ordering` — fill-reducing orderings (approximate minimum degree, nested dissection);
 * :mod:`.iterative` — :class:`SPDSolver` (factorize small, CG with AMG/Jacobi large), :func:`pcg`,
   :func:`amg_preconditioner`;
 * :mod:`.saddle` — :func:`saddle_matrix` of equality-constrained least squares (Eq. 14);

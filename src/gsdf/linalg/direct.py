@@ -43,13 +43,14 @@ def _in_blas_region(method):
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
            "cholesky", "cached_factorization", "spd_factorization", "LDL_MAX_UNKNOWNS"]
 
-#: Size rule of the factorization backend (bench_heat_surface.py --solver-rule / --speed, issue 17), in real
-#: unknowns (a complex unknown counts 2): up to this size the numba LDLᴴ of :mod:`gsdf.linalg.ldl` (nested
-#: dissection) factorizes faster than SuperLU, whose fixed costs dominate small systems (7.4k complex unknowns:
-#: 7.8 vs 17.5 ms; 29k complex: 66 vs 100 ms, first solve of camel.off 0.13 vs 0.18 s CPU; 37k real: 136 vs
-#: 179 ms); above it SuperLU's supernodes and its minimum-degree fill win (39k complex, mannequin-devil.off:
-#: first solve 0.25–0.35 s CPU with SuperLU vs 0.41–0.55 s; 113k complex: 655 vs 1086 ms).
-LDL_MAX_UNKNOWNS = 64_000
+#: Size rule of the factorization backend (bench/bench_ldl_ordering.py, issue 17), in real unknowns (a complex
+#: unknown counts 2): up to this size the numba LDLᴴ of :mod:`gsdf.linalg.ldl` (approximate minimum degree
+#: ordering). With nested dissection it lost to SuperLU above 64k (ND's fill was 1.5–2× SuperLU's minimum
+#: degree); with AMD the fill matches SuperLU's MMD (0.95–1.04×) without SuperLU's L *and* U and supernode
+#: overhead: ordering + factorization 0.31–0.41× SuperLU's time on the three largest systems of the benchmark
+#: (bunny00 113k complex unknowns, armadillo 78k, refined_elephant 133k), solves 0.4–0.9×. The limit is the
+#: largest system measured (267k real unknowns), rounded up; above it SuperLU.
+LDL_MAX_UNKNOWNS = 300_000
 
 
 def _ldl_size(A) -> int:
@@ -68,8 +69,8 @@ def _ldl_or_none(A):
 
 
 def spd_factorization(A, reorder: bool = True):
-    """A factorization of the real symmetric positive definite ``A`` with ``solve(b)``: LDLᵀ (numba, nested
-    dissection) up to :data:`LDL_MAX_UNKNOWNS` (real) unknowns, else (or when a pivot is not positive) SuperLU's
+    """A factorization of the real symmetric positive definite ``A`` with ``solve(b)``: LDLᵀ (numba, AMD
+    ordered) up to :data:`LDL_MAX_UNKNOWNS` (real) unknowns, else (or when a pivot is not positive) SuperLU's
     :class:`Factorization` (``reorder`` = its RCM renumbering).
 
     Example

@@ -6,11 +6,9 @@ vector heat operator of a 2.8k-vertex scan (7.4k unknowns, L with 47k entries) t
 the arithmetic is ~10⁵ multiply-adds (issue 17: first solves on small meshes were slower than potpourri3d,
 whose Eigen ``SimplicialLDLT`` does exactly this). Here:
 
-* **ordering** — nested dissection by breadth-first level structures (George 1973): a pseudo-peripheral node
-  of the subgraph, its BFS levels, and the smallest level near the median as the vertex separator (thinned:
-  separator nodes without a neighbour on the far side move to the near side); the two sides recurse, the
-  separator is numbered last. Graph-only (no coordinates), O(nnz log n); disconnected subgraphs split into
-  components for free;
+* **ordering** — a fill-reducing permutation from :mod:`.ordering`: by default approximate minimum degree,
+  and on small systems whose AMD factor is flop-heavy also nested dissection, keeping the one with fewer
+  flops (:data:`AUTO_ND_MAX_N`, :data:`AUTO_ND_FLOPS`); or one named or given by the caller;
 * **symbolic** — elimination tree and column counts of L (Davis, "Algorithm 849: LDL", 2005);
 * **numeric** — up-looking LDLᴴ: row k of L from a sparse triangular solve along the elimination tree,
   ``l_k = conj(y) / D``, ``D_k = a_kk − Σ l_ki y_i`` (no pivoting: the matrix must be positive definite;
@@ -34,181 +32,24 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-__all__ = ["LDLFactorization", "nested_dissection"]
+from .ordering import ORDERING_NAMES, nested_dissection, order_csr
 
+__all__ = ["LDLFactorization", "nested_dissection", "fill_count", "AUTO_ND_MAX_N", "AUTO_ND_FLOPS"]
 
-# ------------------------------------------------------------------------------------------ ordering
-@njit(cache=True)
-def _bfs(indptr, indices, part, label, root, level, queue):
-    """BFS from ``root`` inside the nodes with ``part == label``; fills ``level`` (-1 elsewhere must be preset
-    by the caller for the subset) and ``queue`` (visit order); returns the number of nodes reached."""
-    head, tail = 0, 1
-    queue[0] = root
-    level[root] = 0
-    while head < tail:
-        u = queue[head]
-        head += 1
-        for q in range(indptr[u], indptr[u + 1]):
-            w = indices[q]
-            if part[w] == label and level[w] < 0:
-                level[w] = level[u] + 1
-                queue[tail] = w
-                tail += 1
-    return tail
+#: The ``ordering="auto"`` rule (bench/bench_ldl_ordering.py, RESULTS section "ldl-ordering", 16 + 6 meshes):
+#: AMD's fill is 0.5–0.9× nested dissection's on the triangle-mesh systems and its ordering 1.5–4× faster, so
+#: AMD is the default. Nested dissection has fewer flops only on regular grids (the quad meshes of the polygon
+#: benchmark, 0.57–0.96×, and one CAD part); there the factor is flop-heavy: Σ_j c_j² ≥ AUTO_ND_FLOPS ·
+#: nnz(A) · log2 n (c_j = entries of column j of L). Up to AUTO_ND_MAX_N unknowns, when the AMD factor is that
+#: heavy, nested dissection is computed too (its ordering and symbolic pass cost ≤ ~10 % of such a
+#: factorization) and kept when its flop count is below AUTO_ND_GAIN × AMD's. Above that size an ND attempt
+#: (up to 160 ms on bunny00) costs more than it can save.
+AUTO_ND_MAX_N = 10_000
+AUTO_ND_FLOPS = 12.0
+AUTO_ND_GAIN = 0.9
 
-
-@njit(cache=True)
-def _nested_dissection(indptr, indices, n, leaf):
-    perm = np.arange(n)                      # perm[lo:hi] = the nodes of one subset; output order at the end
-    part = np.zeros(n, np.int64)             # subset label of every node (labels = range start lo)
-    level = np.full(n, -1, np.int64)
-    queue = np.empty(n, np.int64)
-    tmp = np.empty(n, np.int64)
-    stack = np.empty((2 * n + 2, 2), np.int64)
-    top = 0
-    stack[0, 0], stack[0, 1] = 0, n
-    top = 1
-    while top > 0:
-        top -= 1
-        lo, hi = stack[top, 0], stack[top, 1]
-        size = hi - lo
-        if size <= leaf:
-            continue
-        # pseudo-peripheral node: two BFS sweeps from the first node
-        root = perm[lo]
-        for s in range(2):
-            reached = _bfs(indptr, indices, part, lo, root, level, queue)
-            last = queue[reached - 1]
-            if s == 0:
-                for r in range(reached):
-                    level[queue[r]] = -1
-                root = last
-        if reached < size:
-            # disconnected: the reached component first, the rest after; no separator
-            k = 0
-            m = reached
-            for r in range(lo, hi):
-                v = perm[r]
-                if level[v] >= 0:
-                    tmp[k] = v
-                    k += 1
-                else:
-                    tmp[m] = v
-                    m += 1
-            for r in range(size):
-                perm[lo + r] = tmp[r]
-                level[tmp[r]] = -1
-            for r in range(reached, size):
-                part[perm[lo + r]] = lo + reached
-            stack[top, 0], stack[top, 1] = lo, lo + reached
-            top += 1
-            stack[top, 0], stack[top, 1] = lo + reached, hi
-            top += 1
-            continue
-        nlev = level[queue[reached - 1]] + 1
-        if nlev < 3:                          # (nearly) a clique: nothing to dissect
-            for r in range(reached):
-                level[queue[r]] = -1
-            continue
-        counts = np.zeros(nlev, np.int64)
-        for r in range(reached):
-            counts[level[queue[r]]] += 1
-        # the smallest level whose cumulative count lies in the middle 60 % of the subset (ties: nearest half)
-        best, best_score = -1, 1e300
-        below = 0
-        for L in range(nlev):
-            if L > 0 and L < nlev - 1:
-                frac = (below + 0.5 * counts[L]) / size
-                if 0.2 <= frac <= 0.8:
-                    score = counts[L] * (1.0 + 2.0 * abs(frac - 0.5))
-                    if score < best_score:
-                        best, best_score = L, score
-            below += counts[L]
-        if best < 0:                          # no level in the middle band: the one closest to the half
-            below = 0
-            for L in range(1, nlev - 1):
-                frac = (below + counts[0] + 0.5 * counts[L]) / size
-                score = abs(frac - 0.5)
-                if score < best_score:
-                    best, best_score = L, score
-                below += counts[L]
-        # sides: 0 = near (level < best), 1 = far (level > best), 2 = separator; thin the separator
-        for r in range(reached):
-            v = queue[r]
-            lv = level[v]
-            if lv < best:
-                tmp[v] = 0
-            elif lv > best:
-                tmp[v] = 1
-            else:
-                tmp[v] = 2
-        for r in range(reached):
-            v = queue[r]
-            if tmp[v] == 2:
-                far = False
-                for q in range(indptr[v], indptr[v + 1]):
-                    w = indices[q]
-                    if part[w] == lo and level[w] >= 0 and tmp[w] == 1:
-                        far = True
-                        break
-                if not far:
-                    tmp[v] = 0
-        n0 = 0
-        n1 = 0
-        for r in range(lo, hi):
-            sd = tmp[perm[r]]
-            if sd == 0:
-                n0 += 1
-            elif sd == 1:
-                n1 += 1
-        a, b, c = 0, n0, n0 + n1
-        for r in range(lo, hi):
-            v = perm[r]
-            sd = tmp[v]
-            if sd == 0:
-                queue[a] = v
-                a += 1
-            elif sd == 1:
-                queue[b] = v
-                b += 1
-            else:
-                queue[c] = v
-                c += 1
-        for r in range(size):
-            v = queue[r]
-            perm[lo + r] = v
-            level[v] = -1
-            if r < n0:
-                part[v] = lo
-            elif r < n0 + n1:
-                part[v] = lo + n0
-            else:
-                part[v] = -1                  # numbered: out of every later subset
-        if n0 > 0:
-            stack[top, 0], stack[top, 1] = lo, lo + n0
-            top += 1
-        if n1 > 0:
-            stack[top, 0], stack[top, 1] = lo + n0, lo + n0 + n1
-            top += 1
-    return perm
-
-
-def nested_dissection(A, leaf: int = 8) -> np.ndarray:
-    """Fill-reducing ordering of the symmetric sparsity pattern of ``A`` (n, n): ``perm[k]`` = the node
-    eliminated k-th (module docs). Subgraphs of at most ``leaf`` nodes keep their order.
-
-    Example
-    -------
-    >>> import scipy.sparse as sp
-    >>> P = sp.diags([1, 1, 1], [-1, 0, 1], shape=(7, 7)).tocsr()   # a path: the middle node goes last
-    >>> int(nested_dissection(P, leaf=1)[-1])
-    3
-    """
-    A = sp.csr_matrix(A)
-    n = A.shape[0]
-    if n == 0:
-        return np.zeros(0, np.int64)
-    return _nested_dissection(A.indptr.astype(np.int64), A.indices.astype(np.int64), n, int(leaf))
+#: The orderings :class:`LDLFactorization` takes by name.
+LDL_ORDERINGS = ("auto",) + ORDERING_NAMES
 
 
 # ------------------------------------------------------------------------------------------ factorization
@@ -330,14 +171,80 @@ def _solve(lp, li, lx, d, b):
     return x
 
 
+def _check_perm(perm, n):
+    """``perm`` as an int64 permutation of range(n), or ValueError."""
+    p = np.asarray(perm)
+    if p.shape != (n,) or p.dtype.kind not in "iu":
+        raise ValueError(f"ordering: expected a name in {LDL_ORDERINGS} or an integer permutation of shape ({n},), "
+                         f"got {p.dtype} array of shape {p.shape}")
+    p = p.astype(np.int64)
+    seen = np.zeros(n, bool)
+    if n and (p.min() < 0 or p.max() >= n):
+        raise ValueError("ordering: permutation entries out of range")
+    seen[p] = True
+    if not seen.all():
+        raise ValueError("ordering: not a permutation (repeated entries)")
+    return p
+
+
+def _pattern(indptr, indices, n, perm):
+    """(colptr, rows, src, parent, lp): the upper pattern of P A Pᵀ (A's int64 CSR arrays) and its symbolic
+    factor."""
+    pinv = np.empty(n, np.int64)
+    pinv[perm] = np.arange(n)
+    colptr, rows, src = _upper_csc(indptr, indices, n, pinv)
+    parent, lp = _symbolic(colptr, rows, n)
+    return colptr, rows, src, parent, lp
+
+
+def _flops(lp) -> float:
+    """Σ_j c_j² over the column counts c_j of L (the multiply-adds of the factorization, up to a factor)."""
+    c = np.diff(lp).astype(np.float64)
+    return float(c @ c)
+
+
+def _auto_pattern(indptr, indices, n):
+    """The ``ordering="auto"`` rule (:data:`AUTO_ND_MAX_N`): (perm, pattern)."""
+    perm = order_csr(indptr, indices, n, "amd")
+    pat = _pattern(indptr, indices, n, perm)
+    if 2 < n <= AUTO_ND_MAX_N:
+        f_amd = _flops(pat[4])
+        if f_amd >= AUTO_ND_FLOPS * len(indices) * np.log2(n):
+            perm_nd = order_csr(indptr, indices, n, "nd")
+            pat_nd = _pattern(indptr, indices, n, perm_nd)
+            if _flops(pat_nd[4]) < AUTO_ND_GAIN * f_amd:
+                return perm_nd, pat_nd
+    return perm, pat
+
+
+def fill_count(A, perm) -> int:
+    """Entries of L below the diagonal in the LDLᴴ of ``A[perm][:, perm]`` (symbolic only; ``A`` (n, n) with
+    a symmetric pattern, ``perm`` (n,) with ``perm[k]`` the node eliminated k-th).
+
+    Example
+    -------
+    >>> import numpy as np, scipy.sparse as sp
+    >>> star = sp.csr_matrix(np.array([[4.0, 1, 1], [1, 4, 0], [1, 0, 4]]))
+    >>> fill_count(star, [0, 1, 2]), fill_count(star, [1, 2, 0])   # hub first: one fill entry
+    (3, 2)
+    """
+    A = sp.csr_matrix(A)
+    n = A.shape[0]
+    return int(_pattern(A.indptr.astype(np.int64), A.indices.astype(np.int64), n, _check_perm(perm, n))[4][-1])
+
+
 class LDLFactorization:
-    """LDLᴴ of a sparse Hermitian (or real symmetric) positive definite matrix, nested-dissection ordered.
+    """LDLᴴ of a sparse Hermitian (or real symmetric) positive definite matrix, fill-reducing ordered.
 
     Parameters
     ----------
     A : scipy.sparse matrix (n, n), float64 or complex128
         Only the pattern's symmetry and the values of the upper triangle of the reordered matrix are used (A is
         assumed Hermitian; nothing checks it).
+    ordering : {"auto", "amd", "nd"} or int array (n,)
+        The fill-reducing ordering: ``"auto"`` the measured rule (module docs, :data:`AUTO_ND_MAX_N`), a
+        name of :func:`gsdf.linalg.ordering.fill_reducing_ordering`, or a permutation (``ordering[k]`` = the
+        unknown eliminated k-th). The factors are those of ``A``, whatever the ordering.
 
     Raises
     ------
@@ -354,7 +261,7 @@ class LDLFactorization:
     True
     """
 
-    def __init__(self, A):
+    def __init__(self, A, ordering="auto"):
         if not sp.issparse(A) or A.format not in ("csr", "csc"):
             A = sp.csr_matrix(A)
         n = A.shape[0]
@@ -366,11 +273,17 @@ class LDLFactorization:
             data = np.conj(data)             # CSC arrays read as CSR are Aᵀ = conj(A) for a Hermitian A
         indptr, indices = A.indptr.astype(np.int64), A.indices.astype(np.int64)
         self.n, self.dtype = n, data.dtype
-        self.perm = _nested_dissection(indptr, indices, n, 8) if n else np.zeros(0, np.int64)
-        pinv = np.empty(n, np.int64)
-        pinv[self.perm] = np.arange(n)
-        colptr, rows, src = _upper_csc(indptr, indices, n, pinv)
-        parent, self._lp = _symbolic(colptr, rows, n)
+        if isinstance(ordering, str) and ordering == "auto":
+            self.perm, pat = _auto_pattern(indptr, indices, n)
+        else:
+            if isinstance(ordering, str):
+                if ordering not in LDL_ORDERINGS:
+                    raise ValueError(f"ordering: expected one of {LDL_ORDERINGS} or a permutation, got {ordering!r}")
+                self.perm = order_csr(indptr, indices, n, ordering)
+            else:
+                self.perm = _check_perm(ordering, n)
+            pat = _pattern(indptr, indices, n, self.perm)
+        colptr, rows, src, parent, self._lp = pat
         self._li, self._lx, self._d, bad = _numeric(colptr, rows, data[src], n, parent, self._lp)
         if bad >= 0:
             raise ValueError(f"matrix: not positive definite (pivot {int(bad)} of the LDL factorization ≤ 0)")
