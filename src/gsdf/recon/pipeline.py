@@ -401,6 +401,12 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     subdivide : int in 0..3 — 1-to-4 splits of the output, the new vertices moved onto the local surface of
         the samples (:func:`.relocate.subdivide_onto_samples`; each split multiplies the faces by 4 and keeps
         the topology).  0: the faces of the tet region's boundary as they are.
+    fit_k : int in 3..64 — samples in the moving-least-squares fit that the relocation and the subdivision
+        project onto (:func:`.relocate.local_surface`).  Vertex positions only: the faces are the same for
+        every value.  8 (default): on the Table-2 clouds (CGAL meshes, 1K–8K samples + outliers) CD is lower
+        than with 12 on 32 of 33 measured cases (−0.005 to −0.018 ×100 at 2K, bench/RESULTS.md section recon):
+        12 samples reach across thin parts and round off details at that density; on a smooth, densely
+        sampled body 12 is a few per cent better.
     band : float — F0 lies within ``band`` × median spacing of the inliers (:func:`.orient.face_chain`).
     outlier_gap : float — in the alternation, points farther than this × median spacing from the output are
         judged outliers for the next round.
