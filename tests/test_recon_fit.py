@@ -43,10 +43,10 @@ def test_fit_k_moves_vertices_only_and_keeps_the_sphere_on_a_noisy_cloud():
 
 
 def test_default_fit_lowers_the_error_against_an_analytic_ellipsoid():
-    # sparse samples of a plate (an oblate ellipsoid, half thickness 0.15, rim curvature radius 0.02 — about
+    # sparse samples of a plate (an oblate ellipsoid, half thickness 0.15, rim curvature radius 0.02 — below
     # the sample spacing): the 12 nearest samples of a point near the rim reach round to the other side, the 8
     # nearest much less.  Errors against the analytic surface of the faceted ball boundary, of the fit over 12
-    # neighbours, and of the default fit over 8.  (On a smooth, wide body — a sphere — the larger fit is a few
+    # neighbours, and of the default fit over 8.  (On a smooth body — an ellipsoid 1 × 0.3 × 0.3 — the larger fit is a few
     # per cent better instead; the CGAL Table-2 shapes side with the plate: bench/RESULTS.md, section recon.)
     abc = (1.0, 1.0, 0.15)
     P = _ellipsoid_samples(1200, abc, np.random.default_rng(3))
