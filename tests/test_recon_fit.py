@@ -17,7 +17,8 @@ def _ellipsoid_samples(n, abc, rng):
 
 
 def _ellipsoid_error(V, F, abc):
-    """Mean first-order distance |g(x)| / |∇g(x)| (g = Σ x_i² / a_i² − 1) over face centroids and edge midpoints."""
+    """Mean first-order distance |g(x)| / |∇g(x)| (g = Σ x_i² / a_i² − 1) over face centroids and edge
+    midpoints (exact to first order near the surface: the error of a reconstruction is a small fraction of a)."""
     Q = np.concatenate([V[F].mean(axis=1), 0.5 * (V[F[:, 0]] + V[F[:, 1]])])
     a2 = np.asarray(abc, float) ** 2
     g = (Q ** 2 / a2).sum(axis=1) - 1.0
@@ -45,9 +46,10 @@ def test_fit_k_moves_vertices_only_and_keeps_the_sphere_on_a_noisy_cloud():
 def test_default_fit_lowers_the_error_against_an_analytic_ellipsoid():
     # sparse samples of a plate (an oblate ellipsoid, half thickness 0.15, rim curvature radius 0.02 — below
     # the sample spacing): the 12 nearest samples of a point near the rim reach round to the other side, the 8
-    # nearest much less.  Errors against the analytic surface of the faceted ball boundary, of the fit over 12
-    # neighbours, and of the default fit over 8.  (On a smooth body — an ellipsoid 1 × 0.3 × 0.3 — the larger fit is a few
-    # per cent better instead; the CGAL Table-2 shapes side with the plate: bench/RESULTS.md, section recon.)
+    # nearest much less.  Errors against the analytic surface of the faceted ball boundary, of the fit over
+    # 12 neighbours, and of the default fit over 8.  (On a smooth body — an ellipsoid 1 × 0.3 × 0.3 — the
+    # larger fit is a few per cent better instead; the CGAL Table-2 shapes side with the plate:
+    # bench/RESULTS.md, section recon.)
     abc = (1.0, 1.0, 0.15)
     P = _ellipsoid_samples(1200, abc, np.random.default_rng(3))
     Vf, Ff = gsdf.reconstruct_simply_connected(P, relocate=False, subdivide=0)
