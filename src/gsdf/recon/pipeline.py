@@ -403,10 +403,10 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         the topology).  0: the faces of the tet region's boundary as they are.
     fit_k : int in 3..64 — samples in the moving-least-squares fit that the relocation and the subdivision
         project onto (:func:`.relocate.local_surface`).  Vertex positions only: the faces are the same for
-        every value.  8 (default): on the Table-2 clouds (CGAL meshes, 1K–8K samples + outliers) CD is lower
-        than with 12 on 32 of 33 measured cases (−0.005 to −0.018 ×100 at 2K, bench/RESULTS.md section recon):
-        12 samples reach across thin parts and round off details at that density; on a smooth, densely
-        sampled body 12 is a few per cent better.
+        every value.  8 (default): on Table-2 clouds (CGAL meshes, 1K–8K samples + outliers) CD is lower than
+        with 12 on 22 of 23 measured (−0.008 to −0.018 ×100 at 2K; bench/RESULTS.md section recon: lower on
+        16 of 32 at two decimals, higher on none) — 12 samples reach across thin parts and round off details
+        at that density; on a smooth, well-sampled body 12 is a few per cent better.
     band : float — F0 lies within ``band`` × median spacing of the inliers (:func:`.orient.face_chain`).
     outlier_gap : float — in the alternation, points farther than this × median spacing from the output are
         judged outliers for the next round.
