@@ -139,7 +139,6 @@ def get_num_threads() -> int:
     return env if env is not None else available_cpus()
 
 
-
 def run_ranges(fn, n: int, grain: int = 512) -> None:
     """Call ``fn(s, e)`` on contiguous ranges covering ``0 <= i < n``, on numba's current number of threads.
 
@@ -173,6 +172,7 @@ def run_ranges(fn, n: int, grain: int = 512) -> None:
     with ThreadPoolExecutor(max_workers=min(threads, len(bounds))) as pool:
         for f in [pool.submit(fn, s, e) for s, e in bounds]:
             f.result()
+
 
 def _numba_loaded() -> bool:
     return "numba" in sys.modules
