@@ -21,6 +21,7 @@ from scipy.spatial import cKDTree
 from .._checks import as_normals, as_points, integer
 from .._normalize import Frame
 from ..spatial.knn import SelfKNN
+from .fast import _single_thread
 
 __all__ = ["point_areas", "estimate_normals"]
 
@@ -262,6 +263,12 @@ class _KDRows:
         return np.ascontiguousarray(idx.reshape(e - s, self.k), dtype=np.int64)
 
 
+#: Below this many points the two kernels run on the calling thread: together ~1-3 ms of serial work at
+#: 1.4k-6k points (CGAL's oni / kitten / hippo1), while a parallel launch on a loaded machine waited for its
+#: workers: 10-25 ms at load 5-6 (issue 17; the same rule as gsdf.winding.fast's SERIAL_BUILD_FACES).
+SERIAL_POINTS = 16_384
+
+
 def _candidate_search(P, k):
     """The k nearest of every point (itself included) by the faster structure for this k
     (:data:`KD_TREE_MAX_K`)."""
@@ -372,8 +379,9 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
         cand = knn.rows(s, e)
         sel = np.full((e - s, kk + 1), -1, np.int64)
         plane = np.zeros((e - s, 3))
-        _tangent_neighbours(P, N, cand, s, kk, sel, plane)
-        _voronoi_areas(P, N, plane, sel, s, boundary == "hull", out[s:e])
+        with _single_thread(n < SERIAL_POINTS):
+            _tangent_neighbours(P, N, cand, s, kk, sel, plane)
+            _voronoi_areas(P, N, plane, sel, s, boundary == "hull", out[s:e])
     a = frame.area(out)
     if not np.isfinite(a).all():
         raise ValueError(f"P: point areas overflow float64 at this scale (cloud half-size 2^{frame.exponent})")

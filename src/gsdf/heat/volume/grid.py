@@ -334,7 +334,7 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
         x += RT @ coarse.solve(R @ res)
         return x
 
-    M = LinearOperator((n, n), matvec=precondition)
+    M = LinearOperator((n, n), matvec=precondition, dtype=np.float64)  # dtype given: no probe call
     x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
     x0 += (rhs.sum() - (A @ x0).sum()) / penalty.sum()  # best constant shift (L annihilates constants)
     x, _ = pcg(A, rhs, M=M, x0=x0, rtol=tol, maxiter=maxiter, warn="step III")
@@ -441,7 +441,8 @@ def solve_constrained(rhs, shape, spacing, C, w, rho: float, tol: float, max_out
     if direct is None:
         delta = float(A.diagonal().sum() - L.diagonal().sum()) / n
         lam = _dct_eigenvalues(shape, spacing, delta)
-        M = LinearOperator((n, n), matvec=lambda r: dct_poisson(r, shape, spacing, delta, lam))
+        M = LinearOperator((n, n), matvec=lambda r: dct_poisson(r, shape, spacing, delta, lam),
+                           dtype=np.float64)
     mu = np.zeros(C.shape[0])
     phi = dct_poisson(rhs - rhs.mean(), shape, spacing)
     res = np.inf
