@@ -2,7 +2,8 @@
 :mod:`gsdf.heat.core` over :class:`gsdf.heat.domains.grid.GridDomain`; ``solve_grid`` is in :mod:`.solve`.
 
 Step I   X_t(x) = Σ_f |f| N_f G_t(x, b_f), the Yukawa potential of the sources (the fundamental solution of
-         id − tΔ, λ = 1/√t), by a tree walk (:mod:`.yukawa`) instead of the anchor's O(nodes × faces) sum.
+         id − tΔ, λ = 1/√t), by a tree walk (:mod:`.yukawa`) instead of the anchor's O(nodes × faces) sum, or
+         (clouds, ``step1="auto"``) by one screened solve on the grid itself (:mod:`.screened`).
 Step II  Y = X / |X| (Eq. 3 of the seed: only the direction is kept).
 Step III Δφ = ∇·Y with the seven-point Laplacian, Neumann boundary and forward differences: we minimise
          Σ_edges (φ_j − φ_i − h Ŷ_ij)² over the grid edges, Ŷ_ij the edge component of Y averaged over the
