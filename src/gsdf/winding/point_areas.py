@@ -14,6 +14,8 @@ in a parallel numba kernel; :func:`estimate_normals` gives PCA normals for unori
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import numpy as np
 from numba import njit, prange
 from scipy.spatial import cKDTree
@@ -21,7 +23,6 @@ from scipy.spatial import cKDTree
 from .._checks import as_normals, as_points, integer
 from .._normalize import Frame
 from ..spatial.knn import SelfKNN
-from .fast import _single_thread
 
 __all__ = ["point_areas", "estimate_normals"]
 
@@ -267,6 +268,24 @@ class _KDRows:
 #: 1.4k-6k points (CGAL's oni / kitten / hippo1), while a parallel launch on a loaded machine waited for its
 #: workers: 10-25 ms at load 5-6 (issue 17; the same rule as gsdf.winding.fast's SERIAL_BUILD_FACES).
 SERIAL_POINTS = 16_384
+
+
+@contextmanager
+def _single_thread(serial: bool):
+    """numba kernels called inside run on one thread when ``serial`` (numba's setting is per calling thread;
+    the twin of gsdf.winding.fast._single_thread, not imported from there: fast imports exact, which imports
+    this module)."""
+    if not serial:
+        yield
+        return
+    import numba
+
+    before = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
 
 
 def _candidate_search(P, k):

@@ -108,6 +108,10 @@ class GridDomain(HeatDomain):
         self.spacing = (self.hi - self.lo) / (np.array(self.shape) - 1)
         self.h = float(self.spacing.max())
         self.n_nodes = int(np.prod(self.shape))
+        from ..._checks import nonnegative, positive
+
+        # the Yukawa tree's options are checked here too: step1="auto" may not build the tree
+        theta, eps = nonnegative(theta, "theta"), positive(eps, "eps", most=0.5)
         self.t, self.theta, self.eps, self.rho, self.tol = float(t), theta, eps, rho, tol
         self.row_weight = 1.0
         self._progress = progress or (lambda stage, fraction: None)
