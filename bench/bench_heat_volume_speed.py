@@ -107,6 +107,7 @@ STAGES = [  # (label, file suffix, function name): disjoint stages of the grid p
     ("step I tree build", "volume/yukawa.py", "__init__"),
     ("step I nearest", "volume/yukawa.py", "grid_nearest_distance"),
     ("step I sum", "volume/yukawa.py", "__call__"),
+    ("step I sum", "volume/screened.py", "screened_heat"),  # the grid solve of clouds (step1="auto")
     ("step II normalize", "heat/core.py", "unit_field"),
     ("divergence", "domains/grid.py", "divergence"),
     ("factorization (coarse)", "linalg/direct.py", "__init__"),
@@ -273,6 +274,9 @@ def scaling_table(quick):
 
 
 def main(argv):
+    if "--help" in argv or "-h" in argv:
+        print(__doc__)
+        return
     quick = "--quick" in argv
     only = [a.split("=", 1)[1] for a in argv if a.startswith("--only=")]
     names = [n for n in ALL if n in only[0].split(",")] if only else (QUICK if quick else ALL)

@@ -261,6 +261,12 @@ class _KDRows:
         return np.ascontiguousarray(idx.reshape(e - s, self.k), dtype=np.int64)
 
 
+#: Below this many points the two kernels run as one call on the calling thread: together ~1-3 ms of serial
+#: work at 1.4k-6k points (CGAL's oni / kitten / hippo1), while running them on two threads on a loaded
+#: machine waited for the second thread: 10-25 ms at load 5-6 (issue 17).
+SERIAL_POINTS = 16_384
+
+
 def _candidate_search(P, k):
     """The k nearest of every point (itself included) by the faster structure for this k
     (:data:`KD_TREE_MAX_K`)."""
@@ -372,8 +378,9 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
         sel = np.full((e - s, kk + 1), -1, np.int64)
         plane = np.zeros((e - s, 3))
         part = out[s:e]
-        run_ranges(lambda r0, r1: _tangent_neighbours(P, N, cand, s, kk, sel, plane, r0, r1), e - s)
-        run_ranges(lambda r0, r1: _voronoi_areas(P, N, plane, sel, s, boundary == "hull", part, r0, r1), e - s)
+        grain = SERIAL_POINTS if n < SERIAL_POINTS else 512  # small clouds: one call on this thread
+        run_ranges(lambda r0, r1: _tangent_neighbours(P, N, cand, s, kk, sel, plane, r0, r1), e - s, grain)
+        run_ranges(lambda r0, r1: _voronoi_areas(P, N, plane, sel, s, boundary == "hull", part, r0, r1), e - s, grain)
     a = frame.area(out)
     if not np.isfinite(a).all():
         raise ValueError(f"P: point areas overflow float64 at this scale (cloud half-size 2^{frame.exponent})")

@@ -2,7 +2,8 @@
 :mod:`gsdf.heat.core` over :class:`gsdf.heat.domains.grid.GridDomain`; ``solve_grid`` is in :mod:`.solve`.
 
 Step I   X_t(x) = Σ_f |f| N_f G_t(x, b_f), the Yukawa potential of the sources (the fundamental solution of
-         id − tΔ, λ = 1/√t), by a tree walk (:mod:`.yukawa`) instead of the anchor's O(nodes × faces) sum.
+         id − tΔ, λ = 1/√t), by a tree walk (:mod:`.yukawa`) instead of the anchor's O(nodes × faces) sum, or
+         (clouds, ``step1="auto"``) by one screened solve on the grid itself (:mod:`.screened`).
 Step II  Y = X / |X| (Eq. 3 of the seed: only the direction is kept).
 Step III Δφ = ∇·Y with the seven-point Laplacian, Neumann boundary and forward differences: we minimise
          Σ_edges (φ_j − φ_i − h Ŷ_ij)² over the grid edges, Ŷ_ij the edge component of Y averaged over the
@@ -334,7 +335,7 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
         x += RT @ coarse.solve(R @ res)
         return x
 
-    M = LinearOperator((n, n), matvec=precondition)
+    M = LinearOperator((n, n), matvec=precondition, dtype=np.float64)  # dtype given: no probe call
     x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
     x0 += (rhs.sum() - (A @ x0).sum()) / penalty.sum()  # best constant shift (L annihilates constants)
     x, _ = pcg(A, rhs, M=M, x0=x0, rtol=tol, maxiter=maxiter, warn="step III")
@@ -441,7 +442,8 @@ def solve_constrained(rhs, shape, spacing, C, w, rho: float, tol: float, max_out
     if direct is None:
         delta = float(A.diagonal().sum() - L.diagonal().sum()) / n
         lam = _dct_eigenvalues(shape, spacing, delta)
-        M = LinearOperator((n, n), matvec=lambda r: dct_poisson(r, shape, spacing, delta, lam))
+        M = LinearOperator((n, n), matvec=lambda r: dct_poisson(r, shape, spacing, delta, lam),
+                           dtype=np.float64)
     mu = np.zeros(C.shape[0])
     phi = dct_poisson(rhs - rhs.mean(), shape, spacing)
     res = np.inf

@@ -39,7 +39,7 @@ def _mode(level_set_constraint, soft_weight, constraint, constraint_weight):
 def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=None,
                level_set_constraint: str = "zero", soft_weight=None, theta: float = 1.5, eps: float = 1e-4,
                progress=None, constraint_tol: float = 1e-4, exact_rho: float = 1e5, constraint=None,
-               constraint_weight: float = 10.0, frame=None) -> GridField:
+               constraint_weight: float = 10.0, frame=None, step1: str = "auto") -> GridField:
     """Run Steps I–III on the grid ``shape`` spanning ``[bbox_min, bbox_max]``; returns a :class:`GridField`.
 
     ``t`` defaults to ``t_coef · h²``, h the largest grid spacing (the seed's t = h², §10). Level sets
@@ -50,7 +50,9 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     spelling of ``soft_weight`` / hard. ``progress(stage, fraction)``. ``frame``: the
     :class:`gsdf._normalize.Frame` the inputs are in; the field is returned in world units. ``eps`` prunes sources weighing less than
     ``eps`` × the nearest one (Step I, :class:`YukawaTree`); 1e-4 instead of 1e-6 moves φ by < 3e-6 of the box
-    diagonal on the broken bunny at 64³ and saves ~25 % of Step I.
+    diagonal on the broken bunny at 64³ and saves ~25 % of Step I. ``step1``: "yukawa" (the tree sum), "heat" (one
+    screened solve on the grid, :mod:`gsdf.heat.volume.screened`) or "auto" (:class:`GridDomain`'s rule: the
+    grid solve for clouds where it is trusted).
     """
     mode, lam = _mode(level_set_constraint, soft_weight, constraint, constraint_weight)
     report = adapt_progress(progress)
@@ -58,7 +60,8 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     shape = tuple(int(s) for s in shape)
     h = float(((hi - lo) / (np.array(shape) - 1)).max())
     t = float(t_coef) * h * h if t is None else positive(t, "t")
-    domain = GridDomain(lo, hi, shape, t, theta=theta, eps=eps, rho=exact_rho, tol=constraint_tol, progress=report)
+    domain = GridDomain(lo, hi, shape, t, theta=theta, eps=eps, rho=exact_rho, tol=constraint_tol, progress=report,
+                        step1=step1)
     core = SignedHeatCore(domain)
     S = domain.prepare(src, source_components(src) if mode == "multiple" else None)
     timings = {}
@@ -79,7 +82,8 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     field = GridField(fr.length(phi.reshape(shape)), fr.point(lo), fr.point(hi))
     info = core.poisson.info if (mode != "none" and lam is None) else {}
     field.meta = {"method": "signed heat (grid)", "t": float(fr.area(t)), "theta": theta, "eps": eps, "timings": timings,
-                  "level_set_constraint": mode, "soft_weight": lam, "n_sources": len(src.B), **info}
+                  "level_set_constraint": mode, "soft_weight": lam, "n_sources": len(src.B),
+                  "step1": domain.step1_used, **info}
     return field
 
 
