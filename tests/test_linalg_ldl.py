@@ -54,7 +54,7 @@ def test_nested_dissection_is_a_permutation_with_less_fill_than_natural():
     D = sp.block_diag([A, A]).tocsr()
     np.testing.assert_allclose(LDLFactorization(D).solve(np.ones(D.shape[0])), np.tile(f.solve(np.ones(A.shape[0])), 2),
                                rtol=1e-12)
-    P = sp.diags([1, 1, 1], [-1, 0, 1], shape=(7, 7)).tocsr()
+    P = sp.diags([1, 1, 1], [-1, 0, 1], shape=(7, 7), dtype=float).tocsr()
     assert int(nested_dissection(P, leaf=1)[-1]) == 3
 
 
