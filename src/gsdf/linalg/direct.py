@@ -58,20 +58,21 @@ def _ldl_size(A) -> int:
     return A.shape[0] * (2 if np.iscomplexobj(A.data if sp.issparse(A) else A) else 1)
 
 
-def _ldl_or_none(A):
+def _ldl_or_none(A, ordering="auto"):
     """:class:`~gsdf.linalg.ldl.LDLFactorization` of ``A``, or None when it is not positive definite."""
     from .ldl import LDLFactorization
 
     try:
-        return LDLFactorization(A)
+        return LDLFactorization(A, ordering=ordering)
     except ValueError:
         return None
 
 
-def spd_factorization(A, reorder: bool = True):
+def spd_factorization(A, reorder: bool = True, ordering="auto"):
     """A factorization of the real symmetric positive definite ``A`` with ``solve(b)``: LDLᵀ (numba, AMD
     ordered) up to :data:`LDL_MAX_UNKNOWNS` (real) unknowns, else (or when a pivot is not positive) SuperLU's
-    :class:`Factorization` (``reorder`` = its RCM renumbering).
+    :class:`Factorization` (``reorder`` = its RCM renumbering). ``ordering``: the LDLᵀ's fill-reducing ordering
+    (:class:`~gsdf.linalg.ldl.LDLFactorization`: a name or a permutation (n,)); SuperLU orders by itself.
 
     Example
     -------
@@ -80,7 +81,7 @@ def spd_factorization(A, reorder: bool = True):
     array([1. , 0.5])
     """
     if _ldl_size(A) <= LDL_MAX_UNKNOWNS:
-        f = _ldl_or_none(A)
+        f = _ldl_or_none(A, ordering)
         if f is not None:
             return f
     return Factorization(sp.csc_matrix(A), reorder=reorder)
@@ -200,6 +201,12 @@ class HermitianFactorization:
             return
         self._lu = Factorization(A.astype(np.complex128), reorder=bool(reorder))
         self.backend = "superlu"
+
+    @property
+    def ordering(self):
+        """The fill-reducing permutation (n,) of the LDLᴴ backend (``perm[k]`` = the unknown eliminated k-th),
+        None for the other backends (they order internally)."""
+        return None if self._ldl is None else self._ldl.perm
 
     @_in_blas_region
     def solve(self, b: np.ndarray) -> np.ndarray:

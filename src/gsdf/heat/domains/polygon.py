@@ -259,6 +259,9 @@ class PolygonDomain(VertexSurfaceDomain):
     # polygon meshes: SuperLU's minimum degree alone factorizes faster than after an RCM renumbering (1.2–2.4×
     # on every polygon row of bench_heat_surface.py --solver-rule)
     renumber = False
+    # Lconn has L's pattern exactly (connection_laplacian): the Dirichlet systems of step III take step I's
+    # ordering restricted to their free vertices (one AMD / nested-dissection pass instead of two)
+    heat_on_nodes = True
 
     def __init__(self, V, polygons, t_coef: float = 1.0):
         V = _checks.as_points(V, "V")
