@@ -198,10 +198,10 @@ class FactorizedPoisson(PoissonSolver):
     :class:`gsdf.linalg.SPDSolver`, CG/AMG above a size).
 
     ``ordering``: a callable returning a fill-reducing permutation (n,) of all nodes, or None. When given (and
-    ``spd`` is not), a Dirichlet system takes that permutation restricted to its free nodes instead of
-    ordering its own graph: the elimination graph of a principal submatrix under the induced order is a
-    subgraph of the full one, so its fill is at most the full factor's (polygon meshes: Step I's ordering of
-    the same vertex graph, which saves the second AMD / nested-dissection pass).
+    ``spd`` is not), a Dirichlet system's LDLᵀ tries that permutation restricted to its free nodes in place of
+    a nested-dissection pass, against AMD (the elimination graph of a principal submatrix under the induced
+    order is a subgraph of the full one, so its fill is at most the full factor's). Polygon meshes: Step I's
+    ordering of the same vertex graph.
     """
 
     def __init__(self, L, Mv, spd=None, exact_gauge: bool = False, renumber: bool = True, ordering=None):
@@ -214,8 +214,8 @@ class FactorizedPoisson(PoissonSolver):
         self._spd = spd or (lambda A: Factorization(sp.csc_matrix(A)))
         # the Dirichlet systems (no ε: well-conditioned) may take a bandwidth renumbering before the ordering
         renumber = bool(renumber)
-        self._spd_dirichlet = (lambda A, perm="auto": spd_factorization(A, reorder=renumber, ordering=perm)) \
-            if spd is None else (lambda A, perm="auto": self._spd(A))
+        self._spd_dirichlet = (lambda A, hint=None: spd_factorization(A, reorder=renumber, hint=hint)) \
+            if spd is None else (lambda A, hint=None: self._spd(A))
         self._ordering = ordering
         self._cache: dict = {}
         self._last_fixed = None                      # (fixed array, key, free) of the last Dirichlet solve

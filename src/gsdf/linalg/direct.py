@@ -58,21 +58,22 @@ def _ldl_size(A) -> int:
     return A.shape[0] * (2 if np.iscomplexobj(A.data if sp.issparse(A) else A) else 1)
 
 
-def _ldl_or_none(A, ordering="auto"):
-    """:class:`~gsdf.linalg.ldl.LDLFactorization` of ``A``, or None when it is not positive definite."""
+def _ldl_or_none(A, hint=None):
+    """:class:`~gsdf.linalg.ldl.LDLFactorization` of ``A`` (``hint``: its ordering hint), or None when it is
+    not positive definite."""
     from .ldl import LDLFactorization
 
     try:
-        return LDLFactorization(A, ordering=ordering)
+        return LDLFactorization(A, hint=hint)
     except ValueError:
         return None
 
 
-def spd_factorization(A, reorder: bool = True, ordering="auto"):
+def spd_factorization(A, reorder: bool = True, hint=None):
     """A factorization of the real symmetric positive definite ``A`` with ``solve(b)``: LDLᵀ (numba, AMD
     ordered) up to :data:`LDL_MAX_UNKNOWNS` (real) unknowns, else (or when a pivot is not positive) SuperLU's
-    :class:`Factorization` (``reorder`` = its RCM renumbering). ``ordering``: the LDLᵀ's fill-reducing ordering
-    (:class:`~gsdf.linalg.ldl.LDLFactorization`: a name or a permutation (n,)); SuperLU orders by itself.
+    :class:`Factorization` (``reorder`` = its RCM renumbering). ``hint``: a permutation (n,) the LDLᵀ's
+    ordering rule also tries (:class:`~gsdf.linalg.ldl.LDLFactorization`); SuperLU orders by itself.
 
     Example
     -------
@@ -81,7 +82,7 @@ def spd_factorization(A, reorder: bool = True, ordering="auto"):
     array([1. , 0.5])
     """
     if _ldl_size(A) <= LDL_MAX_UNKNOWNS:
-        f = _ldl_or_none(A, ordering)
+        f = _ldl_or_none(A, hint)
         if f is not None:
             return f
     return Factorization(sp.csc_matrix(A), reorder=reorder)
