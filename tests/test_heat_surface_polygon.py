@@ -222,6 +222,8 @@ def test_step3_reuses_step1_ordering_and_matches_its_own():
     st = s.core._state()
     full = st["vec"].ordering
     assert full is not None and sorted(full.tolist()) == list(range(len(V)))
+    H = sp.csr_matrix(s.domain.vector_heat_matrix())                        # step I: AMD (heat_ordering)
+    assert np.array_equal(full, order_csr(H.indptr.astype(np.int64), H.indices.astype(np.int64), len(V), "amd"))
     fact = next(iter(st["poisson"]._cache.values()))
     assert isinstance(fact, LDLFactorization)
     free = np.setdiff1d(np.arange(len(V)), loop)

@@ -359,7 +359,8 @@ class SignedHeatCore:
             form = self.domain.heat_form
             if form == "complex":
                 st["vec"] = HermitianFactorization(self.domain.vector_heat_matrix(),
-                                                   reorder=getattr(self.domain, "renumber", True))
+                                                   reorder=getattr(self.domain, "renumber", True),
+                                                   ordering=getattr(self.domain, "heat_ordering", "auto"))
             elif form == "real2":
                 st["vec"] = BlockHermitianFactorization(self.domain.vector_heat_matrix())
             else:

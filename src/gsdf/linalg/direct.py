@@ -58,13 +58,13 @@ def _ldl_size(A) -> int:
     return A.shape[0] * (2 if np.iscomplexobj(A.data if sp.issparse(A) else A) else 1)
 
 
-def _ldl_or_none(A, hint=None):
-    """:class:`~gsdf.linalg.ldl.LDLFactorization` of ``A`` (``hint``: its ordering hint), or None when it is
-    not positive definite."""
+def _ldl_or_none(A, hint=None, ordering="auto"):
+    """:class:`~gsdf.linalg.ldl.LDLFactorization` of ``A`` (``ordering``, ``hint``: its ordering options), or
+    None when it is not positive definite."""
     from .ldl import LDLFactorization
 
     try:
-        return LDLFactorization(A, hint=hint)
+        return LDLFactorization(A, ordering=ordering, hint=hint)
     except ValueError:
         return None
 
@@ -164,6 +164,7 @@ class HermitianFactorization:
     113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2–3.5× faster (0.58 vs 1.14 s,
     0.15 vs 0.53 s) and solves as fast (bench/bench_solver_choices.py), so the 2n embedding is not worth it.
     ``reorder``: the reverse Cuthill–McKee renumbering of :class:`Factorization` (default True).
+    ``ordering``: the LDLᴴ backend's fill-reducing ordering (:class:`~gsdf.linalg.ldl.LDLFactorization`).
 
     Example
     -------
@@ -175,14 +176,14 @@ class HermitianFactorization:
     """
 
     @_in_blas_region
-    def __init__(self, A, backend: str = "auto", reorder: bool = True):
+    def __init__(self, A, backend: str = "auto", reorder: bool = True, ordering="auto"):
         n = A.shape[0]
         self.n = n
         self._chol = self._ldl = None
         if backend not in ("auto", "superlu", "cholmod", "ldl"):
             raise ValueError(f"backend: expected 'auto', 'ldl', 'superlu' or 'cholmod', got {backend!r}")
         if backend == "ldl" or (backend == "auto" and 2 * n <= LDL_MAX_UNKNOWNS):
-            self._ldl = _ldl_or_none(sp.csr_matrix(A, dtype=np.complex128))
+            self._ldl = _ldl_or_none(sp.csr_matrix(A, dtype=np.complex128), ordering=ordering)
             if self._ldl is not None:
                 self.backend = "ldl"
                 return

@@ -270,9 +270,14 @@ class PolygonDomain(VertexSurfaceDomain):
     # polygon meshes: SuperLU's minimum degree alone factorizes faster than after an RCM renumbering (1.2–2.4×
     # on every polygon row of bench_heat_surface.py --solver-rule)
     renumber = False
-    # Lconn has L's pattern exactly (connection_laplacian): the Dirichlet systems of step III take step I's
-    # ordering restricted to their free vertices (one AMD / nested-dissection pass instead of two)
+    # Lconn has L's pattern exactly (connection_laplacian): the Dirichlet systems of step III try step I's
+    # ordering restricted to their free vertices against AMD (no nested-dissection pass)
     heat_on_nodes = True
+    # step I's operator ordered by AMD alone: of the 6 polygon meshes of bench_heat_surface.py --speed
+    # --polygon the "auto" rule's nested-dissection attempt ran on 4 (≤ 10k vertices) and won on one (UV
+    # sphere, 0.68× AMD's flops); on the others (bear 1.5×, quad torus 1.2×, cube sphere 32 0.96× — under the
+    # 0.9 gain) it cost 1.5–6 ms of a 20–50 ms first solve for nothing
+    heat_ordering = "amd"
 
     def __init__(self, V, polygons, t_coef: float = 1.0):
         V = _checks.as_points(V, "V")
