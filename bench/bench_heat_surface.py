@@ -832,6 +832,56 @@ def speed_table(names, rounds=3, label="idle"):
     return table(hdr, rows), ratios
 
 
+def _warm_polygon():
+    """First-call costs of both libraries' polygon solvers (numba cache loads) outside the timings."""
+    from gsdf.heat import PolygonMeshSignedHeatSolver
+
+    Vq, Q = _cube_sphere(4)
+    cq = np.array([Vq[q].mean(0) for q in Q])
+    lq = _poly_region_loops(Vq, Q, cq[:, 1] < np.median(cq[:, 1]))
+    PolygonMeshSignedHeatSolver(Vq, Q).compute_distance(lq)
+    pp3d.PolygonMeshHeatSolver(Vq, np.asarray(Q)).compute_signed_distance([list(map(int, c)) for c in lq])
+
+
+def poly_speed(quick=False, load=False):
+    """Issue 17 goal 4, polygon meshes only (the polygon rows of :func:`speed`, same protocol), idle and, with
+    ``load``, with two busy processes competing; RESULTS section "heat-surface-speed-polygon"."""
+    from importlib.metadata import version
+
+    from load import BusyLoad, uptime
+
+    _warm_polygon()
+    pnames, rounds = (POLY_QUICK if quick else POLY_SPEED), 3
+    start = uptime()
+    tp_idle, rp_idle = poly_speed_table(pnames, rounds, "idle")
+    parts = [f"### Idle ({start} at start, {uptime()} at end)\n\n" + tp_idle]
+    rp_load = None
+    if load:
+        with BusyLoad(2):
+            s2 = uptime()
+            tp_load, rp_load = poly_speed_table(pnames, rounds, "load")
+            e2 = uptime()
+        parts.append(f"### Two busy processes competing (bench/load.py BusyLoad(2); {s2} at start, {e2} at end)"
+                     "\n\n" + tp_load)
+    pi = [r[1] for r in rp_idle]
+    summ = (f"Idle: first-solve ratio gsdf / potpourri3d {min(pi):.2f}–{max(pi):.2f} (≤ 1.0 on "
+            f"{sum(x <= 1.0 for x in pi)}/{len(pi)}), repeated {min(r[2] for r in rp_idle):.2f}–"
+            f"{max(r[2] for r in rp_idle):.2f}")
+    if rp_load is not None:
+        pl = [r[1] for r in rp_load]
+        summ += (f"; under load: first {min(pl):.2f}–{max(pl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in pl)}/{len(pl)}), "
+                 f"loaded / idle ratio {min(b / a for a, b in zip(pi, pl)):.2f}–"
+                 f"{max(b / a for a, b in zip(pi, pl)):.2f}")
+    return (f"## Surface signed heat method on polygon meshes: speed against potpourri3d on {len(pnames)} meshes "
+            f"(issue 17)\n\nMachine: {machine()}; shared with other helpers (load averages per table). Command: "
+            f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --polygon --load"
+            f"{' --quick' if quick else ''}`. potpourri3d {version('potpourri3d')} `PolygonMeshHeatSolver` "
+            "(`compute_signed_distance`), gsdf `PolygonMeshSignedHeatSolver`; the polygon rows of the "
+            "\"heat-surface-speed\" section, same protocol (first = constructor + first solve, medians over "
+            f"{rounds} fresh solvers, interleaved; under {FAST_CASE_S} s: {FAST_ROUNDS} solvers). Ratios = gsdf / "
+            "potpourri3d (goal: first ≤ 1.0).\n\n" + summ + ".\n\n" + "\n\n".join(parts) + "\n")
+
+
 def speed(quick=False, load=False, small=False):
     """Issue 17 goals 4–5: the surface signed heat method against potpourri3d on ≥ 10 meshes, idle and with two
     busy processes competing (bench/load.py)."""
@@ -850,13 +900,7 @@ def speed(quick=False, load=False, small=False):
     lv = region_boundary_curves(Fw, Vw[Fw].mean(1)[:, 2] < 0)
     SurfaceSignedHeatSolver(Vw, Fw).compute_distance(lv)
     pp3d.MeshSignedHeatSolver(Vw, Fw).compute_distance([[(int(v), []) for v in c] for c in lv])
-    from gsdf.heat import PolygonMeshSignedHeatSolver              # the polygon kernels too (numba cache load)
-
-    Vq, Q = _cube_sphere(4)
-    cq = np.array([Vq[q].mean(0) for q in Q])
-    lq = _poly_region_loops(Vq, Q, cq[:, 1] < np.median(cq[:, 1]))
-    PolygonMeshSignedHeatSolver(Vq, Q).compute_distance(lq)
-    pp3d.PolygonMeshHeatSolver(Vq, np.asarray(Q)).compute_signed_distance([list(map(int, c)) for c in lq])
+    _warm_polygon()                                               # the polygon kernels too (numba cache load)
     pnames = POLY_QUICK if quick else POLY_SPEED
     start = uptime()
     t_idle, r_idle = speed_table(names, rounds, "idle")
@@ -1008,6 +1052,8 @@ def main():
     ap.add_argument("--solver-rule", action="store_true", help="factorization options per mesh (issue 17)")
     ap.add_argument("--small", action="store_true", help="with --speed: without the three meshes above 20k vertices")
     ap.add_argument("--load", action="store_true", help="with --speed: also under two busy processes")
+    ap.add_argument("--polygon", action="store_true",
+                    help="with --speed: only the polygon meshes (own RESULTS section; with --quick 3 meshes)")
     args = ap.parse_args()
     if args.solver_rule:
         from load import uptime
@@ -1030,6 +1076,12 @@ def main():
                + ".\n\n" + tab + "\n")
         print(txt)
         write_section("heat-surface-solver-rule" + ("-quick" if args.quick else ""), txt)
+        return
+    if args.speed and args.polygon:
+        txt = poly_speed(quick=args.quick, load=args.load)
+        print(txt)
+        if args.load and not args.quick:
+            write_section("heat-surface-speed-polygon", txt)
         return
     if args.speed:
         txt = speed(quick=args.quick, load=args.load, small=args.small)

@@ -151,3 +151,33 @@ def test_nested_blas_regions_restore_the_outer_limit():
             assert blas() in ([2], [1], [])                           # a 1-thread BLAS build stays at 1
         assert blas() in ([1], [])
     assert blas() == before
+
+
+def test_prolongation_csr_equals_the_coo_build_and_connection_fast_path():
+    """P is built directly in canonical CSR: bit-identical to scipy's COO conversion of (virtual vertex,
+    corner, weight) triplets; the connection Laplacian without the transpose check equals the checked one."""
+    from gsdf.heat.domains.polygon import virtual_vertex_weights
+
+    V, polys = _nonplanar_mixed()
+    d = PolygonDomain(V, polys)
+    n = len(V)
+    rows, cols, vals = [np.arange(n)], [np.arange(n)], [np.ones(n)]
+    nv = n
+    for s in sorted({len(p) for p in polys}):                 # the domain numbers virtual vertices by degree
+        if s == 3:
+            continue
+        Q = np.array([p for p in polys if len(p) == s])
+        w = virtual_vertex_weights(V[Q])
+        rows.append(np.repeat(nv + np.arange(len(Q)), s))
+        cols.append(Q.ravel())
+        vals.append(w.ravel())
+        nv += len(Q)
+    P_ref = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(nv, n))
+    assert d.P.shape == P_ref.shape
+    for k in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(d.P, k), getattr(P_ref, k))
+    assert np.allclose(d.V_refined[n:], P_ref[n:] @ V, rtol=0, atol=1e-14)
+    fast = connection_laplacian(d.L, d.N, d.e1, d.e2, symmetric_pattern=True)
+    slow = connection_laplacian(d.L, d.N, d.e1, d.e2)
+    assert (fast != slow).nnz == 0 and (fast != d.Lconn).nnz == 0
+    assert (fast != fast.conj().T).nnz == 0                   # exactly Hermitian

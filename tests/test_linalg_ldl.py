@@ -85,3 +85,32 @@ def test_coo_to_csr_matches_scipy_real_and_complex():
     ops = _ops()
     np.testing.assert_allclose(ops.cr_vector_heat_matrix(0.1).toarray(),
                                (ops.cr_mass() + 0.1 * ops.cr_connection_laplacian()).toarray(), atol=1e-15)
+
+
+def test_ordering_hint_kept_only_when_it_has_fewer_flops():
+    """``hint`` competes with AMD on flops: a good hint (nested dissection on a grid) or AMD is kept,
+    whichever is cheaper; the natural order (a banded, flop-heavy one) never beats AMD; bad hints raise."""
+    from gsdf.linalg.ldl import _flops, _pattern
+    from gsdf.linalg.ordering import approximate_minimum_degree
+
+    V, F = grid_mesh(24)
+    ops = TriangleMeshOperators(V, F)
+    A = (ops.cotan_laplacian() + sp.diags(ops.vertex_mass())).tocsr()
+    n = A.shape[0]
+    ip, ix = A.indptr.astype(np.int64), A.indices.astype(np.int64)
+    amd = approximate_minimum_degree(A)
+    nd = nested_dissection(A)
+    fl = {k: _flops(_pattern(ip, ix, n, p)[4]) for k, p in (("amd", amd), ("nd", nd))}
+    f = LDLFactorization(A, hint=nd)
+    assert np.array_equal(f.perm, nd if fl["nd"] <= fl["amd"] else amd)
+    natural = np.arange(n)
+    assert _flops(_pattern(ip, ix, n, natural)[4]) > fl["amd"]
+    g = LDLFactorization(A, hint=natural)
+    assert np.array_equal(g.perm, amd)
+    b = np.random.default_rng(0).normal(size=n)
+    np.testing.assert_allclose(A @ f.solve(b), b, atol=1e-10)
+    np.testing.assert_allclose(spd_factorization(A, hint=nd).solve(b), f.solve(b), rtol=0, atol=0)
+    with pytest.raises(ValueError, match="ordering"):
+        LDLFactorization(A, hint=np.zeros(n, np.int64))
+    with pytest.raises(ValueError, match="ordering"):
+        LDLFactorization(A, hint=np.arange(n - 1))

@@ -196,9 +196,15 @@ class FactorizedPoisson(PoissonSolver):
 
     ``spd``: the factory of SPD solves (default :class:`gsdf.linalg.Factorization`; tets use
     :class:`gsdf.linalg.SPDSolver`, CG/AMG above a size).
+
+    ``ordering``: a callable returning a fill-reducing permutation (n,) of all nodes, or None. When given (and
+    ``spd`` is not), a Dirichlet system's LDLᵀ tries that permutation restricted to its free nodes in place of
+    a nested-dissection pass, against AMD (the elimination graph of a principal submatrix under the induced
+    order is a subgraph of the full one, so its fill is at most the full factor's). Polygon meshes: Step I's
+    ordering of the same vertex graph.
     """
 
-    def __init__(self, L, Mv, spd=None, exact_gauge: bool = False, renumber: bool = True):
+    def __init__(self, L, Mv, spd=None, exact_gauge: bool = False, renumber: bool = True, ordering=None):
         self.L = sp.csr_matrix(L).tocsc()
         self.Mv = np.asarray(Mv, np.float64)
         self.n = self.L.shape[0]
@@ -208,7 +214,9 @@ class FactorizedPoisson(PoissonSolver):
         self._spd = spd or (lambda A: Factorization(sp.csc_matrix(A)))
         # the Dirichlet systems (no ε: well-conditioned) may take a bandwidth renumbering before the ordering
         renumber = bool(renumber)
-        self._spd_dirichlet = (lambda A: spd_factorization(A, reorder=renumber)) if spd is None else self._spd
+        self._spd_dirichlet = (lambda A, hint=None: spd_factorization(A, reorder=renumber, hint=hint)) \
+            if spd is None else (lambda A, hint=None: self._spd(A))
+        self._ordering = ordering
         self._cache: dict = {}
         self._last_fixed = None                      # (fixed array, key, free) of the last Dirichlet solve
 
@@ -256,7 +264,14 @@ class FactorizedPoisson(PoissonSolver):
 
         def build():
             A = self.L[free][:, free]
-            return self._spd_dirichlet((A + sp.diags(self._eps * self.Mv[free])).tocsc() if self._eps else A.tocsc())
+            A = (A + sp.diags(self._eps * self.Mv[free])).tocsc() if self._eps else A.tocsc()
+            full = self._ordering() if self._ordering is not None else None
+            if full is None:
+                return self._spd_dirichlet(A)
+            rank = np.full(self.n, -1, np.int64)            # the full order restricted to the free nodes
+            rank[free] = np.arange(len(free))
+            sub = rank[full]
+            return self._spd_dirichlet(A, sub[sub >= 0])
 
         phi = np.zeros(self.n)
         if len(free):
@@ -344,7 +359,8 @@ class SignedHeatCore:
             form = self.domain.heat_form
             if form == "complex":
                 st["vec"] = HermitianFactorization(self.domain.vector_heat_matrix(),
-                                                   reorder=getattr(self.domain, "renumber", True))
+                                                   reorder=getattr(self.domain, "renumber", True),
+                                                   ordering=getattr(self.domain, "heat_ordering", "auto"))
             elif form == "real2":
                 st["vec"] = BlockHermitianFactorization(self.domain.vector_heat_matrix())
             else:
@@ -356,9 +372,17 @@ class SignedHeatCore:
         """The domain's Step III solver (its own, or :class:`FactorizedPoisson` of its Laplacian)."""
         st = self._state()
         if st["poisson"] is None:
+            share = getattr(self.domain, "heat_on_nodes", False) and self.domain.heat_form == "complex"
             st["poisson"] = self.domain.poisson_solver() or FactorizedPoisson(
-                self.domain.laplacian(), self.domain.mass(), renumber=getattr(self.domain, "renumber", True))
+                self.domain.laplacian(), self.domain.mass(), renumber=getattr(self.domain, "renumber", True),
+                ordering=(lambda: self._step1_ordering(st)) if share else None)
         return st["poisson"]
+
+    @staticmethod
+    def _step1_ordering(st):
+        """Step I's fill-reducing permutation of the nodes (None before Step I or off the LDLᴴ backend)."""
+        vec = st["vec"]
+        return getattr(vec, "ordering", None) if vec is not None else None
 
     def diffuse(self, S: Sources) -> np.ndarray:
         """Step I."""

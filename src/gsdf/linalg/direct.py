@@ -58,20 +58,22 @@ def _ldl_size(A) -> int:
     return A.shape[0] * (2 if np.iscomplexobj(A.data if sp.issparse(A) else A) else 1)
 
 
-def _ldl_or_none(A):
-    """:class:`~gsdf.linalg.ldl.LDLFactorization` of ``A``, or None when it is not positive definite."""
+def _ldl_or_none(A, hint=None, ordering="auto"):
+    """:class:`~gsdf.linalg.ldl.LDLFactorization` of ``A`` (``ordering``, ``hint``: its ordering options), or
+    None when it is not positive definite."""
     from .ldl import LDLFactorization
 
     try:
-        return LDLFactorization(A)
+        return LDLFactorization(A, ordering=ordering, hint=hint)
     except ValueError:
         return None
 
 
-def spd_factorization(A, reorder: bool = True):
+def spd_factorization(A, reorder: bool = True, hint=None):
     """A factorization of the real symmetric positive definite ``A`` with ``solve(b)``: LDLᵀ (numba, AMD
     ordered) up to :data:`LDL_MAX_UNKNOWNS` (real) unknowns, else (or when a pivot is not positive) SuperLU's
-    :class:`Factorization` (``reorder`` = its RCM renumbering).
+    :class:`Factorization` (``reorder`` = its RCM renumbering). ``hint``: a permutation (n,) the LDLᵀ's
+    ordering rule also tries (:class:`~gsdf.linalg.ldl.LDLFactorization`); SuperLU orders by itself.
 
     Example
     -------
@@ -80,7 +82,7 @@ def spd_factorization(A, reorder: bool = True):
     array([1. , 0.5])
     """
     if _ldl_size(A) <= LDL_MAX_UNKNOWNS:
-        f = _ldl_or_none(A)
+        f = _ldl_or_none(A, hint)
         if f is not None:
             return f
     return Factorization(sp.csc_matrix(A), reorder=reorder)
@@ -162,6 +164,7 @@ class HermitianFactorization:
     113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2–3.5× faster (0.58 vs 1.14 s,
     0.15 vs 0.53 s) and solves as fast (bench/bench_solver_choices.py), so the 2n embedding is not worth it.
     ``reorder``: the reverse Cuthill–McKee renumbering of :class:`Factorization` (default True).
+    ``ordering``: the LDLᴴ backend's fill-reducing ordering (:class:`~gsdf.linalg.ldl.LDLFactorization`).
 
     Example
     -------
@@ -173,14 +176,14 @@ class HermitianFactorization:
     """
 
     @_in_blas_region
-    def __init__(self, A, backend: str = "auto", reorder: bool = True):
+    def __init__(self, A, backend: str = "auto", reorder: bool = True, ordering="auto"):
         n = A.shape[0]
         self.n = n
         self._chol = self._ldl = None
         if backend not in ("auto", "superlu", "cholmod", "ldl"):
             raise ValueError(f"backend: expected 'auto', 'ldl', 'superlu' or 'cholmod', got {backend!r}")
         if backend == "ldl" or (backend == "auto" and 2 * n <= LDL_MAX_UNKNOWNS):
-            self._ldl = _ldl_or_none(sp.csr_matrix(A, dtype=np.complex128))
+            self._ldl = _ldl_or_none(sp.csr_matrix(A, dtype=np.complex128), ordering=ordering)
             if self._ldl is not None:
                 self.backend = "ldl"
                 return
@@ -200,6 +203,12 @@ class HermitianFactorization:
             return
         self._lu = Factorization(A.astype(np.complex128), reorder=bool(reorder))
         self.backend = "superlu"
+
+    @property
+    def ordering(self):
+        """The fill-reducing permutation (n,) of the LDLᴴ backend (``perm[k]`` = the unknown eliminated k-th),
+        None for the other backends (they order internally)."""
+        return None if self._ldl is None else self._ldl.perm
 
     @_in_blas_region
     def solve(self, b: np.ndarray) -> np.ndarray:

@@ -144,7 +144,10 @@ def _refine(V: np.ndarray, groups: dict):
     group order; ``vid`` = the virtual vertex of each polygon, -1 for triangles; ``wflat`` aligned with
     ``corners``)."""
     n = len(V)
-    newV, fans, prow, pcol, pval = [], [], [np.arange(n)], [np.arange(n)], [np.ones(n)]
+    # P in canonical CSR, built directly: identity rows for the original vertices, then one row per virtual
+    # vertex holding its polygon's weights with the columns sorted (the layout scipy's COO conversion gives)
+    newV, fans, pcol, pval = [], [], [np.arange(n)], [np.ones(n)]
+    prow_len = [np.zeros(1, np.int64), np.ones(n, np.int64)]          # entries per row of P (after a 0)
     tris = [groups[3]] if 3 in groups else []
     flat, vids, wts = [], [], []
     nv = n
@@ -154,19 +157,25 @@ def _refine(V: np.ndarray, groups: dict):
             vids.append(np.full(len(Q), -1, np.int64))
             wts.append(np.zeros(Q.size))
             continue
-        w = virtual_vertex_weights(V[Q])                                # (q, s) polygons of this degree
+        X = V[Q]                                                        # (q, s, 3) polygons of this degree
+        w = virtual_vertex_weights(X)
         ids = nv + np.arange(len(Q))
         nv += len(Q)
-        newV.append(np.einsum("qs,qsj->qj", w, V[Q]))
+        newV.append(np.einsum("qs,qsj->qj", w, X))
         fans.append(np.stack([np.repeat(ids, s), Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1))
-        prow.append(np.repeat(ids, s))
-        pcol.append(Q.ravel())
-        pval.append(w.ravel())
+        o = np.argsort(Q, axis=1)
+        prow_len.append(np.full(len(Q), s, np.int64))
+        pcol.append(np.take_along_axis(Q, o, 1).ravel())
+        pval.append(np.take_along_axis(w, o, 1).ravel())
         vids.append(ids)
         wts.append(w.ravel())
     Vr = np.concatenate([V] + newV) if newV else V.copy()
     Fr = np.concatenate(tris + fans) if (tris or fans) else np.zeros((0, 3), np.int64)
-    P = sp.csr_matrix((np.concatenate(pval), (np.concatenate(prow), np.concatenate(pcol))), shape=(nv, n))
+    indptr = np.cumsum(np.concatenate(prow_len))
+    idx = np.int32 if indptr[-1] < 2 ** 31 - 1 else np.int64
+    P = sp.csr_matrix((np.concatenate(pval), np.concatenate(pcol).astype(idx), indptr.astype(idx)), shape=(nv, n))
+    P.has_sorted_indices = True
+    P.has_canonical_format = True
     sizes = np.concatenate([np.full(len(Q), s, np.int64) for s, Q in groups.items()])
     start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
     return Vr, Fr, P, start, np.concatenate(flat).astype(np.int64), np.concatenate(vids), np.concatenate(wts)
@@ -208,18 +217,20 @@ def frame_transport(N, e1, e2, i, j) -> np.ndarray:
     return np.where(mag > 0, z / np.where(mag > 0, mag, 1.0), 1.0)
 
 
-def connection_laplacian(L: sp.spmatrix, N, e1, e2) -> sp.csr_matrix:
+def connection_laplacian(L: sp.spmatrix, N, e1, e2, symmetric_pattern: bool = False) -> sp.csr_matrix:
     """Vertex connection Laplacian: off-diagonal entries of the real Laplacian L times the frame rotations
     r_ij (Eq. 9 / §8.3–8.4), the diagonal unchanged; Hermitian by construction (upper part, conjugated).
     On a symmetric pattern one numba pass over the upper entries writes both halves in L's own CSR layout
-    (:func:`~gsdf.heat.domains._polygon_kernels.connection_values`)."""
+    (:func:`~gsdf.heat.domains._polygon_kernels.connection_values`). ``symmetric_pattern=True``: the caller
+    guarantees a canonical CSR ``L`` with a symmetric pattern (the transpose is not formed to check it)."""
     L = sp.csr_matrix(L)
     L.sum_duplicates()
     L.sort_indices()
     n = L.shape[0]
-    Lt = L.T.tocsr()
-    Lt.sort_indices()
-    if np.array_equal(L.indptr, Lt.indptr) and np.array_equal(L.indices, Lt.indices):
+    if not symmetric_pattern:
+        Lt = L.T.tocsr()
+        Lt.sort_indices()
+    if symmetric_pattern or (np.array_equal(L.indptr, Lt.indptr) and np.array_equal(L.indices, Lt.indices)):
         N, e1, e2 = (np.ascontiguousarray(a, dtype=np.float64) for a in (N, e1, e2))
         vals = connection_values(L.indptr.astype(np.int64), L.indices.astype(np.int64), L.data.astype(np.float64),
                                  N, e1, e2)
@@ -259,6 +270,14 @@ class PolygonDomain(VertexSurfaceDomain):
     # polygon meshes: SuperLU's minimum degree alone factorizes faster than after an RCM renumbering (1.2–2.4×
     # on every polygon row of bench_heat_surface.py --solver-rule)
     renumber = False
+    # Lconn has L's pattern exactly (connection_laplacian): the Dirichlet systems of step III try step I's
+    # ordering restricted to their free vertices against AMD (no nested-dissection pass)
+    heat_on_nodes = True
+    # step I's operator ordered by AMD alone: of the 6 polygon meshes of bench_heat_surface.py --speed
+    # --polygon the "auto" rule's nested-dissection attempt ran on 4 (≤ 10k vertices) and won on one (UV
+    # sphere, 0.68× AMD's flops); on the others (bear 1.5×, quad torus 1.2×, cube sphere 32 0.96× — under the
+    # 0.9 gain) it cost 1.5–6 ms of a 20–50 ms first solve for nothing
+    heat_ordering = "amd"
 
     def __init__(self, V, polygons, t_coef: float = 1.0):
         V = _checks.as_points(V, "V")
@@ -280,8 +299,11 @@ class PolygonDomain(VertexSurfaceDomain):
                                                                       thresh)
         if not good.any():
             raise ValueError("polygons: all polygons have zero area")
-        self.F_refined = F[good]
-        self._fine_normals, self._fine_G = fn[good], fG[good]      # steps II–III on the fine triangles
+        if good.all():                                             # the usual case: no copies
+            self.F_refined, self._fine_normals, self._fine_G = F, fn, fG
+        else:
+            self.F_refined, self._fine_normals, self._fine_G = F[good], fn[good], fG[good]
+        # (the fine triangles' normals and divergence weights are steps II–III's data)
         self._fine_ops = None
         # per polygon exactly symmetric, and coo_to_csr sums duplicates in input (polygon) order for (i, j) and
         # (j, i) alike: L is exactly symmetric
@@ -291,7 +313,7 @@ class PolygonDomain(VertexSurfaceDomain):
         An[nrm == 0] = [0, 0, 1.0]
         N = An / np.maximum(nrm, 1e-300)[:, None]
         e1, e2 = tangent_frames(N)
-        Lconn = connection_laplacian(L, N, e1, e2)
+        Lconn = connection_laplacian(L, N, e1, e2, symmetric_pattern=True)   # the blocks emit (i, j) and (j, i)
         super().__init__(V, L, self.M, Lconn, N, e1, e2, t_coef * self.mean_edge ** 2)
 
     @staticmethod
