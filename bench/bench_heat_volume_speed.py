@@ -194,6 +194,11 @@ def worker(args):
     base = rss_mb()
     times, phi, fallbacks = [], None, []
     for _ in range(repeat):
+        if who == "gsdf":  # every run builds its grid operators, as the anchor's new solver object does
+            from gsdf.heat.volume import grid as _grid
+
+            _grid._grid_operators_cached.cache_clear()
+            _grid._dct_matrix.cache_clear()
         t = time.perf_counter()
         if who == "gsdf":
             from gsdf.heat.volume import signed_heat_volume
@@ -321,7 +326,8 @@ def main(argv):
             "ratios are same-run).", "",
             f"Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_heat_volume_speed.py {' '.join(argv)}`",
             "", f"gsdf: median of {rep_g}; signedheat3d: median of {rep_a} (a run over {SLOW_ANCHOR:.0f} s is not repeated), "
-            "both in a process of their own, every run timed (gsdf's numba kernels loaded before the first). "
+            "both in a process of their own, every run timed (gsdf's numba kernels loaded before the first; its "
+            "per-grid operator cache cleared before each run, as signedheat3d gets a new solver object per run). "
             "signedheat3d's time varies between runs because its Step 3 (AMGCL BiCGStab, tol 1e-2) starts from an "
             "uninitialised vector: when it fails to converge in 1000 iterations the solver falls back to a sparse "
             "direct LU (\"AMGCL fell back\": runs that did, from its own log); its Steps 1-2 (direct sums over all "
