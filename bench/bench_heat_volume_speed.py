@@ -270,7 +270,8 @@ def speed_table(names, repeat_gsdf, repeat_anchor, label, partial=None):
                          f"failed: {g.get('failed', '')} {a.get('failed', '')}"])
             continue
         ratio, ratio_min = a["median"] / g["median"], min(a["times"]) / g["median"]
-        nrep = f" (1 run: > {SLOW_ANCHOR:.0f} s)" if len(a["times"]) < repeat_anchor else ""
+        nrep = (f" ({len(a['times'])} runs: stopped after one > {SLOW_ANCHOR:.0f} s)"
+                if len(a["times"]) < repeat_anchor else "")
         spread = f"{min(a['times']):.2f} / **{a['median']:.2f}** / {max(a['times']):.2f}{nrep}"
 
         def fmt(r):
@@ -325,7 +326,7 @@ def main(argv):
     head = [f"Machine: {machine()}. Load at start: {uptime()} (shared machine: other helpers' jobs running; "
             "ratios are same-run).", "",
             f"Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_heat_volume_speed.py {' '.join(argv)}`",
-            "", f"gsdf: median of {rep_g}; signedheat3d: median of {rep_a} (a run over {SLOW_ANCHOR:.0f} s is not repeated), "
+            "", f"gsdf: median of {rep_g}; signedheat3d: median of {rep_a} (no further run after one over {SLOW_ANCHOR:.0f} s), "
             "both in a process of their own, every run timed (gsdf's numba kernels loaded before the first; its "
             "per-grid operator cache cleared before each run, as signedheat3d gets a new solver object per run). "
             "signedheat3d's time varies between runs because its Step 3 (AMGCL BiCGStab, tol 1e-2) starts from an "
