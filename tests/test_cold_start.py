@@ -159,12 +159,15 @@ def test_background_wait_for_returns_when_its_job_is_reported(fresh_listener):
         bg.wait_for("soup")
     bg.wait_for("distance")  # nothing started (warm / no compile yet): returns at once
     # a stand-in for the warm-up process: reports demo-cloud, then keeps running
-    bg.proc = subprocess.Popen([sys.executable, "-c", "import time; print('compiling ...', flush=True); "
-                                "print('  demo-cloud     1.0 s  the cloud', flush=True); time.sleep(60)"],
-                               stdout=subprocess.PIPE, text=True)
+    bg._attach(subprocess.Popen([sys.executable, "-c", "import time; print('compiling ...', flush=True); "
+                                 "print('  demo-cloud     1.0 s  the cloud', flush=True); time.sleep(60)"],
+                                stdout=subprocess.PIPE, text=True))
     t = time.perf_counter()
     bg.wait_for("demo-cloud")
     assert time.perf_counter() - t < 30 and bg.proc.poll() is None and bg.done == {"demo-cloud"}
+    t = time.perf_counter()
+    bg.wait_for("distance", timeout=0.5)  # never reported, process still running: the timeout returns
+    assert time.perf_counter() - t < 10 and bg.done == {"demo-cloud"}
     bg.proc.kill()
     bg.wait_for("distance")  # the process ended without reporting it: return, the caller compiles it
     assert bg.done == {"demo-cloud", "distance"}
