@@ -49,6 +49,18 @@ def _flip(x):
     return -x - 2
 
 
+@njit(cache=True, inline="always")
+def _unlink(i, lst, nxt, head, degree):
+    """Take variable i out of the doubly linked list of the variables of its degree."""
+    ilast, inext = lst[i], nxt[i]
+    if inext >= 0:
+        lst[inext] = ilast
+    if ilast >= 0:
+        nxt[ilast] = inext
+    else:
+        head[degree[i]] = inext
+
+
 @njit(cache=True)
 def _amd(indptr, indices, n):
     """Approximate minimum degree (Amestoy, Davis & Duff 1996) on the quotient graph of the symmetric pattern
@@ -152,13 +164,7 @@ def _amd(indptr, indices, n):
                     nv[i] = -nvi
                     iw[pme2] = i
                     pme2 += 1
-                    ilast, inext = lst[i], nxt[i]
-                    if inext >= 0:
-                        lst[inext] = ilast
-                    if ilast >= 0:
-                        nxt[ilast] = inext
-                    else:
-                        head[degree[i]] = inext
+                    _unlink(i, lst, nxt, head, degree)
         else:
             if pfree + (n - nel) + 1 > iwlen:     # room for the new list: copy the live lists to a fresh array
                 used = 0
@@ -194,13 +200,7 @@ def _amd(indptr, indices, n):
                         nv[i] = -nvi
                         iw[pme2] = i
                         pme2 += 1
-                        ilast, inext = lst[i], nxt[i]
-                        if inext >= 0:
-                            lst[inext] = ilast
-                        if ilast >= 0:
-                            nxt[ilast] = inext
-                        else:
-                            head[degree[i]] = inext
+                        _unlink(i, lst, nxt, head, degree)
                 if e != me:                   # element e absorbed into me
                     pe[e] = _flip(me)
                     w[e] = 0
