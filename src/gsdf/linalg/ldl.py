@@ -12,7 +12,9 @@ whose Eigen ``SimplicialLDLT`` does exactly this). Here:
 * **symbolic** — elimination tree and column counts of L (Davis, "Algorithm 849: LDL", 2005);
 * **numeric** — up-looking LDLᴴ: row k of L from a sparse triangular solve along the elimination tree,
   ``l_k = conj(y) / D``, ``D_k = a_kk − Σ l_ki y_i`` (no pivoting: the matrix must be positive definite;
-  a pivot ≤ 0 raises ValueError and callers fall back to SuperLU).
+  a pivot ≤ 0 raises ValueError and callers fall back to SuperLU); or, for complex flop-heavy factors with
+  wide supernodes (:data:`SUPERNODAL_FLOPS`), left-looking supernodal: dense blocks per fundamental supernode
+  (:func:`_supernodal_numeric`), the same L and D up to rounding.
 
 All kernels are serial: their sizes are the ones where thread wake-up would cost more than the work (and a
 parallel region waits for a descheduled thread under contention).
@@ -47,6 +49,19 @@ __all__ = ["LDLFactorization", "nested_dissection", "fill_count", "AUTO_ND_MAX_N
 AUTO_ND_MAX_N = 10_000
 AUTO_ND_FLOPS = 12.0
 AUTO_ND_GAIN = 0.9
+
+#: Complex (Hermitian) factors with at least SUPERNODAL_FLOPS flops (Σ_j c_j², :func:`_flops`), a fundamental
+#: supernode of at least SUPERNODAL_WIDTH columns and at least SUPERNODAL_MEAN columns per supernode on average
+#: are computed by the supernodal kernel (:func:`_supernodal_numeric`), the others by the up-looking one.
+#: Measured (numeric time, supernodal incl. its symbolic pass / up-looking; load 1–2.7): the vertex connection
+#: Laplacians of the polygon benchmark (bench_heat_surface.py --speed --polygon; mean width 2.0–2.6, widest
+#: 134–475) 0.74× (cube sphere 64, 2.0e8 flops), 0.9× (quad torus 2.4e7, polygon-bear 5.7e6); the CR-edge
+#: systems of triangle meshes (mean width 1.5) 0.9–1.08× (fandisk, blade 0.9; mannequin-devil 1.0; camel, bunny00
+#: 1.05–1.08) and 1.1× with narrow supernodes (cow, widest 73); the real Poisson systems 0.9–1.0× before the
+#: extra symbolic pass. So: complex, flop-heavy, wide supernodes.
+SUPERNODAL_FLOPS = 4e6
+SUPERNODAL_WIDTH = 100
+SUPERNODAL_MEAN = 1.8
 
 #: The orderings :class:`LDLFactorization` takes by name.
 LDL_ORDERINGS = ("auto",) + ORDERING_NAMES
@@ -197,6 +212,26 @@ def _pattern(indptr, indices, n, perm):
     return colptr, rows, src, parent, lp
 
 
+def _supernode_widths(parent, lp):
+    """(widest, mean) columns of the fundamental supernodes of L (:func:`_supernodes`' rule, without their
+    patterns)."""
+    n = len(parent)
+    if n < 2:
+        return n, float(n)
+    c = np.diff(lp)
+    cont = (parent[:-1] == np.arange(1, n)) & (c[:-1] == c[1:] + 1)       # column j+1 continues j's supernode
+    starts = np.flatnonzero(np.concatenate([[True], ~cont, [True]]))
+    return int(np.diff(starts).max()), n / (len(starts) - 1)
+
+
+def _use_supernodal(cplx, parent, lp) -> bool:
+    """The :data:`SUPERNODAL_FLOPS` rule."""
+    if not cplx or _flops(lp) < SUPERNODAL_FLOPS:
+        return False
+    widest, mean = _supernode_widths(parent, lp)
+    return widest >= SUPERNODAL_WIDTH and mean >= SUPERNODAL_MEAN
+
+
 def _flops(lp) -> float:
     """Σ_j c_j² over the column counts c_j of L (the multiply-adds of the factorization, up to a factor)."""
     c = np.diff(lp).astype(np.float64)
@@ -292,7 +327,14 @@ class LDLFactorization:
                 self.perm = _check_perm(ordering, n)
             pat = _pattern(indptr, indices, n, self.perm)
         colptr, rows, src, parent, self._lp = pat
-        self._li, self._lx, self._d, bad = _numeric(colptr, rows, data[src], n, parent, self._lp)
+        if _use_supernodal(cplx, parent, self._lp):
+            pinv = np.empty(n, np.int64)
+            pinv[self.perm] = np.arange(n)
+            lcol, lrows, lsrc = _lower_csc(indptr, indices, n, pinv)
+            sn = _supernodes(colptr, rows, n, parent, self._lp)
+            self._li, self._lx, self._d, bad = _supernodal_numeric(lcol, lrows, data[lsrc], n, self._lp, *sn)
+        else:
+            self._li, self._lx, self._d, bad = _numeric(colptr, rows, data[src], n, parent, self._lp)
         if bad >= 0:
             raise ValueError(f"matrix: not positive definite (pivot {int(bad)} of the LDL factorization ≤ 0)")
 
@@ -314,3 +356,172 @@ class LDLFactorization:
         x = np.empty(self.n, dt)
         x[self.perm] = _solve(self._lp, self._li, self._lx, self._d, np.ascontiguousarray(b[self.perm], dt))
         return x
+
+
+# ------------------------------------------------------------------------------------ supernodal numeric
+@njit(cache=True)
+def _lower_csc(indptr, indices, n, pinv):
+    """Pattern of the lower triangle (i ≥ j) of P A Pᵀ in CSC, from the CSR of A: (colptr, rows, src), ``src``
+    the position of each entry in A's data (value A[i, j]; duplicates kept, the numeric step sums them)."""
+    cnt = np.zeros(n + 1, np.int64)
+    for r in range(n):
+        i = pinv[r]
+        for q in range(indptr[r], indptr[r + 1]):
+            j = pinv[indices[q]]
+            if i >= j:
+                cnt[j + 1] += 1
+    for j in range(n):
+        cnt[j + 1] += cnt[j]
+    pos = cnt[:-1].copy()
+    rows = np.empty(cnt[n], np.int64)
+    src = np.empty(cnt[n], np.int64)
+    for r in range(n):
+        i = pinv[r]
+        for q in range(indptr[r], indptr[r + 1]):
+            j = pinv[indices[q]]
+            if i >= j:
+                rows[pos[j]] = i
+                src[pos[j]] = q
+                pos[j] += 1
+    return cnt, rows, src
+
+
+@njit(cache=True)
+def _supernodes(colptr, rows, n, parent, lp):
+    """Fundamental supernodes of L (columns j, j+1 share one when parent[j] = j+1 and column j's pattern is
+    column j+1's plus j+1, i.e. c_j = c_{j+1} + 1) and the row pattern of each: (first, snode, rptr, srow) with
+    ``first`` (S+1,) the first column of each supernode, ``snode`` the supernode of each column and
+    ``srow[rptr[s]:rptr[s+1]]`` its rows, ascending (its own columns first). The patterns come from the
+    elimination-tree reach of each row of the upper pattern (colptr, rows), as in the up-looking factorization."""
+    cnt = np.empty(n, np.int64)
+    for j in range(n):
+        cnt[j] = lp[j + 1] - lp[j]
+    snode = np.empty(n, np.int64)
+    first = np.empty(n + 1, np.int64)
+    ns = 0
+    for j in range(n):
+        if j == 0 or not (parent[j - 1] == j and cnt[j - 1] == cnt[j] + 1):
+            first[ns] = j
+            ns += 1
+        snode[j] = ns - 1
+    first[ns] = n
+    first = first[:ns + 1].copy()
+    rptr = np.zeros(ns + 1, np.int64)
+    for s in range(ns):
+        rptr[s + 1] = rptr[s] + 1 + cnt[first[s]]
+    srow = np.empty(rptr[ns], np.int64)
+    fill = np.empty(ns, np.int64)
+    for s in range(ns):
+        srow[rptr[s]] = first[s]
+        fill[s] = rptr[s] + 1
+    flag = np.empty(n, np.int64)
+    for k in range(n):
+        flag[k] = k
+        for p in range(colptr[k], colptr[k + 1]):
+            i = rows[p]
+            while i < k and flag[i] != k:
+                s = snode[i]
+                if first[s] == i:
+                    srow[fill[s]] = k
+                    fill[s] += 1
+                flag[i] = k
+                i = parent[i]
+    return first, snode, rptr, srow
+
+
+@njit(cache=True)
+def _supernodal_numeric(colptr, rows, vals, n, lp, first, snode, rptr, srow):
+    """Left-looking supernodal LDLᴴ (the scheme of CHOLMOD's supernodal factorization, without BLAS): each
+    supernode is a dense block (its rows × its columns, row-major); it receives the updates
+    ``L_d[r, :] D_d L_d[c, :]ᴴ`` of every earlier supernode d whose pattern meets its columns (scattered through
+    a row map), then is factorized densely, ``D_j = a_jj − Σ_k |l_jk|² D_k``, ``l_ij = (a_ij − Σ_k l_ik D_k
+    conj(l_jk)) / D_j``. (colptr, rows, vals): the lower triangle of the reordered matrix in CSC. Returns
+    (Li, Lx, D, k_bad) in the simplicial layout of :func:`_numeric` (column pointers ``lp``)."""
+    ns_tot = len(first) - 1
+    off = np.zeros(ns_tot + 1, np.int64)
+    wmax = 1
+    for s in range(ns_tot):
+        w = first[s + 1] - first[s]
+        off[s + 1] = off[s] + (rptr[s + 1] - rptr[s]) * w
+        if w > wmax:
+            wmax = w
+    X = np.zeros(off[ns_tot], vals.dtype)
+    d = np.empty(n, np.float64)
+    wk = np.empty(wmax, vals.dtype)
+    rmap = np.empty(n, np.int64)
+    rel = np.empty(n + 1, np.int64)
+    head = np.full(ns_tot, -1, np.int64)
+    nxt = np.full(ns_tot, -1, np.int64)
+    ptr = np.zeros(ns_tot, np.int64)
+    li = np.empty(lp[n], np.int64)
+    lx = np.empty(lp[n], vals.dtype)
+    for s in range(ns_tot):
+        f = first[s]
+        w = first[s + 1] - f
+        r0 = rptr[s]
+        nr = rptr[s + 1] - r0
+        o = off[s]
+        for i in range(nr):
+            rmap[srow[r0 + i]] = i
+        for c in range(w):
+            for p in range(colptr[f + c], colptr[f + c + 1]):
+                X[o + rmap[rows[p]] * w + c] += vals[p]
+        dd = head[s]
+        while dd != -1:
+            dnext = nxt[dd]
+            fd = first[dd]
+            wd = first[dd + 1] - fd
+            rd = rptr[dd]
+            nrd = rptr[dd + 1] - rd
+            od = off[dd]
+            p1 = ptr[dd]
+            p2 = p1
+            while p2 < nrd and srow[rd + p2] < f + w:
+                p2 += 1
+            for ii in range(p1, nrd):
+                rel[ii] = o + rmap[srow[rd + ii]] * w
+            for jj in range(p1, p2):
+                c = srow[rd + jj] - f
+                bj = od + jj * wd
+                for k in range(wd):
+                    wk[k] = d[fd + k] * np.conj(X[bj + k])
+                for ii in range(jj, nrd):
+                    bi = od + ii * wd
+                    t = X[bi] * wk[0]
+                    for k in range(1, wd):
+                        t += X[bi + k] * wk[k]
+                    X[rel[ii] + c] -= t
+            ptr[dd] = p2
+            if p2 < nrd:
+                tg = snode[srow[rd + p2]]
+                nxt[dd] = head[tg]
+                head[tg] = dd
+            dd = dnext
+        for j in range(w):
+            bj = o + j * w
+            for k in range(j):
+                wk[k] = d[f + k] * np.conj(X[bj + k])
+            for i in range(j, nr):
+                bi = o + i * w
+                t = X[bi + j] * 0.0
+                for k in range(j):
+                    t += X[bi + k] * wk[k]
+                X[bi + j] -= t
+            dj = X[bj + j].real
+            if not dj > 0.0:
+                return li, lx, d, f + j
+            d[f + j] = dj
+            for i in range(j + 1, nr):
+                X[o + i * w + j] /= dj
+        ptr[s] = w
+        if w < nr:
+            tg = snode[srow[r0 + w]]
+            nxt[s] = head[tg]
+            head[tg] = s
+        for c in range(w):
+            q = lp[f + c]
+            for i in range(c + 1, nr):
+                li[q] = srow[r0 + i]
+                lx[q] = X[o + i * w + c]
+                q += 1
+    return li, lx, d, -1
