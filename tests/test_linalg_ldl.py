@@ -114,3 +114,52 @@ def test_ordering_hint_kept_only_when_it_has_fewer_flops():
         LDLFactorization(A, hint=np.zeros(n, np.int64))
     with pytest.raises(ValueError, match="ordering"):
         LDLFactorization(A, hint=np.arange(n - 1))
+
+
+def _quad_connection_laplacian(nx=40, ny=30):
+    """A complex Hermitian PD operator on a quad grid (mass + Laplacian with unit-modulus off-diagonal phases):
+    the polygon meshes' kind of system, whose AMD factor has wide supernodes."""
+    from gsdf.heat.domains.polygon import PolygonDomain
+
+    x, y = np.meshgrid(np.linspace(0, 1, nx), np.linspace(0, 1, ny), indexing="ij")
+    V = np.stack([x.ravel(), y.ravel(), 0.1 * np.sin(3 * x.ravel()) * np.cos(2 * y.ravel())], 1)
+    idx = np.arange(nx * ny).reshape(nx, ny)
+    Q = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4)
+    D = PolygonDomain(V, Q)
+    return D.vector_heat_matrix().tocsr()
+
+
+def test_supernodal_kernel_matches_up_looking_and_dense_solve(monkeypatch):
+    import gsdf.linalg.ldl as ldl
+
+    A = _quad_connection_laplacian()
+    b = np.random.default_rng(3).normal(size=A.shape[0]) * (1 + 0.5j)
+    monkeypatch.setattr(ldl, "SUPERNODAL_FLOPS", np.inf)          # up-looking
+    f0 = LDLFactorization(A, ordering="amd")
+    monkeypatch.setattr(ldl, "SUPERNODAL_FLOPS", 0.0)             # supernodal whenever the widths allow
+    monkeypatch.setattr(ldl, "SUPERNODAL_WIDTH", 1)
+    monkeypatch.setattr(ldl, "SUPERNODAL_MEAN", 1.0)
+    calls = []
+    kernel = ldl._supernodal_numeric
+    monkeypatch.setattr(ldl, "_supernodal_numeric", lambda *a: calls.append(1) or kernel(*a))
+    f1 = LDLFactorization(A, ordering="amd")
+    assert calls and np.array_equal(f1._lp, f0._lp) and np.array_equal(f1._li, f0._li)
+    assert ldl._supernode_widths(*ldl._pattern(A.indptr.astype(np.int64), A.indices.astype(np.int64),
+                                               A.shape[0], f1.perm)[3:])[0] > 8
+    np.testing.assert_allclose(f1._lx, f0._lx, rtol=0, atol=1e-12 * np.abs(f0._lx).max())
+    np.testing.assert_allclose(f1._d, f0._d, rtol=1e-12)
+    x = f1.solve(b)
+    np.testing.assert_allclose(x, np.linalg.solve(A.toarray(), b), rtol=1e-10, atol=1e-12)
+    # not positive definite: the supernodal kernel reports the pivot, the constructor raises
+    with pytest.raises(ValueError, match="not positive definite"):
+        LDLFactorization((A - 10 * sp.identity(A.shape[0])).tocsr(), ordering="amd")
+
+
+def test_supernodal_rule_picks_complex_polygon_systems_only():
+    import gsdf.linalg.ldl as ldl
+
+    A = _quad_connection_laplacian(90, 90)
+    pat = ldl._pattern(A.indptr.astype(np.int64), A.indices.astype(np.int64), A.shape[0],
+                       ldl.order_csr(A.indptr.astype(np.int64), A.indices.astype(np.int64), A.shape[0], "amd"))
+    assert ldl._use_supernodal(True, pat[3], pat[4])
+    assert not ldl._use_supernodal(False, pat[3], pat[4])          # real systems stay up-looking
