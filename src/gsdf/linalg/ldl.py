@@ -212,16 +212,23 @@ def _pattern(indptr, indices, n, perm):
     return colptr, rows, src, parent, lp
 
 
+@njit(cache=True)
 def _supernode_widths(parent, lp):
     """(widest, mean) columns of the fundamental supernodes of L (:func:`_supernodes`' rule, without their
-    patterns)."""
+    patterns): one pass over the columns."""
     n = len(parent)
     if n < 2:
         return n, float(n)
-    c = np.diff(lp)
-    cont = (parent[:-1] == np.arange(1, n)) & (c[:-1] == c[1:] + 1)       # column j+1 continues j's supernode
-    starts = np.flatnonzero(np.concatenate([[True], ~cont, [True]]))
-    return int(np.diff(starts).max()), n / (len(starts) - 1)
+    count, widest, w = 1, 1, 1
+    for j in range(1, n):
+        if parent[j - 1] == j and lp[j] - lp[j - 1] == lp[j + 1] - lp[j] + 1:
+            w += 1
+        else:
+            count += 1
+            w = 1
+        if w > widest:
+            widest = w
+    return widest, n / count
 
 
 def _use_supernodal(cplx, parent, lp) -> bool:
