@@ -847,7 +847,10 @@ def _compare(names, setup, load, tag):
                 _interleaved(c["runs"], res, c["rounds"])
                 l1 = os.getloadavg()[0]
             med = {lib: [float(np.median([x[j] for x in v])) for j in range(3)] for lib, v in res.items()}
+            # per-round ratios (the two libraries measured next to each other): their spread shows the noise
+            pr = np.array([[g[0] / q[0], g[1] / q[1]] for g, q in zip(res["gsdf"], res["pp3d"])])
             e = dict(label=c["label"], info=c["info"], med=med, rounds=c["rounds"], load=(l0, l1),
+                     iqr=np.percentile(pr, [25, 75], axis=0),
                      diff=c["diff"](res["gsdf"][-1][3], res["pp3d"][-1][3]),
                      rf=med["gsdf"][0] / med["pp3d"][0], rr=med["gsdf"][1] / med["pp3d"][1])
             out[mode].append(e)
@@ -872,9 +875,11 @@ def _grow_rows(res):
     rows = []
     for a, b in zip(res["idle"], res["load"]):
         gf, gr = b["rf"] / a["rf"], b["rr"] / a["rr"]
-        rows.append([a["label"], f"{a['rf']:.2f} → {b['rf']:.2f}", f"**{gf:.2f}**", f"{a['rr']:.2f} → {b['rr']:.2f}",
-                     f"**{gr:.2f}**", f"{a['load'][0]:.1f} / {b['load'][0]:.1f}"])
-    return table(["mesh", "first ratio idle → loaded", "loaded / idle", "repeat ratio idle → loaded", "loaded / idle",
+        q = [f"{a['iqr'][0, j]:.2f}–{a['iqr'][1, j]:.2f} / {b['iqr'][0, j]:.2f}–{b['iqr'][1, j]:.2f}" for j in (0, 1)]
+        rows.append([a["label"], f"{a['rf']:.2f} → {b['rf']:.2f}", f"**{gf:.2f}**", q[0],
+                     f"{a['rr']:.2f} → {b['rr']:.2f}", f"**{gr:.2f}**", q[1], f"{a['load'][0]:.1f} / {b['load'][0]:.1f}"])
+    return table(["mesh", "first ratio idle → loaded", "loaded / idle", "per-round first ratio 25–75 % idle / loaded",
+                  "repeat ratio idle → loaded", "loaded / idle", "per-round repeat ratio 25–75 % idle / loaded",
                   "load 1 min idle / loaded"], rows)
 
 
