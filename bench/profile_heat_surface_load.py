@@ -161,9 +161,9 @@ def finding(stats):
     vmax = max(st["vcsw"] for st in stats.values())
     return (f"**Reading.** gsdf's runs show at most {vmax:.0f} voluntary context switch(es) in any stage (nothing "
             "waits on a worker thread, a lock or I/O: the surface path has no numba parallel kernel and runs BLAS "
-            "on one thread inside `threads.blas_region`), and CPU time grows little under load (gsdf first "
+            "on one thread inside `threads.blas_region`), and CPU time grows under load by similar factors for both libraries (gsdf first "
             f"{rng('TOTAL first', 1)}×, potpourri3d first {rng('pp3d first', 1)}×; repeat {rng('TOTAL repeat', 1)}× "
-            f"vs {rng('pp3d repeat', 1)}×: cache refills after preemption). The wall-time factors (gsdf first "
+            f"vs {rng('pp3d repeat', 1)}×: cache refills after preemption, more at a higher background load; one block of 5 rounds, so ±0.2 is noise). The wall-time factors (gsdf first "
             f"{rng('TOTAL first', 0)}×, potpourri3d first {rng('pp3d first', 0)}×) are the process's share of the "
             "cores: every stage of both libraries stretches by about the same factor, and stages of a few "
             "milliseconds stretch by either ~1× (not preempted) or 3–4× (a whole time slice of another process), "
