@@ -769,8 +769,34 @@ def _speed_case(path):
     return V, F, loops
 
 
-def _time_first_repeat(make, solve, repeat):
-    """(first = constructor + first solve, repeated = median of ``repeat`` further solves, peak RSS increase MB)."""
+#: Every timing sample lasts at least BATCH_S seconds: a faster call is repeated back to back (fresh solvers for
+#: the first solve, the same solver for the repeated one) and the mean taken — the same rule for both libraries.
+#: Under load the scheduler hands the cores out in slices of a few milliseconds, so a single millisecond-scale
+#: call either runs unpreempted or waits a whole slice of another process: per-call times of short solves jump
+#: between ~1× and 3–4× the idle time with the share of calls preempted (RESULTS "heat-repeat-load"; per stage:
+#: bench/profile_heat_surface_load.py), while a batch of ≥ 0.1 s averages over many slices.
+BATCH_S = 0.1
+#: Fresh solvers (rounds) per library and condition; LARGE_ROUNDS for SPEED_LARGE, whose first solves (0.6–3 s
+#: idle) each span hundreds of slices already.
+ROUNDS, LARGE_ROUNDS = 7, 5
+
+
+def _batch(fn, min_s=BATCH_S):
+    """Mean wall time of ``fn()`` called back to back until at least ``min_s`` seconds have passed."""
+    k, t0 = 0, time.perf_counter()
+    while True:
+        fn()
+        k += 1
+        t = time.perf_counter() - t0
+        if t >= min_s:
+            return t / k
+
+
+def _time_first_repeat(make, solve):
+    """(first, repeated, peak RSS increase MB, result) of one round: first = constructor + first solve, the mean
+    over fresh solvers built and solved back to back until ≥ BATCH_S s (the first of them measured for memory
+    too); repeated = a further solve with the same solver, the mean of a batch of ≥ BATCH_S s (:func:`_batch`);
+    peak RSS = VmHWM growth over the first solver's construction, first solve and repeats."""
     import gc
 
     gc.collect()
@@ -779,57 +805,128 @@ def _time_first_repeat(make, solve, repeat):
     t0 = time.perf_counter()
     s = make()
     out = solve(s)
-    first = time.perf_counter() - t0
-    rep, _ = median_time(lambda: solve(s), repeat)
+    first = [time.perf_counter() - t0]
+    rep = _batch(lambda: solve(s))
     peak = (_rss_kb() - base) / 1024
     del s
-    return first, rep, peak, out
-
-
-#: Cases whose first solve takes less than FAST_CASE_S seconds are timed over FAST_ROUNDS fresh solvers (and
-#: FAST_REPEAT repeated solves each) instead of ``rounds`` / 3: millisecond timings on a shared machine need
-#: more samples for a stable median.
-FAST_CASE_S, FAST_ROUNDS, FAST_REPEAT = 0.1, 7, 7
+    while sum(first) < BATCH_S:
+        t0 = time.perf_counter()
+        s = make()
+        solve(s)
+        first.append(time.perf_counter() - t0)
+        del s
+    return float(np.mean(first)), rep, peak, out
 
 
 def _interleaved(runs, res, rounds):
     """Time both libraries ``rounds`` times in one process, interleaved with alternating order (gsdf first on
-    even rounds); after the first round, cases under FAST_CASE_S get FAST_ROUNDS rounds and FAST_REPEAT repeated
-    solves (more samples, same quantities)."""
-    r, total, repeat = 0, rounds, 3
-    while r < total:
+    even rounds)."""
+    for r in range(rounds):
         for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
-            res[lib].append(_time_first_repeat(*runs[lib], repeat=repeat))
-        if r == 0 and max(res["gsdf"][0][0], res["pp3d"][0][0]) < FAST_CASE_S:
-            total, repeat = max(rounds, FAST_ROUNDS), FAST_REPEAT
-        r += 1
+            res[lib].append(_time_first_repeat(*runs[lib]))
 
 
-def speed_table(names, rounds=3, label="idle"):
-    """Per mesh: gsdf vs potpourri3d, first (constructor + first solve) and repeated solve, medians over
-    ``rounds`` fresh solvers each (the libraries interleaved, the order alternating), constraint "zero" =
-    potpourri3d's default ZeroSet; peak RSS increase of one first + repeated run."""
-    rows, ratios = [], []
-    for name in names:
-        path = os.path.join(SHM_DATA, name[4:]) if name.startswith("shm:") else os.path.join(data_dir(), "meshes", name)
-        V, F, loops = _speed_case(path)
-        pp_loops = [[(int(v), []) for v in c] for c in loops]
-        res = {"gsdf": [], "pp3d": []}
-        runs = {"gsdf": (lambda: SurfaceSignedHeatSolver(V, F), lambda s: s.compute_distance(loops)),
-                "pp3d": (lambda: pp3d.MeshSignedHeatSolver(V, F), lambda s: s.compute_distance(pp_loops))}
-        _interleaved(runs, res, rounds)
-        med = {k: [float(np.median([x[i] for x in v])) for i in range(3)] for k, v in res.items()}
-        p, q = res["gsdf"][-1][3], -res["pp3d"][-1][3]
-        d = float(np.linalg.norm(p - q) / np.linalg.norm(q))
-        rf, rr = med["gsdf"][0] / med["pp3d"][0], med["gsdf"][1] / med["pp3d"][1]
-        ratios.append((name, rf, rr))
-        rows.append([name.replace("shm:", ""), len(V), len(F), len(loops), f"{med['gsdf'][0]:.3f}",
-                     f"{med['pp3d'][0]:.3f}", f"**{rf:.2f}**", f"{med['gsdf'][1]:.4f}", f"{med['pp3d'][1]:.4f}",
-                     f"**{rr:.2f}**", f"{med['gsdf'][2]:.0f} / {med['pp3d'][2]:.0f}", f"{d:.1e}"])
-        print("speed", label, rows[-1], os.getloadavg()[0], flush=True)
-    hdr = ["mesh", "vertices", "faces", "loops", "gsdf first s", "pp3d first s", "first ratio", "gsdf repeat s",
-           "pp3d repeat s", "repeat ratio", "peak RSS +MB gsdf / pp3d", "rel. L2 diff"]
-    return table(hdr, rows), ratios
+def _compare(names, setup, load, tag):
+    """Per case (``setup(name)``: label, sizes, both libraries' constructor / solve, rounds, difference): both
+    libraries interleaved over the case's rounds, idle and — with ``load`` — with two busy processes
+    (bench/load.py BusyLoad(2), started and stopped per case). The two conditions run back to back for each case,
+    in alternating order from case to case, so that both see the same background load of the shared machine
+    (the load average moves over minutes; a whole idle table, then a whole loaded one, compared different
+    moments). Returns {condition: [entry per case]} with the medians over rounds and the 1-minute load averages
+    at the start and end of the condition's measurement."""
+    from load import BusyLoad
+
+    modes = ("idle", "load") if load else ("idle",)
+    out = {m: [] for m in modes}
+    for k, name in enumerate(names):
+        c = setup(name)
+        for mode in (modes if k % 2 == 0 else modes[::-1]):
+            with BusyLoad(2 if mode == "load" else 0):
+                l0 = os.getloadavg()[0]
+                res = {"gsdf": [], "pp3d": []}
+                _interleaved(c["runs"], res, c["rounds"])
+                l1 = os.getloadavg()[0]
+            med = {lib: [float(np.median([x[j] for x in v])) for j in range(3)] for lib, v in res.items()}
+            # per-round ratios (the two libraries measured next to each other): their spread shows the noise
+            pr = np.array([[g[0] / q[0], g[1] / q[1]] for g, q in zip(res["gsdf"], res["pp3d"])])
+            e = dict(label=c["label"], info=c["info"], med=med, rounds=c["rounds"], load=(l0, l1),
+                     iqr=np.percentile(pr, [25, 75], axis=0),
+                     diff=c["diff"](res["gsdf"][-1][3], res["pp3d"][-1][3]),
+                     rf=med["gsdf"][0] / med["pp3d"][0], rr=med["gsdf"][1] / med["pp3d"][1])
+            out[mode].append(e)
+            print(tag, mode, e["label"], f"first {med['gsdf'][0]:.4f} / {med['pp3d'][0]:.4f} = {e['rf']:.2f}, "
+                  f"repeat {med['gsdf'][1]:.5f} / {med['pp3d'][1]:.5f} = {e['rr']:.2f}, load {l0:.2f}-{l1:.2f}",
+                  flush=True)
+    return out
+
+
+def _speed_rows(entries, hdr):
+    """The markdown table of one condition (``hdr``: the first four and the last column names)."""
+    rows = [[e["label"], *e["info"], f"{e['med']['gsdf'][0]:.3f}", f"{e['med']['pp3d'][0]:.3f}", f"**{e['rf']:.2f}**",
+             f"{e['med']['gsdf'][1]:.4f}", f"{e['med']['pp3d'][1]:.4f}", f"**{e['rr']:.2f}**",
+             f"{e['med']['gsdf'][2]:.0f} / {e['med']['pp3d'][2]:.0f}", f"{e['diff']:.1e}", e["rounds"],
+             f"{e['load'][0]:.1f}–{e['load'][1]:.1f}"] for e in entries]
+    return table(hdr[:4] + ["gsdf first s", "pp3d first s", "first ratio", "gsdf repeat s", "pp3d repeat s",
+                            "repeat ratio", "peak RSS +MB gsdf / pp3d", hdr[4], "rounds", "load 1 min"], rows)
+
+
+def _grow_rows(res):
+    """Per case: loaded ratio / idle ratio (first, repeat), and the idle and loaded load averages."""
+    rows = []
+    for a, b in zip(res["idle"], res["load"]):
+        gf, gr = b["rf"] / a["rf"], b["rr"] / a["rr"]
+        q = [f"{a['iqr'][0, j]:.2f}–{a['iqr'][1, j]:.2f} / {b['iqr'][0, j]:.2f}–{b['iqr'][1, j]:.2f}" for j in (0, 1)]
+        rows.append([a["label"], f"{a['rf']:.2f} → {b['rf']:.2f}", f"**{gf:.2f}**", q[0],
+                     f"{a['rr']:.2f} → {b['rr']:.2f}", f"**{gr:.2f}**", q[1], f"{a['load'][0]:.1f} / {b['load'][0]:.1f}"])
+    return table(["mesh", "first ratio idle → loaded", "loaded / idle", "per-round first ratio 25–75 % idle / loaded",
+                  "repeat ratio idle → loaded", "loaded / idle", "per-round repeat ratio 25–75 % idle / loaded",
+                  "load 1 min idle / loaded"], rows)
+
+
+def _summary(res, what):
+    """One sentence of ratio ranges (idle, loaded, loaded / idle) for one mesh family."""
+    fi, ri = [e["rf"] for e in res["idle"]], [e["rr"] for e in res["idle"]]
+    s = (f"{what}, idle: first-solve ratio gsdf / potpourri3d {min(fi):.2f}–{max(fi):.2f} (≤ 1.0 on "
+         f"{sum(x <= 1.0 for x in fi)}/{len(fi)}), repeated {min(ri):.2f}–{max(ri):.2f} (≤ 0.5 on "
+         f"{sum(x <= 0.5 for x in ri)}/{len(ri)})")
+    if "load" in res:
+        fl, rl = [e["rf"] for e in res["load"]], [e["rr"] for e in res["load"]]
+        gf = [b / a for a, b in zip(fi, fl)]
+        gr = [b / a for a, b in zip(ri, rl)]
+        s += (f"; under load: first {min(fl):.2f}–{max(fl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in fl)}/{len(fl)}), "
+              f"repeated {min(rl):.2f}–{max(rl):.2f} (≤ 0.5 on {sum(x <= 0.5 for x in rl)}/{len(rl)}); loaded ratio / "
+              f"idle ratio: first {min(gf):.2f}–{max(gf):.2f}, repeated {min(gr):.2f}–{max(gr):.2f} (≤ 1.25 on "
+              f"{sum(x <= 1.25 for x in gf)}/{len(gf)} and {sum(x <= 1.25 for x in gr)}/{len(gr)})")
+    return s + "."
+
+
+def _tri_setup(name):
+    """A triangle-mesh --speed case: mesh (degenerate faces dropped), the loops of {y < median}, both solvers."""
+    path = os.path.join(SHM_DATA, name[4:]) if name.startswith("shm:") else os.path.join(data_dir(), "meshes", name)
+    V, F, loops = _speed_case(path)
+    pp_loops = [[(int(v), []) for v in c] for c in loops]
+    return dict(label=name.replace("shm:", ""), info=[len(V), len(F), len(loops)],
+                rounds=LARGE_ROUNDS if name in SPEED_LARGE else ROUNDS,
+                runs={"gsdf": (lambda: SurfaceSignedHeatSolver(V, F), lambda s: s.compute_distance(loops)),
+                      "pp3d": (lambda: pp3d.MeshSignedHeatSolver(V, F), lambda s: s.compute_distance(pp_loops))},
+                # potpourri3d: the left of a curve is positive; gsdf: negative
+                diff=lambda p, q: float(np.linalg.norm(p + q) / np.linalg.norm(q)))
+
+
+TRI_HDR = ["mesh", "vertices", "faces", "loops", "rel. L2 diff"]
+POLY_HDR = ["polygon mesh", "vertices", "polygons", "loops", "rel. L2 diff (two discretizations)"]
+
+
+def _protocol(rounds_note):
+    return ("first = constructor + first solve, repeat = a further solve with the same solver and curves; every "
+            f"sample is the mean over calls back to back lasting ≥ {BATCH_S} s (fresh solvers for first; "
+            "millisecond calls are otherwise either unpreempted or a whole time slice late under load, section "
+            f"\"heat-repeat-load\"); each figure the median over {rounds_note} rounds, the libraries interleaved with "
+            "alternating order. Per mesh the idle and the loaded measurement (two busy processes, bench/load.py "
+            "BusyLoad(2), started and stopped per mesh) run back to back, in alternating order from mesh to mesh, "
+            "so that both see the same background load (`load 1 min` = the 1-minute load average at the start and "
+            "end of the mesh's measurement, busy processes included). Peak RSS = growth of the process's VmHWM over "
+            "the RSS before the round (median).")
 
 
 def _warm_polygon():
@@ -843,56 +940,49 @@ def _warm_polygon():
     pp3d.PolygonMeshHeatSolver(Vq, np.asarray(Q)).compute_signed_distance([list(map(int, c)) for c in lq])
 
 
+def _tables(res, hdr, poly_note=""):
+    parts = [f"### Idle\n\n{poly_note}" + _speed_rows(res["idle"], hdr)]
+    if "load" in res:
+        parts.append(f"### Two busy processes competing (bench/load.py BusyLoad(2))\n\n{poly_note}"
+                     + _speed_rows(res["load"], hdr))
+    return parts
+
+
 def poly_speed(quick=False, load=False):
     """Issue 17 goal 4, polygon meshes only (the polygon rows of :func:`speed`, same protocol), idle and, with
     ``load``, with two busy processes competing; RESULTS section "heat-surface-speed-polygon"."""
     from importlib.metadata import version
 
-    from load import BusyLoad, uptime
+    from load import uptime
 
     _warm_polygon()
-    pnames, rounds = (POLY_QUICK if quick else POLY_SPEED), 3
+    pnames = POLY_QUICK if quick else POLY_SPEED
     start = uptime()
-    tp_idle, rp_idle = poly_speed_table(pnames, rounds, "idle")
-    parts = [f"### Idle ({start} at start, {uptime()} at end)\n\n" + tp_idle]
-    rp_load = None
+    res = _compare(pnames, _poly_setup, load, "poly-speed")
+    end = uptime()
+    parts = _tables(res, POLY_HDR)
     if load:
-        with BusyLoad(2):
-            s2 = uptime()
-            tp_load, rp_load = poly_speed_table(pnames, rounds, "load")
-            e2 = uptime()
-        parts.append(f"### Two busy processes competing (bench/load.py BusyLoad(2); {s2} at start, {e2} at end)"
-                     "\n\n" + tp_load)
-    pi = [r[1] for r in rp_idle]
-    summ = (f"Idle: first-solve ratio gsdf / potpourri3d {min(pi):.2f}–{max(pi):.2f} (≤ 1.0 on "
-            f"{sum(x <= 1.0 for x in pi)}/{len(pi)}), repeated {min(r[2] for r in rp_idle):.2f}–"
-            f"{max(r[2] for r in rp_idle):.2f}")
-    if rp_load is not None:
-        pl = [r[1] for r in rp_load]
-        summ += (f"; under load: first {min(pl):.2f}–{max(pl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in pl)}/{len(pl)}), "
-                 f"loaded / idle ratio {min(b / a for a, b in zip(pi, pl)):.2f}–"
-                 f"{max(b / a for a, b in zip(pi, pl)):.2f}")
+        parts.append("### Loaded ratio / idle ratio per mesh\n\n" + _grow_rows(res))
     return (f"## Surface signed heat method on polygon meshes: speed against potpourri3d on {len(pnames)} meshes "
-            f"(issue 17)\n\nMachine: {machine()}; shared with other helpers (load averages per table). Command: "
-            f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --polygon --load"
+            f"(issue 17)\n\nMachine: {machine()}; shared with other helpers ({start} at start, {end} at end). "
+            f"Command: `/work/anchors/bin/python bench/bench_heat_surface.py --speed --polygon --load"
             f"{' --quick' if quick else ''}`. potpourri3d {version('potpourri3d')} `PolygonMeshHeatSolver` "
             "(`compute_signed_distance`), gsdf `PolygonMeshSignedHeatSolver`; the polygon rows of the "
-            "\"heat-surface-speed\" section, same protocol (first = constructor + first solve, medians over "
-            f"{rounds} fresh solvers, interleaved; under {FAST_CASE_S} s: {FAST_ROUNDS} solvers). Ratios = gsdf / "
-            "potpourri3d (goal: first ≤ 1.0).\n\n" + summ + ".\n\n" + "\n\n".join(parts) + "\n")
+            "\"heat-surface-speed\" section, same protocol: " + _protocol(ROUNDS)
+            + " Ratios = gsdf / potpourri3d (goal: first ≤ 1.0).\n\n" + _summary(res, "Polygon meshes")
+            + "\n\n" + "\n\n".join(parts) + "\n")
 
 
 def speed(quick=False, load=False, small=False):
     """Issue 17 goals 4–5: the surface signed heat method against potpourri3d on ≥ 10 meshes, idle and with two
-    busy processes competing (bench/load.py)."""
+    busy processes competing (bench/load.py), per mesh back to back (:func:`_compare`)."""
     from importlib.metadata import version
 
-    from load import BusyLoad, uptime
+    from load import uptime
 
     names = SPEED_QUICK if quick else SPEED_MESHES
     if small:                                               # the 13 meshes below 20k vertices
         names = [m for m in names if m not in SPEED_LARGE]
-    rounds = 3
     # warm-up: numba kernels and first-call costs of both libraries outside the timings
     Vw, Fw = sphere_mesh(2)
     lw = level_set_curves(Vw, Fw, Vw[:, 2] - 0.1)
@@ -903,56 +993,28 @@ def speed(quick=False, load=False, small=False):
     _warm_polygon()                                               # the polygon kernels too (numba cache load)
     pnames = POLY_QUICK if quick else POLY_SPEED
     start = uptime()
-    t_idle, r_idle = speed_table(names, rounds, "idle")
-    tp_idle, rp_idle = poly_speed_table(pnames, rounds, "idle")
-    parts = [f"### Idle ({start} at start, {uptime()} at end)\n\n" + t_idle + "\n\nPolygon meshes (§8.3):\n\n"
-             + tp_idle]
-    r_load = rp_load = None
+    res = _compare(names, _tri_setup, load, "speed")
+    pres = _compare(pnames, _poly_setup, load, "poly-speed")
+    end = uptime()
+    parts = _tables(res, TRI_HDR)
+    pparts = _tables(pres, POLY_HDR, "Polygon meshes (§8.3):\n\n")
+    parts = [parts[0] + "\n\n" + pparts[0].split("\n\n", 1)[1]] + \
+        ([parts[1] + "\n\n" + pparts[1].split("\n\n", 1)[1]] if load else [])
     if load:
-        with BusyLoad(2):
-            s2 = uptime()
-            t_load, r_load = speed_table(names, rounds, "load")
-            tp_load, rp_load = poly_speed_table(pnames, rounds, "load")
-            e2 = uptime()
-        parts.append(f"### Two busy processes competing (bench/load.py BusyLoad(2); {s2} at start, {e2} at end)"
-                     "\n\n" + t_load + "\n\nPolygon meshes (§8.3):\n\n" + tp_load)
-    fi = [r[1] for r in r_idle]
-    ri = [r[2] for r in r_idle]
-    summ = (f"Idle: first-solve ratio gsdf / potpourri3d {min(fi):.2f}–{max(fi):.2f} (≤ 1.0 on "
-            f"{sum(x <= 1.0 for x in fi)}/{len(fi)}), repeated {min(ri):.2f}–{max(ri):.2f} (≤ 0.5 on "
-            f"{sum(x <= 0.5 for x in ri)}/{len(ri)}).")
-    if r_load is not None:
-        fl = [r[1] for r in r_load]
-        rl = [r[2] for r in r_load]
-        gf = [b / a for a, b in zip(fi, fl)]
-        gr = [b / a for a, b in zip(ri, rl)]
-        summ += (f" Under load: first {min(fl):.2f}–{max(fl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in fl)}/{len(fl)}), "
-                 f"repeated {min(rl):.2f}–{max(rl):.2f} (≤ 0.5 on {sum(x <= 0.5 for x in rl)}/{len(rl)}); "
-                 f"loaded ratio / idle ratio: first {min(gf):.2f}–{max(gf):.2f}, repeated {min(gr):.2f}–"
-                 f"{max(gr):.2f} (≤ 1.25 on {sum(x <= 1.25 for x in gf)}/{len(gf)} and "
-                 f"{sum(x <= 1.25 for x in gr)}/{len(gr)}).")
-    pi = [r[1] for r in rp_idle]
-    summ += (f" Polygon meshes, idle: first {min(pi):.2f}–{max(pi):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in pi)}/"
-             f"{len(pi)}), repeated {min(r[2] for r in rp_idle):.2f}–{max(r[2] for r in rp_idle):.2f}")
-    if rp_load is not None:
-        pl = [r[1] for r in rp_load]
-        summ += (f"; under load: first {min(pl):.2f}–{max(pl):.2f} (≤ 1.0 on {sum(x <= 1.0 for x in pl)}/{len(pl)}), "
-                 f"loaded / idle ratio {min(b / a for a, b in zip(pi, pl)):.2f}–"
-                 f"{max(b / a for a, b in zip(pi, pl)):.2f}")
-    summ += "."
+        parts.append("### Loaded ratio / idle ratio per mesh\n\n" + _grow_rows(res) + "\n\nPolygon meshes:\n\n"
+                     + _grow_rows(pres))
+    summ = _summary(res, "Triangle meshes") + " " + _summary(pres, "Polygon meshes")
+    large = [m for m in names if m in SPEED_LARGE]
+    rounds_note = f"{ROUNDS}" + (f" ({LARGE_ROUNDS} for {', '.join(large)})" if large else "")
     txt = (f"## Surface signed heat method: speed against potpourri3d on {len(names)} meshes (issue 17)\n\n"
-           f"Machine: {machine()}; shared with other helpers (load averages per table). Command: "
+           f"Machine: {machine()}; shared with other helpers ({start} at start, {end} at end). Command: "
            f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --load{' --quick' if quick else ''}"
            f"{' --small' if small else ''}`. "
            f"potpourri3d {version('potpourri3d')} `MeshSignedHeatSolver`, gsdf `SurfaceSignedHeatSolver`, one "
            "process, same mesh and curves (the boundary loops of {y < median} along edges), constraint \"zero\" = "
-           "potpourri3d's default `ZeroSet` (both: φ = 0 at the curve vertices). first = constructor + first "
-           "solve; repeat = median of 3 further solves with the same curves; each the median over "
-           f"{rounds} fresh solvers, the libraries interleaved with alternating order (cases whose first solve "
-           f"is under {FAST_CASE_S} s: {FAST_ROUNDS} fresh solvers and {FAST_REPEAT} repeated solves each). Peak RSS = growth of the "
-           "process's VmHWM over the RSS before the case (median). Ratios = gsdf / potpourri3d (goal: first ≤ 1.0, "
-           "repeat ≤ 0.5, loaded ratio within 1.25× of the idle one).\n\n" + summ + "\n\n" + "\n\n".join(parts)
-           + "\n")
+           "potpourri3d's default `ZeroSet` (both: φ = 0 at the curve vertices). " + _protocol(rounds_note)
+           + " Ratios = gsdf / potpourri3d (goal: first ≤ 1.0, repeat ≤ 0.5, loaded ratio within 1.25× of the "
+           "idle one).\n\n" + summ + "\n\n" + "\n\n".join(parts) + "\n")
     return txt
 
 
@@ -1422,35 +1484,20 @@ def _poly_speed_case(name):
     return V, polys, loops
 
 
-def poly_speed_table(names, rounds=3, label="idle"):
-    """Polygon meshes: gsdf PolygonMeshSignedHeatSolver vs potpourri3d PolygonMeshHeatSolver, constructor + first
-    signed-distance solve and a repeated solve, "zero" = potpourri3d's default ZeroSet."""
+def _poly_setup(name):
+    """A polygon-mesh --speed case: gsdf PolygonMeshSignedHeatSolver vs potpourri3d PolygonMeshHeatSolver,
+    constructor + first signed-distance solve and a repeated solve, "zero" = potpourri3d's default ZeroSet."""
     from gsdf.heat import PolygonMeshSignedHeatSolver
 
-    rows, ratios = [], []
-    for name in names:
-        V, polys, loops = _poly_speed_case(name)
-        arr = np.asarray(polys) if len({len(p) for p in polys}) == 1 else None
-        pp_polys = arr if arr is not None else [list(map(int, p)) for p in polys]
-        pp_loops = [list(map(int, c)) for c in loops]
-        res = {"gsdf": [], "pp3d": []}
-        runs = {"gsdf": (lambda: PolygonMeshSignedHeatSolver(V, polys), lambda s: s.compute_distance(loops)),
-                "pp3d": (lambda: pp3d.PolygonMeshHeatSolver(V, pp_polys),
-                         lambda s: s.compute_signed_distance(pp_loops))}
-        _interleaved(runs, res, rounds)
-        med = {k: [float(np.median([x[i] for x in v])) for i in range(3)] for k, v in res.items()}
-        p, q = res["gsdf"][-1][3], res["pp3d"][-1][3]
-        d = float(np.linalg.norm(p - q) / np.linalg.norm(q))
-        rf, rr = med["gsdf"][0] / med["pp3d"][0], med["gsdf"][1] / med["pp3d"][1]
-        ratios.append((name, rf, rr))
-        rows.append([name[5:], len(V), len(polys), len(loops), f"{med['gsdf'][0]:.3f}", f"{med['pp3d'][0]:.3f}",
-                     f"**{rf:.2f}**", f"{med['gsdf'][1]:.4f}", f"{med['pp3d'][1]:.4f}", f"**{rr:.2f}**",
-                     f"{med['gsdf'][2]:.0f} / {med['pp3d'][2]:.0f}", f"{d:.1e}"])
-        print("poly-speed", label, rows[-1], os.getloadavg()[0], flush=True)
-    hdr = ["polygon mesh", "vertices", "polygons", "loops", "gsdf first s", "pp3d first s", "first ratio",
-           "gsdf repeat s", "pp3d repeat s", "repeat ratio", "peak RSS +MB gsdf / pp3d",
-           "rel. L2 diff (two discretizations)"]
-    return table(hdr, rows), ratios
+    V, polys, loops = _poly_speed_case(name)
+    arr = np.asarray(polys) if len({len(p) for p in polys}) == 1 else None
+    pp_polys = arr if arr is not None else [list(map(int, p)) for p in polys]
+    pp_loops = [list(map(int, c)) for c in loops]
+    return dict(label=name[5:], info=[len(V), len(polys), len(loops)], rounds=ROUNDS,
+                runs={"gsdf": (lambda: PolygonMeshSignedHeatSolver(V, polys), lambda s: s.compute_distance(loops)),
+                      "pp3d": (lambda: pp3d.PolygonMeshHeatSolver(V, pp_polys),
+                               lambda s: s.compute_signed_distance(pp_loops))},
+                diff=lambda p, q: float(np.linalg.norm(p - q) / np.linalg.norm(q)))
 
 
 if __name__ == "__main__" and "--polygon-pointcloud" not in sys.argv:
