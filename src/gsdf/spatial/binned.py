@@ -413,7 +413,8 @@ def build_volume_rows(E, leaf_size, threads=1):
     in place (to tree order: row j is then element ``order[j]``).
 
     With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
-    of the tree is split on the calling thread down to nodes of about n/64 elements, whose subtrees are then
+    of the tree is split down to nodes of about n/64 elements (the root on the calling thread, then its two
+    halves at once, :func:`_parallel_top`), whose subtrees are then
     grown on ``threads`` Python threads (:func:`_grow` releases the GIL; the subtrees own disjoint rows) and
     spliced into the preorder arrays by :func:`_splice` (the same tree as the serial build). Both builds are
     the one compiled kernel :func:`_grow` driven from here: no parallel numba kernel (a parfor over the tasks
