@@ -14,7 +14,7 @@ build cheap (on the 75k-face bunny it is several times faster than splitting by 
   come out of the bins, so no node is read again for its bounds;
 * a node of at most :data:`SMALL` elements instead tries every split of its elements sorted along each axis
   (insertion sort): there the 3 × 32 bins cost more than the elements, and an exhaustive sweep never finds a
-  worse split than the bins.
+  worse split than the bins. Its prefix / suffix costs are computed with the running bounds in registers.
 
 Example
 -------
@@ -166,11 +166,19 @@ def _split_sweep(E, order, s, e, perm, pre, tmp, tmpo, out):
                 p[k] = p[k - 1]
                 k -= 1
             p[k] = i
-        for i in range(n):
+        # pre[i, 0]: (i + 1) r³ of the first i + 1 sorted elements' box, pre[i, 1]: (n − i) r³ of the rest
+        # (running bounds in registers: 30 % faster than chaining them through pre)
+        pl0 = pl1 = pl2 = np.inf
+        ph0 = ph1 = ph2 = -np.inf
+        for i in range(n - 1):
             r = s + p[i]
-            for d in range(3):
-                pre[i, d] = min(pre[i - 1, d], E[r, 3 + d]) if i > 0 else E[r, 3 + d]
-                pre[i, 3 + d] = max(pre[i - 1, 3 + d], E[r, 6 + d]) if i > 0 else E[r, 6 + d]
+            pl0 = min(pl0, E[r, 3])
+            pl1 = min(pl1, E[r, 4])
+            pl2 = min(pl2, E[r, 5])
+            ph0 = max(ph0, E[r, 6])
+            ph1 = max(ph1, E[r, 7])
+            ph2 = max(ph2, E[r, 8])
+            pre[i, 0] = (i + 1) * _cube_half_diag(pl0, pl1, pl2, ph0, ph1, ph2)
         rl0 = rl1 = rl2 = np.inf
         rh0 = rh1 = rh2 = -np.inf
         for i in range(n - 1, 0, -1):  # left = first i sorted, right = the rest
@@ -181,9 +189,9 @@ def _split_sweep(E, order, s, e, perm, pre, tmp, tmpo, out):
             rh0 = max(rh0, E[r, 6])
             rh1 = max(rh1, E[r, 7])
             rh2 = max(rh2, E[r, 8])
-            c = (i * _cube_half_diag(pre[i - 1, 0], pre[i - 1, 1], pre[i - 1, 2],
-                                     pre[i - 1, 3], pre[i - 1, 4], pre[i - 1, 5])
-                 + (n - i) * _cube_half_diag(rl0, rl1, rl2, rh0, rh1, rh2))
+            pre[i, 1] = (n - i) * _cube_half_diag(rl0, rl1, rl2, rh0, rh1, rh2)
+        for i in range(1, n):
+            c = pre[i - 1, 0] + pre[i, 1]
             # equal costs (coincident or flat elements): the more balanced split, so duplicates give no chains
             if c < best or (c == best and abs(2 * i - n) < abs(2 * best_pos - n)):
                 best = c
@@ -347,7 +355,8 @@ def build_volume_rows(E, leaf_size, threads=1):
     in place (to tree order: row j is then element ``order[j]``).
 
     With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
-    of the tree is split on the calling thread down to nodes of about n/64 elements, whose subtrees are then
+    of the tree is split down to nodes of about n/64 elements (the root on the calling thread, then its two
+    halves at once, :func:`_parallel_top`), whose subtrees are then
     grown on ``threads`` Python threads (:func:`_grow` releases the GIL; the subtrees own disjoint rows) and
     spliced into the preorder arrays by :func:`_splice` (the same tree as the serial build). Both builds are
     the one compiled kernel :func:`_grow` driven from here: no parallel numba kernel (a parfor over the tasks
@@ -356,23 +365,22 @@ def build_volume_rows(E, leaf_size, threads=1):
     order = np.arange(n, dtype=np.int64)
     root = _root_bounds(E)
     if threads > 1 and n > PARALLEL_ELEMENTS:
-        cutoff = max(leaf_size + 1, n // 64)
-        kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, 0, n, root, leaf_size, cutoff,
-                                                        np.empty((256, 4), np.int64), np.empty((256, 6)), 0)
-        # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
-        sub_i = np.empty((2 * n, 4), np.int64)
-        sub_b = np.empty((2 * n, 6))
-        counts = np.empty(ntask, np.int64)
-
-        def grow_task(t):
-            s, e = task_i[t, 0], task_i[t, 1]
-            counts[t] = _grow(E, order, s, e, task_b[t], leaf_size, 0, sub_i, sub_b, 2 * s)[0]
-
         from concurrent.futures import ThreadPoolExecutor
 
-        # largest subtrees first, so the threads finish together
-        todo = np.argsort(task_i[:ntask, 0] - task_i[:ntask, 1], kind="stable")
+        cutoff = max(leaf_size + 1, n // 64)
         with ThreadPoolExecutor(max_workers=threads) as pool:
+            kt, top_i, top_b, ntask, task_i, task_b = _parallel_top(E, order, root, leaf_size, cutoff, pool)
+            # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
+            sub_i = np.empty((2 * n, 4), np.int64)
+            sub_b = np.empty((2 * n, 6))
+            counts = np.empty(ntask, np.int64)
+
+            def grow_task(t):
+                s, e = task_i[t, 0], task_i[t, 1]
+                counts[t] = _grow(E, order, s, e, task_b[t], leaf_size, 0, sub_i, sub_b, 2 * s)[0]
+
+            # largest subtrees first, so the threads finish together
+            todo = np.argsort(task_i[:ntask, 0] - task_i[:ntask, 1], kind="stable")
             list(pool.map(grow_task, todo))
         start, end, right, lo, hi = _splice(kt, top_i, top_b, task_i[:ntask], counts, sub_i, sub_b)
     else:
@@ -381,6 +389,38 @@ def build_volume_rows(E, leaf_size, threads=1):
         start, end, right = (node_i[:k, c].copy() for c in range(3))
         lo, hi = node_b[:k, 0:3].copy(), node_b[:k, 3:6].copy()
     return order, start, end, right, _skips(start, end, right), lo, hi
+
+
+def _parallel_top(E, order, root, leaf_size, cutoff, pool):
+    """The top of the tree down to nodes of at most ``cutoff`` elements (the tasks), as :func:`_grow` with
+    that cutoff returns it, with the two halves below the root grown at the same time on ``pool``'s threads
+    (the top levels were ~25 % of the build on one thread while the other waited). The same tree as one
+    :func:`_grow`: the root's split, then each child's subtree, numbered root, left's nodes, right's."""
+    n = E.shape[0]
+    # the root alone: nodes of at most n − 1 elements (its two children) become tasks
+    k0, i0, b0, nt0, ti0, tb0 = _grow(E, order, 0, n, root, leaf_size, n - 1, np.empty((4, 4), np.int64),
+                                      np.empty((4, 6)), 0)
+    if k0 != 3 or nt0 != 2:  # root is a leaf (cannot happen above PARALLEL_ELEMENTS), or not split in two
+        return _grow(E, order, 0, n, root, leaf_size, cutoff, np.empty((256, 4), np.int64), np.empty((256, 6)), 0)
+    halves = list(pool.map(lambda h: _grow(E, order, ti0[h, 0], ti0[h, 1], tb0[h], leaf_size, cutoff,
+                                           np.empty((128, 4), np.int64), np.empty((128, 6)), 0), (0, 1)))
+    (kl, il, bl, ntl, tl, tbl), (kr, ir, br, ntr, tr, tbr) = halves
+    kt = 1 + kl + kr
+    top_i = np.empty((kt, 4), np.int64)
+    top_b = np.empty((kt, 6))
+    top_i[0] = (0, n, 1 + kl, -1)
+    top_b[0] = b0[0]
+    for off, k, ih, bh, toff in ((1, kl, il, bl, 0), (1 + kl, kr, ir, br, ntl)):
+        rows = top_i[off:off + k]
+        rows[:, 0:2] = ih[:k, 0:2]
+        rows[:, 2] = np.where(ih[:k, 2] >= 0, ih[:k, 2] + off, -1)
+        rows[:, 3] = np.where(ih[:k, 3] >= 0, ih[:k, 3] + toff, -1)
+        top_b[off:off + k] = bh[:k]
+    task_i = np.concatenate((tl[:ntl], tr[:ntr]))
+    task_i[:ntl, 2] += 1
+    task_i[ntl:, 2] += 1 + kl
+    task_b = np.concatenate((tbl[:ntl], tbr[:ntr]))
+    return kt, top_i, top_b, ntl + ntr, task_i, task_b
 
 
 @njit(cache=True)
