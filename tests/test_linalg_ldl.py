@@ -87,9 +87,11 @@ def test_coo_to_csr_matches_scipy_real_and_complex():
                                (ops.cr_mass() + 0.1 * ops.cr_connection_laplacian()).toarray(), atol=1e-15)
 
 
-def test_ordering_hint_kept_only_when_it_has_fewer_flops():
-    """``hint`` competes with AMD on flops: a good hint (nested dissection on a grid) or AMD is kept,
-    whichever is cheaper; the natural order (a banded, flop-heavy one) never beats AMD; bad hints raise."""
+def test_ordering_hint_taken_unless_flop_heavy_then_fewer_flops_kept():
+    """``hint`` is taken as it is when its factor is not flop-heavy (HINT_AMD_FLOPS); a flop-heavy hint
+    competes with AMD on flops: a good hint (nested dissection on a grid) or AMD is kept, whichever is
+    cheaper; the natural order (a banded, flop-heavy one) never beats AMD; bad hints raise."""
+    from gsdf.linalg import ldl
     from gsdf.linalg.ldl import _flops, _pattern
     from gsdf.linalg.ordering import approximate_minimum_degree
 
@@ -101,15 +103,27 @@ def test_ordering_hint_kept_only_when_it_has_fewer_flops():
     amd = approximate_minimum_degree(A)
     nd = nested_dissection(A)
     fl = {k: _flops(_pattern(ip, ix, n, p)[4]) for k, p in (("amd", amd), ("nd", nd))}
-    f = LDLFactorization(A, hint=nd)
-    assert np.array_equal(f.perm, nd if fl["nd"] <= fl["amd"] else amd)
     natural = np.arange(n)
-    assert _flops(_pattern(ip, ix, n, natural)[4]) > fl["amd"]
-    g = LDLFactorization(A, hint=natural)
-    assert np.array_equal(g.perm, amd)
+    f_nat = _flops(_pattern(ip, ix, n, natural)[4])
+    assert f_nat > fl["amd"]
+    heavy = ldl.HINT_AMD_FLOPS * len(ix) * np.log2(n)
+    assert max(fl["nd"], f_nat) < heavy                       # both light: taken as given, no AMD pass
+    assert np.array_equal(LDLFactorization(A, hint=nd).perm, nd)
+    assert np.array_equal(LDLFactorization(A, hint=natural).perm, natural)
+    # with a lower threshold both are flop-heavy and compete with AMD
+    old = ldl.HINT_AMD_FLOPS
+    try:
+        ldl.HINT_AMD_FLOPS = 0.5 * min(fl["nd"], f_nat) / (len(ix) * np.log2(n))
+        f = LDLFactorization(A, hint=nd)
+        assert np.array_equal(f.perm, nd if fl["nd"] <= fl["amd"] else amd)
+        g = LDLFactorization(A, hint=natural)
+        assert np.array_equal(g.perm, amd)
+    finally:
+        ldl.HINT_AMD_FLOPS = old
     b = np.random.default_rng(0).normal(size=n)
     np.testing.assert_allclose(A @ f.solve(b), b, atol=1e-10)
-    np.testing.assert_allclose(spd_factorization(A, hint=nd).solve(b), f.solve(b), rtol=0, atol=0)
+    np.testing.assert_allclose(spd_factorization(A, hint=nd).solve(b), LDLFactorization(A, hint=nd).solve(b),
+                               rtol=0, atol=0)
     with pytest.raises(ValueError, match="ordering"):
         LDLFactorization(A, hint=np.zeros(n, np.int64))
     with pytest.raises(ValueError, match="ordering"):

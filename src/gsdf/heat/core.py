@@ -198,10 +198,10 @@ class FactorizedPoisson(PoissonSolver):
     :class:`gsdf.linalg.SPDSolver`, CG/AMG above a size).
 
     ``ordering``: a callable returning a fill-reducing permutation (n,) of all nodes, or None. When given (and
-    ``spd`` is not), a Dirichlet system's LDLᵀ tries that permutation restricted to its free nodes in place of
-    a nested-dissection pass, against AMD (the elimination graph of a principal submatrix under the induced
-    order is a subgraph of the full one, so its fill is at most the full factor's). Polygon meshes: Step I's
-    ordering of the same vertex graph.
+    ``spd`` is not), a Dirichlet system's LDLᵀ is ordered by that permutation restricted to its free nodes, with
+    no ordering pass of its own (AMD too only when that factor is flop-heavy, :data:`gsdf.linalg.ldl.HINT_AMD_FLOPS`;
+    the elimination graph of a principal submatrix under the induced order is a subgraph of the full one, so
+    its fill is at most the full factor's). Polygon meshes: Step I's ordering of the same vertex graph.
     """
 
     def __init__(self, L, Mv, spd=None, exact_gauge: bool = False, renumber: bool = True, ordering=None):

@@ -36,7 +36,8 @@ from numba import njit
 
 from .ordering import ORDERING_NAMES, nested_dissection, order_csr
 
-__all__ = ["LDLFactorization", "nested_dissection", "fill_count", "AUTO_ND_MAX_N", "AUTO_ND_FLOPS"]
+__all__ = ["LDLFactorization", "nested_dissection", "fill_count", "AUTO_ND_MAX_N", "AUTO_ND_FLOPS",
+           "HINT_AMD_FLOPS"]
 
 #: The ``ordering="auto"`` rule (bench/bench_ldl_ordering.py, RESULTS section "ldl-ordering", 16 + 6 meshes):
 #: AMD's fill is 0.5–0.9× nested dissection's on the triangle-mesh systems and its ordering 1.5–4× faster, so
@@ -49,6 +50,16 @@ __all__ = ["LDLFactorization", "nested_dissection", "fill_count", "AUTO_ND_MAX_N
 AUTO_ND_MAX_N = 10_000
 AUTO_ND_FLOPS = 12.0
 AUTO_ND_GAIN = 0.9
+
+#: An ordering ``hint`` (:class:`LDLFactorization`) is taken as it is unless its factor is flop-heavy, Σ_j c_j² ≥
+#: HINT_AMD_FLOPS · nnz(A) · log2 n; then AMD is computed too and the fewer-flop one kept. Measured on step III's
+#: Dirichlet systems of the 6 polygon meshes of bench_heat_surface.py --speed --polygon (hint = step I's AMD
+#: order restricted to the free vertices; Σ c_j² / (nnz log2 n) = 7–36) AMD had 0.62–0.85× the hint's flops on
+#: 5 of them (2.3× on the quad torus), but its ordering and second symbolic pass cost more than the numeric
+#: time they saved on every one (net loss 1.6 ms of a ~25 ms first solve on polygon-bear, 1.3 ms on cube sphere
+#: 32, 8 ms on cube sphere 64, 20 ms on polygon_mesh merged; load ~5). The induced order's fill is at most that
+#: of the factor it came from.
+HINT_AMD_FLOPS = 60.0
 
 #: Complex (Hermitian) factors with at least SUPERNODAL_FLOPS flops (Σ_j c_j², :func:`_flops`), a fundamental
 #: supernode of at least SUPERNODAL_WIDTH columns and at least SUPERNODAL_MEAN columns per supernode on average
@@ -246,13 +257,19 @@ def _flops(lp) -> float:
 
 
 def _auto_pattern(indptr, indices, n, hint=None):
-    """The ``ordering="auto"`` rule (:data:`AUTO_ND_MAX_N`): (perm, pattern). With a ``hint`` permutation:
-    the fewer-flop one of the hint and AMD, no nested dissection (the hint's maker has weighed it already)."""
-    perm = order_csr(indptr, indices, n, "amd")
-    pat = _pattern(indptr, indices, n, perm)
+    """The ``ordering="auto"`` rule (:data:`AUTO_ND_MAX_N`): (perm, pattern). With a ``hint`` permutation: the
+    hint, unless its factor is flop-heavy (:data:`HINT_AMD_FLOPS`); then the fewer-flop one of the hint and AMD
+    (no nested dissection: the hint's maker has weighed it already)."""
     if hint is not None:
         pat_h = _pattern(indptr, indices, n, hint)
-        return (hint, pat_h) if _flops(pat_h[4]) <= _flops(pat[4]) else (perm, pat)
+        f_h = _flops(pat_h[4])
+        if n <= 2 or f_h < HINT_AMD_FLOPS * len(indices) * np.log2(n):
+            return hint, pat_h
+        perm = order_csr(indptr, indices, n, "amd")
+        pat = _pattern(indptr, indices, n, perm)
+        return (hint, pat_h) if f_h <= _flops(pat[4]) else (perm, pat)
+    perm = order_csr(indptr, indices, n, "amd")
+    pat = _pattern(indptr, indices, n, perm)
     if 2 < n <= AUTO_ND_MAX_N:
         f_amd = _flops(pat[4])
         if f_amd >= AUTO_ND_FLOPS * len(indices) * np.log2(n):
@@ -293,8 +310,8 @@ class LDLFactorization:
         unknown eliminated k-th). The factors are those of ``A``, whatever the ordering.
     hint : int array (n,), optional
         With ``ordering="auto"``: a permutation known to suit A (e.g. a related system's ordering restricted
-        to A's unknowns); it replaces the nested-dissection candidate and is kept when its factor needs
-        fewer flops than AMD's.
+        to A's unknowns), used in place of AMD; only when its factor is flop-heavy (:data:`HINT_AMD_FLOPS`) is
+        AMD computed too and the fewer-flop one kept (no nested-dissection candidate).
 
     Raises
     ------

@@ -270,8 +270,8 @@ class PolygonDomain(VertexSurfaceDomain):
     # polygon meshes: SuperLU's minimum degree alone factorizes faster than after an RCM renumbering (1.2–2.4×
     # on every polygon row of bench_heat_surface.py --solver-rule)
     renumber = False
-    # Lconn has L's pattern exactly (connection_laplacian): the Dirichlet systems of step III try step I's
-    # ordering restricted to their free vertices against AMD (no nested-dissection pass)
+    # Lconn has L's pattern exactly (connection_laplacian): the Dirichlet systems of step III take step I's
+    # ordering restricted to their free vertices (no ordering pass of their own, ldl.HINT_AMD_FLOPS)
     heat_on_nodes = True
     # step I's operator ordered by AMD alone: of the 6 polygon meshes of bench_heat_surface.py --speed
     # --polygon the "auto" rule's nested-dissection attempt ran on 4 (≤ 10k vertices) and won on one (UV
