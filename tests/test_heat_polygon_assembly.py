@@ -181,3 +181,39 @@ def test_prolongation_csr_equals_the_coo_build_and_connection_fast_path():
     slow = connection_laplacian(d.L, d.N, d.e1, d.e2)
     assert (fast != slow).nnz == 0 and (fast != d.Lconn).nnz == 0
     assert (fast != fast.conj().T).nnz == 0                   # exactly Hermitian
+
+
+def test_flat_polygon_layout_pattern_and_vector_heat_matrix_equal_the_coo_builds():
+    """The polygon Laplacian's CSR pattern from the incidence (polygon_csr_pattern) and its slot-summed values
+    are bit-identical to coo_to_csr of the (corner, corner) triplets in polygon order; the vector heat matrix
+    built in one pass equals diags(M) + t · Lconn; a repeated vertex names the polygon's input index."""
+    import pytest
+
+    from gsdf.heat.domains._polygon_kernels import polygon_csr_pattern
+    from gsdf.heat.domains.polygon import _parse_polygons
+    from gsdf.linalg.assembly import coo_to_csr
+
+    V, polys = _nonplanar_mixed()
+    n = len(V)
+    start, corners = _parse_polygons(polys, n)
+    sizes = np.diff(start)
+    assert np.all(np.diff(sizes) >= 0)                             # ascending degree
+    order = np.argsort([len(p) for p in polys], kind="stable")
+    assert np.array_equal(corners, np.concatenate([polys[k] for k in order]))
+    rows = np.concatenate([np.repeat(corners[a:b], b - a) for a, b in zip(start[:-1], start[1:])])
+    cols = np.concatenate([np.tile(corners[a:b], b - a) for a, b in zip(start[:-1], start[1:])])
+    vals = np.random.default_rng(2).normal(size=len(rows))
+    ref = coo_to_csr(rows, cols, vals, (n, n))
+    indptr, indices, slot = polygon_csr_pattern(start, corners, n)
+    assert np.array_equal(indptr, ref.indptr) and np.array_equal(indices, ref.indices)
+    assert np.array_equal(np.bincount(slot, weights=vals, minlength=len(indices)), ref.data)
+    d = PolygonDomain(V, polys)
+    A = d.vector_heat_matrix()
+    B = (sp.diags(d.Mv.astype(np.complex128)) + d.t * d.Lconn).tocsr()
+    B.sort_indices()
+    for k in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(A, k), getattr(B, k))
+    bad = [list(p) for p in polys]
+    bad[5] = [bad[5][0]] + list(bad[5])[:-1] if len(bad[5]) > 3 else [bad[5][0], bad[5][0], bad[5][1]]
+    with pytest.raises(ValueError, match=r"polygons\[5\]: repeats a vertex"):
+        PolygonDomain(V, bad)

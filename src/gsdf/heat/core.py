@@ -54,6 +54,7 @@ import scipy.sparse as sp
 from .. import _checks
 from ..linalg import (BlockHermitianFactorization, Factorization, HermitianFactorization, cached_factorization,
                       saddle_matrix, spd_factorization)
+from ..linalg.assembly import principal_submatrix
 from ..threads import blas_region
 from .domains.base import PoissonSolver
 from .sources import Sources, as_curves, as_point_sources
@@ -206,6 +207,7 @@ class FactorizedPoisson(PoissonSolver):
 
     def __init__(self, L, Mv, spd=None, exact_gauge: bool = False, renumber: bool = True, ordering=None):
         self.L = sp.csr_matrix(L).tocsc()
+        self.L.sum_duplicates()                      # canonical (principal_submatrix reads sorted columns)
         self.Mv = np.asarray(Mv, np.float64)
         self.n = self.L.shape[0]
         self.exact_gauge = bool(exact_gauge)
@@ -263,8 +265,8 @@ class FactorizedPoisson(PoissonSolver):
                 else None
 
         def build():
-            A = self.L[free][:, free]
-            A = (A + sp.diags(self._eps * self.Mv[free])).tocsc() if self._eps else A.tocsc()
+            # L[free][:, free] + diag(ε M[free]), in L's CSC format, in one pass
+            A = principal_submatrix(self.L, free, 1.0, self._eps * self.Mv[free] if self._eps else None)
             full = self._ordering() if self._ordering is not None else None
             if full is None:
                 return self._spd_dirichlet(A)

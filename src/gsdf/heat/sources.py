@@ -370,4 +370,6 @@ class Sources:
         if not mats:
             n = self.node_rows.shape[1] if self.node_rows is not None else 0
             return sp.csr_matrix((0, n)), np.zeros(0, np.int64)
+        if len(mats) == 1:
+            return mats[0].copy(), vs[0].copy()
         return sp.vstack(mats).tocsr(), np.concatenate(vs)

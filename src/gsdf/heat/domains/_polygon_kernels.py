@@ -6,8 +6,10 @@ simple"), one pass over the polygons each:
   reproducing x (the same decisions and cut-offs as :func:`numpy.linalg.pinv` with ``rcond=1e-10``);
 * :func:`polygon_assembly` — per polygon the fan's cotan stiffness (s + 1)², prolonged to the s corners by
   ``Wᵀ K W`` (W = [w; I], §4: ``L = Pᵀ C_fan P`` restricted to one polygon), its lumped mass ``Wᵀ a`` (§4.2)
-  and its area-weighted fan normals at the corners (§8.3 of Feng & Crane 2024), emitted as COO triplets and
-  vertex sums: the refined sparse matrices are never built.
+  and its area-weighted fan normals at the corners (§8.3 of Feng & Crane 2024), emitted as triplet values and
+  vertex sums: the refined sparse matrices are never built;
+* :func:`refine_polygons` — the weights, virtual vertices, fans and prolongation of all polygons at once;
+* :func:`polygon_csr_pattern` — L's CSR pattern from the polygons' incidence and the slot of every triplet.
 
 Used by :mod:`gsdf.heat.domains.polygon` (which owns the formulas' description); measured in
 bench/bench_heat_surface.py --speed (polygon rows).
@@ -149,11 +151,86 @@ def _pinv_apply(S, b, keep_ratio, floor):
 
 
 @njit(cache=True)
+def _centred_weights(A, s, Asv, Vsv, sig, out, o):
+    """The weights of one polygon with s corners ``A[:s]`` (centred on their mean) into ``out[o:o + s]``
+    (:func:`polygon_weights`; ``Asv``, ``Vsv``, ``sig``: work arrays)."""
+    # (a - x) × (b - x) = a × b + [d]_× x with d = b - a: normal equations H x = rhs,
+    # H = Σ (|d|² I − d dᵀ), rhs = Σ d × (a × b)
+    h00 = h01 = h02 = h11 = h12 = h22 = 0.0
+    r0 = r1 = r2 = 0.0
+    g00 = g01 = g02 = g11 = g12 = g22 = 0.0
+    for i in range(s):
+        i1 = (i + 1) % s
+        a0, a1, a2 = A[i, 0], A[i, 1], A[i, 2]
+        b0, b1, b2 = A[i1, 0], A[i1, 1], A[i1, 2]
+        d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
+        dd = d0 * d0 + d1 * d1 + d2 * d2
+        h00 += dd - d0 * d0
+        h11 += dd - d1 * d1
+        h22 += dd - d2 * d2
+        h01 -= d0 * d1
+        h02 -= d0 * d2
+        h12 -= d1 * d2
+        c0 = a1 * b2 - a2 * b1
+        c1 = a2 * b0 - a0 * b2
+        c2 = a0 * b1 - a1 * b0
+        r0 += d1 * c2 - d2 * c1
+        r1 += d2 * c0 - d0 * c2
+        r2 += d0 * c1 - d1 * c0
+        g00 += a0 * a0
+        g01 += a0 * a1
+        g02 += a0 * a2
+        g11 += a1 * a1
+        g12 += a1 * a2
+        g22 += a2 * a2
+    scale = h00 + h11 + h22
+    ok = scale > 0
+    floor = max(scale, 1e-300)
+    if _min_eig3(h00, h01, h02, h11, h12, h22) > 1e-6 * floor:
+        x0, x1, x2 = _solve3(h00, h01, h02, h11, h12, h22, r0, r1, r2)
+    else:                                   # collinear corners: the pseudo-inverse (no unique minimizer)
+        H = np.array([[h00, h01, h02], [h01, h11, h12], [h02, h12, h22]])
+        xv, allkept, _ = _pinv_apply(H, np.array([r0, r1, r2]), 1e-10, floor)
+        x0, x1, x2 = xv[0], xv[1], xv[2]
+        ok = ok and allkept
+    # minimum-norm affine weights w = K⁺ [x; 1], K = [Aᵀ; 1ᵀ]: A is centred, so K Kᵀ = diag(AᵀA, s) and
+    # w = A (AᵀA)⁺ x + 1/s, with pinv's cut-off on the singular values of K (those of A, and √s)
+    gtr = g00 + g11 + g22
+    gmin = _min_eig3(g00, g01, g02, g11, g12, g22)
+    cut = 1e-10 * np.sqrt(max(s, gtr))
+    if gmin > 1e-6 * gtr and gmin > (1e4 * cut) ** 2:
+        y0, y1, y2 = _solve3(g00, g01, g02, g11, g12, g22, x0, x1, x2)
+    else:                                   # planar and nearly planar polygons
+        # singular values of A by one-sided Jacobi on A itself (accurate down to eps·|A|; those of AᵀA
+        # would lose the small ones), cut like pinv: σ_k ≤ 1e-10 · max(σ_max(A), √s) count as zero
+        for i in range(s):
+            for j in range(3):
+                Asv[i, j] = A[i, j]
+        _right_svd(Asv, s, Vsv, sig)
+        smax = max(max(sig[0], max(sig[1], sig[2])), np.sqrt(float(s)))
+        y0 = y1 = y2 = 0.0
+        for k in range(3):
+            if sig[k] > 1e-10 * smax:
+                f = (Vsv[0, k] * x0 + Vsv[1, k] * x1 + Vsv[2, k] * x2) / (sig[k] * sig[k])
+                y0 += f * Vsv[0, k]
+                y1 += f * Vsv[1, k]
+                y2 += f * Vsv[2, k]
+    tot = 0.0
+    for i in range(s):
+        out[o + i] = A[i, 0] * y0 + A[i, 1] * y1 + A[i, 2] * y2 + 1.0 / s
+        tot += out[o + i]
+        ok = ok and np.isfinite(out[o + i])
+    if not ok or abs(tot - 1.0) >= 1e-6:
+        for i in range(s):
+            out[o + i] = 1.0 / s
+
+
+@njit(cache=True)
 def polygon_weights(X):
     """Virtual-vertex weights (q, s) of q polygons with s corners ``X`` (q, s, 3) (module docs; Bunge et al.
     2020 §3). Degenerate polygons (no unique minimizer, or weights that do not reproduce it) get 1/s."""
     q, s, _ = X.shape
-    W = np.empty((q, s))
+    W = np.empty(q * s)
     A = np.empty((s, 3))
     Asv = np.empty((s, 3))
     Vsv = np.empty((3, 3))
@@ -166,76 +243,99 @@ def polygon_weights(X):
             c /= s
             for i in range(s):
                 A[i, j] = X[p, i, j] - c
-        # (a - x) × (b - x) = a × b + [d]_× x with d = b - a: normal equations H x = rhs,
-        # H = Σ (|d|² I − d dᵀ), rhs = Σ d × (a × b)
-        h00 = h01 = h02 = h11 = h12 = h22 = 0.0
-        r0 = r1 = r2 = 0.0
-        g00 = g01 = g02 = g11 = g12 = g22 = 0.0
-        for i in range(s):
-            i1 = (i + 1) % s
-            a0, a1, a2 = A[i, 0], A[i, 1], A[i, 2]
-            b0, b1, b2 = A[i1, 0], A[i1, 1], A[i1, 2]
-            d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
-            dd = d0 * d0 + d1 * d1 + d2 * d2
-            h00 += dd - d0 * d0
-            h11 += dd - d1 * d1
-            h22 += dd - d2 * d2
-            h01 -= d0 * d1
-            h02 -= d0 * d2
-            h12 -= d1 * d2
-            c0 = a1 * b2 - a2 * b1
-            c1 = a2 * b0 - a0 * b2
-            c2 = a0 * b1 - a1 * b0
-            r0 += d1 * c2 - d2 * c1
-            r1 += d2 * c0 - d0 * c2
-            r2 += d0 * c1 - d1 * c0
-            g00 += a0 * a0
-            g01 += a0 * a1
-            g02 += a0 * a2
-            g11 += a1 * a1
-            g12 += a1 * a2
-            g22 += a2 * a2
-        scale = h00 + h11 + h22
-        ok = scale > 0
-        floor = max(scale, 1e-300)
-        if _min_eig3(h00, h01, h02, h11, h12, h22) > 1e-6 * floor:
-            x0, x1, x2 = _solve3(h00, h01, h02, h11, h12, h22, r0, r1, r2)
-        else:                                   # collinear corners: the pseudo-inverse (no unique minimizer)
-            H = np.array([[h00, h01, h02], [h01, h11, h12], [h02, h12, h22]])
-            xv, allkept, _ = _pinv_apply(H, np.array([r0, r1, r2]), 1e-10, floor)
-            x0, x1, x2 = xv[0], xv[1], xv[2]
-            ok = ok and allkept
-        # minimum-norm affine weights w = K⁺ [x; 1], K = [Aᵀ; 1ᵀ]: A is centred, so K Kᵀ = diag(AᵀA, s) and
-        # w = A (AᵀA)⁺ x + 1/s, with pinv's cut-off on the singular values of K (those of A, and √s)
-        gtr = g00 + g11 + g22
-        gmin = _min_eig3(g00, g01, g02, g11, g12, g22)
-        cut = 1e-10 * np.sqrt(max(s, gtr))
-        if gmin > 1e-6 * gtr and gmin > (1e4 * cut) ** 2:
-            y0, y1, y2 = _solve3(g00, g01, g02, g11, g12, g22, x0, x1, x2)
-        else:                                   # planar and nearly planar polygons
-            # singular values of A by one-sided Jacobi on A itself (accurate down to eps·|A|; those of AᵀA
-            # would lose the small ones), cut like pinv: σ_k ≤ 1e-10 · max(σ_max(A), √s) count as zero
+        _centred_weights(A, s, Asv, Vsv, sig, W, p * s)
+    return W.reshape(q, s)
+
+
+@njit(cache=True)
+def refine_polygons(V, start, corners):
+    """The virtual-vertex refinement of polygons in the flat layout (``corners[start[p]:start[p + 1]]`` = the
+    corners of polygon p, ascending degree): weights ``wflat`` aligned with ``corners`` (0 for triangles), the
+    virtual vertex ``vid`` of every polygon (-1 for triangles; numbered n, n + 1, … in polygon order), the
+    virtual positions ``Σ w_i x_i`` (#virtual, 3), the refined triangles (a triangle as it is, a polygon as the
+    fan (virtual, c_i, c_{i+1})) and the prolongation in canonical CSR (identity rows, then per virtual vertex
+    its weights by ascending column): ``(wflat, vid, newV, F, p_indptr, p_indices, p_data)``."""
+    n = len(V)
+    m = len(start) - 1
+    nv = 0
+    nf = 0
+    smax = 3
+    for p in range(m):
+        s = start[p + 1] - start[p]
+        smax = max(smax, s)
+        if s > 3:
+            nv += 1
+            nf += s
+        else:
+            nf += 1
+    wflat = np.zeros(len(corners))
+    vid = np.full(m, -1, np.int64)
+    newV = np.zeros((nv, 3))
+    F = np.empty((nf, 3), np.int64)
+    pnz = n + (start[m] - 0)
+    p_indptr = np.empty(n + nv + 1, np.int64)
+    p_indices = np.empty(pnz, np.int64)
+    p_data = np.empty(pnz)
+    for i in range(n):
+        p_indptr[i] = i
+        p_indices[i] = i
+        p_data[i] = 1.0
+    p_indptr[n] = n
+    A = np.empty((smax, 3))
+    Asv = np.empty((smax, 3))
+    Vsv = np.empty((3, 3))
+    sig = np.empty(3)
+    srt = np.empty(smax, np.int64)
+    q = n
+    f = 0
+    k = 0
+    for p in range(m):
+        b0 = start[p]
+        s = start[p + 1] - b0
+        if s == 3:
+            F[f, 0], F[f, 1], F[f, 2] = corners[b0], corners[b0 + 1], corners[b0 + 2]
+            f += 1
+            continue
+        for j in range(3):
+            c = 0.0
             for i in range(s):
-                for j in range(3):
-                    Asv[i, j] = A[i, j]
-            _right_svd(Asv, s, Vsv, sig)
-            smax = max(max(sig[0], max(sig[1], sig[2])), np.sqrt(float(s)))
-            y0 = y1 = y2 = 0.0
-            for k in range(3):
-                if sig[k] > 1e-10 * smax:
-                    f = (Vsv[0, k] * x0 + Vsv[1, k] * x1 + Vsv[2, k] * x2) / (sig[k] * sig[k])
-                    y0 += f * Vsv[0, k]
-                    y1 += f * Vsv[1, k]
-                    y2 += f * Vsv[2, k]
-        tot = 0.0
-        for i in range(s):
-            W[p, i] = A[i, 0] * y0 + A[i, 1] * y1 + A[i, 2] * y2 + 1.0 / s
-            tot += W[p, i]
-            ok = ok and np.isfinite(W[p, i])
-        if not ok or abs(tot - 1.0) >= 1e-6:
+                c += V[corners[b0 + i], j]
+            c /= s
             for i in range(s):
-                W[p, i] = 1.0 / s
-    return W
+                A[i, j] = V[corners[b0 + i], j] - c
+        _centred_weights(A, s, Asv, Vsv, sig, wflat, b0)
+        v = n + k
+        vid[p] = v
+        for i in range(s):
+            w = wflat[b0 + i]
+            for j in range(3):
+                newV[k, j] += w * V[corners[b0 + i], j]
+            F[f, 0], F[f, 1], F[f, 2] = v, corners[b0 + i], corners[b0 + (i + 1) % s]
+            f += 1
+        for i in range(s):                        # the row of P: columns ascending (insertion sort)
+            srt[i] = i
+            a = i
+            while a > 0 and corners[b0 + srt[a - 1]] > corners[b0 + srt[a]]:
+                srt[a - 1], srt[a] = srt[a], srt[a - 1]
+                a -= 1
+        for i in range(s):
+            p_indices[q] = corners[b0 + srt[i]]
+            p_data[q] = wflat[b0 + srt[i]]
+            q += 1
+        k += 1
+        p_indptr[n + k] = q
+    return wflat, vid, newV, F, p_indptr, p_indices[:q].copy(), p_data[:q].copy()
+
+
+@njit(cache=True)
+def first_repeat(start, corners):
+    """The first polygon (in order) with a repeated corner, or -1."""
+    for p in range(len(start) - 1):
+        for a in range(start[p], start[p + 1]):
+            for b in range(a + 1, start[p + 1]):
+                if corners[a] == corners[b]:
+                    return p
+    return -1
 
 
 @njit(cache=True)
@@ -251,7 +351,8 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
 
     Returns
     -------
-    rows, cols, vals : the Σ s² COO triplets of L; mass : (n,); An : (n, 3) area-weighted normal sums;
+    vals : the Σ s² values of L's triplets (polygon p, row corner i, column corner j; CSR slots from
+    :func:`polygon_csr_pattern`); mass : (n,); An : (n, 3) area-weighted normal sums;
     good : (k,) bool, the fine triangles (triangles, then the fans polygon by polygon) that are kept;
     fn : (k, 3) their unit normals; fG : (k, 3, 3) ``|f| ∇λ_c = ½ n × (v_{c+2} − v_{c+1})`` per corner c
     (the divergence weights of :meth:`TriangleMeshOperators.divergence`).
@@ -267,8 +368,6 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
     fn = np.zeros((nfine, 3))
     fG = np.zeros((nfine, 3, 3))
     ft = -1
-    rows = np.empty(tot, np.int64)
-    cols = np.empty(tot, np.int64)
     vals = np.empty(tot)
     mass = np.zeros(n)
     An = np.zeros((n, 3))
@@ -363,11 +462,9 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
                     val = K[1 + i, 1 + j] + (wi * K[0, 1 + j] + wj * K[0, 1 + i]) + K[0, 0] * (wi * wj)
                 else:
                     val = K[i, j]
-                rows[out] = vi
-                cols[out] = corners[b0 + j]
                 vals[out] = val
                 out += 1
-    return rows, cols, vals, mass, An, good, fn, fG
+    return vals, mass, An, good, fn, fG
 
 
 @njit(cache=True)
@@ -415,3 +512,68 @@ def connection_values(indptr, indices, data, N, e1, e2):
                     hi = mid
             out[lo] = data[p] * np.conj(z)
     return out
+
+
+@njit(cache=True)
+def polygon_csr_pattern(start, corners, n):
+    """Canonical CSR pattern of the polygon Laplacian (vertex pairs sharing a polygon, diagonal included) from
+    the polygons' incidence, and the CSR slot of each of the Σ s² triplets in :func:`polygon_assembly`'s order
+    (polygon p, row corner a, column corner b): ``(indptr, indices, slot)``. The triplets of one entry come from
+    distinct polygons, so summing them by slot in triplet order adds them in polygon order, as
+    :func:`gsdf.linalg.assembly.coo_to_csr` does."""
+    m = len(start) - 1
+    nc = len(corners)
+    toff = np.empty(m + 1, np.int64)                 # first triplet of each polygon
+    toff[0] = 0
+    for p in range(m):
+        s = start[p + 1] - start[p]
+        toff[p + 1] = toff[p] + s * s
+    head = np.zeros(n + 1, np.int64)                 # corners by vertex, in polygon order (counting sort)
+    for c in range(nc):
+        head[corners[c] + 1] += 1
+    for i in range(n):
+        head[i + 1] += head[i]
+    pos = head[:-1].copy()
+    inc = np.empty(nc, np.int64)
+    owner = np.empty(nc, np.int64)
+    for p in range(m):
+        for c in range(start[p], start[p + 1]):
+            v = corners[c]
+            inc[pos[v]] = c
+            owner[pos[v]] = p
+            pos[v] += 1
+    cap = toff[m]
+    indptr = np.zeros(n + 1, np.int32)
+    indices = np.empty(cap, np.int32)
+    slot = np.empty(cap, np.int64)
+    mark = np.full(n, -1, np.int64)
+    out = 0
+    for i in range(n):
+        first = out
+        for q in range(head[i], head[i + 1]):
+            p = owner[q]
+            for c in range(start[p], start[p + 1]):
+                j = corners[c]
+                if mark[j] < first:
+                    mark[j] = out
+                    indices[out] = j
+                    out += 1
+        for a in range(first + 1, out):             # insertion sort: rows are short
+            c = indices[a]
+            b = a - 1
+            while b >= first and indices[b] > c:
+                indices[b + 1] = indices[b]
+                b -= 1
+            indices[b + 1] = c
+        for a in range(first, out):
+            mark[indices[a]] = a
+        for q in range(head[i], head[i + 1]):
+            p = owner[q]
+            b0 = start[p]
+            s = start[p + 1] - b0
+            t = toff[p] + (inc[q] - b0) * s
+            for c in range(b0, start[p + 1]):
+                slot[t] = mark[corners[c]]
+                t += 1
+        indptr[i + 1] = out
+    return indptr, indices[:out].copy(), slot

@@ -59,6 +59,7 @@ from abc import ABC, abstractmethod
 import numpy as np
 import scipy.sparse as sp
 
+from ...linalg.assembly import principal_submatrix
 from ..sources import Curve, Sources
 
 __all__ = ["HeatDomain", "PoissonSolver", "VertexSurfaceDomain", "tangent_frames"]
@@ -153,6 +154,11 @@ class HeatDomain(ABC):
         return None
 
 
+def _one_hot_rows(v, n: int) -> sp.csr_matrix:
+    """(len(v), n) CSR with a one in column v[i] of row i (canonical, built directly)."""
+    return sp.csr_matrix((np.ones(len(v)), np.asarray(v), np.arange(len(v) + 1)), shape=(len(v), n))
+
+
 def tangent_frames(N: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """An arbitrary orthonormal tangent basis (e1, e2) per unit normal N (n, 3), e1 × e2 = N.
 
@@ -205,7 +211,13 @@ class VertexSurfaceDomain(HeatDomain):
 
     # ---- operators
     def vector_heat_matrix(self):
-        return sp.diags(self.Mv.astype(np.complex128)) + self.t * self.Lconn
+        """M + t L∇ (Eq. 12) in one pass over L∇ (:func:`~gsdf.linalg.assembly.principal_submatrix`; the same
+        matrix as ``diags(M) + t * Lconn``)."""
+        Lc = self.Lconn
+        if Lc.format != "csr" or Lc.dtype != np.complex128 or not Lc.has_canonical_format:
+            Lc = sp.csr_matrix(Lc, dtype=np.complex128, copy=True)
+            Lc.sum_duplicates()
+        return principal_submatrix(Lc, None, self.t, self.Mv)
 
     def laplacian(self):
         return self.L
@@ -260,20 +272,21 @@ class VertexSurfaceDomain(HeatDomain):
         S = Sources(X0=X0)
         if curves:
             v = np.concatenate(curves)
-            S.node_rows = sp.csr_matrix((np.ones(len(v)), (np.arange(len(v)), v)), shape=(len(v), n))
+            S.node_rows = _one_hot_rows(v, n)
             S.node_vertex = v
-            S.node_curve = np.concatenate([np.full(len(c), k) for k, c in enumerate(curves)])
+            S.node_curve = np.repeat(np.arange(len(curves)), [len(c) for c in curves])
             a = np.concatenate([c[:-1] for c in curves])
             b = np.concatenate([c[1:] for c in curves])
             s = len(a)
-            S.shift_rows = sp.csr_matrix((np.full(2 * s, 0.5), (np.tile(np.arange(s), 2), np.concatenate([a, b]))),
-                                         shape=(s, n))
+            # ½ (φ_a + φ_b) per segment, in canonical CSR directly (a ≠ b: repeated points were dropped)
+            cols = np.stack([np.minimum(a, b), np.maximum(a, b)], 1).ravel()
+            S.shift_rows = sp.csr_matrix((np.full(2 * s, 0.5), cols, np.arange(0, 2 * s + 1, 2)), shape=(s, n))
             S.shift_weights = np.linalg.norm(self.X[b] - self.X[a], axis=1)
         else:
             S.node_rows = sp.csr_matrix((0, n))
             S.node_vertex = S.node_curve = np.zeros(0, np.int64)
         if len(pts):
-            S.point_rows = sp.csr_matrix((np.ones(len(pts)), (np.arange(len(pts)), pts)), shape=(len(pts), n))
+            S.point_rows = _one_hot_rows(pts, n)
             S.point_vertex = pts
         return S
 

@@ -43,14 +43,15 @@ import scipy.sparse as sp
 
 from ... import _checks
 from ..surface.operators import TriangleMeshOperators
-from ...linalg.assembly import coo_to_csr
-from ._polygon_kernels import connection_values, polygon_assembly, polygon_weights
+from ._polygon_kernels import (connection_values, first_repeat, polygon_assembly, polygon_csr_pattern,
+                               polygon_weights, refine_polygons)
 from .base import VertexSurfaceDomain, tangent_frames
 
 
 # --------------------------------------------------------------------------------------------- geometry helpers
-def _parse_polygons(polygons, n: int) -> dict:
-    """Validate polygons; return {degree: (q, degree) int64 array} (vectorized per degree)."""
+def _parse_polygons(polygons, n: int):
+    """Validate polygons; return their flat layout ``(start, corners)`` in ascending degree (stable):
+    ``corners[start[p]:start[p + 1]]`` are the corners of the p-th polygon in that order (int64)."""
     import itertools
 
     if isinstance(polygons, (list, tuple)) and polygons and isinstance(polygons[0], np.ndarray) \
@@ -105,17 +106,17 @@ def _parse_polygons(polygons, n: int) -> dict:
     if bad.any():
         k = int(np.searchsorted(start, np.flatnonzero(bad)[0], side="right") - 1)
         raise ValueError(f"polygons[{k}]: vertex index out of range for {n} vertices")
-    out = {}
-    for s in np.flatnonzero(np.bincount(sizes)):               # the degrees present, ascending
-        sel = np.flatnonzero(sizes == s)
-        Q = flat[start[sel][:, None] + np.arange(s)]
-        S = np.sort(Q, axis=1)
-        rep = (S[:, 1:] == S[:, :-1]).any(1)
-        if rep.any():
-            k = int(sel[np.flatnonzero(rep)[0]])
-            raise ValueError(f"polygons[{k}]: repeats a vertex ({Q[np.flatnonzero(rep)[0]].tolist()})")
-        out[int(s)] = Q
-    return out
+    # the flat layout in ascending degree (stable): the polygon order of the refinement and the assembly
+    order = np.argsort(sizes, kind="stable")
+    gsize = sizes[order]
+    gstart = np.zeros(len(sizes) + 1, np.int64)
+    np.cumsum(gsize, out=gstart[1:])
+    corners = flat[np.repeat(start[order] - gstart[:-1], gsize) + np.arange(gstart[-1])]
+    k = first_repeat(gstart, corners)
+    if k >= 0:
+        q = corners[gstart[k]:gstart[k + 1]]
+        raise ValueError(f"polygons[{int(order[k])}]: repeats a vertex ({q.tolist()})")
+    return gstart, corners
 
 
 def virtual_vertex_weights(X: np.ndarray) -> np.ndarray:
@@ -138,47 +139,19 @@ def virtual_vertex_weights(X: np.ndarray) -> np.ndarray:
     return polygon_weights(X)
 
 
-def _refine(V: np.ndarray, groups: dict):
-    """The virtual-vertex refinement of validated polygon groups ({degree: (q, degree)}), and the flat polygon
-    layout the assembly kernel reads: ``(V_refined, F_refined, P, start, corners, vid, wflat)`` (polygons in
-    group order; ``vid`` = the virtual vertex of each polygon, -1 for triangles; ``wflat`` aligned with
-    ``corners``)."""
+def _refine(V: np.ndarray, start: np.ndarray, corners: np.ndarray):
+    """The virtual-vertex refinement of validated polygons in the flat layout of :func:`_parse_polygons`, and
+    what the assembly kernel reads: ``(V_refined, F_refined, P, vid, wflat)`` (``vid`` = the virtual vertex of
+    each polygon, -1 for triangles; ``wflat`` the weights aligned with ``corners``). One numba pass
+    (:func:`~gsdf.heat.domains._polygon_kernels.refine_polygons`)."""
     n = len(V)
-    # P in canonical CSR, built directly: identity rows for the original vertices, then one row per virtual
-    # vertex holding its polygon's weights with the columns sorted (the layout scipy's COO conversion gives)
-    newV, fans, pcol, pval = [], [], [np.arange(n)], [np.ones(n)]
-    prow_len = [np.zeros(1, np.int64), np.ones(n, np.int64)]          # entries per row of P (after a 0)
-    tris = [groups[3]] if 3 in groups else []
-    flat, vids, wts = [], [], []
-    nv = n
-    for s, Q in groups.items():
-        flat.append(Q.ravel())
-        if s == 3:
-            vids.append(np.full(len(Q), -1, np.int64))
-            wts.append(np.zeros(Q.size))
-            continue
-        X = V[Q]                                                        # (q, s, 3) polygons of this degree
-        w = virtual_vertex_weights(X)
-        ids = nv + np.arange(len(Q))
-        nv += len(Q)
-        newV.append(np.einsum("qs,qsj->qj", w, X))
-        fans.append(np.stack([np.repeat(ids, s), Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1))
-        o = np.argsort(Q, axis=1)
-        prow_len.append(np.full(len(Q), s, np.int64))
-        pcol.append(np.take_along_axis(Q, o, 1).ravel())
-        pval.append(np.take_along_axis(w, o, 1).ravel())
-        vids.append(ids)
-        wts.append(w.ravel())
-    Vr = np.concatenate([V] + newV) if newV else V.copy()
-    Fr = np.concatenate(tris + fans) if (tris or fans) else np.zeros((0, 3), np.int64)
-    indptr = np.cumsum(np.concatenate(prow_len))
-    idx = np.int32 if indptr[-1] < 2 ** 31 - 1 else np.int64
-    P = sp.csr_matrix((np.concatenate(pval), np.concatenate(pcol).astype(idx), indptr.astype(idx)), shape=(nv, n))
+    wflat, vid, newV, F, indptr, indices, data = refine_polygons(V, start, corners)
+    Vr = np.concatenate([V, newV]) if len(newV) else V.copy()
+    idx = np.int32 if len(indices) < 2 ** 31 - 1 else np.int64
+    P = sp.csr_matrix((data, indices.astype(idx), indptr.astype(idx)), shape=(n + len(newV), n))
     P.has_sorted_indices = True
     P.has_canonical_format = True
-    sizes = np.concatenate([np.full(len(Q), s, np.int64) for s, Q in groups.items()])
-    start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    return Vr, Fr, P, start, np.concatenate(flat).astype(np.int64), np.concatenate(vids), np.concatenate(wts)
+    return Vr, F, P, vid, wflat
 
 
 def virtual_vertex_refinement(V: np.ndarray, polygons):
@@ -196,9 +169,8 @@ def virtual_vertex_refinement(V: np.ndarray, polygons):
     >>> (Vr[4].round(3) + 0.0).tolist(), len(Fr), P.shape
     ([0.5, 0.5, 0.0], 4, (5, 4))
     """
-    V = np.asarray(V, dtype=np.float64)
-    groups = polygons if isinstance(polygons, dict) else _parse_polygons(polygons, len(V))
-    return _refine(V, groups)[:3]
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    return _refine(V, *_parse_polygons(polygons, len(V)))[:3]
 
 
 def frame_transport(N, e1, e2, i, j) -> np.ndarray:
@@ -284,10 +256,12 @@ class PolygonDomain(VertexSurfaceDomain):
         t_coef = _checks.positive(t_coef, "t_coef")
         self.n_vertices = n = len(V)
         self.V = V
-        polys = _parse_polygons(polygons, n)
-        self.V_refined, F, self.P, start, corners, vid, wflat = _refine(V, polys)
-        E = self._edges(polys)
-        keys = np.sort(np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1]))
+        start, corners = _parse_polygons(polygons, n)
+        self.V_refined, F, self.P, vid, wflat = _refine(V, start, corners)
+        nxt = np.arange(1, len(corners) + 1)                             # the next corner of each polygon
+        nxt[start[1:] - 1] = start[:-1]
+        a, b = corners, corners[nxt]
+        keys = np.sort(np.minimum(a, b) * n + np.maximum(a, b))
         self._edge_keys = keys[np.concatenate([[True], keys[1:] != keys[:-1]])]
         ell = np.linalg.norm(V[self._edge_keys % n] - V[self._edge_keys // n], axis=1)   # unique polygon edges
         self.mean_edge = float(ell.mean())
@@ -295,8 +269,7 @@ class PolygonDomain(VertexSurfaceDomain):
         # to one, §4.2) and the normals per polygon, without forming the refined matrices; fan triangles of zero
         # area (nonconvex / degenerate polygons) carry no stiffness or mass and are dropped
         thresh = 1e-12 * self.mean_edge ** 2
-        rows, cols, vals, self.M, An, good, fn, fG = polygon_assembly(self.V_refined, start, corners, vid, wflat, n,
-                                                                      thresh)
+        vals, self.M, An, good, fn, fG = polygon_assembly(self.V_refined, start, corners, vid, wflat, n, thresh)
         if not good.any():
             raise ValueError("polygons: all polygons have zero area")
         if good.all():                                             # the usual case: no copies
@@ -305,9 +278,12 @@ class PolygonDomain(VertexSurfaceDomain):
             self.F_refined, self._fine_normals, self._fine_G = F[good], fn[good], fG[good]
         # (the fine triangles' normals and divergence weights are steps II–III's data)
         self._fine_ops = None
-        # per polygon exactly symmetric, and coo_to_csr sums duplicates in input (polygon) order for (i, j) and
-        # (j, i) alike: L is exactly symmetric
-        L = coo_to_csr(rows, cols, vals, (n, n))
+        # per polygon exactly symmetric, and the triplets of (i, j) and (j, i) alike are summed in polygon order:
+        # L is exactly symmetric
+        indptr, indices, slot = polygon_csr_pattern(start, corners, n)
+        L = sp.csr_matrix((np.bincount(slot, weights=vals, minlength=len(indices)), indices, indptr), shape=(n, n))
+        L.has_sorted_indices = True
+        L.has_canonical_format = True
         # vertex normals: area-weighted fine triangle normals (§8.3)
         nrm = np.linalg.norm(An, axis=1)
         An[nrm == 0] = [0, 0, 1.0]
@@ -315,10 +291,6 @@ class PolygonDomain(VertexSurfaceDomain):
         e1, e2 = tangent_frames(N)
         Lconn = connection_laplacian(L, N, e1, e2, symmetric_pattern=True)   # the blocks emit (i, j) and (j, i)
         super().__init__(V, L, self.M, Lconn, N, e1, e2, t_coef * self.mean_edge ** 2)
-
-    @staticmethod
-    def _edges(groups) -> np.ndarray:
-        return np.concatenate([np.stack([Q.ravel(), np.roll(Q, -1, axis=1).ravel()], 1) for Q in groups.values()])
 
     @property
     def fine_ops(self) -> TriangleMeshOperators:
