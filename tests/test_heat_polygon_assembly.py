@@ -213,6 +213,18 @@ def test_flat_polygon_layout_pattern_and_vector_heat_matrix_equal_the_coo_builds
     B.sort_indices()
     for k in ("indptr", "indices", "data"):
         assert np.array_equal(getattr(A, k), getattr(B, k))
+    # steps II–III kernels: the numpy prolongation / projection and bincount divergence, to rounding
+    rng = np.random.default_rng(4)
+    X = rng.normal(size=n) + 1j * rng.normal(size=n)
+    Xf = d.P @ d.to_3d(X)
+    Yr = Xf[d.F_refined].sum(axis=1)
+    Yr -= d._fine_normals * np.einsum("fj,fj->f", Yr, d._fine_normals)[:, None]
+    np.testing.assert_allclose(d.gather(X), Yr, rtol=0, atol=1e-14 * np.abs(Yr).max())
+    Y = rng.normal(size=Yr.shape)
+    bf = np.bincount(d.F_refined.ravel(), weights=np.einsum("fkj,fj->fk", d._fine_G, Y).ravel(),
+                     minlength=d.P.shape[0])
+    br = d.P.T @ bf
+    np.testing.assert_allclose(d.divergence(Y), br, rtol=0, atol=1e-14 * np.abs(br).max())
     bad = [list(p) for p in polys]
     bad[5] = [bad[5][0]] + list(bad[5])[:-1] if len(bad[5]) > 3 else [bad[5][0], bad[5][0], bad[5][1]]
     with pytest.raises(ValueError, match=r"polygons\[5\]: repeats a vertex"):

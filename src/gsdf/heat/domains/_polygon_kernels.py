@@ -577,3 +577,50 @@ def polygon_csr_pattern(start, corners, n):
                 t += 1
         indptr[i + 1] = out
     return indptr, indices[:out].copy(), slot
+
+
+@njit(cache=True)
+def fine_vectors(X, e1, e2, p_indptr, p_indices, p_data, F, Nf):
+    """Step II on the refined mesh in one pass: the complex vertex vectors X (n,) as 3D vectors in the frames
+    (e1, e2), prolonged by P (CSR; virtual vertex = Σ w_i X_i), summed over every fine triangle F (k, 3) and
+    projected into its plane (unit normals Nf): (k, 3), not normalized. The same sums, in the same order, as
+    ``P @ X3``, ``(X_a + X_b) + X_c`` and ``Y - N (Y · N)``."""
+    nr = len(p_indptr) - 1
+    Xf = np.zeros((nr, 3))
+    for r in range(nr):
+        for q in range(p_indptr[r], p_indptr[r + 1]):
+            v = p_indices[q]
+            w = p_data[q]
+            xr, xi = X[v].real, X[v].imag
+            for j in range(3):
+                Xf[r, j] += w * (xr * e1[v, j] + xi * e2[v, j])
+    k = len(F)
+    Y = np.empty((k, 3))
+    for f in range(k):
+        a, b, c = F[f, 0], F[f, 1], F[f, 2]
+        y0 = (Xf[a, 0] + Xf[b, 0]) + Xf[c, 0]
+        y1 = (Xf[a, 1] + Xf[b, 1]) + Xf[c, 1]
+        y2 = (Xf[a, 2] + Xf[b, 2]) + Xf[c, 2]
+        d = y0 * Nf[f, 0] + y1 * Nf[f, 1] + y2 * Nf[f, 2]
+        Y[f, 0] = y0 - Nf[f, 0] * d
+        Y[f, 1] = y1 - Nf[f, 1] * d
+        Y[f, 2] = y2 - Nf[f, 2] * d
+    return Y
+
+
+@njit(cache=True)
+def fine_divergence(G, Y, F, p_indptr, p_indices, p_data, n):
+    """Step III's right-hand side in one pass: b_i = Σ_f |f| ∇λ_i · Y_f on the fine vertices (G (k, 3, 3) the
+    divergence weights per corner), restricted by Pᵀ to the n original vertices; the same sums, in the same
+    order, as ``bincount(F, einsum(G, Y))`` and ``P.T @ b``."""
+    nr = len(p_indptr) - 1
+    bf = np.zeros(nr)
+    for f in range(len(F)):
+        y0, y1, y2 = Y[f, 0], Y[f, 1], Y[f, 2]
+        for c in range(3):
+            bf[F[f, c]] += G[f, c, 0] * y0 + G[f, c, 1] * y1 + G[f, c, 2] * y2
+    out = np.zeros(n)
+    for r in range(nr):
+        for q in range(p_indptr[r], p_indptr[r + 1]):
+            out[p_indices[q]] += p_data[q] * bf[r]
+    return out

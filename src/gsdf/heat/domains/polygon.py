@@ -43,8 +43,8 @@ import scipy.sparse as sp
 
 from ... import _checks
 from ..surface.operators import TriangleMeshOperators
-from ._polygon_kernels import (connection_values, first_repeat, polygon_assembly, polygon_csr_pattern,
-                               polygon_weights, refine_polygons)
+from ._polygon_kernels import (connection_values, fine_divergence, fine_vectors, first_repeat, polygon_assembly,
+                               polygon_csr_pattern, polygon_weights, refine_polygons)
 from .base import VertexSurfaceDomain, tangent_frames
 
 
@@ -302,18 +302,18 @@ class PolygonDomain(VertexSurfaceDomain):
 
     def gather(self, X) -> np.ndarray:
         """§8.3: prolong the vertex vectors to the fine vertices (virtual vertex = Σ w_i X_i as 3D vectors), sum
-        them over every fine triangle and project into its plane (normalized by the core)."""
-        Xf = self.P @ self.to_3d(X)                                      # (n + #virtual, 3)
-        F, Nf = self.F_refined, self._fine_normals
-        Y = Xf[F[:, 0]] + Xf[F[:, 1]] + Xf[F[:, 2]]                     # (a + b) + c, as .sum(axis=1) adds
-        Y -= Nf * np.einsum("fj,fj->f", Y, Nf)[:, None]
-        return Y
+        them over every fine triangle and project into its plane (normalized by the core); one numba pass
+        (:func:`~gsdf.heat.domains._polygon_kernels.fine_vectors`)."""
+        P = self.P
+        return fine_vectors(np.ascontiguousarray(X, np.complex128), self.e1, self.e2, P.indptr, P.indices, P.data,
+                            self.F_refined, self._fine_normals)
 
     def divergence(self, Y) -> np.ndarray:
-        """The fine divergence (b_i = Σ_f |f| ∇λ_i · Y_f) restricted by Pᵀ (Bunge et al. §4.5)."""
-        contrib = np.einsum("fkj,fj->fk", self._fine_G, Y)
-        b = np.bincount(self.F_refined.ravel(), weights=contrib.ravel(), minlength=self.P.shape[0])
-        return self.P.T @ b
+        """The fine divergence (b_i = Σ_f |f| ∇λ_i · Y_f) restricted by Pᵀ (Bunge et al. §4.5); one numba pass
+        (:func:`~gsdf.heat.domains._polygon_kernels.fine_divergence`)."""
+        P = self.P
+        return fine_divergence(self._fine_G, np.ascontiguousarray(Y, np.float64), self.F_refined, P.indptr,
+                               P.indices, P.data, self.n_vertices)
 
     def check_curve_edges(self, a, k):
         n = self.n_vertices
