@@ -49,6 +49,13 @@ off the input: no case changed). One extra LP per decomposition pass that has a 
 Also measured and dropped (41 closed cases with broken loops, cases 0–9 per mesh, scratch runs): ε = 1e-3
 instead of 1e-2 — no case crosses the 0.5 % line (38 of 41 replayed: 19 < 0.5 % either way); ε = 0.1 — 17
 instead of 19 (torus:8 0.03 → 0.54 %, author-torus:6 0.19 → 0.81 %; author-double-torus:2 9.9 → 2.0 %).
+Forbidding pieces of the chosen cycle one at a time as well (pieces = its input edges split at crossings of
+the curves, the 6 lightest, each kept when the share grows): 26 of the 41 cases replayed before it was stopped,
+none crossed the 0.5 % line (author-torus:8 stays 35.6 %), 1–18 LPs per case — dropped.
+Cost of the kept rule: the second LP about doubles the LP time of every case that needs an LP (also when it
+is not chosen); ``cycle_choice="lp"`` is the thesis' single LP.
+Simply connected surfaces never reach the LP (the solve stops after the jump solve): their results (sections
+swn, swn-floor) are unchanged.
 The misses left are cycles that follow the loop for most of their length and the region for a stretch
 (knot1:9, author-torus:8: the loops and the region cross, so the second LP, which may not use the loop's edges
 either, is worse) and the other causes of swn-ns-diagnose-quick (truth inside the gaps, offsets).
