@@ -238,5 +238,7 @@ def test_cycle_choice_keeps_the_whole_loop_not_the_band_side():
     assert mislabeled(r, truth, A) < 0.01
     for alg in ("highs-ipm", "band", "network"):                 # every form of the LP chooses alike
         assert np.array_equal(swn.solve(g, method="lp", lp_algorithm=alg).face_labels, r.face_labels)
+    cyc = SurfaceWindingNumbers(swn.dec.V, swn.dec.F, lp_form="cycles")
+    assert np.array_equal(cyc.solve(g, method="lp").face_labels, r.face_labels)
     with pytest.raises(ValueError, match="cycle_choice"):
         swn.solve(g, cycle_choice="shortest")
