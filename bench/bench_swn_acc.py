@@ -185,7 +185,7 @@ def run(per_mesh, time_limit):
             sw._residual_full = joint_residual(sw)
             t0 = time.perf_counter()
             try:
-                rj = sw.solve(gb, method="lp", homology="integer", time_limit=time_limit)
+                rj = sw.solve(gb, method="lp", homology="integer", time_limit=time_limit, cycle_choice="lp")
                 row["joint"] = B.mislabeled(rj.face_labels, truth, A)
             except ValueError:
                 row["joint"] = float("nan")

@@ -198,7 +198,7 @@ def ns_diagnose(per_mesh, breaking, time_limit):
             forbid = (parts["region"] != 0) & (loops == 0)
             sw._residual_full = _lp_without(sw, forbid)
             try:
-                ro = sw.solve(gb, method="lp", time_limit=time_limit)
+                ro = sw.solve(gb, method="lp", time_limit=time_limit, cycle_choice="lp")   # the oracle's own LP
             finally:
                 del sw._residual_full
             w = r.corner_values.mean(1) + r.offset

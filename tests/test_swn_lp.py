@@ -187,9 +187,58 @@ def test_time_limit_bounds_the_lps_of_all_passes(monkeypatch):
         Jv, obj, _ = real(gamma, g_, eps, time_limit, algorithm)
         return Jv, obj, 0.75 * time_limit if len(calls) == 1 else 0.0   # the first LP takes 3/4 of the budget
     monkeypatch.setattr(swn, "_residual_full", slow)
-    r = swn.solve(g, method="lp", time_limit=8.0)
+    r = swn.solve(g, method="lp", time_limit=8.0, cycle_choice="lp")
     assert calls == [8.0, 2.0] and r.passes >= 2                   # the second LP gets what is left
     # the first LP takes the whole budget: the second is refused, naming the fallback
     monkeypatch.setattr(swn, "_residual_full", lambda gm, g_, e, tl, alg="highs-ds": real(gm, g_, e, tl, alg)[:2] + (tl,))
     with pytest.raises(ValueError, match=r"whole time_limit.*method='reduced'"):
-        swn.solve(g, method="lp", time_limit=8.0)
+        swn.solve(g, method="lp", time_limit=8.0, cycle_choice="lp")
+
+
+def _band_and_long_loop():
+    """Torus (R = 1, r = 0.4): a band round the inner side (region: 10 ≤ j ≤ 14 round the tube, both sides are
+    longitudes of length 2π·0.65, homologous to each other) and a nonbounding loop along the outer equator
+    (j = 0, length 2π·1.4, homologous to the band's sides), every curve broken in gaps of a few edges. The loop
+    misses a quarter of its edges, the band's side j = 10 a third: that side has less gap length, the loop a
+    larger share of its length on the input."""
+    V, F, idx = torus(48, 24)
+    swn = SurfaceWindingNumbers(V, F)
+    fj = F % 24
+    R = (fj.min(1) >= 10) & (fj.max(1) <= 14)
+    g = boundary_chain(swn, np.flatnonzero(R))
+    E = swn.dec.edges
+    ej, ei = E % 24, E // 24
+    along = (ej[:, 0] == ej[:, 1])                                # longitude edges (i varies)
+    lo_i = np.where(np.abs(ei[:, 0] - ei[:, 1]) == 1, ei.min(1), ei.max(1))     # the edge's first i (mod 48)
+
+    def cut(j, gaps):                                           # delete the longitude edges i ∈ gaps at j
+        return along & (ej[:, 0] == j) & np.isin(lo_i, gaps)
+    g[cut(10, [0, 1, 2, 3, 12, 13, 14, 15, 24, 25, 26, 27, 36, 37, 38, 39])] = 0       # a third of side j = 10
+    g[cut(14, [6, 7, 18, 19, 30, 31, 42, 43])] = 0                                      # a sixth of side j = 14
+    e0 = np.flatnonzero(along & (ej[:, 0] == 10) & (g != 0) & (np.abs(ei[:, 0] - ei[:, 1]) == 1))[0]
+    s = int(np.sign(g[e0]))                                     # +1: side j = 10 runs towards increasing i
+    loop = swn.chain([idx[list(range(48)) + [0], 0][::s]])      # the loop runs like it (the same class)
+    loop[cut(0, [5, 6, 7, 17, 18, 19, 29, 30, 31, 41, 42, 43])] = 0                    # a quarter of the loop
+    return swn, g + loop, loop != 0, R.astype(int)
+
+
+def test_cycle_choice_keeps_the_whole_loop_not_the_band_side():
+    """cycle_choice: the LP's optimum (least ε-weighted length, thesis §6.1.2) carries the class on the band's
+    side j = 10 — its gaps are shorter than the loop's — and cuts the band open. "complete" (default) solves the
+    LP again without that side's edges, finds the loop, and keeps it: 3/4 of its jump mass lies on the input
+    against 2/3 on the side."""
+    swn, g, loop, truth = _band_and_long_loop()
+    A = swn.dec.face_area
+    lp = swn.solve(g, method="lp", cycle_choice="lp")
+    assert np.abs(lp.residual[loop]).max() < 0.1                 # the LP's cycle avoids the loop ...
+    assert mislabeled(lp, truth, A) > 0.1                        # ... and cuts the band
+    r = swn.solve(g, method="lp")
+    assert np.abs(r.residual[loop]).min() > 0.5                  # the loop carries the class
+    assert not np.any(r.bounding[loop])
+    assert mislabeled(r, truth, A) < 0.01
+    for alg in ("highs-ipm", "band", "network"):                 # every form of the LP chooses alike
+        assert np.array_equal(swn.solve(g, method="lp", lp_algorithm=alg).face_labels, r.face_labels)
+    cyc = SurfaceWindingNumbers(swn.dec.V, swn.dec.F, lp_form="cycles")
+    assert np.array_equal(cyc.solve(g, method="lp").face_labels, r.face_labels)
+    with pytest.raises(ValueError, match="cycle_choice"):
+        swn.solve(g, cycle_choice="shortest")

@@ -20,6 +20,9 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    has one shift per piece;
    With ``homology="integer"`` the class of γ (its periods on a tree–cotree homology basis) is first rounded
    to the nearest integer class; a class 0 skips the LP;
+   ``cycle_choice="complete"`` (default) solves the full LP a second time with the input edges of its cycle
+   forbidden and keeps, of the two homologous cycles, the one with the larger share of its jump mass on the
+   input (a broken loop rather than a shorter, more broken side of a region round the same handle);
 5. the jumps of v (Jv, the completed nonbounding part) are removed from the input: the jump Laplace equation is
    solved again with jumps "Γ ∖ Jv" (§6.1.2) on the input's edges only — Jv off the input (where the
    LP closed the gaps of nonbounding loops) is the completion of the nonbounding part, not a jump of w: w.
@@ -67,6 +70,9 @@ BOUNDING = ("subset", "fractional")
 MAX_PASSES = 3          # bounding="subset": decompositions of the remainder at most (bench: a third pass is rare)
 LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm", "network", "band")   # gsdf.dec.netflow / .band_lp
 ENDPOINT_RULES = ("auto", "branch", "exclude")
+CYCLE_CHOICES = ("complete", "lp")
+CHOICE_TOL = 0.1        # cycle_choice="complete": input edges with |Jv| above this are the LP cycle's own (bench:
+                        # 0.1 and 0.3 chose alike on 41 replayed cases; 1e-3 also forbids the loop's traces)
 LP_FORMS = ("faces", "cycles")    # the full residual LP: face shifts (dual_graph_l1, default) or cycle form
 IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
                         # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
@@ -239,7 +245,7 @@ class SurfaceWindingNumbers:
     # ----------------------------------------------------------------------------------------------- solve
     def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
               homology: str = "real", lp_algorithm: str = "auto", bounding: str = "subset", progress=None,
-              endpoint_rule: str = "auto", _final: str = "curves") -> SWNResult:
+              endpoint_rule: str = "auto", cycle_choice: str = "complete", _final: str = "curves") -> SWNResult:
         """Surface winding numbers of ``curves``.
 
         Parameters
@@ -286,6 +292,16 @@ class SurfaceWindingNumbers:
             surfaces, "exclude" otherwise — on 64 replayed not simply connected bench cases "branch" had the
             same mean error (2.15 % vs 2.16 %) but 2 more cases over 0.5 % (73.4 % vs 76.6 % under), so the
             surfaces with an LP keep the rule their LP was validated with
+        cycle_choice : "complete" (default) or "lp" — which of two homologous candidate cycles carries the class
+            of γ (``method="lp"`` only). "lp": the LP's optimum, the cycle of least ε-weighted length (thesis
+            §6.1.2; Fig. 6.10: the shortest nonbounding set). Between a broken nonbounding loop and a homologous
+            side of a broken region (a band round a handle) that is the one with the least *gap* length, so a
+            long, little-broken loop loses to a shorter, more broken region side and the region is cut open.
+            "complete": the LP is solved a second time with the input edges the first cycle uses
+            (``|Jv| > CHOICE_TOL``) forbidden, and of the two cycles the one with the larger share of its
+            jump mass Σ ℓ|Jv| on input edges is kept — the candidate that is more nearly a whole input curve,
+            a share that does not grow with the curve's length (derived; the gap share of a broken curve is
+            its deletion rate). One more LP per decomposition pass
 
         Returns
         -------
@@ -306,6 +322,8 @@ class SurfaceWindingNumbers:
             raise ValueError(f"endpoint_rule: expected one of {ENDPOINT_RULES}, got {endpoint_rule!r}")
         if endpoint_rule == "auto":
             endpoint_rule = "branch" if self.simply_connected else "exclude"
+        if cycle_choice not in CYCLE_CHOICES:
+            raise ValueError(f"cycle_choice: expected one of {CYCLE_CHOICES}, got {cycle_choice!r}")
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
         steps = iter(range(1, 6))
@@ -353,7 +371,8 @@ class SurfaceWindingNumbers:
                 T["jump_solve"] += time.perf_counter() - t0
             left = float(time_limit) - T["lp"]     # time_limit bounds the LPs of all passes together
             om_k, gamma_k, Jv_k, obj_k = self._decompose(u_cur, cur, ends_cur, method, homology, epsilon,
-                                                         left, lp_algorithm, T, say if k_pass == 0 else None)
+                                                         left, lp_algorithm, T, say if k_pass == 0 else None,
+                                                         cycle_choice)
             if k_pass == 0:
                 om, gamma = om_k, gamma_k
             Jv = Jv + Jv_k
@@ -395,7 +414,8 @@ class SurfaceWindingNumbers:
             progress(5, 5)
         return res
 
-    def _decompose(self, u, g, ends, method, homology, epsilon, time_limit, lp_algorithm, T, say=None):
+    def _decompose(self, u, g, ends, method, homology, epsilon, time_limit, lp_algorithm, T, say=None,
+                   cycle_choice="lp"):
         """Steps ②–④ for the chain g with jump-harmonic u: (ω, γ, Jv, LP objective); adds to T's steps."""
         dec = self.dec
         say = say if say is not None else (lambda _name: None)
@@ -438,6 +458,9 @@ class SurfaceWindingNumbers:
                         alg = "band"
                     extra = (ends,) if alg == "band" else ()          # the band's seeds need the endpoints
                     Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit, alg, *extra)
+                    if cycle_choice == "complete":
+                        Jv, obj, lp_s = self._complete_cycle(gamma_lp, g, float(epsilon), time_limit, alg, extra,
+                                                             Jv, obj, lp_s)
                 else:
                     Jv, obj, lp_s = self._residual_reduced(gamma_lp, g, ends, time_limit)
             except ValueError as exc:
@@ -546,8 +569,32 @@ class SurfaceWindingNumbers:
         d_hi = vinit[A, (sa + 1) % 3] - vinit[B, sb]
         return 0.5 * (d_lo + d_hi)
 
-    def _full_lp_terms(self, gamma, g, eps):
-        """The full residual LP's data (spec §1(b) ④): interior edges, offsets d, weights, bounds (k, 2)."""
+    def _complete_cycle(self, gamma, g, eps, time_limit, alg, extra, Jv, obj, lp_s):
+        """``cycle_choice="complete"`` (see :meth:`solve`): the LP again with the input edges of the first cycle
+        ``Jv`` forbidden; (Jv, objective, seconds) of the cycle with the larger share of Σ ℓ|Jv| on the input.
+        The first cycle is kept when the second LP does not finish within the time left."""
+        used = (g != 0) & (np.abs(Jv) > CHOICE_TOL)
+        left = time_limit - lp_s
+        if not used.any() or not left > 0:
+            return Jv, obj, lp_s
+        t0 = time.perf_counter()
+        try:
+            J2, obj2, s2 = self._residual_full(gamma, g, eps, left, alg, *extra, forbid=used)
+        except ValueError:              # the second LP did not finish in the time left: the LP's own cycle
+            return Jv, obj, lp_s + time.perf_counter() - t0
+        ell = self.dec.edge_length
+        on = g != 0
+
+        def share(J):
+            m = ell * np.abs(J)
+            return m[on].sum() / max(m.sum(), 1e-300)
+        if share(J2) > share(Jv) + 1e-9:
+            return J2, obj2, lp_s + s2
+        return Jv, obj, lp_s + s2
+
+    def _full_lp_terms(self, gamma, g, eps, forbid=None):
+        """The full residual LP's data (spec §1(b) ④): interior edges, offsets d, weights, bounds (k, 2); jumps
+        fixed at 0 on the edges ``forbid`` (nE,) bool, if given."""
         dec, topo = self.dec, self.topology
         interior = np.flatnonzero(topo.edge_face_count == 2)
         vinit = self._face_integrals(gamma)
@@ -558,15 +605,18 @@ class SurfaceWindingNumbers:
         # "no extra loops": 0 ≤ g·Jv ≤ g² on the input's edges
         lo = np.where(on, np.minimum(0.0, gi), -np.inf)
         hi = np.where(on, np.maximum(0.0, gi), np.inf)
+        if forbid is not None:
+            lo[forbid[interior]] = 0.0
+            hi[forbid[interior]] = 0.0
         return interior, d, w, np.column_stack([lo, hi])
 
-    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds", ends=None):
+    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds", ends=None, forbid=None):
         if self.lp_form == "cycles":
             if algorithm in ("network", "band"):
                 raise ValueError(f"lp_algorithm={algorithm!r} solves the face form (lp_form='faces') only")
-            return self._residual_cycles(gamma, g, eps, time_limit, algorithm)
+            return self._residual_cycles(gamma, g, eps, time_limit, algorithm, forbid)
         dec, topo = self.dec, self.topology
-        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps)
+        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps, forbid)
         pairs = topo.edge_faces[interior]
         if algorithm == "band":
             from ..dec.band_lp import banded_l1
@@ -582,12 +632,12 @@ class SurfaceWindingNumbers:
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
 
-    def _residual_cycles(self, gamma, g, eps, time_limit, algorithm="highs-ds"):
+    def _residual_cycles(self, gamma, g, eps, time_limit, algorithm="highs-ds", forbid=None):
         """The full residual LP in cycle form (:class:`gsdf.dec.cycle_lp.CycleL1`: the same program without face
         unknowns — vertex conservation rows plus one row per homology generator; same optimum, built once)."""
         from ..dec.cycle_lp import CycleL1
 
-        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps)
+        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps, forbid)
         if self._cycle_lp is None:
             self._cycle_lp = CycleL1(self.dec, interior)
         r = self._cycle_lp.solve(d, w, bounds=bounds, time_limit=time_limit, algorithm=algorithm)
@@ -693,7 +743,7 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
 def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
                            time_limit: float = 300.0, homology: str = "real",
                            lp_algorithm: str = "auto", bounding: str = "subset",
-                           endpoint_rule: str = "auto") -> SWNResult:
+                           endpoint_rule: str = "auto", cycle_choice: str = "complete") -> SWNResult:
     """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
     Examples
@@ -703,4 +753,4 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float =
     """
     return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit,
                                              homology=homology, lp_algorithm=lp_algorithm, bounding=bounding,
-                                             endpoint_rule=endpoint_rule)
+                                             endpoint_rule=endpoint_rule, cycle_choice=cycle_choice)
