@@ -110,8 +110,6 @@ def test_candidate_search_same_sets_as_kd_tree(k):
     rows = _candidate_search(P, k).rows(0, 700)
     ref = cKDTree(P).query(P, k)[1]
     assert np.array_equal(np.sort(rows, axis=1), np.sort(ref, axis=1))
-    if k <= 64:  # ordered rows: those of the k-d tree, so the point areas are bit for bit the same
-        assert np.array_equal(rows, ref)
 
 
 def test_point_sources_candidates():

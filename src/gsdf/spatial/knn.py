@@ -78,7 +78,10 @@ class SelfKNN:
         if self.degenerate:
             return np.tile(np.arange(self.k, dtype=np.int64), (e - s, 1))
         out = np.empty((e - s, self.k), np.int64)
-        _knn_kernel(self.P, *self._grid, self.k, int(s), self.ordered, out)
+        if s == 0 and e == self.n:  # every row: cell by cell, the candidates of a cell gathered once
+            _knn_by_cell(self.P, *self._grid, self.k, self.ordered, out)
+        else:
+            _knn_kernel(self.P, *self._grid, self.k, int(s), self.ordered, out)
         return out
 
 
@@ -148,7 +151,7 @@ def _knn_kernel(P, Ps, order, start, cells, dims, lo, cell, k, s, ordered, out):
 
 
 @njit(cache=True)
-def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd, ci, tmp, out):
+def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd, ci, tmp, out, R0=1):
     """The k nearest of point i into out[row] (sorted by (distance, index) when ``ordered``); returns the
     (possibly grown) scratch buffers.
 
@@ -158,7 +161,7 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd,
     beyond ``reach`` are not read."""
     x, y, z = P[i, 0], P[i, 1], P[i, 2]
     cx, cy, cz = cells[i, 0], cells[i, 1], cells[i, 2]
-    R = 1
+    R = R0
     while True:
         x0, x1 = max(cx - R, 0), min(cx + R, dims[0] - 1)
         y0, y1 = max(cy - R, 0), min(cy + R, dims[1] - 1)
@@ -211,7 +214,14 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd,
         if m >= k:
             break
         R += 1
-    # the k smallest (d², index): a quickselect threshold, then the ties at it by smallest index
+    _keep_k(cd, ci, tmp, m, k, ordered, out, row)
+    return cd, ci, tmp
+
+
+@njit(cache=True)
+def _keep_k(cd, ci, tmp, m, k, ordered, out, row):
+    """out[row] = the indices of the k smallest (d², index) among cd[:m], ci[:m] (m >= k): a quickselect
+    threshold, then the ties at it by smallest index (sorted by (d², index) when ``ordered``)."""
     for q in range(m):
         tmp[q] = cd[q]
     thr = _select(tmp, np.int64(m), k - 1)  # int64, not Literal[int](0): one specialisation
@@ -234,4 +244,72 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd,
             ci[b] = iv
     for t in range(k):
         out[row, t] = ci[t]
-    return cd, ci, tmp
+
+
+@njit(cache=True, nogil=True)
+def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
+    """Every row of out (original point order): per nonempty cell, the points of its 3×3×3 block are gathered
+    once (coordinates contiguous); each of the cell's points keeps those closer than its reach (the nearest
+    face of the block with cells beyond it), and when fewer than k are kept it falls back to
+    :func:`_knn_one` from R = 2."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    cap = 8 * k + 64
+    bx, by, bz = np.empty(cap), np.empty(cap), np.empty(cap)
+    bi = np.empty(cap, np.int64)
+    cd = np.empty(cap)
+    ci = np.empty(cap, np.int64)
+    tmp = np.empty(cap)
+    for cid in range(start.shape[0] - 1):
+        s, e = start[cid], start[cid + 1]
+        if e == s:
+            continue
+        cx, cy, cz = cid // (n1 * n2), (cid // n2) % n1, cid % n2
+        x0, x1 = max(cx - 1, 0), min(cx + 1, n0 - 1)
+        y0, y1 = max(cy - 1, 0), min(cy + 1, n1 - 1)
+        z0, z1 = max(cz - 1, 0), min(cz + 1, n2 - 1)
+        M = 0
+        for ax in range(x0, x1 + 1):
+            for ay in range(y0, y1 + 1):
+                base = (ax * n1 + ay) * n2
+                a, b = start[base + z0], start[base + z1 + 1]   # the z-run of cells is contiguous
+                if M + (b - a) > bx.shape[0]:
+                    c2 = 2 * (M + b - a)
+                    nx, ny, nz, ni = np.empty(c2), np.empty(c2), np.empty(c2), np.empty(c2, np.int64)
+                    for q in range(M):
+                        nx[q], ny[q], nz[q], ni[q] = bx[q], by[q], bz[q], bi[q]
+                    bx, by, bz, bi = nx, ny, nz, ni
+                for q in range(a, b):
+                    bx[M], by[M], bz[M], bi[M] = Ps[q, 0], Ps[q, 1], Ps[q, 2], order[q]
+                    M += 1
+        if cd.shape[0] < M:
+            cd, ci, tmp = np.empty(M), np.empty(M, np.int64), np.empty(M)
+        for p in range(s, e):
+            x, y, z = Ps[p, 0], Ps[p, 1], Ps[p, 2]
+            reach = np.inf
+            if x0 > 0:
+                reach = min(reach, x - (lo[0] + x0 * cell))
+            if x1 < n0 - 1:
+                reach = min(reach, lo[0] + (x1 + 1) * cell - x)
+            if y0 > 0:
+                reach = min(reach, y - (lo[1] + y0 * cell))
+            if y1 < n1 - 1:
+                reach = min(reach, lo[1] + (y1 + 1) * cell - y)
+            if z0 > 0:
+                reach = min(reach, z - (lo[2] + z0 * cell))
+            if z1 < n2 - 1:
+                reach = min(reach, lo[2] + (z1 + 1) * cell - z)
+            lim = reach * reach
+            m = 0
+            for q in range(M):
+                u, v, w = bx[q] - x, by[q] - y, bz[q] - z
+                d = u * u + v * v + w * w
+                if d <= lim:
+                    cd[m] = d
+                    ci[m] = bi[q]
+                    m += 1
+            i = order[p]
+            if m >= k:
+                _keep_k(cd, ci, tmp, m, k, ordered, out, i)
+            else:
+                cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, i, ordered, cd, ci, tmp,
+                                       out, 2)

@@ -151,23 +151,23 @@ def _polygon_area(poly, m):
 
 @njit(cache=True)
 def _convex_hull(pts, m, hull):
-    """Andrew's monotone chain on ``pts[:m]`` (small m); CCW hull into ``hull``, returns its size."""
-    # insertion sort by (x, y): m <= k + 1 is small
-    order = np.arange(m)
+    """Andrew's monotone chain on ``pts[:m]`` (small m), which it sorts in place by (x, y); CCW hull into
+    ``hull``, returns its size."""
+    # insertion sort by (x, y) in place: m <= k + 1 is small (no index array to allocate per cell)
     for a in range(1, m):
-        key = order[a]
+        kx, ky = pts[a, 0], pts[a, 1]
         b = a - 1
-        while b >= 0 and (
-            pts[order[b], 0] > pts[key, 0] or (pts[order[b], 0] == pts[key, 0] and pts[order[b], 1] > pts[key, 1])
-        ):
-            order[b + 1] = order[b]
+        while b >= 0 and (pts[b, 0] > kx or (pts[b, 0] == kx and pts[b, 1] > ky)):
+            pts[b + 1, 0] = pts[b, 0]
+            pts[b + 1, 1] = pts[b, 1]
             b -= 1
-        order[b + 1] = key
+        pts[b + 1, 0] = kx
+        pts[b + 1, 1] = ky
     h = 0
     for pass_ in range(2):
         start = h
         for s in range(m):
-            j = order[s] if pass_ == 0 else order[m - 1 - s]
+            j = s if pass_ == 0 else m - 1 - s
             while h >= start + 2:
                 ox = hull[h - 2, 0]
                 oy = hull[h - 2, 1]
@@ -287,7 +287,7 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
         # the border of an open surface only gets the part of its cell that lies on the surface
         Q[cnt, 0] = 0.0
         Q[cnt, 1] = 0.0
-        nh = _convex_hull(Q, cnt + 1, H)
+        nh = _convex_hull(Q, cnt + 1, H)  # (sorts Q: not used after this)
         if nh < 3:
             k = 0
         else:
@@ -315,12 +315,6 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
 # ----------------------------------------------------------------------------------------------
 
 
-#: Candidate counts up to this get their rows sorted by distance (ties by index), as scipy's k-d tree returns them:
-#: the areas are then bit for bit those of the k-d tree search it replaced (the plane fit sums the candidates in
-#: row order). Above, rows are unordered (the neighbour sets, not their order, decide the areas up to rounding).
-ORDERED_MAX_K = 64
-
-
 #: Below this many points the two kernels run as one call on the calling thread: together ~1-3 ms of serial
 #: work at 1.4k-6k points (CGAL's oni / kitten / hippo1), while running them on two threads on a loaded
 #: machine waited for the second thread: 10-25 ms at load 5-6 (issue 17).
@@ -328,10 +322,11 @@ SERIAL_POINTS = 16_384
 
 
 def _candidate_search(P, k):
-    """The k nearest of every point (itself included): the cell grid of :class:`SelfKNN`, rows ordered up to
-    :data:`ORDERED_MAX_K`. Measured on the CGAL clouds oni / kitten / hippo1 (1.4k-6k points) against
-    scipy's k-d tree: 1.1-1.3× faster at k = 41 (ordered), 1.4-1.6× at k = 161, on one thread."""
-    return SelfKNN(P, k, ordered=k <= ORDERED_MAX_K)
+    """The k nearest of every point (itself included), rows unordered: the cell grid of :class:`SelfKNN`.
+    Measured on the CGAL clouds oni / kitten / hippo1 (1.4k-6k points) against the scipy k-d tree it replaced
+    for k <= 64: 1.3-1.7× faster at k = 41, 1.4-1.6× at k = 161, on one thread. Only the neighbour sets decide
+    the areas: the row order changes the plane fit's sums by rounding (areas within ~1e-15 relative)."""
+    return SelfKNN(P, k)
 
 
 def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) -> np.ndarray:
@@ -400,8 +395,7 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     (8) to within 1 %
     (``bench/bench_winding.py`` prints the figure). On a clean sphere both are within 0.1 %.
 
-    Cost: one k-nearest-neighbour search (scipy's k-d tree up to 64 candidates, the cell grid of
-    :class:`gsdf.spatial.knn.SelfKNN` above) plus
+    Cost: one k-nearest-neighbour search (the cell grid of :class:`gsdf.spatial.knn.SelfKNN`) plus
     O(n (candidates k + k^2)) work in numba kernels on the threads.
 
     Examples
