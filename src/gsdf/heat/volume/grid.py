@@ -336,7 +336,7 @@ def _aggregation(shape, block: int) -> sp.csr_matrix:
 
 
 def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter: int = 300,
-                  coarse_size: int = 4096, min_block: int = 3) -> np.ndarray:
+                  coarse_size: int = 4096, min_block: int = 4) -> np.ndarray:
     """Solve the Step III system.
 
     Without ``penalty`` the system is the singular Neumann Laplacian L φ = rhs, solved exactly by
@@ -362,8 +362,11 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
 
     Iterations on the broken bunny at 64³: 14 (DCT alone: 116); 10–16 at 32³. The start is the unconstrained
     DCT solution plus the best constant. ``tol`` is CG's relative residual (1e-5 moves φ by ~1e-5 of the
-    box diagonal, far under the discretization error). Blocks of at least 3 nodes: at 32³ the coarse LU of
-    2-node blocks (2.7k unknowns) cost 10–30 ms, more than the 1–3 extra iterations of 3-node blocks.
+    box diagonal, far under the discretization error). Blocks of at least 4 nodes: at 32³ the coarse LU of
+    2-node blocks (2.7k unknowns) cost 10–30 ms, more than the 1–3 extra iterations of 3-node blocks; with the
+    numba stages an iteration is cheap enough that 4-node blocks (~350 coarse unknowns at 32³, LU < 1 ms) win
+    again: on 7 of bench/bench_heat_volume_speed.py's inputs the solve took 0.84–1.0× the time of 3-node blocks
+    for 1–2 more iterations, the mean errors equal to 5–6 digits.
     """
     shape = tuple(shape)
     if penalty is None:
@@ -384,7 +387,7 @@ class PenalizedPoisson:
     (L as its stencil; P as CSR). Attributes: ``band`` (the nodes P touches), ``block`` (aggregate size),
     ``coarse`` (the factorized R A Rᵀ), ``delta`` (the DCT stage's shift tr(P)/N)."""
 
-    def __init__(self, shape, spacing, penalty, coarse_size: int = 4096, min_block: int = 3):
+    def __init__(self, shape, spacing, penalty, coarse_size: int = 4096, min_block: int = 4):
         from ...linalg import Factorization
 
         self.shape = tuple(int(s) for s in shape)
