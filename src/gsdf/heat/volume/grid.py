@@ -388,8 +388,6 @@ class PenalizedPoisson:
     ``coarse`` (the factorized R A Rᵀ), ``delta`` (the DCT stage's shift tr(P)/N)."""
 
     def __init__(self, shape, spacing, penalty, coarse_size: int = 4096, min_block: int = 4):
-        from ...linalg import Factorization
-
         self.shape = tuple(int(s) for s in shape)
         self.spacing = np.asarray(spacing, float)
         n = int(np.prod(self.shape))
