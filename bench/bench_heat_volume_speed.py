@@ -112,6 +112,7 @@ STAGES = [  # (label, file suffix, function name): disjoint stages of the grid p
     ("divergence", "domains/grid.py", "divergence"),
     ("factorization (coarse)", "linalg/direct.py", "__init__"),
     ("CG solve", "linalg/iterative.py", "pcg"),
+    ("CG solve", "linalg/iterative.py", "cg_loop"),       # the grid's soft-penalty solve (numba operators)
     ("shift", "heat/core.py", "shift"),
 ]
 
@@ -197,8 +198,7 @@ def worker(args):
         if who == "gsdf":  # every run builds its grid operators, as the anchor's new solver object does
             from gsdf.heat.volume import grid as _grid
 
-            _grid._grid_operators_cached.cache_clear()
-            _grid._dct_matrix.cache_clear()
+            _grid._dct_matrix.cache_clear()  # (the Step III operators are built per solve)
         t = time.perf_counter()
         if who == "gsdf":
             from gsdf.heat.volume import signed_heat_volume
@@ -328,7 +328,7 @@ def main(argv):
             f"Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_heat_volume_speed.py {' '.join(argv)}`",
             "", f"gsdf: median of {rep_g}; signedheat3d: median of {rep_a} (no further run after one over {SLOW_ANCHOR:.0f} s), "
             "both in a process of their own, every run timed (gsdf's numba kernels loaded before the first; its "
-            "per-grid operator cache cleared before each run, as signedheat3d gets a new solver object per run). "
+            "DCT-matrix cache cleared before each run and its Step III operators built in every run, as signedheat3d gets a new solver object per run). "
             "signedheat3d's time varies between runs because its Step 3 (AMGCL BiCGStab, tol 1e-2) starts from an "
             "uninitialised vector: when it fails to converge in 1000 iterations the solver falls back to a sparse "
             "direct LU (\"AMGCL fell back\": runs that did, from its own log); its Steps 1-2 (direct sums over all "

@@ -50,15 +50,30 @@ def test_smallest_eigenvector3_matches_lapack():
     assert wmid <= 1e-12 * wmax
 
 
-def test_grid_operators_cached_equal_a_fresh_build():
+def test_kron_laplacian_equals_the_direct_assembly():
     shape, h = (10, 7, 9), (0.1, 0.1, 0.1)
-    a = G._grid_operators(shape, h, 3)
-    b = G._build_grid_operators(shape, h, 3)
-    assert G._grid_operators(shape, h, 3)[0] is a[0]          # built once
-    for x, y in zip(a, b):
-        assert (abs(x - y)).max() == 0
-    ref = (G._neumann_laplacian_kron(shape, h) - a[0]).tocsr()
+    ref = (G._neumann_laplacian_kron(shape, h) - G.neumann_laplacian(shape, h)).tocsr()
     assert abs(ref).max() < 1e-9
+
+
+def test_cg_loop_matches_scipy_cg():
+    """gsdf.linalg.iterative.cg_loop is SciPy's cg on callables: the same iterates, the same stopping rule."""
+    from scipy.sparse.linalg import LinearOperator, cg
+
+    from gsdf.linalg.iterative import cg_loop
+
+    rng = np.random.default_rng(4)
+    A = sp.random(300, 300, 0.02, random_state=4)
+    A = (A @ A.T + sp.identity(300)).tocsr()
+    d = 1.0 / A.diagonal()
+    b = rng.standard_normal(300)
+    for maxiter in (3, 200):
+        ref, info = cg(A, b, x0=np.zeros(300), M=LinearOperator(A.shape, matvec=lambda r: d * r), rtol=1e-8,
+                       atol=0.0, maxiter=maxiter)
+        x, ok = cg_loop(lambda v: A @ v, lambda r: d * r, b, np.zeros(300), rtol=1e-8, maxiter=maxiter)
+        assert ok == (info == 0)
+        assert np.abs(x - ref).max() <= 1e-12 * np.abs(ref).max()
+    assert cg_loop(lambda v: A @ v, lambda r: r, np.zeros(300), np.ones(300))[0].any() == 0
 
 
 def test_solve_poisson_penalized_against_a_direct_solve():

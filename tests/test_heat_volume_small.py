@@ -35,7 +35,8 @@ def test_carried_residual_preconditioner_solves_the_penalized_system():
 
 
 def test_carried_residual_is_the_same_operator_as_recomputing_it():
-    """One preconditioner application of the fast path equals the stage-by-stage r − A x version."""
+    """One preconditioner application of the fast path (numba kernels, carried residual) equals the
+    stage-by-stage r − A x version with SciPy matrices, and its A x equals (L + P) x."""
     from scipy.sparse.linalg import LinearOperator
 
     import gsdf.heat.volume.grid as G
@@ -50,18 +51,48 @@ def test_carried_residual_is_the_same_operator_as_recomputing_it():
 
     G.pcg = capture
     try:
-        G.solve_poisson(b, shape, spacing, P, min_block=3)
         G._solve_poisson_reference(b, shape, spacing, P, block=3)
     finally:
         G.pcg = real_pcg
-    fast, slow = seen["M"]
-    assert isinstance(fast, LinearOperator) and isinstance(slow, LinearOperator)
+    (slow,) = seen["M"]
+    assert isinstance(slow, LinearOperator)
+    fast = G.PenalizedPoisson(shape, spacing, P, min_block=3)
+    assert fast.block == 3
     r = np.random.default_rng(1).normal(size=L.shape[0])
-    zf, zs = fast.matvec(r), slow.matvec(r)
+    zf, zs = fast.precondition(r), slow.matvec(r)
     assert np.abs(zf - zs).max() <= 1e-9 * np.abs(zs).max()
+    assert np.abs(fast.matvec(r) - (L + P) @ r).max() <= 1e-12 * np.abs((L + P) @ r).max()
     # symmetric (CG needs it): <M r, s> = <r, M s>
     s = np.random.default_rng(2).normal(size=L.shape[0])
-    assert abs(fast.matvec(r) @ s - r @ fast.matvec(s)) <= 1e-9 * abs(r @ fast.matvec(s))
+    assert abs(fast.precondition(r) @ s - r @ fast.precondition(s)) <= 1e-9 * abs(r @ fast.precondition(s))
+    # the coarse matrix assembled on the grid is the Galerkin product R (L + P) Rᵀ
+    R = G._aggregation(shape, 3)
+    C = (R @ (L + P) @ R.T).toarray()
+    x = np.random.default_rng(3).normal(size=C.shape[0])
+    assert np.abs(fast.coarse.solve(C @ x) - x).max() <= 1e-8 * np.abs(x).max()
+
+
+def test_penalty_matrix_equals_the_sparse_product():
+    """P = Aᵀ diag(w) A: the cell kernel for trilinear rows (points on nodes, faces and corners of the box
+    included), SciPy's product for rows spanning several cells."""
+    import scipy.sparse as sp
+
+    import gsdf.heat.volume.grid as G
+
+    rng = np.random.default_rng(0)
+    shape, h = (12, 9, 7), np.full(3, 0.1)
+    B = rng.random((300, 3)) * (np.array(shape) - 1) * h
+    B[:4] = 0.0
+    B[4] = (np.array(shape) - 1) * h
+    B[5] = np.array([3, 4, 2]) * h                       # on a node
+    T = G.trilinear_matrix(B, np.zeros(3), h, shape)
+    assert T.has_canonical_format
+    assert abs(T - sp.csr_matrix(T.toarray())).max() == 0
+    w = rng.random(300)
+    ref = (T.T @ sp.diags(w) @ T).tocsr()
+    assert abs(G.penalty_matrix(T, w, shape) - ref).max() <= 1e-15 * abs(ref).max()
+    D = sp.csr_matrix(np.vstack([T[:3].toarray(), T[10].toarray() - T[200].toarray()]))   # not in one cell
+    assert abs(G.penalty_matrix(D, 2.0, shape) - 2.0 * (D.T @ D)).max() <= 1e-15 * abs(D.T @ D).max()
 
 
 def test_small_cloud_volume_field_unchanged_by_the_fast_path():
@@ -106,12 +137,19 @@ def test_self_knn_matches_the_kd_tree():
         got = knn_self(P, k)
         assert np.array_equal(np.sort(got, axis=1), np.sort(ref, axis=1))
     assert np.array_equal(SelfKNN(P, 9).rows(100, 130), knn_self(P, 9)[100:130])
+    for k in (1, 7, 41):   # ordered rows: sorted by distance, ties by index — the k-d tree's rows
+        assert np.array_equal(SelfKNN(P, k, ordered=True).rows(), cKDTree(P).query(P, k)[1].reshape(len(P), k))
     g = np.arange(7) * 0.5
     G = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
     d_ref = cKDTree(G).query(G, 19)[0]
     got = knn_self(G, 19)
     assert np.allclose(np.sort(np.linalg.norm(G[got] - G[:, None], axis=2), axis=1), d_ref)
     assert all(len(set(r)) == 19 for r in got.tolist())
+    ordered = SelfKNN(G, 19, ordered=True).rows()   # a lattice: many ties at every distance, broken by index
+    d = np.linalg.norm(G[ordered] - G[:, None], axis=2)
+    assert np.allclose(d, d_ref) and np.all(np.diff(d, axis=1) >= -1e-12)
+    tie = np.isclose(d[:, 1:], d[:, :-1])
+    assert np.all(ordered[:, 1:][tie] > ordered[:, :-1][tie])
     assert np.array_equal(knn_self(np.ones((5, 3)), 3), np.tile([0, 1, 2], (5, 1)))
     for bad, k in ((P[:, :2], 3), (P, 0), (P, len(P) + 1), (P, True), (P, 2.5)):
         with pytest.raises(ValueError):

@@ -19,7 +19,7 @@ import scipy.sparse as sp
 
 from .direct import cholesky
 
-__all__ = ["SPDSolver", "pcg", "amg_preconditioner"]
+__all__ = ["SPDSolver", "pcg", "cg_loop", "amg_preconditioner"]
 
 
 def amg_preconditioner(A):
@@ -45,6 +45,39 @@ def pcg(A, b, M=None, x0=None, rtol: float = 1e-8, maxiter: int = 500, warn: str
     if info > 0 and warn:
         warnings.warn(f"{warn}: conjugate gradients stopped after {maxiter} iterations above rtol={rtol:g}")
     return x, info == 0
+
+
+def cg_loop(matvec, psolve, b, x0, rtol: float = 1e-8, maxiter: int = 500, warn: str | None = None):
+    """Preconditioned conjugate gradients on plain callables ``matvec(x)`` = A x and ``psolve(r)`` = M r: SciPy's
+    ``cg`` iteration step for step (same stopping rule, ‖r‖ < rtol ‖b‖; same updates), without its
+    LinearOperator wrapping — for solvers whose operators are a few numba kernels, where that wrapping was a
+    visible part of an iteration. Returns ``(x, converged)``; ``x0`` is updated in place."""
+    b = np.asarray(b, dtype=np.float64)
+    bnrm2 = float(np.linalg.norm(b))
+    if bnrm2 == 0.0:
+        return b.copy(), True
+    atol = rtol * bnrm2
+    x = x0
+    r = b - matvec(x) if x.any() else b.copy()
+    rho_prev, p = 0.0, None
+    for it in range(maxiter):
+        if np.linalg.norm(r) < atol:
+            return x, True
+        z = psolve(r)
+        rho = float(np.dot(r, z))
+        if it > 0:
+            p *= rho / rho_prev
+            p += z
+        else:
+            p = z.copy()
+        q = matvec(p)
+        alpha = rho / float(np.dot(p, q))
+        x += alpha * p
+        r -= alpha * q
+        rho_prev = rho
+    if warn:
+        warnings.warn(f"{warn}: conjugate gradients stopped after {maxiter} iterations above rtol={rtol:g}")
+    return x, False
 
 
 class SPDSolver:

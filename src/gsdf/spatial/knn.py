@@ -1,16 +1,18 @@
 """The k nearest neighbours of every point of a cloud among the cloud itself, on a uniform cell grid.
 
-What :func:`gsdf.winding.point_areas` needs (k = 161 candidates per point): scipy's ``cKDTree.query`` keeps a
+What :func:`gsdf.winding.point_areas` needs (its 21-161 candidates per point): scipy's ``cKDTree.query`` keeps a
 sorted heap of k per query, and its cost grows with k (1.4k points: 25-45 ms for k = 161 against 3 ms for
 k = 21). Here the points are bucketed in cubic cells of about the typical k-th neighbour distance; each point
-scans rings of cells around its own (Chebyshev distance R = 0, 1, 2, ...) until at least k of the points seen
-are closer than the nearest face of the scanned cube (faces on the border of the grid do not count: nothing
-lies beyond them) — every unseen point is farther than that face, so those k are exact. The k smallest
-squared distances are then kept by a quickselect threshold; ties at the threshold go to the smallest indices.
+scans the cubes of cells around its own (Chebyshev distance R = 1, 2, ...) keeping the points closer than the
+nearest face of the scanned cube (faces on the border of the grid do not count: nothing lies beyond them; cells
+wholly beyond that face are not read) until at least k are kept — every unseen point is farther, so those k are
+exact. The k smallest squared distances are then kept by a quickselect threshold; ties at the threshold go to
+the smallest indices.
 
-The rows come out in no particular order (the caller needs the set; sorting 161 entries per point would cost
-as much as the search). Cost: O(n log n) bucketing plus O(n m) for m ≈ 3-5 k candidates per point on a
-surface sample, on the calling thread.
+Rows come out in no particular order unless ``ordered`` (sorted by distance, ties by index: the rows of
+``cKDTree.query``, so a caller gets bit-identical results from either; the sort costs ~15 % at k = 41).
+Cost: O(n log n) bucketing plus O(n m) for m ≈ 1.5-2 k candidates per point on a surface sample, on the calling
+thread.
 
 Example
 -------
@@ -39,11 +41,12 @@ class SelfKNN:
 
     ``rows(s, e)`` gives (e − s, k) int64: the same sets as ``cKDTree(P).query(P[s:e], k)[1]`` (ties at the
     k-th distance by smallest index), each row in no particular order, the point itself among them.
-    ``k`` must be in [1, n]. The kernel is serial: under 0.1 ms per 1k points a parallel launch does not pay
-    on a loaded machine (and compiles 5× longer).
+    ``k`` must be in [1, n]. ``ordered``: each row sorted by distance, ties by index. The kernel is serial and
+    GIL-free: under 0.1 ms per 1k points a parallel launch does not pay on a loaded machine (and compiles 5×
+    longer).
     """
 
-    def __init__(self, P, k: int):
+    def __init__(self, P, k: int, ordered: bool = False):
         P = np.ascontiguousarray(P, dtype=np.float64)
         if P.ndim != 2 or P.shape[1] != 3:
             raise ValueError(f"P: expected an (n, 3) array, got shape {P.shape}")
@@ -52,7 +55,7 @@ class SelfKNN:
             raise ValueError(f"k: must be an integer in [1, {n}] (the number of points), got {k!r}")
         if not np.isfinite(P).all():
             raise ValueError("P: contains NaN or inf")
-        self.P, self.n, self.k = P, n, int(k)
+        self.P, self.n, self.k, self.ordered = P, n, int(k), bool(ordered)
         lo = P.min(axis=0)
         ext = float((P.max(axis=0) - lo).max())
         self.degenerate = ext == 0.0  # all points coincide: the k smallest indices
@@ -75,7 +78,10 @@ class SelfKNN:
         if self.degenerate:
             return np.tile(np.arange(self.k, dtype=np.int64), (e - s, 1))
         out = np.empty((e - s, self.k), np.int64)
-        _knn_kernel(self.P, *self._grid, self.k, int(s), out)
+        if s == 0 and e == self.n:  # every row: cell by cell, the candidates of a cell gathered once
+            _knn_by_cell(self.P, *self._grid, self.k, self.ordered, out)
+        else:
+            _knn_kernel(self.P, *self._grid, self.k, int(s), self.ordered, out)
         return out
 
 
@@ -134,52 +140,32 @@ def _select(a, m, r):
     return a[r]
 
 
-@njit(cache=True)
-def _knn_kernel(P, Ps, order, start, cells, dims, lo, cell, k, s, out):
+@njit(cache=True, nogil=True)
+def _knn_kernel(P, Ps, order, start, cells, dims, lo, cell, k, s, ordered, out):
     cap = 8 * k + 64
     cd = np.empty(cap)
     ci = np.empty(cap, np.int64)
     tmp = np.empty(cap)
     for r in range(out.shape[0]):
-        cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, s + r, r, cd, ci, tmp, out)
+        cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, s + r, r, ordered, cd, ci, tmp, out)
 
 
 @njit(cache=True)
-def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, cd, ci, tmp, out):
-    """The k nearest of point i into out[row]; returns the (possibly grown) scratch buffers."""
+def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd, ci, tmp, out, R0=1):
+    """The k nearest of point i into out[row] (sorted by (distance, index) when ``ordered``); returns the
+    (possibly grown) scratch buffers.
+
+    Scans the cube of cells at Chebyshev distance <= R of the point's own cell (R = 1, 2, ...), keeping only
+    points closer than ``reach``, the distance to the nearest face of the cube that has cells beyond it (a
+    point outside the cube is farther than that): once k are kept they are the k nearest. Cells wholly
+    beyond ``reach`` are not read."""
     x, y, z = P[i, 0], P[i, 1], P[i, 2]
     cx, cy, cz = cells[i, 0], cells[i, 1], cells[i, 2]
-    m = 0
-    R = 0
+    R = R0
     while True:
-        # the cells at Chebyshev distance exactly R from the point's own cell
         x0, x1 = max(cx - R, 0), min(cx + R, dims[0] - 1)
         y0, y1 = max(cy - R, 0), min(cy + R, dims[1] - 1)
         z0, z1 = max(cz - R, 0), min(cz + R, dims[2] - 1)
-        for ax in range(x0, x1 + 1):
-            for ay in range(y0, y1 + 1):
-                shell = abs(ax - cx) == R or abs(ay - cy) == R
-                az = z0
-                while az <= z1:
-                    if not shell and abs(az - cz) != R:  # inside the cube scanned before
-                        az = cz + R
-                        continue
-                    cid = (ax * dims[1] + ay) * dims[2] + az
-                    s, e = start[cid], start[cid + 1]
-                    if m + (e - s) > cd.shape[0]:  # grow the scratch buffers
-                        cap = 2 * (m + e - s)
-                        cd2, ci2 = np.empty(cap), np.empty(cap, np.int64)
-                        for q in range(m):  # a loop, not a slice assignment (whose shape-mismatch error
-                            cd2[q] = cd[q]  # path costs ~2 s of a cold compile)
-                            ci2[q] = ci[q]
-                        cd, ci, tmp = cd2, ci2, np.empty(cap)
-                    for p in range(s, e):
-                        u, v, w = Ps[p, 0] - x, Ps[p, 1] - y, Ps[p, 2] - z
-                        cd[m] = u * u + v * v + w * w
-                        ci[m] = order[p]
-                        m += 1
-                    az += 1
-        # distance from the point to the nearest face of the scanned cube that has cells beyond it
         reach = np.inf
         if x0 > 0:
             reach = min(reach, x - (lo[0] + x0 * cell))
@@ -193,45 +179,137 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, cd, ci, tmp,
             reach = min(reach, z - (lo[2] + z0 * cell))
         if z1 < dims[2] - 1:
             reach = min(reach, lo[2] + (z1 + 1) * cell - z)
+        lim = reach * reach
+        m = 0
+        for ax in range(x0, x1 + 1):
+            gx = max(0.0, max(lo[0] + ax * cell - x, x - (lo[0] + (ax + 1) * cell)))
+            gx *= gx
+            if gx > lim:
+                continue
+            for ay in range(y0, y1 + 1):
+                gy = max(0.0, max(lo[1] + ay * cell - y, y - (lo[1] + (ay + 1) * cell)))
+                gy = gx + gy * gy
+                if gy > lim:
+                    continue
+                base = (ax * dims[1] + ay) * dims[2]
+                for az in range(z0, z1 + 1):
+                    gz = max(0.0, max(lo[2] + az * cell - z, z - (lo[2] + (az + 1) * cell)))
+                    if gy + gz * gz > lim:
+                        continue  # the whole cell lies beyond reach
+                    s, e = start[base + az], start[base + az + 1]
+                    if m + (e - s) > cd.shape[0]:  # grow the scratch buffers
+                        cap = 2 * (m + e - s)
+                        cd2, ci2 = np.empty(cap), np.empty(cap, np.int64)
+                        for q in range(m):  # a loop, not a slice assignment (whose shape-mismatch error
+                            cd2[q] = cd[q]  # path costs ~2 s of a cold compile)
+                            ci2[q] = ci[q]
+                        cd, ci, tmp = cd2, ci2, np.empty(cap)
+                    for p in range(s, e):
+                        u, v, w = Ps[p, 0] - x, Ps[p, 1] - y, Ps[p, 2] - z
+                        d = u * u + v * v + w * w
+                        if d <= lim:
+                            cd[m] = d
+                            ci[m] = order[p]
+                            m += 1
         if m >= k:
-            if reach == np.inf:
-                break  # every point has been seen
-            lim = reach * reach
-            cnt = 0
-            for q in range(m):
-                if cd[q] <= lim:
-                    cnt += 1
-            if cnt >= k:
-                break
+            break
         R += 1
-    # the k smallest (d², index): a quickselect threshold, then the ties at it by smallest index
+    _keep_k(cd, ci, tmp, m, k, ordered, out, row)
+    return cd, ci, tmp
+
+
+@njit(cache=True)
+def _keep_k(cd, ci, tmp, m, k, ordered, out, row):
+    """out[row] = the indices of the k smallest (d², index) among cd[:m], ci[:m] (m >= k): a quickselect
+    threshold, then the ties at it by smallest index (sorted by (d², index) when ``ordered``)."""
     for q in range(m):
         tmp[q] = cd[q]
     thr = _select(tmp, np.int64(m), k - 1)  # int64, not Literal[int](0): one specialisation
     c = 0
     for q in range(m):
-        if cd[q] < thr:
-            out[row, c] = ci[q]
+        if cd[q] <= thr:
+            cd[c] = cd[q]
+            ci[c] = ci[q]
             c += 1
-    if c < k:
-        nt = 0
-        for q in range(m):
-            if cd[q] == thr:
-                nt += 1
-        ties = np.empty(nt, np.int64)
-        nt = 0
-        for q in range(m):
-            if cd[q] == thr:
-                ties[nt] = ci[q]
-                nt += 1
-        for a in range(1, nt):  # insertion sort (few ties; ndarray.sort would compile numba's quicksort)
-            v = ties[a]
+    if ordered or c > k:
+        # insertion sort by (d², index) of the c (about k) kept: ordered rows, and the ties at the threshold
+        for a in range(1, c):
+            dv, iv = cd[a], ci[a]
             b = a
-            while b > 0 and ties[b - 1] > v:
-                ties[b] = ties[b - 1]
+            while b > 0 and (cd[b - 1] > dv or (cd[b - 1] == dv and ci[b - 1] > iv)):
+                cd[b] = cd[b - 1]
+                ci[b] = ci[b - 1]
                 b -= 1
-            ties[b] = v
-        for t in range(k - c):
-            out[row, c] = ties[t]
-            c += 1
-    return cd, ci, tmp
+            cd[b] = dv
+            ci[b] = iv
+    for t in range(k):
+        out[row, t] = ci[t]
+
+
+@njit(cache=True, nogil=True)
+def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
+    """Every row of out (original point order): per nonempty cell, the points of its 3×3×3 block are gathered
+    once (coordinates contiguous); each of the cell's points keeps those closer than its reach (the nearest
+    face of the block with cells beyond it), and when fewer than k are kept it falls back to
+    :func:`_knn_one` from R = 2."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    cap = 8 * k + 64
+    bx, by, bz = np.empty(cap), np.empty(cap), np.empty(cap)
+    bi = np.empty(cap, np.int64)
+    cd = np.empty(cap)
+    ci = np.empty(cap, np.int64)
+    tmp = np.empty(cap)
+    for cid in range(start.shape[0] - 1):
+        s, e = start[cid], start[cid + 1]
+        if e == s:
+            continue
+        cx, cy, cz = cid // (n1 * n2), (cid // n2) % n1, cid % n2
+        x0, x1 = max(cx - 1, 0), min(cx + 1, n0 - 1)
+        y0, y1 = max(cy - 1, 0), min(cy + 1, n1 - 1)
+        z0, z1 = max(cz - 1, 0), min(cz + 1, n2 - 1)
+        M = 0
+        for ax in range(x0, x1 + 1):
+            for ay in range(y0, y1 + 1):
+                base = (ax * n1 + ay) * n2
+                a, b = start[base + z0], start[base + z1 + 1]   # the z-run of cells is contiguous
+                if M + (b - a) > bx.shape[0]:
+                    c2 = 2 * (M + b - a)
+                    nx, ny, nz, ni = np.empty(c2), np.empty(c2), np.empty(c2), np.empty(c2, np.int64)
+                    for q in range(M):
+                        nx[q], ny[q], nz[q], ni[q] = bx[q], by[q], bz[q], bi[q]
+                    bx, by, bz, bi = nx, ny, nz, ni
+                for q in range(a, b):
+                    bx[M], by[M], bz[M], bi[M] = Ps[q, 0], Ps[q, 1], Ps[q, 2], order[q]
+                    M += 1
+        if cd.shape[0] < M:
+            cd, ci, tmp = np.empty(M), np.empty(M, np.int64), np.empty(M)
+        for p in range(s, e):
+            x, y, z = Ps[p, 0], Ps[p, 1], Ps[p, 2]
+            reach = np.inf
+            if x0 > 0:
+                reach = min(reach, x - (lo[0] + x0 * cell))
+            if x1 < n0 - 1:
+                reach = min(reach, lo[0] + (x1 + 1) * cell - x)
+            if y0 > 0:
+                reach = min(reach, y - (lo[1] + y0 * cell))
+            if y1 < n1 - 1:
+                reach = min(reach, lo[1] + (y1 + 1) * cell - y)
+            if z0 > 0:
+                reach = min(reach, z - (lo[2] + z0 * cell))
+            if z1 < n2 - 1:
+                reach = min(reach, lo[2] + (z1 + 1) * cell - z)
+            lim = reach * reach
+            m = 0
+            for q in range(M):
+                u, v, w = bx[q] - x, by[q] - y, bz[q] - z
+                d = u * u + v * v + w * w
+                if d <= lim:
+                    cd[m] = d
+                    ci[m] = bi[q]
+                    m += 1
+            i = order[p]
+            if m >= k:
+                _keep_k(cd, ci, tmp, m, k, ordered, out, i)
+            else:
+                cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, i, ordered, cd, ci, tmp,
+                                       out, 2)

@@ -73,6 +73,71 @@ def _clip_halfplane(src, m, dst, a0, a1, b):
     return out
 
 
+#: Skip tests of the cell clipping (``_cell_area``). A half-plane x . q <= |q|^2 / 2 cannot cut a cell whose
+#: vertices lie within r of the origin when |q| >= 2 r (x . q <= r |q| <= |q|^2 / 2); with |q|^2 > _SKIP r^2 the
+#: margin is 5e-7 |q|^2, far above the rounding of the clip's tests, so skipping leaves the cell bit for bit as
+#: the clip would. The same for the hull edges a . x <= b: skipped when b > |a| r by the same relative margin.
+#: On a clean sample the cell is settled by its ~6-8 nearest sites and the rest of the 20 are skipped.
+_SKIP = 4.0 * (1.0 + 1e-6)
+_SKIP_HULL = 1.0 + 1e-6
+
+
+@njit(cache=True)
+def _inside_hull(Q, m, r2):
+    """True when the disc of squared radius ``r2`` about the origin lies inside the convex hull of ``Q[:m]`` by a
+    margin (then clipping a cell within that disc to the hull changes nothing, bit for bit, and the hull need
+    not be built). Sufficient test: take the farthest point a_s of every nonempty 45° sector about the origin;
+    when consecutive ones (in angular order) are less than 180° apart, the triangles (0, a_s, a_next) cover the
+    disc whose radius is the smallest distance from the origin to the lines a_s a_next."""
+    far = np.zeros(8)
+    fx = np.zeros(8)
+    fy = np.zeros(8)
+    for s in range(m):
+        x = Q[s, 0]
+        y = Q[s, 1]
+        ax, ay = abs(x), abs(y)
+        if y >= 0.0:
+            sec = (0 if ax >= ay else 1) if x >= 0.0 else (3 if ax >= ay else 2)
+        else:
+            sec = (7 if ax >= ay else 6) if x >= 0.0 else (4 if ax >= ay else 5)
+        d = x * x + y * y
+        if d > far[sec]:
+            far[sec] = d
+            fx[sec] = x
+            fy[sec] = y
+    first = -1
+    for s in range(8):
+        if far[s] > 0.0:
+            first = s
+            break
+    if first < 0:
+        return False
+    prev = first
+    for t in range(1, 9):
+        s = (first + t) % 8
+        if far[s] == 0.0:
+            continue
+        cr = fx[prev] * fy[s] - fy[prev] * fx[s]          # |a| |b| sin(angle from a to b)
+        if cr <= 0.0:
+            return False                                  # 180° or more apart: the origin is not enclosed
+        ex, ey = fx[s] - fx[prev], fy[s] - fy[prev]
+        if cr * cr <= _SKIP_HULL * (ex * ex + ey * ey) * r2:  # distance to the line a b: cr / |a - b|
+            return False
+        prev = s
+    return True
+
+
+@njit(cache=True)
+def _max_radius2(poly, m):
+    """Largest squared distance of the vertices ``poly[:m]`` to the origin."""
+    r2 = 0.0
+    for a in range(m):
+        d = poly[a, 0] * poly[a, 0] + poly[a, 1] * poly[a, 1]
+        if d > r2:
+            r2 = d
+    return r2
+
+
 @njit(cache=True)
 def _polygon_area(poly, m):
     s = 0.0
@@ -86,23 +151,23 @@ def _polygon_area(poly, m):
 
 @njit(cache=True)
 def _convex_hull(pts, m, hull):
-    """Andrew's monotone chain on ``pts[:m]`` (small m); CCW hull into ``hull``, returns its size."""
-    # insertion sort by (x, y): m <= k + 1 is small
-    order = np.arange(m)
+    """Andrew's monotone chain on ``pts[:m]`` (small m), which it sorts in place by (x, y); CCW hull into
+    ``hull``, returns its size."""
+    # insertion sort by (x, y) in place: m <= k + 1 is small (no index array to allocate per cell)
     for a in range(1, m):
-        key = order[a]
+        kx, ky = pts[a, 0], pts[a, 1]
         b = a - 1
-        while b >= 0 and (
-            pts[order[b], 0] > pts[key, 0] or (pts[order[b], 0] == pts[key, 0] and pts[order[b], 1] > pts[key, 1])
-        ):
-            order[b + 1] = order[b]
+        while b >= 0 and (pts[b, 0] > kx or (pts[b, 0] == kx and pts[b, 1] > ky)):
+            pts[b + 1, 0] = pts[b, 0]
+            pts[b + 1, 1] = pts[b, 1]
             b -= 1
-        order[b + 1] = key
+        pts[b + 1, 0] = kx
+        pts[b + 1, 1] = ky
     h = 0
     for pass_ in range(2):
         start = h
         for s in range(m):
-            j = order[s] if pass_ == 0 else order[m - 1 - s]
+            j = s if pass_ == 0 else m - 1 - s
             while h >= start + 2:
                 ox = hull[h - 2, 0]
                 oy = hull[h - 2, 1]
@@ -199,6 +264,7 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
     A[3, 1] = R
     k = np.int64(4)  # not the literal 4: one compiled _clip_halfplane
     ndup = 0
+    r2cell = 2.0 * R * R  # squared radius of the cell so far (its farthest vertex)
     for s in range(cnt):
         qx = Q[s, 0]
         qy = Q[s, 1]
@@ -206,17 +272,22 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
         if q2 <= tol2:
             ndup += 1
             continue
+        if q2 > _SKIP * r2cell:
+            # x . q <= |x| |q| < |q|^2 / 2 on every vertex, by a margin far above rounding: the clip would
+            # return the cell unchanged (bit for bit), so it is skipped
+            continue
         # Voronoi half-plane of the origin against site q: x . q <= |q|^2 / 2
         k = _clip_halfplane(A, k, B, qx, qy, 0.5 * q2)
         A, B = B, A
         if k == 0:
             break
-    if clip_hull and k > 0:
+        r2cell = _max_radius2(A, k)
+    if clip_hull and k > 0 and not _inside_hull(Q, cnt, r2cell):
         # restrict the cell to the convex hull of p_i and its kept neighbours, so that a point on
         # the border of an open surface only gets the part of its cell that lies on the surface
         Q[cnt, 0] = 0.0
         Q[cnt, 1] = 0.0
-        nh = _convex_hull(Q, cnt + 1, H)
+        nh = _convex_hull(Q, cnt + 1, H)  # (sorts Q: not used after this)
         if nh < 3:
             k = 0
         else:
@@ -227,10 +298,14 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
                 ex = H[e, 0] - H[s, 0]
                 ey = H[e, 1] - H[s, 1]
                 # inside = left of the CCW edge: ey*x - ex*y <= ey*Hs_x - ex*Hs_y
-                k = _clip_halfplane(A, k, B, ey, -ex, ey * H[s, 0] - ex * H[s, 1])
+                b = ey * H[s, 0] - ex * H[s, 1]
+                if b > 0.0 and b * b > _SKIP_HULL * (ex * ex + ey * ey) * r2cell:
+                    continue  # the cell lies inside this edge's half-plane by a wide margin: unchanged
+                k = _clip_halfplane(A, k, B, ey, -ex, b)
                 A, B = B, A
                 if k == 0:
                     break
+                r2cell = _max_radius2(A, k)
     area = _polygon_area(A, k) if k >= 3 else 0.0
     return area / (1.0 + ndup)
 
@@ -240,27 +315,6 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
 # ----------------------------------------------------------------------------------------------
 
 
-#: Candidate counts up to this use scipy's k-d tree, above it the cell grid of :class:`SelfKNN` (measured on
-#: the CGAL clouds oni / kitten / hippo1, 1.4k-6k points: the k-d tree is 1.2-2.5x faster at k = 21-41, the
-#: cell grid 1.5-2x faster at k = 161).
-KD_TREE_MAX_K = 64
-
-
-class _KDRows:
-    """The ``rows(s, e)`` interface of :class:`SelfKNN` over ``cKDTree.query`` (gsdf's thread count from 2,000
-    points: scipy's query threads are joined, never spin, so they do not stall under load; below, one)."""
-
-    def __init__(self, P, k):
-        from ..threads import get_num_threads
-
-        self.tree, self.P, self.k = cKDTree(P), P, k
-        self.workers = 1 if len(P) < 2000 else get_num_threads()
-
-    def rows(self, s, e):
-        idx = self.tree.query(self.P[s:e], k=self.k, workers=self.workers)[1]
-        return np.ascontiguousarray(idx.reshape(e - s, self.k), dtype=np.int64)
-
-
 #: Below this many points the two kernels run as one call on the calling thread: together ~1-3 ms of serial
 #: work at 1.4k-6k points (CGAL's oni / kitten / hippo1), while running them on two threads on a loaded
 #: machine waited for the second thread: 10-25 ms at load 5-6 (issue 17).
@@ -268,9 +322,11 @@ SERIAL_POINTS = 16_384
 
 
 def _candidate_search(P, k):
-    """The k nearest of every point (itself included) by the faster structure for this k
-    (:data:`KD_TREE_MAX_K`)."""
-    return _KDRows(P, k) if k <= KD_TREE_MAX_K else SelfKNN(P, k)
+    """The k nearest of every point (itself included), rows unordered: the cell grid of :class:`SelfKNN`.
+    Measured on the CGAL clouds oni / kitten / hippo1 (1.4k-6k points) against the scipy k-d tree it replaced
+    for k <= 64: 1.3-1.7× faster at k = 41, 1.4-1.6× at k = 161, on one thread. Only the neighbour sets decide
+    the areas: the row order changes the plane fit's sums by rounding (areas within ~1e-15 relative)."""
+    return SelfKNN(P, k)
 
 
 def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) -> np.ndarray:
@@ -339,8 +395,7 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     (8) to within 1 %
     (``bench/bench_winding.py`` prints the figure). On a clean sphere both are within 0.1 %.
 
-    Cost: one k-nearest-neighbour search (scipy's k-d tree up to 64 candidates, the cell grid of
-    :class:`gsdf.spatial.knn.SelfKNN` above) plus
+    Cost: one k-nearest-neighbour search (the cell grid of :class:`gsdf.spatial.knn.SelfKNN`) plus
     O(n (candidates k + k^2)) work in numba kernels on the threads.
 
     Examples

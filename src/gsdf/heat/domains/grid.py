@@ -34,8 +34,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..sources import Sources
-from ..volume.grid import (cell_constraint_matrix, divergence_rhs, dct_poisson, neumann_laplacian, solve_constrained,
-                           solve_poisson, trilinear_matrix)
+from ..volume.grid import (cell_constraint_matrix, divergence_rhs, dct_poisson, neumann_laplacian, penalty_matrix,
+                           solve_constrained, solve_poisson, trilinear_matrix)
 from .base import HeatDomain, PoissonSolver
 
 __all__ = ["GridDomain", "GridPoisson"]
@@ -58,8 +58,7 @@ class GridPoisson(PoissonSolver):
     penalty_tol = 1e-4
 
     def penalized(self, A, w, b):
-        w = np.broadcast_to(np.asarray(w, np.float64), (A.shape[0],))
-        penalty = (A.T @ sp.diags(w) @ A).tocsr()
+        penalty = penalty_matrix(A, w, self.d.shape)
         return solve_poisson(b, self.d.shape, self.d.spacing, penalty, tol=self.penalty_tol)
 
     def dirichlet(self, fixed, b):

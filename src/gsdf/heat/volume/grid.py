@@ -135,24 +135,114 @@ def divergence_rhs(Y, spacing) -> np.ndarray:
 
 
 def trilinear_matrix(P, bbox_min, spacing, shape) -> sp.csr_matrix:
-    """Sparse (len(P), nodes) matrix of trilinear interpolation weights at points ``P`` inside the grid."""
+    """Sparse (len(P), nodes) matrix of trilinear interpolation weights at points ``P`` inside the grid.
+
+    Every row holds the 8 corners of the point's cell; listed with dx, then dy, then dz as the slow index, the
+    corners' node numbers ascend, so the CSR arrays are written directly (canonical: sorted, no duplicates)."""
     n = np.array(shape)
     t = np.clip((P - bbox_min) / spacing, 0.0, n - 1.0)
     i0 = np.minimum(np.floor(t).astype(np.int64), n - 2)
     f = t - i0
-    rows, cols, vals = [], [], []
-    r = np.arange(len(P))
+    m = len(P)
+    base = (i0[:, 0] * n[1] + i0[:, 1]) * n[2] + i0[:, 2]
+    cols = np.empty((m, 8), np.int64)
+    vals = np.empty((m, 8))
+    c = 0
     for dx in (0, 1):
+        fx = f[:, 0] if dx else 1 - f[:, 0]
         for dy in (0, 1):
+            fy = fx * (f[:, 1] if dy else 1 - f[:, 1])
             for dz in (0, 1):
-                w = ((f[:, 0] if dx else 1 - f[:, 0]) * (f[:, 1] if dy else 1 - f[:, 1])
-                     * (f[:, 2] if dz else 1 - f[:, 2]))
-                idx = ((i0[:, 0] + dx) * n[1] + (i0[:, 1] + dy)) * n[2] + (i0[:, 2] + dz)
-                rows.append(r)
-                cols.append(idx)
-                vals.append(w)
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(len(P), int(np.prod(n))))
+                vals[:, c] = fy * (f[:, 2] if dz else 1 - f[:, 2])
+                cols[:, c] = base + (dx * n[1] + dy) * n[2] + dz
+                c += 1
+    N = int(np.prod(n))
+    itype = np.int32 if N < 2 ** 31 and 8 * m < 2 ** 31 else np.int64
+    T = sp.csr_matrix((vals.ravel(), cols.ravel().astype(itype), np.arange(0, 8 * m + 1, 8, dtype=itype)),
+                      shape=(m, N))
+    T.has_sorted_indices = True
+    return T
+
+
+def penalty_matrix(A, w, shape) -> sp.csr_matrix:
+    """P = Aᵀ diag(w) A, CSR, for the soft level-set penalty. Rows of ``A`` whose entries all lie in one grid cell
+    (trilinear rows) are summed by a numba kernel straight into P's 27-point rows; any other row set (the
+    differences of the "multiple" constraint) by SciPy's products."""
+    A = sp.csr_matrix(A)
+    w = np.ascontiguousarray(np.broadcast_to(np.asarray(w, np.float64), (A.shape[0],)))
+    dims = np.array(shape, np.int64)
+    out = _cell_penalty(A.indptr.astype(np.int64), A.indices.astype(np.int64), A.data.astype(np.float64), w, dims)
+    if out is None:
+        return (A.T @ sp.diags(w) @ A).tocsr()
+    indptr, indices, data = out
+    return sp.csr_matrix((data, indices, indptr), shape=(A.shape[1], A.shape[1]))
+
+
+@njit(cache=True)
+def _cell_penalty(Ap, Ai, Av, w, dims):
+    """CSR (indptr, indices, data) of Aᵀ diag(w) A when every row of A lies in one cell, else None."""
+    n1, n2 = dims[1], dims[2]
+    s0 = n1 * n2
+    N = dims[0] * s0
+    m = Ap.shape[0] - 1
+    slot = np.full(N, -1, np.int64)          # node -> its row of the accumulator (the nodes A touches)
+    nodes = np.empty(min(N, Ai.shape[0]) + 1, np.int64)
+    nb = 0
+    for r in range(m):
+        s, e = Ap[r], Ap[r + 1]
+        if e == s:
+            continue
+        c0 = Ai[s]
+        i0, j0, k0 = c0 // s0, (c0 // n2) % n1, c0 % n2
+        for p in range(s, e):
+            c = Ai[p]
+            i, j, k = c // s0, (c // n2) % n1, c % n2
+            if abs(i - i0) > 1 or abs(j - j0) > 1 or abs(k - k0) > 1:
+                return None
+            if slot[c] < 0:
+                slot[c] = nb
+                nodes[nb] = c
+                nb += 1
+    acc = np.zeros((nb, 27))                 # offset (di + 1) * 9 + (dj + 1) * 3 + (dk + 1)
+    code = np.empty(8, np.int64)             # per entry of a row: 9 i + 3 j + k, relative to its first entry
+    for r in range(m):
+        s, e = Ap[r], Ap[r + 1]
+        if e - s > 8:                        # a cell has 8 nodes: duplicates, not a trilinear row
+            return None
+        if e == s:
+            continue
+        c0 = Ai[s]
+        i0, j0, k0 = c0 // s0, (c0 // n2) % n1, c0 % n2
+        for p in range(s, e):
+            c = Ai[p]
+            code[p - s] = (c // s0 - i0) * 9 + ((c // n2) % n1 - j0) * 3 + (c % n2 - k0)
+        wr = w[r]
+        for p in range(s, e):
+            va = wr * Av[p]
+            row = slot[Ai[p]]
+            ca = code[p - s]
+            for q in range(s, e):
+                acc[row, code[q - s] - ca + 13] += va * Av[q]
+    cnt = np.zeros(N + 1, np.int64)
+    for t in range(nb):
+        c = nodes[t]
+        for o in range(27):
+            if acc[t, o] != 0.0:
+                cnt[c + 1] += 1
+    for c in range(N):
+        cnt[c + 1] += cnt[c]
+    indices = np.empty(cnt[N], np.int64)
+    data = np.empty(cnt[N])
+    for t in range(nb):
+        c = nodes[t]
+        q = cnt[c]
+        for o in range(27):                  # lexicographic offsets: columns ascending
+            v = acc[t, o]
+            if v != 0.0:
+                indices[q] = c + (o // 9 - 1) * s0 + ((o // 3) % 3 - 1) * n2 + (o % 3 - 1)
+                data[q] = v
+                q += 1
+    return cnt, indices, data
 
 
 def _dct_eigenvalues(shape, spacing, shift: float = 0.0) -> np.ndarray:
@@ -245,31 +335,8 @@ def _aggregation(shape, block: int) -> sp.csr_matrix:
     return sp.csr_matrix((np.ones(n), (agg, np.arange(n))), shape=(int(np.prod(coarse)), n))
 
 
-def _grid_operators(shape, spacing, block):
-    """(L, R, Rᵀ, L Rᵀ, R L Rᵀ) of a grid: its Neumann Laplacian, the block aggregation and the Laplacian's parts
-    of the coarse step of :func:`solve_poisson` — they depend only on the grid, not on the sources, so they are
-    built once per grid (kept for the last few grids of up to 2¹⁸ nodes; at 32³ building them took a few ms of
-    every solve). The matrices are shared: callers must not modify them."""
-    if int(np.prod(shape)) <= 1 << 18:
-        return _grid_operators_cached(tuple(shape), tuple(spacing), int(block))
-    return _build_grid_operators(shape, spacing, block)
-
-
-def _build_grid_operators(shape, spacing, block):
-    L = neumann_laplacian(shape, spacing)
-    R = _aggregation(shape, block)
-    RT = R.T.tocsr()
-    LR = (L @ RT).tocsr()
-    return L, R, RT, LR, (R @ LR).tocsr()
-
-
-@functools.lru_cache(maxsize=4)
-def _grid_operators_cached(shape, spacing, block):
-    return _build_grid_operators(shape, spacing, block)
-
-
 def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter: int = 300,
-                  coarse_size: int = 4096, min_block: int = 3) -> np.ndarray:
+                  coarse_size: int = 4096, min_block: int = 4) -> np.ndarray:
     """Solve the Step III system.
 
     Without ``penalty`` the system is the singular Neumann Laplacian L φ = rhs, solved exactly by
@@ -286,60 +353,338 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     4. the backward band sweep and the coarse correction again (so the preconditioner is symmetric).
 
     The residual is carried through the stages instead of recomputed: after the coarse step it is
-    r − (ARᵀ) c, a band sweep changes it only through the band's columns of A, and after the DCT step y solves
+    r − A Rᵀc, a band sweep changes it only through the band's columns of A, and after the DCT step y solves
     (L + δI) y = r exactly, so r − A y = δ y − P y, which differs from δ y only on the band. One
     application therefore costs one DCT pair, two tiny coarse solves and O(N) vector work — no full product
-    with A (the same operator as recomputing r − A x after each stage, in fewer flops).
+    with A (the same operator as recomputing r − A x after each stage, in fewer flops). The stages are numba
+    kernels on the grid (:class:`PenalizedPoisson`: L applied as its stencil, never assembled), so a CG
+    iteration makes a dozen calls instead of ~40 SciPy ones.
 
     Iterations on the broken bunny at 64³: 14 (DCT alone: 116); 10–16 at 32³. The start is the unconstrained
     DCT solution plus the best constant. ``tol`` is CG's relative residual (1e-5 moves φ by ~1e-5 of the
-    box diagonal, far under the discretization error). Blocks of at least 3 nodes: at 32³ the coarse LU of
-    2-node blocks (2.7k unknowns) cost 10–30 ms, more than the 1–3 extra iterations of 3-node blocks.
+    box diagonal, far under the discretization error). Blocks of at least 4 nodes: at 32³ the coarse LU of
+    2-node blocks (2.7k unknowns) cost 10–30 ms, more than the 1–3 extra iterations of 3-node blocks; with the
+    numba stages an iteration is cheap enough that 4-node blocks (~350 coarse unknowns at 32³, LU < 1 ms) win
+    again: on 7 of bench/bench_heat_volume_speed.py's inputs the solve took 0.84–1.0× the time of 3-node blocks
+    for 1–2 more iterations, the mean errors equal to 5–6 digits.
     """
     shape = tuple(shape)
     if penalty is None:
         return dct_poisson(rhs, shape, spacing)
-    from scipy.sparse.linalg import LinearOperator
+    from ...linalg.iterative import cg_loop
 
-    n = int(np.prod(shape))
-    penalty = sp.csr_matrix(penalty)
-    block = max(int(min_block), int(np.ceil((n / coarse_size) ** (1.0 / 3.0))))
-    L, R, RT, LR, RLR = _grid_operators(shape, tuple(float(h) for h in spacing), block)
-    A = (L + penalty).tocsr()
-    delta = float(penalty.diagonal().sum()) / n
-    lam = _dct_eigenvalues(shape, spacing, delta)
-    band = np.flatnonzero(np.diff(penalty.indptr) > 0)
-    A_b = A[band]                                   # band rows (CSR); its transpose is A's band columns
-    A_cols = A_b.T.tocsr()
-    A_bb = A_b[:, band]
-    P_bb = penalty[band][:, band]
-    A_bb.sort_indices()                            # the sweeps read its lower / upper triangle in place
-    PR = (penalty @ RT).tocsr()
-    AR = (LR + PR).tocsr()                          # A times the coarse basis: the coarse step's residual
-    coarse = Factorization((RLR + R @ PR).tocsc())  # R A Rᵀ, SPD (P > 0): SuperLU's symmetric mode
+    system = PenalizedPoisson(shape, spacing, penalty, coarse_size=coarse_size, min_block=min_block)
+    rhs = np.ascontiguousarray(rhs, dtype=np.float64)
+    x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
+    x0 += (rhs.sum() - system.matvec(x0).sum()) / system.penalty_sum  # best constant (L annihilates constants)
+    x, _ = cg_loop(system.matvec, system.precondition, rhs, x0, rtol=tol, maxiter=maxiter, warn="step III")
+    return x
 
-    def precondition(r):
-        c = coarse.solve(R @ r)
-        x = RT @ c
-        res = r - AR @ c
-        d = _triangular_solve(A_bb.indptr, A_bb.indices, A_bb.data, res[band], True)
-        x[band] += d
-        res -= A_cols @ d
-        y = dct_poisson(res, shape, spacing, delta, lam)
-        x += y
-        res = delta * y                            # r − A y, as (L + δI) y = r exactly
-        res[band] -= P_bb @ y[band]
-        d = _triangular_solve(A_bb.indptr, A_bb.indices, A_bb.data, res[band], False)
-        x[band] += d
-        res -= A_cols @ d
-        x += RT @ coarse.solve(R @ res)
+
+class PenalizedPoisson:
+    """A = L + P on a grid (L the Neumann 7-point Laplacian, P a sparse symmetric penalty) with the preconditioner
+    of :func:`solve_poisson`: ``matvec(x)`` = A x, ``precondition(r)`` = M r, in numba kernels over the grid
+    (L as its stencil; P as CSR). Attributes: ``band`` (the nodes P touches), ``block`` (aggregate size),
+    ``coarse`` (the factorized R A Rᵀ), ``delta`` (the DCT stage's shift tr(P)/N)."""
+
+    def __init__(self, shape, spacing, penalty, coarse_size: int = 4096, min_block: int = 4):
+        self.shape = tuple(int(s) for s in shape)
+        self.spacing = np.asarray(spacing, float)
+        n = int(np.prod(self.shape))
+        P = sp.csr_matrix(penalty)
+        if P.shape != (n, n):
+            raise ValueError(f"penalty: expected a ({n}, {n}) matrix for the grid {self.shape}, got {P.shape}")
+        P.sum_duplicates()
+        self.Pp, self.Pi, self.Pv = P.indptr.astype(np.int64), P.indices.astype(np.int64), P.data.astype(np.float64)
+        self.w = 1.0 / self.spacing ** 2                       # the Laplacian's edge weights per axis
+        self.dims = np.array(self.shape, np.int64)
+        self.block = max(int(min_block), int(np.ceil((n / coarse_size) ** (1.0 / 3.0))))
+        self.cdims = (self.dims + self.block - 1) // self.block
+        self.band = np.flatnonzero(np.diff(self.Pp) > 0).astype(np.int64)
+        diagP = P.diagonal()
+        self.delta = float(diagP.sum()) / n
+        self.penalty_sum = float(self.Pv.sum())
+        self.lam = _dct_eigenvalues(self.shape, self.spacing, self.delta)
+        self.adiag = _laplacian_diagonal(self.dims, self.w, self.band) + diagP[self.band]
+        ip, ix, val, local = _coarse_matrix(self.dims, self.w, self.block, self.cdims, self.Pp, self.Pi, self.Pv,
+                                            self.band)
+        nc = int(np.prod(self.cdims))
+        if local:
+            C = sp.csc_matrix((val, ix, ip), shape=(nc, nc))   # CSR of a symmetric matrix = its CSC
+        else:  # P couples nodes more than one cell apart (difference rows): the Galerkin product by SciPy
+            R = _aggregation(self.shape, self.block)
+            C = (R @ (neumann_laplacian(self.shape, self.spacing) + P) @ R.T).tocsc()
+        self.coarse = Factorization(C)
+        self._d = np.zeros(n)
+
+    def matvec(self, x):
+        out = np.empty(len(x))
+        _apply_system(np.ascontiguousarray(x, dtype=np.float64), self.dims, self.w, self.Pp, self.Pi, self.Pv,
+                      self.band, out)
+        return out
+
+    def _coarse_solve(self, r):
+        rc = np.zeros(int(np.prod(self.cdims)))
+        _restrict(r, self.dims, self.block, self.cdims, rc)
+        return self.coarse.solve(rc)
+
+    def precondition(self, r):
+        r = np.ascontiguousarray(r, dtype=np.float64)
+        dims, w, Pp, Pi, Pv, band = self.dims, self.w, self.Pp, self.Pi, self.Pv, self.band
+        x = np.empty(len(r))
+        res = np.empty(len(r))
+        _prolong_residual(self._coarse_solve(r), r, dims, self.block, self.cdims, w, Pp, Pi, Pv, band, x, res)
+        d = self._d
+        _band_sweep(res, d, x, band, dims, w, Pp, Pi, Pv, self.adiag, True)
+        y = dct_poisson(res, self.shape, self.spacing, self.delta, self.lam)
+        _after_dct(y, self.delta, band, Pp, Pi, Pv, x, res)
+        _band_sweep(res, d, x, band, dims, w, Pp, Pi, Pv, self.adiag, False)
+        _prolong_add(self._coarse_solve(res), dims, self.block, self.cdims, x)
         return x
 
-    M = LinearOperator((n, n), matvec=precondition, dtype=np.float64)  # dtype given: no probe call
-    x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
-    x0 += (rhs.sum() - (A @ x0).sum()) / penalty.sum()  # best constant shift (L annihilates constants)
-    x, _ = pcg(A, rhs, M=M, x0=x0, rtol=tol, maxiter=maxiter, warn="step III")
-    return x
+
+@njit(cache=True)
+def _laplacian_diagonal(dims, w, nodes):
+    """The Neumann Laplacian's diagonal at ``nodes``: Σ_a w_a × (neighbours along axis a)."""
+    n1, n2 = dims[1], dims[2]
+    out = np.empty(nodes.shape[0])
+    for t in range(nodes.shape[0]):
+        r = nodes[t]
+        c = (r // (n1 * n2), (r // n2) % n1, r % n2)
+        acc = 0.0
+        for a in range(3):
+            if c[a] > 0:
+                acc += w[a]
+            if c[a] < dims[a] - 1:
+                acc += w[a]
+        out[t] = acc
+    return out
+
+
+@njit(cache=True)
+def _apply_system(x, dims, w, Pp, Pi, Pv, band, out):
+    """out = (L + P) x: the 7-point stencil of every node, then P's rows (those of ``band``)."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    s0, s1 = n1 * n2, n2
+    w0, w1, w2 = w[0], w[1], w[2]
+    for i in range(n0):
+        for j in range(n1):
+            base = (i * n1 + j) * n2
+            for k in range(n2):
+                r = base + k
+                xr = x[r]
+                acc = 0.0
+                if i > 0:
+                    acc += w0 * (xr - x[r - s0])
+                if i < n0 - 1:
+                    acc += w0 * (xr - x[r + s0])
+                if j > 0:
+                    acc += w1 * (xr - x[r - s1])
+                if j < n1 - 1:
+                    acc += w1 * (xr - x[r + s1])
+                if k > 0:
+                    acc += w2 * (xr - x[r - 1])
+                if k < n2 - 1:
+                    acc += w2 * (xr - x[r + 1])
+                out[r] = acc
+    for t in range(band.shape[0]):
+        r = band[t]
+        acc = 0.0
+        for p in range(Pp[r], Pp[r + 1]):
+            acc += Pv[p] * x[Pi[p]]
+        out[r] += acc
+
+
+@njit(cache=True)
+def _subtract_columns(res, d, band, dims, w, Pp, Pi, Pv):
+    """res −= A d for d supported on ``band`` (A's band columns: the stencil's and P's, P symmetric)."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    s0, s1 = n1 * n2, n2
+    for t in range(band.shape[0]):
+        r = band[t]
+        v = d[r]
+        if v == 0.0:
+            continue
+        i, j, k = r // s0, (r // s1) % n1, r % n2
+        if i > 0:
+            res[r - s0] += w[0] * v
+            res[r] -= w[0] * v
+        if i < n0 - 1:
+            res[r + s0] += w[0] * v
+            res[r] -= w[0] * v
+        if j > 0:
+            res[r - s1] += w[1] * v
+            res[r] -= w[1] * v
+        if j < n1 - 1:
+            res[r + s1] += w[1] * v
+            res[r] -= w[1] * v
+        if k > 0:
+            res[r - 1] += w[2] * v
+            res[r] -= w[2] * v
+        if k < n2 - 1:
+            res[r + 1] += w[2] * v
+            res[r] -= w[2] * v
+        for p in range(Pp[r], Pp[r + 1]):
+            res[Pi[p]] -= Pv[p] * v
+
+
+@njit(cache=True)
+def _band_sweep(res, d, x, band, dims, w, Pp, Pi, Pv, adiag, forward):
+    """One Gauss–Seidel sweep of A over the band nodes against ``res`` (forward: ascending nodes, the lower
+    triangle of A's band block; else descending, the upper), then x += d and res −= A d. ``d`` is a zero
+    scratch vector of the grid's size on entry and is left zero."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    s0, s1 = n1 * n2, n2
+    nb = band.shape[0]
+    for q in range(nb):
+        t = q if forward else nb - 1 - q
+        r = band[t]
+        i, j, k = r // s0, (r // s1) % n1, r % n2
+        acc = res[r]
+        # d is zero off the band and on the rows not swept yet: the sums run over the triangle only
+        if i > 0:
+            acc += w[0] * d[r - s0]
+        if i < n0 - 1:
+            acc += w[0] * d[r + s0]
+        if j > 0:
+            acc += w[1] * d[r - s1]
+        if j < n1 - 1:
+            acc += w[1] * d[r + s1]
+        if k > 0:
+            acc += w[2] * d[r - 1]
+        if k < n2 - 1:
+            acc += w[2] * d[r + 1]
+        for p in range(Pp[r], Pp[r + 1]):
+            c = Pi[p]
+            if c != r:
+                acc -= Pv[p] * d[c]
+        d[r] = acc / adiag[t]
+    _subtract_columns(res, d, band, dims, w, Pp, Pi, Pv)
+    for t in range(nb):
+        r = band[t]
+        x[r] += d[r]
+        d[r] = 0.0
+
+
+@njit(cache=True)
+def _after_dct(y, delta, band, Pp, Pi, Pv, x, res):
+    """After the DCT stage: x += y and res = r − A y = δ y − P y (y solves (L + δI) y = r exactly)."""
+    for r in range(y.shape[0]):
+        x[r] += y[r]
+        res[r] = delta * y[r]
+    for t in range(band.shape[0]):
+        r = band[t]
+        acc = 0.0
+        for p in range(Pp[r], Pp[r + 1]):
+            acc += Pv[p] * y[Pi[p]]
+        res[r] -= acc
+
+
+@njit(cache=True)
+def _block_of(r, dims, block, cdims):
+    n1, n2 = dims[1], dims[2]
+    i, j, k = r // (n1 * n2), (r // n2) % n1, r % n2
+    return ((i // block) * cdims[1] + j // block) * cdims[2] + k // block
+
+
+@njit(cache=True)
+def _restrict(r, dims, block, cdims, out):
+    """out += R r: the sums of r over the block aggregates."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    for i in range(n0):
+        for j in range(n1):
+            cb = ((i // block) * cdims[1] + j // block) * cdims[2]
+            base = (i * n1 + j) * n2
+            for k in range(n2):
+                out[cb + k // block] += r[base + k]
+
+
+@njit(cache=True)
+def _prolong_add(c, dims, block, cdims, x):
+    """x += Rᵀ c: every node gets its aggregate's value."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    for i in range(n0):
+        for j in range(n1):
+            cb = ((i // block) * cdims[1] + j // block) * cdims[2]
+            base = (i * n1 + j) * n2
+            for k in range(n2):
+                x[base + k] += c[cb + k // block]
+
+
+@njit(cache=True)
+def _prolong_residual(c, r, dims, block, cdims, w, Pp, Pi, Pv, band, x, res):
+    """The first coarse stage: x = Rᵀ c and res = r − A x."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    for i in range(n0):
+        for j in range(n1):
+            cb = ((i // block) * cdims[1] + j // block) * cdims[2]
+            base = (i * n1 + j) * n2
+            for k in range(n2):
+                x[base + k] = c[cb + k // block]
+    _apply_system(x, dims, w, Pp, Pi, Pv, band, res)
+    for q in range(r.shape[0]):
+        res[q] = r[q] - res[q]
+
+
+@njit(cache=True)
+def _coarse_matrix(dims, w, block, cdims, Pp, Pi, Pv, band):
+    """CSR (indptr, indices, data) of the Galerkin coarse matrix R (L + P) Rᵀ on the block aggregates, and
+    whether P only couples nodes of one cell (else the 27-entry coarse rows cannot hold it: the caller forms
+    the product with SciPy). L's part: every grid edge between two blocks adds w_a to both diagonals and −w_a
+    between them."""
+    n0, n1, n2 = dims[0], dims[1], dims[2]
+    c0, c1, c2 = cdims[0], cdims[1], cdims[2]
+    nc = c0 * c1 * c2
+    C = np.zeros((nc, 27))     # coarse row, offset (dI + 1) * 9 + (dJ + 1) * 3 + (dK + 1)
+    for i in range(n0):
+        for j in range(n1):
+            for k in range(n2):
+                I = ((i // block) * c1 + j // block) * c2 + k // block
+                for a in range(3):
+                    ii, jj, kk = i + (a == 0), j + (a == 1), k + (a == 2)
+                    if ii >= n0 or jj >= n1 or kk >= n2:
+                        continue
+                    J = ((ii // block) * c1 + jj // block) * c2 + kk // block
+                    if J == I:
+                        continue
+                    C[I, 13] += w[a]
+                    C[J, 13] += w[a]
+                    up = 13 + (9 if a == 0 else (3 if a == 1 else 1))
+                    C[I, up] -= w[a]
+                    C[J, 26 - up] -= w[a]
+    s0, s1 = n1 * n2, n2
+    local = True
+    for t in range(band.shape[0]):
+        r = band[t]
+        ri, rj, rk = r // s0, (r // s1) % n1, r % n2
+        I0, I1, I2 = ri // block, rj // block, rk // block
+        I = (I0 * c1 + I1) * c2 + I2
+        for p in range(Pp[r], Pp[r + 1]):
+            c = Pi[p]
+            ci, cj, ck = c // s0, (c // s1) % n1, c % n2
+            d0, d1, d2 = ci // block - I0, cj // block - I1, ck // block - I2
+            if abs(d0) > 1 or abs(d1) > 1 or abs(d2) > 1:
+                local = False
+                continue
+            C[I, (d0 + 1) * 9 + (d1 + 1) * 3 + (d2 + 1)] += Pv[p]
+    indptr = np.zeros(nc + 1, np.int64)
+    cnt = 0
+    for I in range(nc):
+        for o in range(27):
+            if C[I, o] != 0.0:
+                cnt += 1
+        indptr[I + 1] = cnt
+    indices = np.empty(cnt, np.int64)
+    data = np.empty(cnt)
+    q = 0
+    for I in range(nc):
+        for o in range(27):   # offsets in lexicographic order: columns ascending
+            if C[I, o] != 0.0:
+                d0, d1, d2 = o // 9 - 1, (o // 3) % 3 - 1, o % 3 - 1
+                indices[q] = I + (d0 * c1 + d1) * c2 + d2
+                data[q] = C[I, o]
+                q += 1
+    return indptr, indices, data, local
 
 
 def _solve_poisson_reference(rhs, shape, spacing, penalty, tol: float = 1e-5, maxiter: int = 300,
