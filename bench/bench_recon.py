@@ -19,6 +19,8 @@ Run: ``PYTHONPATH=src /work/anchors/bin/python bench/bench_recon.py [--quick] [-
 a subset and ASSERTS the topology promise (CC = 1, genus 0, closed manifold) on every case of ours;
 ``--relocation`` adds a before / after table of the vertex relocation (same clouds, with SPSR); ``--meshes
 bull,camel --table2-only`` runs the Table-2 cases of those meshes only (section ``recon-subset``).
+``--only-remesh`` writes the before / after table of the edge flips (``remesh=False`` against the default) on
+the full run's Table-2 clouds, with SPSR (section ``recon-remesh``).
 """
 
 from __future__ import annotations
@@ -249,6 +251,72 @@ def relocation_table(rng):
                  rows)
 
 
+def remesh_table():
+    """The Table-2 clouds of the full run (same rng stream: the draws of the other methods' metric samples
+    are skipped), three reconstructions each: ours with ``remesh=False`` (before), ours (default, with the
+    edge flips), SPSR given the true normals; the metric samples come from one fixed rng per case, the same for
+    all three.  Returns (table text, summary line)."""
+    rng = np.random.default_rng(0)
+    rows, lower, higher, d_all, ratios = [], 0, 0, [], []
+    n_le_before = n_le_after = 0
+    for mname in MESHES:
+        V0, F0 = gsdf.read_mesh(os.path.join(data_dir(), "meshes", mname))
+        V0 = normalise(V0)
+        GT, _ = sample_surface(V0, F0, 100_000, rng)
+        cases = ([(a, b) for a in INLIERS for b in OUTLIERS] if mname == "bunny00.off"
+                 else [(8000, 200), (4000, 400), (2000, 400), (1000, 800)])
+        for n_in, n_out in cases:
+            P, N = make_case(V0, F0, n_in, n_out, rng)
+            # the full run draws metric samples for ours, SPSR and the level sets of this case: skip them
+            n_metric = 2 + (mname == "bunny00.off" or (n_in, n_out) == (2000, 400)) \
+                + ((n_in, n_out) == (2000, 400)) + (mname == "bunny00.off" and (n_in, n_out) == (2000, 400))
+            for _ in range(n_metric):
+                rng.random(3 * 100_000)
+            t = time.perf_counter()
+            Va, Fa = gsdf.reconstruct_simply_connected(P, remesh=False)
+            ta = time.perf_counter() - t
+            t = time.perf_counter()
+            Vb, Fb, rep = gsdf.reconstruct_simply_connected(P, return_report=True)
+            tb = time.perf_counter() - t
+            if len(Va) != len(Vb) or not gsdf.recon.is_sphere(Vb, Fb) or not gsdf.recon.is_sphere(Va, Fa):
+                raise SystemExit(f"remesh changed the vertices or the topology on {mname} {n_in}+{n_out}")
+            Vs, Fs, _ = run_spsr(P, N)
+            a, b, c = (cd_hd(V, F, GT, np.random.default_rng(1)) for V, F in ((Va, Fa), (Vb, Fb), (Vs, Fs)))
+            d = round(b[0], 2) - round(a[0], 2)
+            lower += d < -1e-9
+            higher += d > 1e-9
+            n_le_before += round(a[0], 2) <= round(c[0], 2)
+            n_le_after += round(b[0], 2) <= round(c[0], 2)
+            d_all.append(b[0] - a[0])
+            ratios.append(tb / ta)
+            rows.append([mname.replace(".off", ""), f"{n_in // 1000}K+{n_out}", f"{a[0]:.3f} / {a[1]:.1f}",
+                         f"{b[0]:.3f} / {b[1]:.1f}", f"{b[0] - a[0]:+.3f}", f"{c[0]:.3f} / {c[1]:.1f}",
+                         "yes" if round(b[0], 2) <= round(c[0], 2) else "no", rep["flips"]["flipped"],
+                         f"{rep['timings']['remesh']:.2f}", f"{ta:.1f} / {tb:.1f}"])
+            print("remesh", rows[-1], flush=True)
+    summary = (f"After − before (3 decimals): mean {np.mean(d_all):+.4f}, lower on {int(np.sum(np.array(d_all) < 0))} "
+               f"of {len(d_all)}, largest rise {max(d_all):+.4f}; at the table's two decimals lower on {lower}, higher on "
+               f"{higher}.  CD ≤ SPSR (two decimals): before {n_le_before} / {len(d_all)}, after {n_le_after} / "
+               f"{len(d_all)}.  Whole-call time after / before: median {np.median(ratios):.2f} (range "
+               f"{min(ratios):.2f}–{max(ratios):.2f}).")
+    return table(["mesh", "case", "ours before (remesh=False) CD / HD", "ours after (default) CD / HD",
+                  "after − before", "SPSR CD / HD", "after ≤ SPSR", "flips", "flip stage (s)",
+                  "time before / after (s)"], rows), summary
+
+
+def only_remesh():
+    up = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
+    print(up, flush=True)
+    text, summary = remesh_table()
+    up2 = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
+    write_section("recon-remesh", "## recon-remesh: the edge flips (remesh=True) before / after on the Table-2 clouds\n\n"
+                  f"Machine: {machine()}. Load at start: `{up}`; at the end: `{up2}`. Command: `PYTHONPATH=src "
+                  "/work/anchors/bin/python bench/bench_recon.py --only-remesh`.  Same clouds as the full run "
+                  "(section recon); CD×100 / HD×100 with one metric sample per case shared by the three methods "
+                  "(so the after column can differ from section recon in the third decimal).\n\n" + text + "\n\n"
+                  + summary)
+
+
 # ------------------------------------------------------------------------------------------- main
 def main(quick: bool, relocation: bool = False, only_relocation: bool = False, only_meshes=None, table2_only: bool = False):
     rng = np.random.default_rng(0)
@@ -410,6 +478,9 @@ if __name__ == "__main__":
                     help="comma list of Table-2 meshes (bunny00,armadillo,bull,camel,fandisk,homer); the clouds come "
                          "from one rng stream, so they differ from the full run's; written to section recon-subset")
     ap.add_argument("--table2-only", action="store_true", help="skip tubes, torus and time vs size")
+    ap.add_argument("--only-remesh", action="store_true",
+                    help="only the before / after table of the edge flips (remesh) on the full run's Table-2 clouds, "
+                         "with SPSR; written to section recon-remesh")
     ap.add_argument("--size-worker", type=int, default=None)
     ap.add_argument("--only-sizes", default=None, metavar="N,N,...",
                     help="only the time / peak memory vs point count table for these sizes (one process each), "
@@ -417,6 +488,8 @@ if __name__ == "__main__":
     a = ap.parse_args()
     if a.size_worker is not None:
         _size_worker(a.size_worker)
+    elif a.only_remesh:
+        only_remesh()
     elif a.only_sizes:
         only_sizes([int(n) for n in a.only_sizes.split(",")])
     else:

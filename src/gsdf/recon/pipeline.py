@@ -24,7 +24,9 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
 8. vertex relocation (geometry only, :mod:`.relocate`): Steiner vertices and input points off their
    neighbours' surface (kept outliers) move onto the moving-least-squares surface of the inliers, with
    tangential smoothing, damped so that no face flips; the faces — hence the topology — are unchanged;
-9. one 1-to-4 subdivision whose new vertices go onto that surface (:func:`.relocate.subdivide_onto_samples`).
+9. edge flips (connectivity only, :mod:`.remesh`): an edge whose flip makes its two faces follow that surface
+   better is flipped, when the new edge is not one yet — a closed manifold sphere stays one;
+10. one 1-to-4 subdivision whose new vertices go onto that surface (:func:`.relocate.subdivide_onto_samples`).
 
 Example
 -------
@@ -360,10 +362,28 @@ def _relocate(Vn, F, is_pt, S, spacing, tol: float = 0.35, k: int = 12):
     return V, exact, rep
 
 
+def _flip(V, F, exact, S, spacing, k: int, relocate: bool):
+    """Edge flips onto the samples' surface (:func:`.remesh.flip_to_samples`), then — with ``relocate`` — one
+    more relocation round of the free vertices on the new faces and a second flip pass.  Vertex set and
+    topology unchanged (V is modified in place by the relocation round).  Returns ``(F, report)``."""
+    from scipy.spatial import cKDTree
+    from .relocate import relocate_vertices
+    from .remesh import flip_to_samples
+    tree = cKDTree(S)
+    F, rep = flip_to_samples(V, F, S, spacing, k=k, tree=tree, return_report=True)
+    if relocate:
+        V[:] = relocate_vertices(V, F, S, spacing, fixed=exact, k=k, rounds=1)
+        F, rep2 = flip_to_samples(V, F, S, spacing, k=k, tree=tree, return_report=True)
+        rep = {"flipped": rep["flipped"] + rep2["flipped"], "error_before": rep["error_before"],
+               "error_after": rep2["error_after"]}
+    return F, rep
+
+
 def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters: bool = False,
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
                                  sign: str = "tangent", hodge: bool = False, project: bool = True, sculpt: bool = True,
-                                 relocate: bool = True, reach: bool = True, subdivide: int = 1, fit_k: int = 8,
+                                 relocate: bool = True, reach: bool = True, remesh: bool = True, subdivide: int = 1,
+                                 fit_k: int = 8,
                                  band: float = 10.0,
                                  outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
@@ -398,6 +418,11 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     reach : bool — after growth, resume it by simple tets towards samples still farther than one spacing
         from the output (thin parts whose field says "outside"), through the small Delaunay tets near them,
         then peel what was added back to the samples (:func:`_reach`; the topology promise is kept).
+    remesh : bool — flip edges of the output so that its faces follow the moving-least-squares surface of the
+        samples (:func:`.remesh.flip_to_samples`: the boundary of the grown tet region has Delaunay edges that
+        may cut across a bend), then one more relocation round and a second flip pass.  Connectivity only: a
+        flip is taken only where the new edge is not one yet, so the vertices, the counts of edges and faces,
+        hence the topology, stay those of the grown ball.  Default on (bench/RESULTS.md, section recon).
     subdivide : int in 0..3 — 1-to-4 splits of the output, the new vertices moved onto the local surface of
         the samples (:func:`.relocate.subdivide_onto_samples`; each split multiplies the faces by 4 and keeps
         the topology).  0: the faces of the tet region's boundary as they are.
@@ -421,7 +446,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         alternation round, ``outliers`` (n,) bool (pre-filtered, or farther than ``outlier_gap`` spacings
         from the returned surface; duplicates are not flagged), ``surface_fraction`` (share of distinct
         points with a flat, dense neighbourhood), ``gamma_ratio``, ``relocation`` (vertices moved / damped /
-        reverted, ``free_input_points``; None without ``relocate``), ``timings`` (s), sizes.
+        reverted, ``free_input_points``; None without ``relocate``), ``flips`` (``flipped``, summed face fit
+        error before / after; None without ``remesh``), ``timings`` (s), sizes.
 
     Notes
     -----
@@ -451,7 +477,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     max_iterations = integer(max_iterations, "max_iterations", lo=1)
     subdivide = integer(subdivide, "subdivide", lo=0, hi=3)
     fit_k = integer(fit_k, "fit_k", lo=3, hi=64)
-    for name, val in (("clusters", clusters), ("relocate", relocate), ("reach", reach)):
+    for name, val in (("clusters", clusters), ("relocate", relocate), ("reach", reach), ("remesh", remesh)):
         if not isinstance(val, (bool, np.bool_)):
             raise ValueError(f"{name}: expected a bool, got {type(val).__name__}")
     for name, val in (("cluster_gap", cluster_gap), ("band", band), ("outlier_gap", outlier_gap)):
@@ -632,6 +658,12 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         Vn, exact, reloc = _relocate(Vn, Fout, is_pt, Xi[use], spacing, k=fit_k)
     timings["relocate"] = time.perf_counter() - t
     t = time.perf_counter()
+    flips = None
+    if remesh and int(use.sum()) >= 3:
+        say("flipping edges onto the samples")
+        Fout, flips = _flip(Vn, Fout, exact, Xi[use], spacing, k=fit_k, relocate=relocate)
+    timings["remesh"] = time.perf_counter() - t
+    t = time.perf_counter()
     sub = None
     if subdivide and int(use.sum()) >= 3:
         # geometry only: a 1-to-4 split keeps a closed manifold sphere one; the new vertices go onto the
@@ -660,6 +692,6 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         "iterations": len(f0_sizes), "f0_sizes": f0_sizes, "inlier_counts": inlier_counts, "explained": score, "gamma_ratio": gamma_ratios, "cavity_tets": cavities, "rejected_non_simple": rejected_hist, "sculpted_tets": carved, "reach_tets": reached,
         "outliers": outlier_mask & ~dup, "prefiltered": int((~inl).sum()), "dense_rescued": int(inl.sum()) - n_planar, "duplicates": int(dup.sum()),
         "surface_fraction": n_planar / len(X), "n_steiner": int(len(S)), "n_tets": int(K.n_tets), "n_regions": int(n_regions),
-        "region_tets": int((label >= 0).sum()), "relocation": reloc, "subdivision": sub, "timings": timings,
+        "region_tets": int((label >= 0).sum()), "relocation": reloc, "flips": flips, "subdivision": sub, "timings": timings,
     }
     return Vout, Fout, report

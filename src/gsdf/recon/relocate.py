@@ -30,6 +30,32 @@ from .._checks import as_faces, as_points, integer, nonnegative, positive
 __all__ = ["local_surface", "relocate_vertices", "subdivide_onto_samples"]
 
 
+def _fit_quadrics(Q, S, spacing, k, extra, tree):
+    """The weighted quadric fits of :func:`local_surface` around each query (the ``k`` nearest samples after
+    skipping ``extra``): centre c (q, 3), frame (q, 3, 3) rows t1, t2, n, scale h (q,), coefficients (q, 6),
+    and the fit's design B (q, k, 6), weights w (q, k), heights z (q, k)."""
+    d, I = tree.query(Q, k=k + extra)
+    d, I = d.reshape(len(Q), -1)[:, extra:], I.reshape(len(Q), -1)[:, extra:]
+    Y = S[I]                                                   # (q, k, 3)
+    h = np.maximum(1.5 * spacing, np.median(d, axis=1))
+    w = np.exp(-(d / h[:, None]) ** 2)
+    w /= np.maximum(w.sum(axis=1, keepdims=True), 1e-300)
+    c = np.einsum("qk,qkx->qx", w, Y)
+    R = Y - c[:, None, :]
+    C = np.einsum("qk,qki,qkj->qij", w, R, R)
+    _, vec = np.linalg.eigh(C)
+    t1, t2, n = vec[:, :, 2], vec[:, :, 1], vec[:, :, 0]
+    x, y, z = (np.einsum("qkx,qx->qk", R, t) for t in (t1, t2, n))
+    # weighted least squares for the quadric height: normal equations (6×6 per query), coordinates over h
+    xs, ys = x / h[:, None], y / h[:, None]
+    B = np.stack([np.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys], axis=2)     # (q, k, 6)
+    A = np.einsum("qk,qka,qkb->qab", w, B, B)
+    A += np.diag([1e-9, 1e-9, 1e-9, 1e-2, 1e-2, 1e-2])[None]
+    rhs = np.einsum("qk,qka,qk->qa", w, B, z)
+    coef = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
+    return c, np.stack([t1, t2, n], axis=1), h, coef, B, w, z
+
+
 def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False, tree=None,
                   return_fit: bool = False):
     """Project queries onto the moving-least-squares quadric of their nearest samples.
@@ -63,25 +89,8 @@ def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False,
     if k < 3:
         raise ValueError(f"S: needs at least {3 + extra} samples for a local surface, got {len(S)}")
     tree = cKDTree(S) if tree is None else tree
-    d, I = tree.query(Q, k=k + extra)
-    d, I = d.reshape(len(Q), -1)[:, extra:], I.reshape(len(Q), -1)[:, extra:]
-    Y = S[I]                                                   # (q, k, 3)
-    h = np.maximum(1.5 * spacing, np.median(d, axis=1))
-    w = np.exp(-(d / h[:, None]) ** 2)
-    w /= np.maximum(w.sum(axis=1, keepdims=True), 1e-300)
-    c = np.einsum("qk,qkx->qx", w, Y)
-    R = Y - c[:, None, :]
-    C = np.einsum("qk,qki,qkj->qij", w, R, R)
-    _, vec = np.linalg.eigh(C)
-    t1, t2, n = vec[:, :, 2], vec[:, :, 1], vec[:, :, 0]
-    x, y, z = (np.einsum("qkx,qx->qk", R, t) for t in (t1, t2, n))
-    # weighted least squares for the quadric height: normal equations (6×6 per query), coordinates over h
-    xs, ys = x / h[:, None], y / h[:, None]
-    B = np.stack([np.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys], axis=2)     # (q, k, 6)
-    A = np.einsum("qk,qka,qkb->qab", w, B, B)
-    A += np.diag([1e-9, 1e-9, 1e-9, 1e-2, 1e-2, 1e-2])[None]
-    rhs = np.einsum("qk,qka,qk->qa", w, B, z)
-    coef = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
+    c, frame, h, coef, B, w, z = _fit_quadrics(Q, S, spacing, k, extra, tree)
+    t1, t2, n = frame[:, 0], frame[:, 1], frame[:, 2]
     Rq = Q - c
     xq, yq, zq = (np.einsum("qx,qx->q", Rq, t) for t in (t1, t2, n))
     xqs, yqs = xq / h, yq / h
