@@ -13,8 +13,9 @@ build cheap (on the 75k-face bunny it is several times faster than splitting by 
 * the partition pass also collects the two children's centroid boxes, and the children's element boxes
   come out of the bins, so no node is read again for its bounds;
 * a node of at most :data:`SMALL` elements instead tries every split of its elements sorted along each axis
-  (insertion sort): there the 3 × 32 bins cost more than the elements, and an exhaustive sweep never finds a
-  worse split than the bins. Its prefix / suffix costs are computed with the running bounds in registers.
+  (stable, by ranks): there the 3 × 32 bins cost more than the elements, and an exhaustive sweep never finds a
+  worse split than the bins. Its prefix / suffix boxes are running bounds, their costs a loop of their own
+  (the square roots vectorise).
 
 Example
 -------
