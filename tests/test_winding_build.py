@@ -71,6 +71,74 @@ def test_volume_build_is_the_same_tree_on_one_or_more_threads():
         np.testing.assert_array_equal(a, b)
 
 
+def _sweep_reference(E, n):
+    """The exhaustive sweep of binned._split_sweep in numpy: stable sorts, prefix / suffix boxes, n r³ costs,
+    the cheapest position (ties: the more balanced one, then the first axis / position)."""
+    def cube(lo, hi):
+        d2 = 0.25 * ((hi - lo) ** 2).sum(axis=1)
+        return d2 * np.sqrt(d2)
+    best = (np.inf, 0, n // 2)
+    for a in range(3):
+        p = np.argsort(E[:n, a], kind="stable")
+        lo, hi = E[p, 3:6], E[p, 6:9]
+        pre = np.arange(1, n) * cube(np.minimum.accumulate(lo)[:-1], np.maximum.accumulate(hi)[:-1])
+        suf = np.arange(n - 1, 0, -1) * cube(np.minimum.accumulate(lo[::-1])[::-1][1:],
+                                             np.maximum.accumulate(hi[::-1])[::-1][1:])
+        for i in range(1, n):
+            c = pre[i - 1] + suf[i - 1]
+            if c < best[0] or (c == best[0] and abs(2 * i - n) < abs(2 * best[2] - n)):
+                best = (c, a, i)
+    return best[1], best[2], np.argsort(E[:n, best[1]], kind="stable")
+
+
+def test_small_node_sweep_matches_a_reference_sort_and_cost():
+    rng = np.random.default_rng(7)
+    S = binned.SMALL
+    scratch = (np.empty((3, S), np.int64), np.empty(S), np.empty((6, S)), np.empty((2, S)), np.empty((S, 9)),
+               np.empty(S, np.int64), np.empty(24))
+    for trial in range(300):
+        n = int(rng.integers(2, S + 1))
+        c = rng.random((n, 3))
+        if trial % 3 == 0:
+            c = np.round(c * 3) / 3            # many equal centroids: the sort must be stable
+        if trial % 5 == 0:
+            c = np.sort(c, axis=0)             # rows already sorted along every axis
+        E = np.hstack([c, c - rng.random((n, 3)) * 0.1, c + rng.random((n, 3)) * 0.1])
+        order = np.arange(n)
+        E1 = E.copy()
+        m = binned._split_sweep(E1, order, 0, n, *scratch)
+        axis, pos, p = _sweep_reference(E, n)
+        assert m == pos, (trial, axis)
+        np.testing.assert_array_equal(order, p)
+        np.testing.assert_array_equal(E1, E[p])
+        out = scratch[-1]
+        np.testing.assert_array_equal(out[0:3], E[p[:pos], 3:6].min(axis=0))
+        np.testing.assert_array_equal(out[15:18], E[p[pos:], 6:9].max(axis=0))
+
+
+def test_moments_are_the_same_on_one_or_more_threads():
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one numba thread")
+    V, F = _soup(m=fast.PARALLEL_BUILD_FACES + 5000, seed=5)  # above the size where subtrees run on threads
+    t = build_volume_bvh(fast._triangle_elements(V, F), 4)
+    before = numba.get_num_threads()
+    got = []
+    try:
+        for threads in (1, 2):
+            numba.set_num_threads(threads)
+            got.append(fast._tree_moments(V, F, t.order, t.start, t.end, t.right, t.lo, t.hi))
+    finally:
+        numba.set_num_threads(before)
+    for a, b in zip(*got):
+        np.testing.assert_array_equal(a, b)
+    roots, above = fast._split_top(t.start, t.end, t.right, 16)
+    covered = np.zeros(t.n_nodes, int)      # the subtrees and the nodes above them cover every node once
+    for r in roots:
+        covered[r:fast._subtree_end(t.right, r)] += 1
+    covered[above] += 1
+    assert len(roots) == 16 and (covered == 1).all()
+
+
 def test_build_volume_bvh_rejects_bad_rows():
     with pytest.raises(ValueError, match="E"):
         build_volume_bvh(np.zeros((5, 6)), 4)

@@ -57,7 +57,9 @@ class Frame:
     def of(cls, X: np.ndarray) -> "Frame":
         """Frame of the finite (n, d) geometry ``X`` (already validated, n ≥ 1)."""
         X = np.asarray(X, dtype=np.float64)
-        lo, hi = X.min(axis=0), X.max(axis=0)
+        # per column: numpy's axis-0 reduction of an (n, 3) array is ~20x slower (1 ms at 45k rows)
+        lo = np.array([X[:, j].min() for j in range(X.shape[1])])
+        hi = np.array([X[:, j].max() for j in range(X.shape[1])])
         c = 0.5 * lo + 0.5 * hi  # no overflow even for ±1e308
         half = float(np.max(0.5 * hi - 0.5 * lo))
         if half > 0.0 and np.isfinite(half):

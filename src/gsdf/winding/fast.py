@@ -316,9 +316,6 @@ def _area_normal(T, j):
     return 0.5 * (e1y * e2z - e1z * e2y), 0.5 * (e1z * e2x - e1x * e2z), 0.5 * (e1x * e2y - e1y * e2x)
 
 
-# the 6 entries (a, b) of a symmetric 3×3 matrix in the order of the moment rows: xx yy zz xy xz yz
-_PA = (0, 1, 2, 0, 0, 1)
-_PB = (0, 1, 2, 1, 2, 2)
 
 
 def _tree_moments(V, F, order, start, end, right, lo, hi):
@@ -340,19 +337,64 @@ def _tree_moments(V, F, order, start, end, right, lo, hi):
     T = np.empty((m, 10))
     D = np.zeros((k, NODE_WIDTH))
     W = np.empty((k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
-    if m >= PARALLEL_BUILD_FACES and numba.get_num_threads() > 1:  # node ranges on Python threads
-        run_ranges(lambda i0, i1: _leaf_moments(V, F, order, start, end, right, T, D, W, i0, i1), k, 2048)
-    else:
-        _leaf_moments(V, F, order, start, end, right, T, D, W, 0, k)
-    _parent_moments(start, end, right, lo, hi, D, W)
+    threads = numba.get_num_threads()
+    if m < PARALLEL_BUILD_FACES or threads == 1:
+        _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, 0, k)
+        return T, D
+    # whole subtrees on Python threads (leaves, then their parents, while the rows are in cache), then the
+    # few nodes above them on this thread
+    roots, above = _split_top(start, end, right, 8 * threads)
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        list(pool.map(lambda r: _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, r,
+                                                 _subtree_end(right, r)), roots))
+    _node_moments_list(start, end, right, lo, hi, D, W, np.array(sorted(above, reverse=True), np.int64))
     return T, D
 
 
+def _split_top(start, end, right, want):
+    """About ``want`` disjoint subtrees covering the tree's leaves (largest first): the root split, then the
+    largest internal subtree split again; returns their roots and the nodes above them."""
+    roots, above = [0], []
+    while len(roots) < want:
+        big = max(range(len(roots)), key=lambda j: -1 if right[roots[j]] < 0 else end[roots[j]] - start[roots[j]])
+        r = roots[big]
+        if right[r] < 0:
+            break
+        above.append(r)
+        roots[big:big + 1] = [r + 1, int(right[r])]
+    roots.sort(key=lambda r: start[r] - end[r])
+    return roots, above
+
+
+@njit(cache=True)
+def _subtree_end(right, r):
+    """One past the last node of node r's subtree (preorder: follow the right children down to a leaf)."""
+    while right[r] >= 0:
+        r = right[r]
+    return r + 1
+
+
 @njit(cache=True, nogil=True)  # one serial, GIL-free kernel for both drivers (no parallel loop to compile)
-def _leaf_moments(V, F, order, start, end, right, T, D, W, i0, i1):
+def _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, i0, i1):
+    """Moments of the nodes i0..i1 − 1, a whole subtree (or the tree): leaves, then parents bottom-up."""
     for i in range(i0, i1):
         if right[i] < 0:
             _leaf_moment(V, F, order, start[i], end[i], T, D, W, i)
+    for i in range(i1 - 1, i0 - 1, -1):  # preorder: both children of i have larger ids
+        if right[i] >= 0:
+            _parent_moment(start, end, right, D, W, i)
+    for i in range(i0, i1):
+        _finish_moment(lo, hi, D, i)
+
+
+@njit(cache=True)
+def _node_moments_list(start, end, right, lo, hi, D, W, nodes):
+    """Moments of the internal ``nodes`` (ids descending: children first) whose children are done."""
+    for i in nodes:
+        _parent_moment(start, end, right, D, W, i)
+        _finish_moment(lo, hi, D, i)
 
 
 @njit(cache=True)
@@ -451,51 +493,51 @@ def _leaf_moment(V, F, order, s, e, T, D, W, i):
 
 
 @njit(cache=True)
-def _parent_moments(start, end, right, lo, hi, D, W):
-    """The internal nodes of :func:`_tree_moments` from their children (serial, O(k)), then u, v and r² of
-    every node."""
-    k = start.shape[0]
-    for i in range(k - 1, -1, -1):  # preorder: both children of i have larger ids
-        r = right[i]
-        if r < 0:
-            continue
-        l = i + 1
-        for q in range(7):
-            W[i, q] = W[l, q] + W[r, q]
-        if W[i, 0] > 0.0:
-            cx, cy, cz = W[i, 1] / W[i, 0], W[i, 2] / W[i, 0], W[i, 3] / W[i, 0]
-        else:
-            cnt = end[i] - start[i]
-            cx, cy, cz = W[i, 4] / cnt, W[i, 5] / cnt, W[i, 6] / cnt
-        D[i, 0], D[i, 1], D[i, 2] = cx, cy, cz
-        for h in range(2):
-            ch = l if h == 0 else r
-            dl0, dl1, dl2 = D[ch, 0] - cx, D[ch, 1] - cy, D[ch, 2] - cz
-            for a in range(3):
-                D[i, _C0 + a] += D[ch, _C0 + a]
-                da = dl0 if a == 0 else (dl1 if a == 1 else dl2)
-                for b in range(3):
-                    D[i, _C1 + 3 * a + b] += D[ch, _C1 + 3 * a + b] + da * D[ch, _C0 + b]
-            for q in range(6):
-                pa, pb = _PA[q], _PB[q]
-                da = dl0 if pa == 0 else (dl1 if pa == 1 else dl2)
+def _parent_moment(start, end, right, D, W, i):
+    """Internal node i of :func:`_tree_moments` from its two children (their rows done)."""
+    r = right[i]
+    l = i + 1
+    for q in range(7):
+        W[i, q] = W[l, q] + W[r, q]
+    if W[i, 0] > 0.0:
+        cx, cy, cz = W[i, 1] / W[i, 0], W[i, 2] / W[i, 0], W[i, 3] / W[i, 0]
+    else:
+        cnt = end[i] - start[i]
+        cx, cy, cz = W[i, 4] / cnt, W[i, 5] / cnt, W[i, 6] / cnt
+    D[i, 0], D[i, 1], D[i, 2] = cx, cy, cz
+    for h in range(2):
+        ch = l if h == 0 else r
+        dl0, dl1, dl2 = D[ch, 0] - cx, D[ch, 1] - cy, D[ch, 2] - cz
+        for a in range(3):
+            D[i, _C0 + a] += D[ch, _C0 + a]
+            da = dl0 if a == 0 else (dl1 if a == 1 else dl2)
+            for b in range(3):
+                D[i, _C1 + 3 * a + b] += D[ch, _C1 + 3 * a + b] + da * D[ch, _C0 + b]
+        for pa in range(3):  # the pairs pa <= pb in the row order xx yy zz xy xz yz, q their column
+            da = dl0 if pa == 0 else (dl1 if pa == 1 else dl2)
+            for pb in range(pa, 3):
+                q = pa if pa == pb else pa + pb + 2
                 db = dl0 if pb == 0 else (dl1 if pb == 1 else dl2)
                 for c in range(3):
                     D[i, _S + 6 * c + q] += (D[ch, _S + 6 * c + q] + da * D[ch, _C1 + 3 * pb + c]
                                              + db * D[ch, _C1 + 3 * pa + c] + da * db * D[ch, _C0 + c])
-    for i in range(k):  # O(k), serial: one parallel launch per build step is enough
-        # u_a = Σ_b S_ab,b and v_c = Σ_a S_aa,c (see the module docstring)
-        for c in range(3):
-            D[i, _VV + c] = D[i, _S + 6 * c] + D[i, _S + 6 * c + 1] + D[i, _S + 6 * c + 2]
-        D[i, _U] = D[i, _S] + D[i, _S + 6 + 3] + D[i, _S + 12 + 4]
-        D[i, _U + 1] = D[i, _S + 3] + D[i, _S + 6 + 1] + D[i, _S + 12 + 5]
-        D[i, _U + 2] = D[i, _S + 4] + D[i, _S + 6 + 5] + D[i, _S + 12 + 2]
-        # far-field radius: the farthest corner of the node's box from p̃ (see FastWindingNumber._build)
-        r2 = 0.0
-        for d in range(3):
-            g = max(abs(lo[i, d] - D[i, d]), abs(hi[i, d] - D[i, d]))
-            r2 += g * g
-        D[i, _R2] = r2
+
+
+@njit(cache=True)
+def _finish_moment(lo, hi, D, i):
+    """u, v and r² of node i (its moments done)."""
+    # u_a = Σ_b S_ab,b and v_c = Σ_a S_aa,c (see the module docstring)
+    for c in range(3):
+        D[i, _VV + c] = D[i, _S + 6 * c] + D[i, _S + 6 * c + 1] + D[i, _S + 6 * c + 2]
+    D[i, _U] = D[i, _S] + D[i, _S + 6 + 3] + D[i, _S + 12 + 4]
+    D[i, _U + 1] = D[i, _S + 3] + D[i, _S + 6 + 1] + D[i, _S + 12 + 5]
+    D[i, _U + 2] = D[i, _S + 4] + D[i, _S + 6 + 5] + D[i, _S + 12 + 2]
+    # far-field radius: the farthest corner of the node's box from p̃ (see FastWindingNumber._build)
+    r2 = 0.0
+    for d in range(3):
+        g = max(abs(lo[i, d] - D[i, d]), abs(hi[i, d] - D[i, d]))
+        r2 += g * g
+    D[i, _R2] = r2
 
 
 def _pack_nodes(D, tree):
