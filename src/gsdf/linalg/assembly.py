@@ -31,6 +31,21 @@ __all__ = ["coo_to_csr", "csr_pattern", "principal_submatrix"]
 
 
 @njit(cache=True)
+def sort_row(indices, first, out, mark):
+    """Sort the column indices ``indices[first:out]`` of one CSR row in place (insertion sort: rows are short)
+    and record each column's final position in ``mark``."""
+    for a in range(first + 1, out):
+        c = indices[a]
+        b = a - 1
+        while b >= first and indices[b] > c:
+            indices[b + 1] = indices[b]
+            b -= 1
+        indices[b + 1] = c
+    for a in range(first, out):
+        mark[indices[a]] = a
+
+
+@njit(cache=True)
 def _csr_pattern(rows, cols, n_rows, n_cols):
     k = len(rows)
     start = np.zeros(n_rows + 1, np.int64)
@@ -56,15 +71,7 @@ def _csr_pattern(rows, cols, n_rows, n_cols):
                 mark[j] = out
                 indices[out] = j
                 out += 1
-        for a in range(first + 1, out):             # insertion sort: rows are short
-            c = indices[a]
-            b = a - 1
-            while b >= first and indices[b] > c:
-                indices[b + 1] = indices[b]
-                b -= 1
-            indices[b + 1] = c
-        for a in range(first, out):
-            mark[indices[a]] = a
+        sort_row(indices, first, out, mark)
         for q in range(start[i], start[i + 1]):
             t = order[q]
             slot[t] = mark[cols[t]]

@@ -20,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ...linalg.assembly import sort_row
+
 
 @njit(cache=True)
 def _jacobi3(S):
@@ -558,15 +560,7 @@ def polygon_csr_pattern(start, corners, n):
                     mark[j] = out
                     indices[out] = j
                     out += 1
-        for a in range(first + 1, out):             # insertion sort: rows are short
-            c = indices[a]
-            b = a - 1
-            while b >= first and indices[b] > c:
-                indices[b + 1] = indices[b]
-                b -= 1
-            indices[b + 1] = c
-        for a in range(first, out):
-            mark[indices[a]] = a
+        sort_row(indices, first, out, mark)
         for q in range(head[i], head[i + 1]):
             p = owner[q]
             b0 = start[p]
