@@ -2,6 +2,7 @@
 carries its residual through the stages, against a sparse direct solve and the stage-by-stage recomputation."""
 
 import numpy as np
+import pytest
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
@@ -93,6 +94,30 @@ def test_penalty_matrix_equals_the_sparse_product():
     assert abs(G.penalty_matrix(T, w, shape) - ref).max() <= 1e-15 * abs(ref).max()
     D = sp.csr_matrix(np.vstack([T[:3].toarray(), T[10].toarray() - T[200].toarray()]))   # not in one cell
     assert abs(G.penalty_matrix(D, 2.0, shape) - 2.0 * (D.T @ D)).max() <= 1e-15 * abs(D.T @ D).max()
+    # few entries that are not one cell although each is within one node of the row's first entry
+    idx = lambda i, j, k: (i * shape[1] + j) * shape[2] + k
+    E = sp.csr_matrix(([1.0, -2.0, 1.0], ([0, 0, 0], [idx(1, 1, 2), idx(1, 2, 1), idx(1, 2, 3)])),
+                      shape=(1, T.shape[1]))
+    assert abs(G.penalty_matrix(E, 1.0, shape) - E.T @ E).max() == 0
+    with pytest.raises(ValueError, match="columns"):
+        G.penalty_matrix(T[:, :-1], 1.0, shape)
+
+
+def test_solve_poisson_penalty_without_constants():
+    """A penalty of differences only (P·1 = 0) gives a finite answer; an all-zero penalty is refused."""
+    import scipy.sparse as sp
+
+    import gsdf.heat.volume.grid as G
+
+    shape, h = (6, 5, 4), np.full(3, 0.2)
+    n = int(np.prod(shape))
+    rhs = np.random.default_rng(0).normal(size=n)
+    rhs -= rhs.mean()
+    d = sp.csr_matrix(([1.0, -1.0], ([0, 0], [0, n - 1])), shape=(1, n))
+    x = G.solve_poisson(rhs, shape, h, (d.T @ d).tocsr())
+    assert np.isfinite(x).all()
+    with pytest.raises(ValueError, match="penalty"):
+        G.solve_poisson(rhs, shape, h, sp.csr_matrix((n, n)))
 
 
 def test_small_cloud_volume_field_unchanged_by_the_fast_path():
@@ -137,6 +162,11 @@ def test_self_knn_matches_the_kd_tree():
         got = knn_self(P, k)
         assert np.array_equal(np.sort(got, axis=1), np.sort(ref, axis=1))
     assert np.array_equal(SelfKNN(P, 9).rows(100, 130), knn_self(P, 9)[100:130])
+    for s, e in ((-1, 5), (10, 5), (0, len(P) + 1)):
+        with pytest.raises(ValueError, match="rows"):
+            SelfKNN(P, 9).rows(s, e)
+    with pytest.raises(ValueError, match="ordered"):
+        SelfKNN(P, 9, ordered="no")
     for k in (1, 7, 41):   # ordered rows: sorted by distance, ties by index — the k-d tree's rows
         assert np.array_equal(SelfKNN(P, k, ordered=True).rows(), cKDTree(P).query(P, k)[1].reshape(len(P), k))
     g = np.arange(7) * 0.5
@@ -158,3 +188,16 @@ def test_self_knn_matches_the_kd_tree():
     Q[3, 1] = np.nan
     with pytest.raises(ValueError, match="NaN"):
         knn_self(Q, 3)
+
+
+
+def test_grid_multiple_soft_rows_without_components_is_a_clear_error():
+    """Sources without connected components (no node rows): "multiple" soft rows name the problem (was a
+    TypeError from indexing None)."""
+    from types import SimpleNamespace
+
+    from gsdf.heat.domains.grid import GridDomain
+
+    D = GridDomain(np.zeros(3), np.ones(3), (6, 6, 6), t=0.01)
+    with pytest.raises(ValueError, match="multiple"):
+        D.soft_rows(SimpleNamespace(node_rows=None), "multiple", 1.0)

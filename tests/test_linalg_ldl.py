@@ -116,6 +116,14 @@ def test_principal_submatrix_equals_scipy_bit_for_bit():
         principal_submatrix(sp.identity(3, format="csr"), np.array([0, 1]), 1.0, np.ones(3))
     with pytest.raises(ValueError, match="CSR or CSC"):
         principal_submatrix(sp.identity(3, format="coo"))
+    I3 = sp.identity(3, format="csr")
+    for keep in (np.array([2, 0]), np.array([0, 0, 2]), np.array([0, 3]), np.array([-1, 1]), np.array([[0, 1]]),
+                 np.array([0.0, 1.0])):
+        with pytest.raises(ValueError, match="keep"):
+            principal_submatrix(I3, keep)
+    with pytest.raises(ValueError, match="square"):
+        principal_submatrix(sp.csr_matrix(np.ones((2, 3))))
+    assert principal_submatrix(I3, np.array([], np.int64)).shape == (0, 0)
 
 
 def test_ordering_hint_taken_unless_flop_heavy_then_fewer_flops_kept():

@@ -102,7 +102,10 @@ def test_flips_keep_two_components_apart():
 
 @pytest.mark.parametrize("kw, match", [
     (dict(F=np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1]])), "closed"),          # open: three faces of a tet
-    (dict(F=np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2][::-1]])), "closed"),   # one face reversed
+    (dict(F=np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2][::-1]])), "oriented"),   # one face reversed
+    (dict(F=np.array([[0, 2, 1], [0, 1, 3], [0, 3, 3], [1, 2, 3]])), "repeat"),        # a degenerate face
+    (dict(margin=1.0), "margin"),                                                       # would never flip
+    (dict(tree="tree"), "tree"),
     (dict(S=np.zeros((2, 3))), "3 samples"),
     (dict(k=2), "k"),
     (dict(sweeps=-1), "sweeps"),
@@ -140,3 +143,30 @@ def test_reconstruction_remesh_must_be_bool():
     P = _ellipsoid(300, (1, 1, 1), np.random.default_rng(0))
     with pytest.raises(ValueError, match="remesh"):
         gsdf.reconstruct_simply_connected(P, remesh=1)
+
+
+def test_flip_tree_must_be_of_the_samples():
+    from scipy.spatial import cKDTree
+
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    S = np.random.default_rng(0).random((20, 3))
+    with pytest.raises(ValueError, match="tree: expected a cKDTree of the 20 samples"):
+        flip_to_samples(V, F, S, 0.1, tree=cKDTree(np.vstack([S, S])))
+    assert flip_to_samples(V, F, S, 0.1, tree=cKDTree(S)).shape == F.shape
+
+
+def test_flip_memory_follows_each_vertex_degree():
+    """A fan around one high-valence vertex: each vertex's incidence list has room for its own degree (+16),
+    not the largest degree (a dense table would be vertices × max degree)."""
+    n = 400
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    ring = np.column_stack([np.cos(t), np.sin(t), np.zeros(n)])
+    V = np.vstack([ring, [[0, 0, 1.0]], [[0, 0, -1.0]]])
+    i = np.arange(n)
+    F = np.vstack([np.column_stack([i, (i + 1) % n, np.full(n, n)]),
+                   np.column_stack([(i + 1) % n, i, np.full(n, n + 1)])])
+    S = np.vstack([V, np.random.default_rng(1).normal(size=(50, 3)) * 0.01])
+    F2 = flip_to_samples(V, F, S, 0.05)
+    t = mesh_topology(V, F2)
+    assert t["components"] == 1 and t["genus"] == [0] and t["closed"] and t["oriented"]

@@ -165,14 +165,25 @@ def principal_submatrix(A, keep=None, scale: float = 1.0, diag=None):
     if A.format not in ("csr", "csc") or not A.has_sorted_indices:
         raise ValueError(f"A: expected a CSR or CSC matrix with sorted indices, got format {A.format!r}")
     n = A.shape[0]
+    if A.shape[1] != n:
+        raise ValueError(f"A: expected a square matrix, got shape {A.shape}")
     rank = np.full(n, -1, np.int64)
     if keep is None:
         rank[:] = np.arange(n)
         m = n
     else:
-        keep = np.asarray(keep, np.int64)
+        keep = np.asarray(keep)
+        if keep.ndim != 1 or (keep.size and keep.dtype.kind not in "iu"):
+            raise ValueError(f"keep: expected a 1-D array of integer indices, got shape {keep.shape} "
+                             f"dtype {keep.dtype}")
+        keep = keep.astype(np.int64)
+        if keep.size and (keep[0] < 0 or keep[-1] >= n or (np.diff(keep) <= 0).any()):
+            raise ValueError(f"keep: expected strictly increasing indices in [0, {n}), got "
+                             f"{keep.min()}..{keep.max()} ({'not ' if (np.diff(keep) <= 0).any() else ''}increasing)")
         rank[keep] = np.arange(len(keep))
         m = len(keep)
+    if A.nnz + m >= 2 ** 31:
+        raise ValueError(f"A: {A.nnz} stored entries, beyond the 32-bit indices of the submatrix")
     add = diag is not None
     d = np.asarray(diag, np.float64) if add else np.zeros(0)
     if add and d.shape != (m,):

@@ -420,7 +420,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         then peel what was added back to the samples (:func:`_reach`; the topology promise is kept).
     remesh : bool — flip edges of the output so that its faces follow the moving-least-squares surface of the
         samples (:func:`.remesh.flip_to_samples`: the boundary of the grown tet region has Delaunay edges that
-        may cut across a bend), then one more relocation round and a second flip pass.  Connectivity only: a
+        may cut across a bend); with ``relocate`` also one more relocation round and a second flip pass (the
+        report's ``flips`` errors before / after are then on different vertex positions).  Connectivity only: a
         flip is taken only where the new edge is not one yet, so the vertices, the counts of edges and faces,
         hence the topology, stay those of the grown ball.  Default on (bench/RESULTS.md, section recon).
     subdivide : int in 0..3 — 1-to-4 splits of the output, the new vertices moved onto the local surface of

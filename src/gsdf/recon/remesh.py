@@ -33,6 +33,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .._checks import as_faces, as_points, integer, nonnegative, positive
+from ..mesh.connectivity import MeshTopology
 
 __all__ = ["flip_to_samples"]
 
@@ -44,19 +45,20 @@ def _normal(V, i, j, k):
 
 
 @nb.njit(cache=True)
-def _drop(vf, deg, v, f):
-    """Remove face f from vertex v's incidence list."""
+def _drop(vf, off, deg, v, f):
+    """Remove face f from vertex v's incidence list (its faces are vf[off[v] : off[v] + deg[v]])."""
+    o = off[v]
     for t in range(deg[v]):
-        if vf[v, t] == f:
+        if vf[o + t] == f:
             deg[v] -= 1
-            vf[v, t] = vf[v, deg[v]]
+            vf[o + t] = vf[o + deg[v]]
             return
 
 
 @nb.njit(cache=True)
-def _has_edge(F, vf, deg, a, b):
+def _has_edge(F, vf, off, deg, a, b):
     for t in range(deg[a]):
-        f = vf[a, t]
+        f = vf[off[a] + t]
         if F[f, 0] == b or F[f, 1] == b or F[f, 2] == b:
             return True
     return False
@@ -103,19 +105,27 @@ def _side(V, i, j, k, nx, ny, nz):
 
 
 @nb.njit(cache=True)
-def _fit_flips(V, F, S, cen, frame, h, coef, near, cap, sweeps, margin):
+def _fit_flips(V, F, S, cen, frame, h, coef, near, slack, sweeps, margin):
     """Greedy flips in place on F; returns the number of flips.
 
     The flip (a, b) → (c, d) is taken when (c, d) is not an edge yet, both new faces keep the orientation of
     the pair (positive dot product with the pair's summed normal), and the summed face error
-    (:func:`_face_error`) drops below (1 − ``margin``) × its value.  ``cap`` bounds a vertex's face count."""
+    (:func:`_face_error`) drops below (1 − ``margin``) × its value.  A vertex may gain at most ``slack`` faces
+    over its starting count (its incidence list has that much room)."""
     nv, nf = V.shape[0], F.shape[0]
-    vf = np.full((nv, cap), -1, np.int64)
     deg = np.zeros(nv, np.int64)
     for f in range(nf):
         for c in range(3):
+            deg[F[f, c]] += 1
+    off = np.zeros(nv + 1, np.int64)       # vertex v's faces: vf[off[v] : off[v] + deg[v]]
+    for v in range(nv):
+        off[v + 1] = off[v] + deg[v] + slack
+    vf = np.full(off[nv], -1, np.int64)
+    deg[:] = 0
+    for f in range(nf):
+        for c in range(3):
             v = F[f, c]
-            vf[v, deg[v]] = f
+            vf[off[v] + deg[v]] = f
             deg[v] += 1
     err = np.empty(nf)
     for f in range(nf):
@@ -131,14 +141,15 @@ def _fit_flips(V, F, S, cen, frame, h, coef, near, cap, sweeps, margin):
                 f2 = -1                    # the other face on edge (a, b) traverses b → a
                 d = -1
                 for t in range(deg[b]):
-                    g = vf[b, t]
+                    g = vf[off[b] + t]
                     for c2 in range(3):
                         if g != f1 and F[g, c2] == b and F[g, (c2 + 1) % 3] == a:
                             f2 = g
                             d = F[g, (c2 + 2) % 3]
                 if f2 < f1 or not (dirty[f1] or dirty[f2]):
                     continue               # each edge once per sweep, and only next to a change
-                if d == cc or deg[cc] >= cap or deg[d] >= cap or _has_edge(F, vf, deg, cc, d):
+                if d == cc or deg[cc] >= off[cc + 1] - off[cc] or deg[d] >= off[d + 1] - off[d] \
+                        or _has_edge(F, vf, off, deg, cc, d):
                     continue
                 e1 = _face_error(V, S, cen, frame, h, coef, near, cc, a, d)
                 e2 = _face_error(V, S, cen, frame, h, coef, near, d, b, cc)
@@ -150,11 +161,11 @@ def _fit_flips(V, F, S, cen, frame, h, coef, near, cap, sweeps, margin):
                 F[f1, 0], F[f1, 1], F[f1, 2] = cc, a, d
                 F[f2, 0], F[f2, 1], F[f2, 2] = d, b, cc
                 err[f1], err[f2] = e1, e2
-                _drop(vf, deg, a, f2)
-                _drop(vf, deg, b, f1)
-                vf[cc, deg[cc]] = f2
+                _drop(vf, off, deg, a, f2)
+                _drop(vf, off, deg, b, f1)
+                vf[off[cc] + deg[cc]] = f2
                 deg[cc] += 1
-                vf[d, deg[d]] = f1
+                vf[off[d] + deg[d]] = f1
                 deg[d] += 1
                 now[f1] = now[f2] = True
                 changed += 1
@@ -197,29 +208,38 @@ def flip_to_samples(V, F, S, spacing: float, *, k: int = 8, sweeps: int = 10, ma
     spacing = positive(spacing, "spacing")
     k = integer(k, "k", lo=3)
     sweeps = integer(sweeps, "sweeps", lo=0)
-    margin = nonnegative(margin, "margin", most=1.0)
+    margin = nonnegative(margin, "margin")
+    if margin >= 1.0:
+        raise ValueError(f"margin: must be in [0, 1) (a flip must lower its faces' error by this fraction), "
+                         f"got {margin!r}")
     if len(S) < 3:
         raise ValueError(f"S: needs at least 3 samples for a local surface, got {len(S)}")
     F = F.astype(np.int64, copy=True)
     if len(F):
-        H = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-        _, cnt = np.unique(H, axis=0, return_counts=True)
-        _, ucnt = np.unique(np.sort(H, axis=1), axis=0, return_counts=True)
-        if (cnt != 1).any() or (ucnt != 2).any() or (F[:, 0] == F[:, 1]).any() or (F[:, 1] == F[:, 2]).any() \
-                or (F[:, 2] == F[:, 0]).any():
-            raise ValueError("F: expected a closed, edge-manifold, consistently oriented mesh (each edge in two "
-                             "faces, traversed in opposite directions)")
+        if (F[:, 0] == F[:, 1]).any() or (F[:, 1] == F[:, 2]).any() or (F[:, 2] == F[:, 0]).any():
+            raise ValueError("F: expected a closed, edge-manifold, consistently oriented mesh; some faces repeat "
+                             "a vertex")
+        topo = MeshTopology(F, len(V))
+        if not topo.is_closed:
+            raise ValueError(f"F: expected a closed mesh, got {int(topo.boundary_edges.sum())} boundary edges")
+        if len(topo.nonmanifold_edges):
+            e = int(topo.nonmanifold_edges[0])
+            raise ValueError(f"F: expected an edge-manifold mesh: edge {tuple(topo.edges[e].tolist())} has "
+                             f"{int(topo.edge_face_count[e])} faces")
+        topo.require_oriented("F")
     from .relocate import _fit_quadrics
-    tree = cKDTree(S) if tree is None else tree
+    if tree is None:
+        tree = cKDTree(S)
+    elif not isinstance(tree, cKDTree) or tree.n != len(S) or tree.m != 3:
+        raise ValueError(f"tree: expected a cKDTree of the {len(S)} samples S, got "
+                         f"{type(tree).__name__} of {getattr(tree, 'n', '?')} points")
     cen, frame, h, coef, _, _, _ = _fit_quadrics(S, S, spacing, int(min(k, len(S))), 0, tree)
     near = tree.query(V)[1].astype(np.int64)
     frame = np.ascontiguousarray(frame)
-    deg = np.bincount(F.ravel(), minlength=len(V))
-    cap = int(deg.max(initial=0)) + 16
     report = {}
     if return_report:
         report["error_before"] = _total_error(V, F, S, cen, frame, h, coef, near)
-    n = _fit_flips(V, F, S, cen, frame, h, coef, near, cap, sweeps, margin) if len(F) else 0
+    n = _fit_flips(V, F, S, cen, frame, h, coef, near, 16, sweeps, margin) if len(F) else 0
     if not return_report:
         return F
     report.update(flipped=int(n), error_after=_total_error(V, F, S, cen, frame, h, coef, near))

@@ -55,6 +55,8 @@ class SelfKNN:
             raise ValueError(f"k: must be an integer in [1, {n}] (the number of points), got {k!r}")
         if not np.isfinite(P).all():
             raise ValueError("P: contains NaN or inf")
+        if not isinstance(ordered, (bool, np.bool_)):
+            raise ValueError(f"ordered: expected True or False, got {ordered!r}")
         self.P, self.n, self.k, self.ordered = P, n, int(k), bool(ordered)
         lo = P.min(axis=0)
         ext = float((P.max(axis=0) - lo).max())
@@ -75,6 +77,9 @@ class SelfKNN:
 
     def rows(self, s: int = 0, e: int | None = None) -> np.ndarray:
         e = self.n if e is None else int(e)
+        s = int(s)
+        if not 0 <= s <= e <= self.n:
+            raise ValueError(f"rows: expected 0 <= s <= e <= {self.n} (the number of points), got s={s}, e={e}")
         if self.degenerate:
             return np.tile(np.arange(self.k, dtype=np.int64), (e - s, 1))
         out = np.empty((e - s, self.k), np.int64)

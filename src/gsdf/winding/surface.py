@@ -572,7 +572,8 @@ class SurfaceWindingNumbers:
     def _complete_cycle(self, gamma, g, eps, time_limit, alg, extra, Jv, obj, lp_s):
         """``cycle_choice="complete"`` (see :meth:`solve`): the LP again with the input edges of the first cycle
         ``Jv`` forbidden; (Jv, objective, seconds) of the cycle with the larger share of Σ ℓ|Jv| on the input.
-        The first cycle is kept when the second LP does not finish within the time left."""
+        The first cycle is kept when the second LP fails: no time left, HiGHS out of time or in numerical
+        trouble, or no feasible cycle once the first cycle's input edges are forbidden."""
         used = (g != 0) & (np.abs(Jv) > CHOICE_TOL)
         left = time_limit - lp_s
         if not used.any() or not left > 0:
@@ -580,7 +581,7 @@ class SurfaceWindingNumbers:
         t0 = time.perf_counter()
         try:
             J2, obj2, s2 = self._residual_full(gamma, g, eps, left, alg, *extra, forbid=used)
-        except ValueError:              # the second LP did not finish in the time left: the LP's own cycle
+        except ValueError:              # the second LP failed (see above): the LP's own cycle
             return Jv, obj, lp_s + time.perf_counter() - t0
         ell = self.dec.edge_length
         on = g != 0

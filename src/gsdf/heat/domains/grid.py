@@ -145,6 +145,9 @@ class GridDomain(HeatDomain):
 
     def soft_rows(self, S: Sources, mode: str, lam: float):
         if mode == "multiple":                                 # differences of the cell rows per component
+            if S.node_rows is None:
+                raise ValueError('level_set="multiple": the sources have no connected components here (a point '
+                                 'cloud without component labels); use level_set="zero"')
             mats = []
             for c in np.unique(S.components):
                 R = S.node_rows[np.flatnonzero(S.components == c)]

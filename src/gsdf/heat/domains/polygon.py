@@ -280,6 +280,8 @@ class PolygonDomain(VertexSurfaceDomain):
         self._fine_ops = None
         # per polygon exactly symmetric, and the triplets of (i, j) and (j, i) alike are summed in polygon order:
         # L is exactly symmetric
+        if len(vals) >= 2 ** 31:
+            raise ValueError(f"polygons: {len(vals)} stiffness entries (Σ degree²), beyond 32-bit sparse indices")
         indptr, indices, slot = polygon_csr_pattern(start, corners, n)
         L = sp.csr_matrix((np.bincount(slot, weights=vals, minlength=len(indices)), indices, indptr), shape=(n, n))
         L.has_sorted_indices = True

@@ -169,8 +169,10 @@ def penalty_matrix(A, w, shape) -> sp.csr_matrix:
     (trilinear rows) are summed by a numba kernel straight into P's 27-point rows; any other row set (the
     differences of the "multiple" constraint) by SciPy's products."""
     A = sp.csr_matrix(A)
-    w = np.ascontiguousarray(np.broadcast_to(np.asarray(w, np.float64), (A.shape[0],)))
     dims = np.array(shape, np.int64)
+    if dims.shape != (3,) or (dims < 1).any() or A.shape[1] != int(np.prod(dims)):
+        raise ValueError(f"penalty_matrix: A has {A.shape[1]} columns, expected one per node of the grid {tuple(shape)}")
+    w = np.ascontiguousarray(np.broadcast_to(np.asarray(w, np.float64), (A.shape[0],)))
     out = _cell_penalty(A.indptr.astype(np.int64), A.indices.astype(np.int64), A.data.astype(np.float64), w, dims)
     if out is None:
         return (A.T @ sp.diags(w) @ A).tocsr()
@@ -192,13 +194,20 @@ def _cell_penalty(Ap, Ai, Av, w, dims):
         s, e = Ap[r], Ap[r + 1]
         if e == s:
             continue
-        c0 = Ai[s]
-        i0, j0, k0 = c0 // s0, (c0 // n2) % n1, c0 % n2
-        for p in range(s, e):
+        if e - s > 8:                        # a cell has 8 nodes: duplicates, not a trilinear row
+            return None
+        lo0 = lo1 = lo2 = N
+        hi0 = hi1 = hi2 = -1
+        for p in range(s, e):                # the row's nodes must span at most one cell on every axis
             c = Ai[p]
             i, j, k = c // s0, (c // n2) % n1, c % n2
-            if abs(i - i0) > 1 or abs(j - j0) > 1 or abs(k - k0) > 1:
-                return None
+            lo0, hi0 = min(lo0, i), max(hi0, i)
+            lo1, hi1 = min(lo1, j), max(hi1, j)
+            lo2, hi2 = min(lo2, k), max(hi2, k)
+        if hi0 - lo0 > 1 or hi1 - lo1 > 1 or hi2 - lo2 > 1:
+            return None
+        for p in range(s, e):
+            c = Ai[p]
             if slot[c] < 0:
                 slot[c] = nb
                 nodes[nb] = c
@@ -207,8 +216,6 @@ def _cell_penalty(Ap, Ai, Av, w, dims):
     code = np.empty(8, np.int64)             # per entry of a row: 9 i + 3 j + k, relative to its first entry
     for r in range(m):
         s, e = Ap[r], Ap[r + 1]
-        if e - s > 8:                        # a cell has 8 nodes: duplicates, not a trilinear row
-            return None
         if e == s:
             continue
         c0 = Ai[s]
@@ -376,7 +383,9 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     system = PenalizedPoisson(shape, spacing, penalty, coarse_size=coarse_size, min_block=min_block)
     rhs = np.ascontiguousarray(rhs, dtype=np.float64)
     x0 = dct_poisson(rhs - rhs.mean(), shape, spacing)
-    x0 += (rhs.sum() - system.matvec(x0).sum()) / system.penalty_sum  # best constant (L annihilates constants)
+    if abs(system.penalty_sum) > 1e-12 * system.delta * int(np.prod(shape)):   # |P·1| against tr(P)
+        # best constant (L annihilates constants); a penalty of differences only (P·1 = 0) leaves it free
+        x0 += (rhs.sum() - system.matvec(x0).sum()) / system.penalty_sum
     x, _ = cg_loop(system.matvec, system.precondition, rhs, x0, rtol=tol, maxiter=maxiter, warn="step III")
     return x
 
@@ -402,6 +411,9 @@ class PenalizedPoisson:
         self.cdims = (self.dims + self.block - 1) // self.block
         self.band = np.flatnonzero(np.diff(self.Pp) > 0).astype(np.int64)
         diagP = P.diagonal()
+        if not diagP.sum() > 0 or not np.isfinite(self.Pv).all():
+            raise ValueError("penalty: expected a finite positive semi-definite matrix with a positive trace "
+                             "(an all-zero penalty leaves the Neumann problem without a unique solution)")
         self.delta = float(diagP.sum()) / n
         self.penalty_sum = float(self.Pv.sum())
         self.lam = _dct_eigenvalues(self.shape, self.spacing, self.delta)
