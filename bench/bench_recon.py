@@ -20,7 +20,8 @@ a subset and ASSERTS the topology promise (CC = 1, genus 0, closed manifold) on 
 ``--relocation`` adds a before / after table of the vertex relocation (same clouds, with SPSR); ``--meshes
 bull,camel --table2-only`` runs the Table-2 cases of those meshes only (section ``recon-subset``).
 ``--only-remesh`` writes the before / after table of the edge flips (``remesh=False`` against the default) on
-the full run's Table-2 clouds, with SPSR (section ``recon-remesh``).
+the full run's Table-2 clouds, with SPSR (section ``recon-remesh``); ``--only-post`` the same for the flips on
+the subdivided mesh (``flip_subdivided=False`` against the default; section ``recon-post``).
 """
 
 from __future__ import annotations
@@ -251,11 +252,12 @@ def relocation_table(rng):
                  rows)
 
 
-def remesh_table():
+def before_after_table(before_kw, before_label, count, stage):
     """The Table-2 clouds of the full run (same rng stream: the draws of the other methods' metric samples
-    are skipped), three reconstructions each: ours with ``remesh=False`` (before), ours (default, with the
-    edge flips), SPSR given the true normals; the metric samples come from one fixed rng per case, the same for
-    all three.  Returns (table text, summary line)."""
+    are skipped), three reconstructions each: ours with ``before_kw`` (before), ours (the default), SPSR given
+    the true normals; the metric samples come from one fixed rng per case, the same for all three.
+    ``count(report)`` and ``stage(report)`` give the table's count column and stage seconds of the default
+    call.  Returns (table text, summary line)."""
     rng = np.random.default_rng(0)
     rows, lower, higher, d_all, ratios = [], 0, 0, [], []
     n_le_before = n_le_after = 0
@@ -273,13 +275,13 @@ def remesh_table():
             for _ in range(n_metric):
                 rng.random(3 * 100_000)
             t = time.perf_counter()
-            Va, Fa = gsdf.reconstruct_simply_connected(P, remesh=False)
+            Va, Fa = gsdf.reconstruct_simply_connected(P, **before_kw)
             ta = time.perf_counter() - t
             t = time.perf_counter()
             Vb, Fb, rep = gsdf.reconstruct_simply_connected(P, return_report=True)
             tb = time.perf_counter() - t
-            if len(Va) != len(Vb) or not gsdf.recon.is_sphere(Vb, Fb) or not gsdf.recon.is_sphere(Va, Fa):
-                raise SystemExit(f"remesh changed the vertices or the topology on {mname} {n_in}+{n_out}")
+            if not gsdf.recon.is_sphere(Vb, Fb) or not gsdf.recon.is_sphere(Va, Fa):
+                raise SystemExit(f"{before_label} / default broke the topology on {mname} {n_in}+{n_out}")
             Vs, Fs, _ = run_spsr(P, N)
             a, b, c = (cd_hd(V, F, GT, np.random.default_rng(1)) for V, F in ((Va, Fa), (Vb, Fb), (Vs, Fs)))
             d = round(b[0], 2) - round(a[0], 2)
@@ -291,17 +293,23 @@ def remesh_table():
             ratios.append(tb / ta)
             rows.append([mname.replace(".off", ""), f"{n_in // 1000}K+{n_out}", f"{a[0]:.3f} / {a[1]:.1f}",
                          f"{b[0]:.3f} / {b[1]:.1f}", f"{b[0] - a[0]:+.3f}", f"{c[0]:.3f} / {c[1]:.1f}",
-                         "yes" if round(b[0], 2) <= round(c[0], 2) else "no", rep["flips"]["flipped"],
-                         f"{rep['timings']['remesh']:.2f}", f"{ta:.1f} / {tb:.1f}"])
-            print("remesh", rows[-1], flush=True)
+                         "yes" if round(b[0], 2) <= round(c[0], 2) else "no", count(rep),
+                         f"{stage(rep):.2f}", f"{ta:.1f} / {tb:.1f}"])
+            print(before_label, rows[-1], flush=True)
     summary = (f"After − before (3 decimals): mean {np.mean(d_all):+.4f}, lower on {int(np.sum(np.array(d_all) < 0))} "
                f"of {len(d_all)}, largest rise {max(d_all):+.4f}; at the table's two decimals lower on {lower}, higher on "
                f"{higher}.  CD ≤ SPSR (two decimals): before {n_le_before} / {len(d_all)}, after {n_le_after} / "
                f"{len(d_all)}.  Whole-call time after / before: median {np.median(ratios):.2f} (range "
                f"{min(ratios):.2f}–{max(ratios):.2f}).")
-    return table(["mesh", "case", "ours before (remesh=False) CD / HD", "ours after (default) CD / HD",
+    return table(["mesh", "case", f"ours before ({before_label}) CD / HD", "ours after (default) CD / HD",
                   "after − before", "SPSR CD / HD", "after ≤ SPSR", "flips", "flip stage (s)",
                   "time before / after (s)"], rows), summary
+
+
+def remesh_table():
+    """Before / after of the edge flips: ``remesh=False`` against the default."""
+    return before_after_table(dict(remesh=False), "remesh=False", lambda r: r["flips"]["flipped"],
+                              lambda r: r["timings"]["remesh"])
 
 
 def only_remesh():
@@ -315,6 +323,23 @@ def only_remesh():
                   "(section recon); CD×100 / HD×100 with one metric sample per case shared by the three methods "
                   "(so the after column can differ from section recon in the third decimal).\n\n" + text + "\n\n"
                   + summary)
+
+
+def only_post():
+    """Before / after of the flips on the subdivided mesh (``flip_subdivided=False`` against the default), into
+    section recon-post."""
+    up = _uptime()
+    print(up, flush=True)
+    text, summary = before_after_table(dict(flip_subdivided=False), "flip_subdivided=False",
+                                       lambda r: f"{r['flips']['flipped']} + {r['flips']['flipped_subdivided']}",
+                                       lambda r: r["timings"]["remesh"])
+    write_section("recon-post", "## recon-post: edge flips on the subdivided mesh (flip_subdivided=True) before / "
+                  "after on the Table-2 clouds\n\n"
+                  f"Machine: {machine()}. Load at start: `{up}`; at the end: `{_uptime()}`. Command: `PYTHONPATH=src "
+                  "/work/anchors/bin/python bench/bench_recon.py --only-post`.  Same clouds as the full run (section "
+                  "recon); CD×100 / HD×100 with one metric sample per case shared by the three methods.  \"flips\" = "
+                  "flips before the subdivision + flips on the subdivided mesh; \"flip stage\" = all flip passes and "
+                  "the relocation round between them.\n\n" + text + "\n\n" + summary)
 
 
 # ------------------------------------------------------------------------------------------- main
@@ -481,6 +506,9 @@ if __name__ == "__main__":
     ap.add_argument("--only-remesh", action="store_true",
                     help="only the before / after table of the edge flips (remesh) on the full run's Table-2 clouds, "
                          "with SPSR; written to section recon-remesh")
+    ap.add_argument("--only-post", action="store_true",
+                    help="only the before / after table of the flips on the subdivided mesh (flip_subdivided) on the "
+                         "full run's Table-2 clouds, with SPSR; written to section recon-post")
     ap.add_argument("--size-worker", type=int, default=None)
     ap.add_argument("--only-sizes", default=None, metavar="N,N,...",
                     help="only the time / peak memory vs point count table for these sizes (one process each), "
@@ -490,6 +518,8 @@ if __name__ == "__main__":
         _size_worker(a.size_worker)
     elif a.only_remesh:
         only_remesh()
+    elif a.only_post:
+        only_post()
     elif a.only_sizes:
         only_sizes([int(n) for n in a.only_sizes.split(",")])
     else:

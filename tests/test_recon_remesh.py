@@ -170,3 +170,34 @@ def test_flip_memory_follows_each_vertex_degree():
     F2 = flip_to_samples(V, F, S, 0.05)
     t = mesh_topology(V, F2)
     assert t["components"] == 1 and t["genus"] == [0] and t["closed"] and t["oriented"]
+
+
+def test_flips_on_the_subdivided_mesh_keep_vertices_and_sphere_and_lower_the_error():
+    # the 1-to-4 split keeps each parent's diagonals; flipping the subdivided mesh follows the rim closer
+    abc = (1.0, 1.0, 0.15)
+    P = _ellipsoid(1200, abc, np.random.default_rng(3))
+    V0, F0 = gsdf.reconstruct_simply_connected(P, flip_subdivided=False)
+    V1, F1, rep = gsdf.reconstruct_simply_connected(P, return_report=True)
+    assert np.array_equal(V0, V1) and F0.shape == F1.shape and not np.array_equal(F0, F1)
+    assert is_sphere(V0, F0) and is_sphere(V1, F1)
+    assert rep["flips"]["flipped_subdivided"] > 0
+    assert _ellipsoid_error(V1, F1, abc) < _ellipsoid_error(V0, F0, abc)
+    # without a subdivision there is nothing more to flip: the same mesh either way
+    Va, Fa = gsdf.reconstruct_simply_connected(P, subdivide=0)
+    Vb, Fb = gsdf.reconstruct_simply_connected(P, subdivide=0, flip_subdivided=False)
+    assert np.array_equal(Va, Vb) and np.array_equal(Fa, Fb)
+
+
+def test_flip_check_false_gives_the_same_flips_on_a_valid_mesh():
+    rng = np.random.default_rng(5)
+    abc = (1.0, 0.6, 0.35)
+    V = _ellipsoid(300, abc, rng)
+    F = _random_flips(_hull_mesh(V), 100, rng)
+    S = _ellipsoid(4000, abc, rng)
+    assert np.array_equal(flip_to_samples(V, F, S, 0.03), flip_to_samples(V, F, S, 0.03, check=False))
+
+
+def test_reconstruction_flip_subdivided_must_be_bool():
+    P = _ellipsoid(300, (1, 1, 1), np.random.default_rng(0))
+    with pytest.raises(ValueError, match="flip_subdivided"):
+        gsdf.reconstruct_simply_connected(P, flip_subdivided="yes")

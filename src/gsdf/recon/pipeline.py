@@ -26,7 +26,8 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
    tangential smoothing, damped so that no face flips; the faces — hence the topology — are unchanged;
 9. edge flips (connectivity only, :mod:`.remesh`): an edge whose flip makes its two faces follow that surface
    better is flipped, when the new edge is not one yet — a closed manifold sphere stays one;
-10. one 1-to-4 subdivision whose new vertices go onto that surface (:func:`.relocate.subdivide_onto_samples`).
+10. one 1-to-4 subdivision whose new vertices go onto that surface (:func:`.relocate.subdivide_onto_samples`),
+    and the edge flips again on the subdivided mesh (each split face inherits its parent's diagonals).
 
 Example
 -------
@@ -383,7 +384,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
                                  cluster_gap: float = 5.0, max_iterations: int = 4, steiner: bool = True,
                                  sign: str = "tangent", hodge: bool = False, project: bool = True, sculpt: bool = True,
                                  relocate: bool = True, reach: bool = True, remesh: bool = True, subdivide: int = 1,
-                                 fit_k: int = 8,
+                                 flip_subdivided: bool = True, fit_k: int = 8,
                                  band: float = 10.0,
                                  outlier_gap: float = 3.0, progress=None, return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
@@ -427,6 +428,10 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     subdivide : int in 0..3 — 1-to-4 splits of the output, the new vertices moved onto the local surface of
         the samples (:func:`.relocate.subdivide_onto_samples`; each split multiplies the faces by 4 and keeps
         the topology).  0: the faces of the tet region's boundary as they are.
+    flip_subdivided : bool — with ``remesh`` and ``subdivide``, one more flip pass on the subdivided mesh: the
+        four faces of a split face keep its diagonals, and flips among the new edges follow the samples' surface
+        closer (bench/RESULTS.md section recon-post: CD lower on most Table-2 cases).  Connectivity only, as
+        ``remesh``.
     fit_k : int in 3..64 — samples in the moving-least-squares fit that the relocation and the subdivision
         project onto (:func:`.relocate.local_surface`).  Vertex positions only: the faces are the same for
         every value.  8 (default): on Table-2 clouds (CGAL meshes, 1K–8K samples + outliers) CD is lower than
@@ -448,7 +453,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         from the returned surface; duplicates are not flagged), ``surface_fraction`` (share of distinct
         points with a flat, dense neighbourhood), ``gamma_ratio``, ``relocation`` (vertices moved / damped /
         reverted, ``free_input_points``; None without ``relocate``), ``flips`` (``flipped``, summed face fit
-        error before / after; None without ``remesh``), ``timings`` (s), sizes.
+        error before / after of the pass before the subdivision, ``flipped_subdivided`` after it; None without
+        ``remesh``), ``timings`` (s), sizes.
 
     Notes
     -----
@@ -478,7 +484,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     max_iterations = integer(max_iterations, "max_iterations", lo=1)
     subdivide = integer(subdivide, "subdivide", lo=0, hi=3)
     fit_k = integer(fit_k, "fit_k", lo=3, hi=64)
-    for name, val in (("clusters", clusters), ("relocate", relocate), ("reach", reach), ("remesh", remesh)):
+    for name, val in (("clusters", clusters), ("relocate", relocate), ("reach", reach), ("remesh", remesh),
+                      ("flip_subdivided", flip_subdivided)):
         if not isinstance(val, (bool, np.bool_)):
             raise ValueError(f"{name}: expected a bool, got {type(val).__name__}")
     for name, val in (("cluster_gap", cluster_gap), ("band", band), ("outlier_gap", outlier_gap)):
@@ -676,6 +683,14 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
                                                return_report=True)
         exact = np.concatenate([exact, np.zeros(len(Vn) - nv, dtype=bool)])
     timings["subdivide"] = time.perf_counter() - t
+    if remesh and flip_subdivided and subdivide and int(use.sum()) >= 3:
+        # connectivity only, as above; the split of a closed oriented manifold is one (no need to re-check it)
+        from .remesh import flip_to_samples
+        t = time.perf_counter()
+        say("flipping edges of the subdivided mesh")
+        Fout, rep3 = flip_to_samples(Vn, Fout, Xi[use], spacing, k=fit_k, check=False, return_report=True)
+        flips["flipped_subdivided"] = rep3["flipped"]
+        timings["remesh"] += time.perf_counter() - t
     Vout = Vn * scale + centre
     # exact input coordinates for the input vertices that stay where they are
     orig_rows = keep[np.flatnonzero(inl)]
