@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import data_dir, machine, table, write_section  # noqa: E402
+from common import batch_mean, data_dir, machine, table, write_section  # noqa: E402
 from load import BusyLoad  # noqa: E402
 
 import bench_heat_surface as bhs  # noqa: E402
@@ -42,17 +42,6 @@ def per_call(fn, calls):
         r1 = resource.getrusage(resource.RUSAGE_SELF)
         out[k] = (t1 - t0, c1 - c0, r1.ru_nivcsw - r0.ru_nivcsw, r1.ru_nvcsw - r0.ru_nvcsw)
     return out
-
-
-def batch_mean(fn, min_s=0.1):
-    """Mean wall time of a batch of calls lasting at least ``min_s`` seconds."""
-    k, t0 = 0, time.perf_counter()
-    while True:
-        fn()
-        k += 1
-        t = time.perf_counter() - t0
-        if t >= min_s and k >= 3:
-            return t / k
 
 
 def main():
@@ -83,7 +72,7 @@ def main():
                 for lib, f in fns.items():
                     d = per_call(f, args.calls)
                     res[lab, lib] = (np.median(d[:, 0]), d[:, 0].mean(), np.median(d[:, 1]), np.mean(d[:, 2] > 0),
-                                     d[:, 3].mean(), batch_mean(f))
+                                     d[:, 3].mean(), batch_mean(f, min_calls=3))
         for lib in fns:
             i, l_ = res["idle", lib], res["loaded", lib]
             rows.append([name, lib] + [f"{i[0] * 1e3:.2f} / {l_[0] * 1e3:.2f}", f"{i[1] * 1e3:.2f} / {l_[1] * 1e3:.2f}",

@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import data_dir, machine, median_time, table, write_section  # noqa: E402
+from common import batch_mean, data_dir, machine, median_time, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf.heat import SurfaceSignedHeatSolver  # noqa: E402
@@ -781,21 +781,10 @@ BATCH_S = 0.1
 ROUNDS, LARGE_ROUNDS = 7, 5
 
 
-def _batch(fn, min_s=BATCH_S):
-    """Mean wall time of ``fn()`` called back to back until at least ``min_s`` seconds have passed."""
-    k, t0 = 0, time.perf_counter()
-    while True:
-        fn()
-        k += 1
-        t = time.perf_counter() - t0
-        if t >= min_s:
-            return t / k
-
-
 def _time_first_repeat(make, solve):
     """(first, repeated, peak RSS increase MB, result) of one round: first = constructor + first solve, the mean
     over fresh solvers built and solved back to back until ≥ BATCH_S s (the first of them measured for memory
-    too); repeated = a further solve with the same solver, the mean of a batch of ≥ BATCH_S s (:func:`_batch`);
+    too); repeated = a further solve with the same solver, the mean of a batch of ≥ BATCH_S s (common.batch_mean);
     peak RSS = VmHWM growth over the first solver's construction, first solve and repeats."""
     import gc
 
@@ -806,7 +795,7 @@ def _time_first_repeat(make, solve):
     s = make()
     out = solve(s)
     first = [time.perf_counter() - t0]
-    rep = _batch(lambda: solve(s))
+    rep = batch_mean(lambda: solve(s), BATCH_S)
     peak = (_rss_kb() - base) / 1024
     del s
     while sum(first) < BATCH_S:

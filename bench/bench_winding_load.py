@@ -10,26 +10,14 @@ back, and rounds alternate idle / loaded (bench/load.py BusyLoad(2)); the ratio 
 import argparse
 import os
 import sys
-import time
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
-from common import data_dir, machine, table, write_section  # noqa: E402
+from common import batch_mean, data_dir, machine, table, write_section  # noqa: E402
 from load import BusyLoad, uptime  # noqa: E402
 
 import gsdf  # noqa: E402
-
-
-def _time(fn, min_s=0.1):
-    """Seconds per call of fn, over a batch of calls lasting at least min_s."""
-    n, t0 = 0, time.perf_counter()
-    while True:
-        fn()
-        n += 1
-        t = time.perf_counter() - t0
-        if t >= min_s:
-            return t / n
 
 
 def main(argv=None):
@@ -55,9 +43,9 @@ def main(argv=None):
             for mode in (("idle", "loaded") if r % 2 == 0 else ("loaded", "idle")):
                 if mode == "loaded":
                     with BusyLoad(2):
-                        ratios[mode].append(_time(g) / _time(i))
+                        ratios[mode].append(batch_mean(g) / batch_mean(i))
                 else:
-                    ratios[mode].append(_time(g) / _time(i))
+                    ratios[mode].append(batch_mean(g) / batch_mean(i))
         mi, ml = float(np.median(ratios["idle"])), float(np.median(ratios["loaded"]))
         q = lambda x: f"{np.percentile(x, 25):.2f}–{np.percentile(x, 75):.2f}"  # noqa: E731
         rows.append((name, len(F), f"{mi:.2f}", q(ratios["idle"]), f"{ml:.2f}", q(ratios["loaded"]),

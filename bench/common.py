@@ -51,6 +51,18 @@ def median_time(fn, repeat: int = 3):
     return float(np.median(times)), out
 
 
+def batch_mean(fn, min_s: float = 0.1, min_calls: int = 1) -> float:
+    """Mean wall time of ``fn()`` called back to back until at least ``min_s`` seconds and ``min_calls`` calls
+    have passed (a millisecond call timed alone is either not preempted or loses a whole time slice)."""
+    k, t0 = 0, time.perf_counter()
+    while True:
+        fn()
+        k += 1
+        t = time.perf_counter() - t0
+        if t >= min_s and k >= min_calls:
+            return t / k
+
+
 def write_section(name: str, text: str) -> None:
     """Replace (or append) the section between ``<!-- name:start -->`` and ``<!-- name:end -->``, then
     rebuild the index at the top of RESULTS.md (see :func:`results_index`)."""
