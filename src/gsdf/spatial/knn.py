@@ -6,8 +6,9 @@ k = 21). Here the points are bucketed in cubic cells of about the typical k-th n
 scans the cubes of cells around its own (Chebyshev distance R = 1, 2, ...) keeping the points closer than the
 nearest face of the scanned cube (faces on the border of the grid do not count: nothing lies beyond them; cells
 wholly beyond that face are not read) until at least k are kept — every unseen point is farther, so those k are
-exact. The k smallest squared distances are then kept by a quickselect threshold; ties at the threshold go to
-the smallest indices.
+exact. The k-th smallest squared distance is found by a histogram of the kept ones (:func:`_kth_smallest`) and
+the points up to it are kept; ties at the threshold go to the smallest indices. A point whose block keeps fewer
+than k rescans the next cube out to the k-th distance among its block's points, an upper bound of its own k-th.
 
 Rows come out in no particular order unless ``ordered`` (sorted by distance, ties by index: the rows of
 ``cKDTree.query``, so a caller gets bit-identical results from either; the sort costs ~15 % at k = 41).
@@ -151,19 +152,24 @@ def _knn_kernel(P, Ps, order, start, cells, dims, lo, cell, k, s, ordered, out):
     cd = np.empty(cap)
     ci = np.empty(cap, np.int64)
     tmp = np.empty(cap)
+    hist = np.empty(NBUCKET + 1, np.int64)
     for r in range(out.shape[0]):
-        cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, s + r, r, ordered, cd, ci, tmp, out)
+        cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, s + r, r, ordered, cd, ci, tmp, hist,
+                               out)
 
 
 @njit(cache=True)
-def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd, ci, tmp, out, R0=1):
+def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd, ci, tmp, hist, out, R0=1,
+             tau=np.inf):
     """The k nearest of point i into out[row] (sorted by (distance, index) when ``ordered``); returns the
     (possibly grown) scratch buffers.
 
-    Scans the cube of cells at Chebyshev distance <= R of the point's own cell (R = 1, 2, ...), keeping only
-    points closer than ``reach``, the distance to the nearest face of the cube that has cells beyond it (a
-    point outside the cube is farther than that): once k are kept they are the k nearest. Cells wholly
-    beyond ``reach`` are not read."""
+    Scans the cube of cells at Chebyshev distance <= R of the point's own cell (R = R0, R0 + 1, ...), keeping
+    only points closer than ``reach``, the distance to the nearest face of the cube that has cells beyond it (a
+    point outside the cube is farther than that), and not farther than ``tau`` (squared; an upper bound of the
+    k-th nearest distance known to the caller, or inf): once k are kept they are the k nearest. Cells wholly
+    beyond that are not read. The kept points are the same, in the same order, as without ``tau`` once the
+    ones beyond the k-th distance are dropped, so the row does not depend on ``tau``."""
     x, y, z = P[i, 0], P[i, 1], P[i, 2]
     cx, cy, cz = cells[i, 0], cells[i, 1], cells[i, 2]
     R = R0
@@ -184,7 +190,7 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd,
             reach = min(reach, z - (lo[2] + z0 * cell))
         if z1 < dims[2] - 1:
             reach = min(reach, lo[2] + (z1 + 1) * cell - z)
-        lim = reach * reach
+        lim = min(reach * reach, tau)
         m = 0
         for ax in range(x0, x1 + 1):
             gx = max(0.0, max(lo[0] + ax * cell - x, x - (lo[0] + (ax + 1) * cell)))
@@ -209,27 +215,67 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd,
                             cd2[q] = cd[q]  # path costs ~2 s of a cold compile)
                             ci2[q] = ci[q]
                         cd, ci, tmp = cd2, ci2, np.empty(cap)
-                    for p in range(s, e):
+                    for p in range(s, e):   # branch-free: written always, counted when kept
                         u, v, w = Ps[p, 0] - x, Ps[p, 1] - y, Ps[p, 2] - z
                         d = u * u + v * v + w * w
-                        if d <= lim:
-                            cd[m] = d
-                            ci[m] = order[p]
-                            m += 1
+                        cd[m] = d
+                        ci[m] = order[p]
+                        m += d <= lim
         if m >= k:
             break
         R += 1
-    _keep_k(cd, ci, tmp, m, k, ordered, out, row)
+    _keep_k(cd, ci, tmp, hist, m, k, ordered, out, row, lim)
     return cd, ci, tmp
 
 
+NBUCKET = 64  # buckets of the selection histogram (:func:`_kth_smallest`)
+
+
 @njit(cache=True)
-def _keep_k(cd, ci, tmp, m, k, ordered, out, row):
-    """out[row] = the indices of the k smallest (d², index) among cd[:m], ci[:m] (m >= k): a quickselect
-    threshold, then the ties at it by smallest index (sorted by (d², index) when ``ordered``)."""
+def _kth_smallest(a, m, r, top, tmp, hist):
+    """The r-th smallest (0-based) of a[:m] (values >= 0, m > r), a unchanged; tmp (>= m) and hist
+    (NBUCKET + 1) are scratch.
+
+    A histogram of NBUCKET equal buckets over [0, top] (``top``: a bound of most values, e.g. the squared
+    reach they were kept within; inf or 0: their maximum is used; larger values share the last bucket) gives
+    the bucket holding rank r, and the rank within that bucket is selected among its few values by
+    :func:`_select`. Bucketing is monotone in the value (a product by a positive scale, then truncation), so
+    every value of a lower bucket is <= every value of a higher one and the result is exactly the r-th value.
+    On the 50-250 values of a neighbour search this is ~3× faster than a quickselect over all of them, whose
+    comparisons are mispredicted branches."""
+    if not (top > 0.0 and top < np.inf):
+        top = 0.0
+        for q in range(m):
+            top = max(top, a[q])
+        if top == 0.0:
+            return 0.0
+    scale = NBUCKET / top
+    if not scale < np.inf:   # top subnormal
+        for q in range(m):
+            tmp[q] = a[q]
+        return _select(tmp, np.int64(m), r)
+    for b in range(NBUCKET + 1):
+        hist[b] = 0
     for q in range(m):
-        tmp[q] = cd[q]
-    thr = _select(tmp, np.int64(m), k - 1)  # int64, not Literal[int](0): one specialisation
+        hist[int(min(a[q] * scale, float(NBUCKET)))] += 1
+    below = 0
+    B = 0
+    while below + hist[B] <= r:
+        below += hist[B]
+        B += 1
+    c = 0
+    for q in range(m):   # the values of bucket B, branch-free
+        tmp[c] = a[q]
+        c += int(min(a[q] * scale, float(NBUCKET))) == B
+    return _select(tmp, np.int64(c), r - below)
+
+
+@njit(cache=True)
+def _keep_k(cd, ci, tmp, hist, m, k, ordered, out, row, top):
+    """out[row] = the indices of the k smallest (d², index) among cd[:m], ci[:m] (m >= k): the k-th smallest d²
+    (:func:`_kth_smallest`, ``top`` its histogram's range) as threshold, then the ties at it by smallest index
+    (sorted by (d², index) when ``ordered``)."""
+    thr = _kth_smallest(cd, np.int64(m), np.int64(k - 1), top, tmp, hist)  # int64: one specialisation
     c = 0
     for q in range(m):
         if cd[q] <= thr:
@@ -256,7 +302,10 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
     """Every row of out (original point order): per nonempty cell, the points of its 3×3×3 block are gathered
     once (coordinates contiguous); each of the cell's points keeps those closer than its reach (the nearest
     face of the block with cells beyond it), and when fewer than k are kept it falls back to
-    :func:`_knn_one` from R = 2."""
+    :func:`_knn_one` from R = 2, bounded by the k-th distance among the block's points (every one of them is a
+    point of the cloud, so the true k-th nearest is no farther): that rescan reads only the cells within it
+    and keeps about k points instead of the whole 5×5×5 cube's (on CGAL's hippo1 and oni a quarter to a third
+    of the points fall back)."""
     n0, n1, n2 = dims[0], dims[1], dims[2]
     cap = 8 * k + 64
     bx, by, bz = np.empty(cap), np.empty(cap), np.empty(cap)
@@ -264,6 +313,7 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
     cd = np.empty(cap)
     ci = np.empty(cap, np.int64)
     tmp = np.empty(cap)
+    hist = np.empty(NBUCKET + 1, np.int64)
     for cid in range(start.shape[0] - 1):
         s, e = start[cid], start[cid + 1]
         if e == s:
@@ -305,16 +355,21 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
                 reach = min(reach, lo[2] + (z1 + 1) * cell - z)
             lim = reach * reach
             m = 0
-            for q in range(M):
+            for q in range(M):   # branch-free (about half are kept: a branch would mispredict)
                 u, v, w = bx[q] - x, by[q] - y, bz[q] - z
                 d = u * u + v * v + w * w
-                if d <= lim:
-                    cd[m] = d
-                    ci[m] = bi[q]
-                    m += 1
+                cd[m] = d
+                ci[m] = bi[q]
+                m += d <= lim
             i = order[p]
             if m >= k:
-                _keep_k(cd, ci, tmp, m, k, ordered, out, i)
-            else:
-                cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, i, ordered, cd, ci, tmp,
-                                       out, 2)
+                _keep_k(cd, ci, tmp, hist, m, k, ordered, out, i, lim)
+                continue
+            tau = np.inf
+            if M >= k:
+                for q in range(M):
+                    u, v, w = bx[q] - x, by[q] - y, bz[q] - z
+                    cd[q] = u * u + v * v + w * w
+                tau = _kth_smallest(cd, np.int64(M), np.int64(k - 1), np.inf, tmp, hist)
+            cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, i, ordered, cd, ci, tmp, hist,
+                                   out, 2, tau)

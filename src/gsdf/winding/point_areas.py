@@ -80,50 +80,58 @@ def _clip_halfplane(src, m, dst, a0, a1, b):
 #: On a clean sample the cell is settled by its ~6-8 nearest sites and the rest of the 20 are skipped.
 _SKIP = 4.0 * (1.0 + 1e-6)
 _SKIP_HULL = 1.0 + 1e-6
+_HULL_MARGIN2 = 1e-12  # (1e-6)²: the relative margin of _cell_inside_hull
 
 
 @njit(cache=True)
-def _inside_hull(Q, m, r2):
-    """True when the disc of squared radius ``r2`` about the origin lies inside the convex hull of ``Q[:m]`` by a
-    margin (then clipping a cell within that disc to the hull changes nothing, bit for bit, and the hull need
-    not be built). Sufficient test: take the farthest point a_s of every nonempty 45° sector about the origin;
-    when consecutive ones (in angular order) are less than 180° apart, the triangles (0, a_s, a_next) cover the
-    disc whose radius is the smallest distance from the origin to the lines a_s a_next."""
-    far = np.zeros(8)
-    fx = np.zeros(8)
-    fy = np.zeros(8)
+def _cell_inside_hull(Q, m, A, k, F, G):
+    """True when every vertex of the cell ``A[:k]`` lies inside the convex hull of ``Q[:m]`` by a margin: then
+    clipping the cell to that hull changes nothing, bit for bit, and the hull need not be built. ``F``, ``G``:
+    (8, 3) scratch.
+
+    Sufficient test: the farthest points a_s of the nonempty 45° sectors about the origin are points of Q; when
+    consecutive ones (in angular order) are less than 180° apart they bound a polygon, star-shaped about the
+    origin, inside the hull. A vertex left of every directed edge a_s a_next lies in that polygon's kernel, so
+    its distance to the hull's border is at least its distance to the nearest of those edge lines; requiring
+    more than 1e-6 of the edge length times the farther end's distance (cross product cr > 1e-6 |e| |a|) puts
+    every hull edge's clip test (rounding ~1e-15 of that) on the inside. It tests the cell's own vertices, not
+    the disc around its farthest one: on scans with uneven spacing (elongated cells) it spares ~2/3 of the hull
+    builds (CGAL's hippo1: 14 % of the points build the hull instead of 45 %; 12 % have a cell the hull cuts)."""
+    for s in range(8):
+        F[s, 2] = 0.0
     for s in range(m):
         x = Q[s, 0]
         y = Q[s, 1]
-        ax, ay = abs(x), abs(y)
-        if y >= 0.0:
-            sec = (0 if ax >= ay else 1) if x >= 0.0 else (3 if ax >= ay else 2)
-        else:
-            sec = (7 if ax >= ay else 6) if x >= 0.0 else (4 if ax >= ay else 5)
+        h = np.int64(y < 0.0)
+        q = 2 * h + (np.int64(x < 0.0) ^ h)                     # quadrant 0-3, counter-clockwise
+        sec = 2 * q + (np.int64(abs(x) < abs(y)) ^ (q & 1))     # 45° sector 0-7, counter-clockwise
         d = x * x + y * y
-        if d > far[sec]:
-            far[sec] = d
-            fx[sec] = x
-            fy[sec] = y
-    first = -1
+        if d > F[sec, 2]:
+            F[sec, 0] = x
+            F[sec, 1] = y
+            F[sec, 2] = d
+    c = 0
     for s in range(8):
-        if far[s] > 0.0:
-            first = s
-            break
-    if first < 0:
+        if F[s, 2] > 0.0:
+            G[c, 0] = F[s, 0]
+            G[c, 1] = F[s, 1]
+            G[c, 2] = F[s, 2]
+            c += 1
+    if c < 3:
         return False
-    prev = first
-    for t in range(1, 9):
-        s = (first + t) % 8
-        if far[s] == 0.0:
-            continue
-        cr = fx[prev] * fy[s] - fy[prev] * fx[s]          # |a| |b| sin(angle from a to b)
-        if cr <= 0.0:
-            return False                                  # 180° or more apart: the origin is not enclosed
-        ex, ey = fx[s] - fx[prev], fy[s] - fy[prev]
-        if cr * cr <= _SKIP_HULL * (ex * ex + ey * ey) * r2:  # distance to the line a b: cr / |a - b|
+    ok = True
+    for e in range(c):
+        f = e + 1 if e + 1 < c else 0
+        ax, ay = G[e, 0], G[e, 1]
+        ex, ey = G[f, 0] - ax, G[f, 1] - ay
+        if ax * G[f, 1] - ay * G[f, 0] <= 0.0:
+            return False                                          # 180° or more apart: not enclosed
+        lim = _HULL_MARGIN2 * (ex * ex + ey * ey) * max(G[e, 2], G[f, 2])
+        for t in range(k):
+            cr = ex * (A[t, 1] - ay) - ey * (A[t, 0] - ax)        # > 0: left of the edge, inside
+            ok &= (cr > 0.0) & (cr * cr > lim)                    # branch-free over the vertices
+        if not ok:
             return False
-        prev = s
     return True
 
 
@@ -194,12 +202,13 @@ def _voronoi_areas(P, N, plane, idx, offset, clip_hull, out, r0, r1):
     A0 = np.empty((cap, 2))
     B0 = np.empty((cap, 2))
     H = np.empty((2 * m + 4, 2))
+    F, G = np.empty((8, 3)), np.empty((8, 3))
     for r in range(r0, r1):
-        out[r] = _cell_area(P, N, plane, idx, offset + r, r, clip_hull, Q, A0, B0, H)
+        out[r] = _cell_area(P, N, plane, idx, offset + r, r, clip_hull, Q, A0, B0, H, F, G)
 
 
 @njit(cache=True)
-def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
+def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
     """Voronoi cell area of point ``i`` (see point_areas) in the plane with normal ``plane[row]``."""
     n = P.shape[0]
     m = idx.shape[1]
@@ -282,7 +291,7 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H):
         if k == 0:
             break
         r2cell = _max_radius2(A, k)
-    if clip_hull and k > 0 and not _inside_hull(Q, cnt, r2cell):
+    if clip_hull and k > 0 and not _cell_inside_hull(Q, cnt, A, k, F, G):
         # restrict the cell to the convex hull of p_i and its kept neighbours, so that a point on
         # the border of an open surface only gets the part of its cell that lies on the surface
         Q[cnt, 0] = 0.0
@@ -486,6 +495,58 @@ def _smallest_eigenvector3(C):
     return C[mid, mid], C[hi, hi], V[0, lo], V[1, lo], V[2, lo]
 
 
+_NBUCKET = 32  # buckets of _smallest_sorted
+
+
+@njit(cache=True)
+def _smallest_sorted(d, j, c, kk, d2, j2, bucket, count):
+    """The kk (<= c) smallest pairs of (d[:c], j[:c]) by (d, j), sorted, into d2[:kk], j2[:kk]; returns kk.
+    ``bucket`` (>= c) and ``count`` (_NBUCKET + 2) are scratch.
+
+    A counting sort into _NBUCKET equal buckets of [0, max d] — bucketing is monotone in d, so a lower bucket
+    holds only smaller or equal values — of the buckets up to the one holding the kk-th, then an insertion pass
+    that only reorders within buckets: the same result as a bounded insertion sort of all c, about twice as
+    fast on the ~40 candidates of a point (fewer moves and mispredicted branches)."""
+    if kk <= 0:
+        return 0
+    top = 0.0
+    for q in range(c):
+        top = max(top, d[q])
+    scale = _NBUCKET / top if top > 0.0 else 0.0
+    if not scale < np.inf:   # top subnormal: one bucket
+        scale = 0.0
+    for b in range(_NBUCKET + 2):
+        count[b] = 0
+    for q in range(c):
+        b = int(max(0.0, min(d[q] * scale, float(_NBUCKET))))   # (d may be -0.0 or a rounding below 0)
+        bucket[q] = b
+        count[b + 1] += 1
+    n = 0
+    B = -1
+    while n < kk:   # buckets 0..B hold the kk smallest
+        B += 1
+        n += count[B + 1]
+    for b in range(B + 1):   # count[b] = where bucket b starts
+        count[b + 1] += count[b]
+    for q in range(c):
+        b = bucket[q]
+        if b <= B:
+            t = count[b]
+            d2[t] = d[q]
+            j2[t] = j[q]
+            count[b] = t + 1
+    for a in range(1, n):
+        dv, iv = d2[a], j2[a]
+        b = a
+        while b > 0 and (d2[b - 1] > dv or (d2[b - 1] == dv and j2[b - 1] > iv)):
+            d2[b] = d2[b - 1]
+            j2[b] = j2[b - 1]
+            b -= 1
+        d2[b] = dv
+        j2[b] = iv
+    return kk
+
+
 @njit(cache=True, nogil=True)
 def _tangent_neighbours(P, N, cand, offset, k, sel, plane, r0, r1):
     """Per point (rows r0 <= row < r1): the best-fit (PCA) plane of its same-side candidates and their k
@@ -497,13 +558,18 @@ def _tangent_neighbours(P, N, cand, offset, k, sel, plane, r0, r1):
     the projected density equal to the surface density. Serial and GIL-free, run on threads like
     :func:`_voronoi_areas`.
     """
+    m = cand.shape[1]
+    keep, keep2, bucket = np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int64)
+    dist, dist2 = np.empty(m), np.empty(m)
+    count = np.empty(_NBUCKET + 2, np.int64)
     for row in range(r0, r1):
-        _tangent_row(P, N, cand, offset, k, sel, plane, row)
+        _tangent_row(P, N, cand, offset, k, sel, plane, row, keep, dist, keep2, dist2, bucket, count)
 
 
 @njit(cache=True)
-def _tangent_row(P, N, cand, offset, k, sel, plane, row):
-    """One row of :func:`_tangent_neighbours`."""
+def _tangent_row(P, N, cand, offset, k, sel, plane, row, keep, dist, keep2, dist2, bucket, count):
+    """One row of :func:`_tangent_neighbours` (the arrays after ``row``: scratch of the candidates' size, and
+    ``count`` of _NBUCKET + 2)."""
     m = cand.shape[1]
     i = offset + row
     nx, ny, nz = N[i, 0], N[i, 1], N[i, 2]
@@ -513,7 +579,6 @@ def _tangent_row(P, N, cand, offset, k, sel, plane, row):
     nx /= nn
     ny /= nn
     nz /= nn
-    keep = np.empty(m, np.int64)
     c = 0
     for s in range(m):
         j = cand[row, s]
@@ -553,30 +618,16 @@ def _tangent_row(P, N, cand, offset, k, sel, plane, row):
             if vx * nx + vy * ny + vz * nz < 0.0:
                 vx, vy, vz = -vx, -vy, -vz
     plane[row, 0], plane[row, 1], plane[row, 2] = vx, vy, vz
-    dist = np.empty(c)
     for s in range(c):
         j = keep[s]
         d0, d1, d2 = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
         h = d0 * vx + d1 * vy + d2 * vz
         dist[s] = d0 * d0 + d1 * d1 + d2 * d2 - h * h
-    # the min(k, c) smallest by insertion (c is a few dozen; np.argsort would cost seconds of compilation);
-    # ties by point index, so the choice does not depend on the order the candidates come in
-    kk = min(k, c)
-    for s in range(c):
-        d = dist[s]
-        j = keep[s]
-        t = s if s < kk else kk
-        if t == kk and (kk == 0 or d > dist[kk - 1] or (d == dist[kk - 1] and j > keep[kk - 1])):
-            continue  # not among the kk nearest so far
-        while t > 0 and (dist[t - 1] > d or (dist[t - 1] == d and keep[t - 1] > j)):
-            if t < kk:
-                dist[t] = dist[t - 1]
-                keep[t] = keep[t - 1]
-            t -= 1
-        dist[t] = d
-        keep[t] = j
+    # the min(k, c) smallest, sorted by (distance, index): ties by point index, so the choice does not depend on
+    # the order the candidates come in
+    kk = _smallest_sorted(dist, keep, c, min(k, c), dist2, keep2, bucket, count)
     for s in range(kk):
-        sel[row, s] = keep[s]
+        sel[row, s] = keep2[s]
 
 
 def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) -> np.ndarray:
