@@ -34,6 +34,7 @@ from numba import njit
 __all__ = ["SelfKNN", "knn_self"]
 
 MAX_CELLS = 1 << 22  # dense cell table; coarser cells above this
+NBUCKET = 64  # buckets of the selection histogram (:func:`_kth_smallest`)
 CELL_FACTOR = 1.0  # cell / median k-th neighbour distance (0.4-2 measured on three CGAL clouds: 1 was fastest)
 
 
@@ -102,12 +103,14 @@ def _sample_kth(S, P, k):
     """Median over the sample points S of the distance to their k-th nearest point of P (brute force)."""
     m, n = S.shape[0], P.shape[0]
     d = np.empty(n)
+    tmp = np.empty(n)
+    hist = np.empty(NBUCKET + 1, np.int64)
     kth = np.empty(m)
     for a in range(m):
         for j in range(n):
             u, v, w = P[j, 0] - S[a, 0], P[j, 1] - S[a, 1], P[j, 2] - S[a, 2]
             d[j] = u * u + v * v + w * w
-        kth[a] = np.sqrt(_select(d, n, k - 1))
+        kth[a] = np.sqrt(_kth_smallest(d, np.int64(n), np.int64(k - 1), np.inf, tmp, hist))  # 2-3× a quickselect
     # the median by the same quickselect (np.median would compile numba's sort, ~1.5 s cold): after selecting
     # rank m // 2 the smaller half lies before it, so for even m the other middle value is that half's largest
     hi = _select(kth, m, m // 2)
@@ -226,9 +229,6 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd,
         R += 1
     _keep_k(cd, ci, tmp, hist, m, k, ordered, out, row, lim)
     return cd, ci, tmp
-
-
-NBUCKET = 64  # buckets of the selection histogram (:func:`_kth_smallest`)
 
 
 @njit(cache=True)

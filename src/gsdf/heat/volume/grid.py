@@ -410,6 +410,8 @@ class PenalizedPoisson:
         self.block = max(int(min_block), int(np.ceil((n / coarse_size) ** (1.0 / 3.0))))
         self.cdims = (self.dims + self.block - 1) // self.block
         self.band = np.flatnonzero(np.diff(self.Pp) > 0).astype(np.int64)
+        self.band_nbrs = _neighbour_mask(self.band, self.dims)
+        self.kblock = np.arange(self.shape[2], dtype=np.int64) // self.block   # k // block per z index
         diagP = P.diagonal()
         if not diagP.sum() > 0 or not np.isfinite(self.Pv).all():
             raise ValueError("penalty: expected a finite positive semi-definite matrix with a positive trace "
@@ -437,21 +439,22 @@ class PenalizedPoisson:
 
     def _coarse_solve(self, r):
         rc = np.zeros(int(np.prod(self.cdims)))
-        _restrict(r, self.dims, self.block, self.cdims, rc)
+        _restrict(r, self.dims, self.block, self.kblock, self.cdims, rc)
         return self.coarse.solve(rc)
 
     def precondition(self, r):
         r = np.ascontiguousarray(r, dtype=np.float64)
-        dims, w, Pp, Pi, Pv, band = self.dims, self.w, self.Pp, self.Pi, self.Pv, self.band
+        dims, w, Pp, Pi, Pv, band, nbrs = self.dims, self.w, self.Pp, self.Pi, self.Pv, self.band, self.band_nbrs
         x = np.empty(len(r))
         res = np.empty(len(r))
-        _prolong_residual(self._coarse_solve(r), r, dims, self.block, self.cdims, w, Pp, Pi, Pv, band, x, res)
+        _prolong_residual(self._coarse_solve(r), r, dims, self.block, self.kblock, self.cdims, w, Pp, Pi, Pv, band,
+                          x, res)
         d = self._d
-        _band_sweep(res, d, x, band, dims, w, Pp, Pi, Pv, self.adiag, True)
+        _band_sweep(res, d, x, band, nbrs, dims, w, Pp, Pi, Pv, self.adiag, True)
         y = dct_poisson(res, self.shape, self.spacing, self.delta, self.lam)
         _after_dct(y, self.delta, band, Pp, Pi, Pv, x, res)
-        _band_sweep(res, d, x, band, dims, w, Pp, Pi, Pv, self.adiag, False)
-        _prolong_add(self._coarse_solve(res), dims, self.block, self.cdims, x)
+        _band_sweep(res, d, x, band, nbrs, dims, w, Pp, Pi, Pv, self.adiag, False)
+        _prolong_add(self._coarse_solve(res), dims, self.block, self.kblock, self.cdims, x)
         return x
 
 
@@ -508,32 +511,48 @@ def _apply_system(x, dims, w, Pp, Pi, Pv, band, out):
 
 
 @njit(cache=True)
-def _subtract_columns(res, d, band, dims, w, Pp, Pi, Pv):
-    """res −= A d for d supported on ``band`` (A's band columns: the stencil's and P's, P symmetric)."""
+def _neighbour_mask(nodes, dims):
+    """Per node, which of its six grid neighbours exist: bits 1, 2 (x−1, x+1), 4, 8 (y−1, y+1), 16, 32 (z−1, z+1).
+    Computed once per solve so that the band kernels need no integer divisions per node (three of them per node
+    and sweep were most of a sweep's time)."""
     n0, n1, n2 = dims[0], dims[1], dims[2]
+    out = np.empty(nodes.shape[0], np.int64)
+    for t in range(nodes.shape[0]):
+        r = nodes[t]
+        i, j, k = r // (n1 * n2), (r // n2) % n1, r % n2
+        out[t] = ((i > 0) * 1 | (i < n0 - 1) * 2 | (j > 0) * 4 | (j < n1 - 1) * 8 | (k > 0) * 16
+                  | (k < n2 - 1) * 32)
+    return out
+
+
+@njit(cache=True)
+def _subtract_columns(res, d, band, nbrs, dims, w, Pp, Pi, Pv):
+    """res −= A d for d supported on ``band`` (A's band columns: the stencil's and P's, P symmetric); ``nbrs``
+    the band's :func:`_neighbour_mask`."""
+    n1, n2 = dims[1], dims[2]
     s0, s1 = n1 * n2, n2
     for t in range(band.shape[0]):
         r = band[t]
         v = d[r]
         if v == 0.0:
             continue
-        i, j, k = r // s0, (r // s1) % n1, r % n2
-        if i > 0:
+        nb = nbrs[t]
+        if nb & 1:
             res[r - s0] += w[0] * v
             res[r] -= w[0] * v
-        if i < n0 - 1:
+        if nb & 2:
             res[r + s0] += w[0] * v
             res[r] -= w[0] * v
-        if j > 0:
+        if nb & 4:
             res[r - s1] += w[1] * v
             res[r] -= w[1] * v
-        if j < n1 - 1:
+        if nb & 8:
             res[r + s1] += w[1] * v
             res[r] -= w[1] * v
-        if k > 0:
+        if nb & 16:
             res[r - 1] += w[2] * v
             res[r] -= w[2] * v
-        if k < n2 - 1:
+        if nb & 32:
             res[r + 1] += w[2] * v
             res[r] -= w[2] * v
         for p in range(Pp[r], Pp[r + 1]):
@@ -541,37 +560,37 @@ def _subtract_columns(res, d, band, dims, w, Pp, Pi, Pv):
 
 
 @njit(cache=True)
-def _band_sweep(res, d, x, band, dims, w, Pp, Pi, Pv, adiag, forward):
+def _band_sweep(res, d, x, band, nbrs, dims, w, Pp, Pi, Pv, adiag, forward):
     """One Gauss–Seidel sweep of A over the band nodes against ``res`` (forward: ascending nodes, the lower
     triangle of A's band block; else descending, the upper), then x += d and res −= A d. ``d`` is a zero
-    scratch vector of the grid's size on entry and is left zero."""
-    n0, n1, n2 = dims[0], dims[1], dims[2]
+    scratch vector of the grid's size on entry and is left zero; ``nbrs`` the band's :func:`_neighbour_mask`."""
+    n1, n2 = dims[1], dims[2]
     s0, s1 = n1 * n2, n2
     nb = band.shape[0]
     for q in range(nb):
         t = q if forward else nb - 1 - q
         r = band[t]
-        i, j, k = r // s0, (r // s1) % n1, r % n2
+        m = nbrs[t]
         acc = res[r]
         # d is zero off the band and on the rows not swept yet: the sums run over the triangle only
-        if i > 0:
+        if m & 1:
             acc += w[0] * d[r - s0]
-        if i < n0 - 1:
+        if m & 2:
             acc += w[0] * d[r + s0]
-        if j > 0:
+        if m & 4:
             acc += w[1] * d[r - s1]
-        if j < n1 - 1:
+        if m & 8:
             acc += w[1] * d[r + s1]
-        if k > 0:
+        if m & 16:
             acc += w[2] * d[r - 1]
-        if k < n2 - 1:
+        if m & 32:
             acc += w[2] * d[r + 1]
         for p in range(Pp[r], Pp[r + 1]):
             c = Pi[p]
             if c != r:
                 acc -= Pv[p] * d[c]
         d[r] = acc / adiag[t]
-    _subtract_columns(res, d, band, dims, w, Pp, Pi, Pv)
+    _subtract_columns(res, d, band, nbrs, dims, w, Pp, Pi, Pv)
     for t in range(nb):
         r = band[t]
         x[r] += d[r]
@@ -600,39 +619,39 @@ def _block_of(r, dims, block, cdims):
 
 
 @njit(cache=True)
-def _restrict(r, dims, block, cdims, out):
-    """out += R r: the sums of r over the block aggregates."""
+def _restrict(r, dims, block, kblock, cdims, out):
+    """out += R r: the sums of r over the block aggregates (``kblock[k]`` = k // block)."""
     n0, n1, n2 = dims[0], dims[1], dims[2]
     for i in range(n0):
         for j in range(n1):
             cb = ((i // block) * cdims[1] + j // block) * cdims[2]
             base = (i * n1 + j) * n2
             for k in range(n2):
-                out[cb + k // block] += r[base + k]
+                out[cb + kblock[k]] += r[base + k]
 
 
 @njit(cache=True)
-def _prolong_add(c, dims, block, cdims, x):
-    """x += Rᵀ c: every node gets its aggregate's value."""
+def _prolong_add(c, dims, block, kblock, cdims, x):
+    """x += Rᵀ c: every node gets its aggregate's value (``kblock[k]`` = k // block)."""
     n0, n1, n2 = dims[0], dims[1], dims[2]
     for i in range(n0):
         for j in range(n1):
             cb = ((i // block) * cdims[1] + j // block) * cdims[2]
             base = (i * n1 + j) * n2
             for k in range(n2):
-                x[base + k] += c[cb + k // block]
+                x[base + k] += c[cb + kblock[k]]
 
 
 @njit(cache=True)
-def _prolong_residual(c, r, dims, block, cdims, w, Pp, Pi, Pv, band, x, res):
-    """The first coarse stage: x = Rᵀ c and res = r − A x."""
+def _prolong_residual(c, r, dims, block, kblock, cdims, w, Pp, Pi, Pv, band, x, res):
+    """The first coarse stage: x = Rᵀ c and res = r − A x (``kblock[k]`` = k // block)."""
     n0, n1, n2 = dims[0], dims[1], dims[2]
     for i in range(n0):
         for j in range(n1):
             cb = ((i // block) * cdims[1] + j // block) * cdims[2]
             base = (i * n1 + j) * n2
             for k in range(n2):
-                x[base + k] = c[cb + k // block]
+                x[base + k] = c[cb + kblock[k]]
     _apply_system(x, dims, w, Pp, Pi, Pv, band, res)
     for q in range(r.shape[0]):
         res[q] = r[q] - res[q]
@@ -648,15 +667,16 @@ def _coarse_matrix(dims, w, block, cdims, Pp, Pi, Pv, band):
     c0, c1, c2 = cdims[0], cdims[1], cdims[2]
     nc = c0 * c1 * c2
     C = np.zeros((nc, 27))     # coarse row, offset (dI + 1) * 9 + (dJ + 1) * 3 + (dK + 1)
+    q = np.arange(max(n0, n1, n2) + 1) // block   # the aggregate index along an axis (no division per node)
     for i in range(n0):
         for j in range(n1):
             for k in range(n2):
-                I = ((i // block) * c1 + j // block) * c2 + k // block
+                I = (q[i] * c1 + q[j]) * c2 + q[k]
                 for a in range(3):
                     ii, jj, kk = i + (a == 0), j + (a == 1), k + (a == 2)
                     if ii >= n0 or jj >= n1 or kk >= n2:
                         continue
-                    J = ((ii // block) * c1 + jj // block) * c2 + kk // block
+                    J = (q[ii] * c1 + q[jj]) * c2 + q[kk]
                     if J == I:
                         continue
                     C[I, 13] += w[a]
