@@ -297,23 +297,70 @@ def _keep_k(cd, ci, tmp, hist, m, k, ordered, out, row, top):
         out[row, t] = ci[t]
 
 
+@njit(cache=True)
+def _gather(Ps, order, start, dims, x0, x1, y0, y1, z0, z1, bx, by, bz, bi):
+    """The points of the cells [x0, x1] × [y0, y1] × [z0, z1] into bx, by, bz (coordinates) and bi (indices),
+    cell by cell in (x, y, z) order as :func:`_knn_one` scans them; returns the count and the (possibly grown)
+    buffers."""
+    n1, n2 = dims[1], dims[2]
+    M = 0
+    for ax in range(x0, x1 + 1):
+        for ay in range(y0, y1 + 1):
+            base = (ax * n1 + ay) * n2
+            a, b = start[base + z0], start[base + z1 + 1]   # the z-run of cells is contiguous
+            if M + (b - a) > bx.shape[0]:
+                c2 = 2 * (M + b - a)
+                nx, ny, nz, ni = np.empty(c2), np.empty(c2), np.empty(c2), np.empty(c2, np.int64)
+                for q in range(M):
+                    nx[q], ny[q], nz[q], ni[q] = bx[q], by[q], bz[q], bi[q]
+                bx, by, bz, bi = nx, ny, nz, ni
+            for q in range(a, b):
+                bx[M], by[M], bz[M], bi[M] = Ps[q, 0], Ps[q, 1], Ps[q, 2], order[q]
+                M += 1
+    return M, bx, by, bz, bi
+
+
+@njit(cache=True)
+def _reach(x, y, z, x0, x1, y0, y1, z0, z1, dims, lo, cell):
+    """Distance from (x, y, z) to the nearest face of the cells [x0, x1] × [y0, y1] × [z0, z1] that has cells
+    beyond it (inf when none has): every point outside those cells is at least this far."""
+    reach = np.inf
+    if x0 > 0:
+        reach = min(reach, x - (lo[0] + x0 * cell))
+    if x1 < dims[0] - 1:
+        reach = min(reach, lo[0] + (x1 + 1) * cell - x)
+    if y0 > 0:
+        reach = min(reach, y - (lo[1] + y0 * cell))
+    if y1 < dims[1] - 1:
+        reach = min(reach, lo[1] + (y1 + 1) * cell - y)
+    if z0 > 0:
+        reach = min(reach, z - (lo[2] + z0 * cell))
+    if z1 < dims[2] - 1:
+        reach = min(reach, lo[2] + (z1 + 1) * cell - z)
+    return reach
+
+
 @njit(cache=True, nogil=True)
 def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
     """Every row of out (original point order): per nonempty cell, the points of its 3×3×3 block are gathered
     once (coordinates contiguous); each of the cell's points keeps those closer than its reach (the nearest
-    face of the block with cells beyond it), and when fewer than k are kept it falls back to
-    :func:`_knn_one` from R = 2, bounded by the k-th distance among the block's points (every one of them is a
-    point of the cloud, so the true k-th nearest is no farther): that rescan reads only the cells within it
-    and keeps about k points instead of the whole 5×5×5 cube's (on CGAL's hippo1 and oni a quarter to a third
-    of the points fall back)."""
+    face of the block with cells beyond it). A point keeping fewer than k falls back to the 5×5×5 cube (R = 2
+    of :func:`_knn_one`, gathered once per cell that has such points), bounded by the k-th distance among the
+    block's points (every one of them is a point of the cloud, so the true k-th nearest is no farther), and to
+    :func:`_knn_one` from R = 3 if that is not enough either. On CGAL's hippo1 and oni a quarter to a third of
+    the points fall back."""
     n0, n1, n2 = dims[0], dims[1], dims[2]
     cap = 8 * k + 64
     bx, by, bz = np.empty(cap), np.empty(cap), np.empty(cap)
     bi = np.empty(cap, np.int64)
+    gx, gy, gz = np.empty(cap), np.empty(cap), np.empty(cap)
+    gi = np.empty(cap, np.int64)
     cd = np.empty(cap)
     ci = np.empty(cap, np.int64)
     tmp = np.empty(cap)
     hist = np.empty(NBUCKET + 1, np.int64)
+    fb = np.empty(64, np.int64)       # the cell's points that fall back, and their bounds
+    fbt = np.empty(64)
     for cid in range(start.shape[0] - 1):
         s, e = start[cid], start[cid + 1]
         if e == s:
@@ -322,37 +369,15 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
         x0, x1 = max(cx - 1, 0), min(cx + 1, n0 - 1)
         y0, y1 = max(cy - 1, 0), min(cy + 1, n1 - 1)
         z0, z1 = max(cz - 1, 0), min(cz + 1, n2 - 1)
-        M = 0
-        for ax in range(x0, x1 + 1):
-            for ay in range(y0, y1 + 1):
-                base = (ax * n1 + ay) * n2
-                a, b = start[base + z0], start[base + z1 + 1]   # the z-run of cells is contiguous
-                if M + (b - a) > bx.shape[0]:
-                    c2 = 2 * (M + b - a)
-                    nx, ny, nz, ni = np.empty(c2), np.empty(c2), np.empty(c2), np.empty(c2, np.int64)
-                    for q in range(M):
-                        nx[q], ny[q], nz[q], ni[q] = bx[q], by[q], bz[q], bi[q]
-                    bx, by, bz, bi = nx, ny, nz, ni
-                for q in range(a, b):
-                    bx[M], by[M], bz[M], bi[M] = Ps[q, 0], Ps[q, 1], Ps[q, 2], order[q]
-                    M += 1
+        M, bx, by, bz, bi = _gather(Ps, order, start, dims, x0, x1, y0, y1, z0, z1, bx, by, bz, bi)
         if cd.shape[0] < M:
             cd, ci, tmp = np.empty(M), np.empty(M, np.int64), np.empty(M)
+        if fb.shape[0] < e - s:
+            fb, fbt = np.empty(e - s, np.int64), np.empty(e - s)
+        nf = 0
         for p in range(s, e):
             x, y, z = Ps[p, 0], Ps[p, 1], Ps[p, 2]
-            reach = np.inf
-            if x0 > 0:
-                reach = min(reach, x - (lo[0] + x0 * cell))
-            if x1 < n0 - 1:
-                reach = min(reach, lo[0] + (x1 + 1) * cell - x)
-            if y0 > 0:
-                reach = min(reach, y - (lo[1] + y0 * cell))
-            if y1 < n1 - 1:
-                reach = min(reach, lo[1] + (y1 + 1) * cell - y)
-            if z0 > 0:
-                reach = min(reach, z - (lo[2] + z0 * cell))
-            if z1 < n2 - 1:
-                reach = min(reach, lo[2] + (z1 + 1) * cell - z)
+            reach = _reach(x, y, z, x0, x1, y0, y1, z0, z1, dims, lo, cell)
             lim = reach * reach
             m = 0
             for q in range(M):   # branch-free (about half are kept: a branch would mispredict)
@@ -361,9 +386,8 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
                 cd[m] = d
                 ci[m] = bi[q]
                 m += d <= lim
-            i = order[p]
             if m >= k:
-                _keep_k(cd, ci, tmp, hist, m, k, ordered, out, i, lim)
+                _keep_k(cd, ci, tmp, hist, m, k, ordered, out, order[p], lim)
                 continue
             tau = np.inf
             if M >= k:
@@ -371,5 +395,33 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
                     u, v, w = bx[q] - x, by[q] - y, bz[q] - z
                     cd[q] = u * u + v * v + w * w
                 tau = _kth_smallest(cd, np.int64(M), np.int64(k - 1), np.inf, tmp, hist)
-            cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, i, ordered, cd, ci, tmp, hist,
-                                   out, 2, tau)
+            fb[nf] = p
+            fbt[nf] = tau
+            nf += 1
+        if nf == 0:
+            continue
+        X0, X1 = max(cx - 2, 0), min(cx + 2, n0 - 1)
+        Y0, Y1 = max(cy - 2, 0), min(cy + 2, n1 - 1)
+        Z0, Z1 = max(cz - 2, 0), min(cz + 2, n2 - 1)
+        G, gx, gy, gz, gi = _gather(Ps, order, start, dims, X0, X1, Y0, Y1, Z0, Z1, gx, gy, gz, gi)
+        if cd.shape[0] < G:
+            cd, ci, tmp = np.empty(G), np.empty(G, np.int64), np.empty(G)
+        for f in range(nf):
+            p = fb[f]
+            x, y, z = Ps[p, 0], Ps[p, 1], Ps[p, 2]
+            # what _knn_one keeps at R = 2 (the same points in the same order: cells beyond lim hold none)
+            reach = _reach(x, y, z, X0, X1, Y0, Y1, Z0, Z1, dims, lo, cell)
+            lim = min(reach * reach, fbt[f])
+            m = 0
+            for q in range(G):
+                u, v, w = gx[q] - x, gy[q] - y, gz[q] - z
+                d = u * u + v * v + w * w
+                cd[m] = d
+                ci[m] = gi[q]
+                m += d <= lim
+            i = order[p]
+            if m >= k:
+                _keep_k(cd, ci, tmp, hist, m, k, ordered, out, i, lim)
+            else:
+                cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, i, ordered, cd, ci, tmp,
+                                       hist, out, 3, fbt[f])
