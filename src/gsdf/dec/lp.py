@@ -37,7 +37,7 @@ import scipy.sparse as sp
 
 from .l1_terms import DualL1Result, _checked_terms
 
-__all__ = ["DualL1Result", "dual_graph_l1", "decomposition_l1", "ALGORITHMS"]
+__all__ = ["DualL1Result", "dual_graph_l1", "ALGORITHMS"]
 
 ALGORITHMS = ("highs", "highs-ds", "highs-ipm", "network")
 
@@ -127,84 +127,3 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
     x = res.x[:n]
     J = d + x[P[:, 0]] - x[P[:, 1]]
     return DualL1Result(x, J, float(np.dot(w, np.abs(J))), secs)
-
-
-def decomposition_l1(n_cells: int, pairs, offsets, weights, on_input, target, fill_weights, bounds=None,
-                     time_limit: float = 300.0, algorithm: str = "highs-ds"):
-    """Two-layer L1 program: a residual ``J = d + x_A - x_B`` and a labeling jump ``K = y_A - y_B`` together.
-
-    Minimises ``Σ_k w_k |J_k|`` (the residual's completion, as :func:`dual_graph_l1`) plus, with the fill weights
-    f, ``Σ_{k off input} f_k |K_k| + Σ_{k on input} f_k |target_k - J_k - K_k|``: the labeling y must jump by
-    what the residual leaves of the input (``target - J`` on the input dual edges) and pays for every jump off
-    the input (the completion of the bounding part) and for every bit of the input it leaves unexplained.
-    Used by surface winding numbers (``objective="decomposition"``): the cost of a decomposition is the length
-    of *both* completions, the nonbounding one (J) and the bounding one (K).
-
-    Parameters
-    ----------
-    n_cells, pairs, offsets, weights, bounds, time_limit : as :func:`dual_graph_l1` (bounds act on J)
-    on_input : (k,) bool, the dual edges of the input
-    target : (k,) float, the input's jump on each dual edge (ignored off the input)
-    fill_weights : (k,) float ≥ 0
-    algorithm : "highs", "highs-ds" or "highs-ipm"
-
-    Returns
-    -------
-    (J (k,), K (k,), objective, seconds)
-
-    Example
-    -------
-    >>> J, K, obj, _ = decomposition_l1(2, [[0, 1]], [0.0], [1.0], [True], [1.0], [1.0])
-    >>> round(float(K[0]), 6), round(float(obj), 6)       # the labeling explains the input for free
-    (1.0, 0.0)
-    """
-    if algorithm not in ("highs", "highs-ds", "highs-ipm"):
-        raise ValueError(f"algorithm: expected 'highs', 'highs-ds' or 'highs-ipm', got {algorithm!r}")
-    n, P, d, w, lo, hi, first, _ = _checked_terms(n_cells, pairs, offsets, weights, bounds, time_limit,
-                                                   "component")
-    k = len(P)
-    on = np.asarray(on_input, dtype=bool).reshape(-1)
-    tg = np.asarray(target, dtype=float).reshape(-1)
-    f = np.asarray(fill_weights, dtype=float).reshape(-1)
-    for name, a in (("on_input", on), ("target", tg), ("fill_weights", f)):
-        if a.shape != (k,):
-            raise ValueError(f"{name}: expected shape ({k},), got {a.shape}")
-    if not np.all(np.isfinite(tg)):
-        raise ValueError("target: expected finite values")
-    if not (np.all(np.isfinite(f)) and np.all(f >= 0)):
-        raise ValueError("fill_weights: expected finite values >= 0")
-    if k == 0:
-        return np.zeros(0), np.zeros(0), 0.0, 0.0
-    sp_lo = np.where(lo > 0, lo, 0.0)
-    sp_hi = np.where(hi < 0, 0.0, hi)
-    sm_lo = np.where(hi < 0, -hi, 0.0)
-    sm_hi = np.where(lo > 0, 0.0, -lo)
-    fx = np.full(n, -np.inf), np.full(n, np.inf)
-    if first is not None:
-        fx[0][first] = 0.0
-        fx[1][first] = 0.0
-    # columns: x (n), y (n), s+ s- (J's parts), t+ t- (K off the input; the unexplained input on it)
-    r = np.arange(k)
-    one = np.ones(k)
-    A, B = P[:, 0], P[:, 1]
-    ix = np.flatnonzero(on)
-    # rows 0..k-1:  x_A - x_B - s+ + s- = -d
-    rows = [r, r, r, r]
-    cols = [A, B, 2 * n + r, 2 * n + k + r]
-    vals = [one, -one, -one, one]
-    # rows k..2k-1: y_A - y_B (+ x_A - x_B on the input) - t+ + t- = 0 off the input, target - d on it
-    rows += [k + r, k + r, k + r, k + r, k + ix, k + ix]
-    cols += [n + A, n + B, 2 * n + 2 * k + r, 2 * n + 3 * k + r, A[ix], B[ix]]
-    vals += [one, -one, -one, one, np.ones(len(ix)), -np.ones(len(ix))]
-    M = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                      shape=(2 * k, 2 * n + 4 * k))
-    rhs = np.concatenate([-d, np.where(on, tg - d, 0.0)])
-    cost = np.concatenate([np.zeros(2 * n), w, w, f, f])
-    lo_all = np.concatenate([fx[0], fx[0], sp_lo, sm_lo, np.zeros(2 * k)])
-    hi_all = np.concatenate([fx[1], fx[1], sp_hi, sm_hi, np.full(2 * k, np.inf)])
-    res, secs = solve_highs(cost, M, rhs, np.column_stack([lo_all, hi_all]), algorithm, time_limit)
-    x, y = res.x[:n], res.x[n:2 * n]
-    J = d + x[A] - x[B]
-    K = y[A] - y[B]
-    t = np.where(on, tg - J - K, K)
-    return J, K, float(np.dot(w, np.abs(J)) + np.dot(f, np.abs(t))), secs

@@ -71,7 +71,6 @@ MAX_PASSES = 3          # bounding="subset": decompositions of the remainder at 
 LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm", "network", "band")   # gsdf.dec.netflow / .band_lp
 ENDPOINT_RULES = ("auto", "branch", "exclude")
 CYCLE_CHOICES = ("complete", "lp")
-OBJECTIVES = ("decomposition", "nonbounding")   # what the full residual LP measures (solve(objective=...))
 CHOICE_TOL = 0.1        # cycle_choice="complete": input edges with |Jv| above this are the LP cycle's own (bench:
                         # 0.1 and 0.3 chose alike on 41 replayed cases; 1e-3 also forbids the loop's traces)
 LP_FORMS = ("faces", "cycles")    # the full residual LP: face shifts (dual_graph_l1, default) or cycle form
@@ -170,7 +169,6 @@ class SurfaceWindingNumbers:
             raise ValueError(f"lp_form: expected one of {LP_FORMS}, got {lp_form!r}")
         self.lp_form = lp_form
         self._cycle_lp = None
-        self._objective = "nonbounding"     # set by solve(objective=...) for the residual LPs of that call
         self.dec = TriangleDEC(V, F)
         self.topology = self.dec.topology
         self.betti_1 = self.topology.betti_1()
@@ -247,8 +245,7 @@ class SurfaceWindingNumbers:
     # ----------------------------------------------------------------------------------------------- solve
     def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
               homology: str = "real", lp_algorithm: str = "auto", bounding: str = "subset", progress=None,
-              endpoint_rule: str = "auto", cycle_choice: str = "complete", objective: str = "decomposition",
-              _final: str = "curves") -> SWNResult:
+              endpoint_rule: str = "auto", cycle_choice: str = "complete", _final: str = "curves") -> SWNResult:
         """Surface winding numbers of ``curves``.
 
         Parameters
@@ -327,9 +324,6 @@ class SurfaceWindingNumbers:
             endpoint_rule = "branch" if self.simply_connected else "exclude"
         if cycle_choice not in CYCLE_CHOICES:
             raise ValueError(f"cycle_choice: expected one of {CYCLE_CHOICES}, got {cycle_choice!r}")
-        if objective not in OBJECTIVES:
-            raise ValueError(f"objective: expected one of {OBJECTIVES}, got {objective!r}")
-        self._objective = objective
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
         steps = iter(range(1, 6))
@@ -618,8 +612,6 @@ class SurfaceWindingNumbers:
         return interior, d, w, np.column_stack([lo, hi])
 
     def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds", ends=None, forbid=None):
-        if self._objective == "decomposition":
-            return self._residual_decomposition(gamma, g, eps, time_limit, algorithm, forbid)
         if self.lp_form == "cycles":
             if algorithm in ("network", "band"):
                 raise ValueError(f"lp_algorithm={algorithm!r} solves the face form (lp_form='faces') only")
@@ -640,26 +632,6 @@ class SurfaceWindingNumbers:
         Jv = np.zeros(dec.n_edges)
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
-
-    def _residual_decomposition(self, gamma, g, eps, time_limit, algorithm="highs-ds", forbid=None):
-        """``objective="decomposition"`` (see :meth:`solve`): the full residual LP plus the completion of the
-        bounding part (:func:`gsdf.dec.lp.decomposition_l1`): the labeling jumps by what the residual leaves of
-        the input and pays edge length for every jump off the input and every input edge it leaves
-        unexplained. HiGHS on the face form whatever ``lp_form`` / ``lp_algorithm`` say ("band" and "network"
-        solve the one-layer program only: dual simplex below ``IPM_FACES`` faces, interior point from there)."""
-        from ..dec.lp import decomposition_l1
-
-        dec, topo = self.dec, self.topology
-        interior, d, w, bounds = self._full_lp_terms(gamma, g, eps, forbid)
-        if algorithm not in ("highs", "highs-ds", "highs-ipm"):
-            algorithm = "highs-ipm" if dec.n_faces >= IPM_FACES else "highs-ds"
-        gi = g[interior]
-        J, _K, obj, secs = decomposition_l1(dec.n_faces, topo.edge_faces[interior], d, w, gi != 0, gi,
-                                            dec.edge_length[interior], bounds=bounds, time_limit=time_limit,
-                                            algorithm=algorithm)
-        Jv = np.zeros(dec.n_edges)
-        Jv[interior] = J
-        return Jv, obj, secs
 
     def _residual_cycles(self, gamma, g, eps, time_limit, algorithm="highs-ds", forbid=None):
         """The full residual LP in cycle form (:class:`gsdf.dec.cycle_lp.CycleL1`: the same program without face
