@@ -149,6 +149,8 @@ def main():
     ap.add_argument("--per-mesh", type=int, default=None)
     ap.add_argument("--time-limit", type=float, default=120.0)
     ap.add_argument("--summary", action="store_true", help="rewrite the section from the per-case CSV of a run")
+    ap.add_argument("--run-note", default=None, help="with --summary: the run's machine/load/time line, when the "
+                    "CSV was made by another process calling run() (replaces the old section's run lines)")
     a = ap.parse_args()
     per = a.per_mesh or (4 if a.quick else 42)
     csv_path = os.path.join(HERE, f"swn_choice_cases{'_quick' if a.quick else ''}.csv")
@@ -171,6 +173,12 @@ def main():
         old = open(os.path.join(HERE, "RESULTS.md")).read().split(f"<!-- {name}:start -->")[-1]
         old = old.split(f"<!-- {name}:end -->")[0].splitlines()
         head = [ln for ln in old if ln.startswith(("Machine:", "Command:"))] or head
+        if a.run_note:
+            head = [f"Machine: {machine()}. {a.run_note}",
+                    f"Command: `PYTHONPATH=src python3 bench/bench_swn_choice.py` (rewrites the CSV and this section; "
+                    f"`--summary` rewrites the section from the CSV); cases 0–{per - 1} of every not simply connected "
+                    f"mesh of bench_swn.py, random breaking, full LP (lp_algorithm=\"auto\"); rows in "
+                    f"bench/{os.path.basename(csv_path)}."]
     text = ["## Surface winding numbers, not simply connected: which homologous cycle carries the class (issue 12)",
             ""] + head + ["", NOTES, summarize(rows)]
     write_section(name, "\n".join(text))
