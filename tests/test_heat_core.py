@@ -14,6 +14,8 @@ REF = np.load(os.path.join(os.path.dirname(__file__), "data", "heat_core_referen
 
 
 SURFACE = surface_cases()
+# cases whose hard constraint is solved through the saddle system (see the tolerance below)
+SADDLE_CASES = {"sph_eq_zero", "sph_eq_multiple", "intr_bary"}
 
 
 @pytest.mark.parametrize("name,build,curves,kw", SURFACE, ids=[c[0] for c in SURFACE])
@@ -22,8 +24,12 @@ def test_surface_core_matches_pre_core_solvers(name, build, curves, kw):
     ref = REF[name]
     scale = max(1.0, float(np.abs(ref).max()))
     # the soft penalty is solved by preconditioned CG to a relative residual of 1e-4 (GridPoisson.penalty_tol):
-    # agreement with the frozen run holds to that tolerance, not to rounding (issue 17)
-    tol = 1e-4 if name == "grid_mesh_soft" else 1e-8
+    # agreement with the frozen run holds to that tolerance, not to rounding (issue 17). The hard constraints
+    # through points inside faces are a saddle system with a -1e-12 I block (FactorizedPoisson.constrained): rounding
+    # in the BLAS kernels under SuperLU is amplified there, so the same code gives phi differing by up to
+    # 1.7e-7 with OpenBLAS's SkylakeX kernels against the Haswell/Zen ones the fixture was made with
+    # (OPENBLAS_CORETYPE=SkylakeX vs Haswell, measured 2026-12-03); elsewhere they agree to 3e-14.
+    tol = 1e-4 if name == "grid_mesh_soft" else 1e-6 if name in SADDLE_CASES else 1e-8
     assert np.abs(phi - ref).max() <= tol * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
 
 
@@ -153,8 +159,12 @@ def test_volume_core_matches_pre_core_solvers(name, kw, monkeypatch):
     ref = REF[name]
     scale = max(1.0, float(np.abs(ref).max()))
     # the soft penalty is solved by preconditioned CG to a relative residual of 1e-4 (GridPoisson.penalty_tol):
-    # agreement with the frozen run holds to that tolerance, not to rounding (issue 17)
-    tol = 1e-4 if name == "grid_mesh_soft" else 1e-8
+    # agreement with the frozen run holds to that tolerance, not to rounding (issue 17). The hard constraints
+    # through points inside faces are a saddle system with a -1e-12 I block (FactorizedPoisson.constrained): rounding
+    # in the BLAS kernels under SuperLU is amplified there, so the same code gives phi differing by up to
+    # 1.7e-7 with OpenBLAS's SkylakeX kernels against the Haswell/Zen ones the fixture was made with
+    # (OPENBLAS_CORETYPE=SkylakeX vs Haswell, measured 2026-12-03); elsewhere they agree to 3e-14.
+    tol = 1e-4 if name == "grid_mesh_soft" else 1e-6 if name in SADDLE_CASES else 1e-8
     assert np.abs(phi - ref).max() <= tol * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
 
 
