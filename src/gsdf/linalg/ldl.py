@@ -16,10 +16,10 @@ whose Eigen ``SimplicialLDLT`` does exactly this). Here:
   wide supernodes (:data:`SUPERNODAL_FLOPS`), left-looking supernodal: dense blocks per fundamental supernode
   (:func:`_supernodal_numeric`), the same L and D up to rounding.
 
-L's row indices and column pointers are int32 (``int64`` for the symbolic work arrays only): the repeated
-solves are memory-bound sweeps over (Li, Lx), and 4-byte indices cut their traffic by a third for real factors
-(a sixth for complex ones), which matters most when other processes evict the caches between time slices
-(issue 17 goal 5; bench/RESULTS.md "heat-ldl-int32-load").
+L's row indices and column pointers are int32 (``int64`` for the symbolic work arrays only): L takes 12 bytes
+per entry instead of 16 for real factors (20 instead of 24 complex), bit-identical results. Under two busy
+processes the repeated solves' loaded/idle factor was the same as with int64 indices within the run-to-run noise
+(bench/RESULTS.md "heat-ldl-int32-load").
 
 All kernels are serial: their sizes are the ones where thread wake-up would cost more than the work (and a
 parallel region waits for a descheduled thread under contention).
