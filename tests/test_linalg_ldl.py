@@ -216,3 +216,38 @@ def test_supernodal_rule_picks_complex_polygon_systems_only():
                        ldl.order_csr(A.indptr.astype(np.int64), A.indices.astype(np.int64), A.shape[0], "amd"))
     assert ldl._use_supernodal(True, pat[3], pat[4])
     assert not ldl._use_supernodal(False, pat[3], pat[4])          # real systems stay up-looking
+
+
+def test_int32_indices_same_solve_as_int64():
+    """L's indices are int32 (less memory traffic in the solves); the solve is bit-identical to one over
+    int64 copies of the same factor (real and complex Hermitian)."""
+    import scipy.sparse as sp
+
+    from gsdf.linalg import ldl
+
+    rng = np.random.default_rng(3)
+    n = 400
+    B = sp.random(n, n, density=0.02, random_state=4, format="csr")
+    A = (B @ B.T + sp.identity(n) * 5).tocsr()
+    Ac = (A + 1j * sp.triu(B, 1) - 1j * sp.triu(B, 1).T).tocsr()
+    Ac = (Ac + Ac.conj().T) * 0.5 + sp.identity(n) * float(abs(Ac).sum(axis=1).max())
+    for M in (A, Ac.tocsr()):
+        f = ldl.LDLFactorization(M)
+        assert f._li.dtype == np.int32 and f._lp.dtype == np.int32
+        b = rng.standard_normal(n) + (1j * rng.standard_normal(n) if np.iscomplexobj(M.data) else 0)
+        bp = np.ascontiguousarray(b[f.perm], f.dtype)
+        x32 = ldl._solve(f._lp, f._li, f._lx, f._d, bp)
+        x64 = ldl._solve(f._lp.astype(np.int64), f._li.astype(np.int64), f._lx, f._d, bp)
+        assert np.array_equal(x32, x64)
+        assert np.linalg.norm(M @ f.solve(b) - b) <= 1e-10 * np.linalg.norm(b)
+
+
+def test_too_many_entries_for_int32_raises(monkeypatch):
+    import scipy.sparse as sp
+
+    from gsdf.linalg import ldl
+
+    monkeypatch.setattr(ldl, "INDEX_MAX", 2)
+    A = sp.csr_matrix(np.array([[4.0, 1, 1], [1, 3, 1], [1, 1, 2]]))
+    with pytest.raises(ValueError, match="int32"):
+        ldl.LDLFactorization(A)
