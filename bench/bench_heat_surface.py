@@ -807,10 +807,10 @@ def _time_first_repeat(make, solve):
     return float(np.mean(first)), rep, peak, out
 
 
-def _interleaved(runs, res, rounds):
+def _interleaved(runs, res, rounds, start=0):
     """Time both libraries ``rounds`` times in one process, interleaved with alternating order (gsdf first on
-    even rounds)."""
-    for r in range(rounds):
+    even rounds, counted from ``start``)."""
+    for r in range(start, start + rounds):
         for lib in (("gsdf", "pp3d") if r % 2 == 0 else ("pp3d", "gsdf")):
             res[lib].append(_time_first_repeat(*runs[lib]))
 
@@ -818,23 +818,28 @@ def _interleaved(runs, res, rounds):
 def _compare(names, setup, load, tag):
     """Per case (``setup(name)``: label, sizes, both libraries' constructor / solve, rounds, difference): both
     libraries interleaved over the case's rounds, idle and — with ``load`` — with two busy processes
-    (bench/load.py BusyLoad(2), started and stopped per case). The two conditions run back to back for each case,
-    in alternating order from case to case, so that both see the same background load of the shared machine
-    (the load average moves over minutes; a whole idle table, then a whole loaded one, compared different
-    moments). Returns {condition: [entry per case]} with the medians over rounds and the 1-minute load averages
-    at the start and end of the condition's measurement."""
+    (bench/load.py BusyLoad(2), started and stopped per round). The rounds alternate idle / loaded (the order
+    flipping every round and from case to case), so that both conditions see the same background load of the
+    shared machine (the load average moves over minutes: a whole idle block, then a whole loaded one, compared
+    different moments, and the loaded / idle ratio of short repeated solves swung 0.7–1.5 with it). Returns
+    {condition: [entry per case]} with the medians over rounds and the 1-minute load averages at the start of
+    the condition's first round and the end of its last."""
     from load import BusyLoad
 
     modes = ("idle", "load") if load else ("idle",)
     out = {m: [] for m in modes}
     for k, name in enumerate(names):
         c = setup(name)
-        for mode in (modes if k % 2 == 0 else modes[::-1]):
-            with BusyLoad(2 if mode == "load" else 0):
-                l0 = os.getloadavg()[0]
-                res = {"gsdf": [], "pp3d": []}
-                _interleaved(c["runs"], res, c["rounds"])
-                l1 = os.getloadavg()[0]
+        allres = {m: {"gsdf": [], "pp3d": []} for m in modes}
+        lds = {m: [] for m in modes}
+        for r in range(c["rounds"]):
+            for mode in (modes if (k + r) % 2 == 0 else modes[::-1]):
+                with BusyLoad(2 if mode == "load" else 0):
+                    lds[mode].append(os.getloadavg()[0])
+                    _interleaved(c["runs"], allres[mode], 1, start=r)
+                    lds[mode].append(os.getloadavg()[0])
+        for mode in modes:
+            res, l0, l1 = allres[mode], lds[mode][0], lds[mode][-1]
             med = {lib: [float(np.median([x[j] for x in v])) for j in range(3)] for lib, v in res.items()}
             # per-round ratios (the two libraries measured next to each other): their spread shows the noise
             pr = np.array([[g[0] / q[0], g[1] / q[1]] for g, q in zip(res["gsdf"], res["pp3d"])])
@@ -911,10 +916,10 @@ def _protocol(rounds_note):
             f"sample is the mean over calls back to back lasting ≥ {BATCH_S} s (fresh solvers for first; "
             "millisecond calls are otherwise either unpreempted or a whole time slice late under load, section "
             f"\"heat-repeat-load\"); each figure the median over {rounds_note} rounds, the libraries interleaved with "
-            "alternating order. Per mesh the idle and the loaded measurement (two busy processes, bench/load.py "
-            "BusyLoad(2), started and stopped per mesh) run back to back, in alternating order from mesh to mesh, "
-            "so that both see the same background load (`load 1 min` = the 1-minute load average at the start and "
-            "end of the mesh's measurement, busy processes included). Peak RSS = growth of the process's VmHWM over "
+            "alternating order. The rounds alternate idle and loaded (two busy processes, bench/load.py BusyLoad(2), "
+            "started and stopped per round; the order flips every round), so that both conditions see the same "
+            "background load (`load 1 min` = the 1-minute load average at the start of the condition's first and "
+            "the end of its last round, busy processes included). Peak RSS = growth of the process's VmHWM over "
             "the RSS before the round (median).")
 
 
@@ -964,7 +969,7 @@ def poly_speed(quick=False, load=False):
 
 def speed(quick=False, load=False, small=False):
     """Issue 17 goals 4–5: the surface signed heat method against potpourri3d on ≥ 10 meshes, idle and with two
-    busy processes competing (bench/load.py), per mesh back to back (:func:`_compare`)."""
+    busy processes competing (bench/load.py), in alternating rounds per mesh (:func:`_compare`)."""
     from importlib.metadata import version
 
     from load import uptime

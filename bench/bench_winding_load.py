@@ -14,8 +14,8 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
-from common import batch_mean, data_dir, machine, table, write_section  # noqa: E402
-from load import BusyLoad, uptime  # noqa: E402
+from common import alternating_rounds, data_dir, machine, table, write_section  # noqa: E402
+from load import uptime  # noqa: E402
 
 import gsdf  # noqa: E402
 
@@ -38,14 +38,8 @@ def main(argv=None):
         g = lambda: gsdf.FastWindingNumber(V, F)(Q)         # noqa: E731
         i = lambda: igl.fast_winding_number(V, F, Q)         # noqa: E731
         g(), i()
-        ratios = {"idle": [], "loaded": []}
-        for r in range(a.rounds):
-            for mode in (("idle", "loaded") if r % 2 == 0 else ("loaded", "idle")):
-                if mode == "loaded":
-                    with BusyLoad(2):
-                        ratios[mode].append(batch_mean(g) / batch_mean(i))
-                else:
-                    ratios[mode].append(batch_mean(g) / batch_mean(i))
+        t = alternating_rounds({"gsdf": g, "igl": i}, a.rounds)
+        ratios = {m: np.array(t[m, "gsdf"]) / np.array(t[m, "igl"]) for m in ("idle", "loaded")}
         mi, ml = float(np.median(ratios["idle"])), float(np.median(ratios["loaded"]))
         q = lambda x: f"{np.percentile(x, 25):.2f}–{np.percentile(x, 75):.2f}"  # noqa: E731
         rows.append((name, len(F), f"{mi:.2f}", q(ratios["idle"]), f"{ml:.2f}", q(ratios["loaded"]),

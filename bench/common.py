@@ -63,6 +63,22 @@ def batch_mean(fn, min_s: float = 0.1, min_calls: int = 1) -> float:
             return t / k
 
 
+def alternating_rounds(fns: dict, rounds: int = 7, nbusy: int = 2) -> dict:
+    """Issue 17's loaded protocol: ``rounds`` rounds alternating idle / loaded (``nbusy`` busy processes,
+    bench/load.py BusyLoad, started and stopped per round; the order flips every round), each round timing
+    every ``fns[name]()`` as :func:`batch_mean` (≥ 0.1 s back to back). Returns ``{("idle" | "loaded", name):
+    [mean seconds per round]}``; ratios are best taken per round (same background load) and then the median."""
+    from load import BusyLoad
+
+    out = {(m, k): [] for m in ("idle", "loaded") for k in fns}
+    for r in range(rounds):
+        for mode in (("idle", "loaded") if r % 2 == 0 else ("loaded", "idle")):
+            with BusyLoad(nbusy if mode == "loaded" else 0):
+                for k, f in fns.items():
+                    out[mode, k].append(batch_mean(f))
+    return out
+
+
 def write_section(name: str, text: str) -> None:
     """Replace (or append) the section between ``<!-- name:start -->`` and ``<!-- name:end -->``, then
     rebuild the index at the top of RESULTS.md (see :func:`results_index`)."""
