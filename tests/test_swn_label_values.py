@@ -45,3 +45,17 @@ def test_gapped_line_labels_follow_the_line():
     fs = fs[fs >= 0]
     shift = np.bincount((lab_full - res.face_labels) + 5).argmax() - 5
     assert np.array_equal(res.face_labels[fs] + shift, lab_full[fs])
+
+
+def test_solve_fills_endpoint_corners():
+    # through solve(): a corner at an interior endpoint holds the mean of its face's other two corners (the raw
+    # branch-rule ramp value there is different), so the face is labelled by its far edge
+    swn, runs, _ = _case()
+    res = swn.solve(runs)
+    E = res.endpoints[swn.dec.F]
+    one = np.flatnonzero(E.sum(1) == 1)
+    assert len(one) > 0
+    w = res.corner_values[one]
+    e = E[one]
+    others = (w * ~e).sum(1) / 2.0
+    assert np.allclose(w[e], others)

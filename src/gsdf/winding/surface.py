@@ -30,7 +30,9 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    when Jv explains at least half of its jump, the bounding part is g − round(Jv); a remainder that still
    has a harmonic part (a broken loop the LP explained only partly) is decomposed again (steps ①–④, at
    most ``MAX_PASSES``). ``bounding="fractional"`` keeps g − Jv (one pass).
-   Faces are labelled ``round(w − s)`` with the offset s the level of w on the input curves minus ½
+   Faces are labelled ``round(w − s)`` (w the mean of the face's corners, a corner at an interior endpoint
+   filled by the mean of the other two: :meth:`SurfaceWindingNumbers.label_values`, thesis §6.1) with the
+   offset s the level of w on the input curves minus ½
    (circular mean of the mean of the two faces of every bounding input edge; see
    :meth:`SurfaceWindingNumbers.rounding_offset`), then shifted so that the faces to the right of the curves get
    label 0 (the thesis' "+1 crossing from the right").
