@@ -180,19 +180,7 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd,
         x0, x1 = max(cx - R, 0), min(cx + R, dims[0] - 1)
         y0, y1 = max(cy - R, 0), min(cy + R, dims[1] - 1)
         z0, z1 = max(cz - R, 0), min(cz + R, dims[2] - 1)
-        reach = np.inf
-        if x0 > 0:
-            reach = min(reach, x - (lo[0] + x0 * cell))
-        if x1 < dims[0] - 1:
-            reach = min(reach, lo[0] + (x1 + 1) * cell - x)
-        if y0 > 0:
-            reach = min(reach, y - (lo[1] + y0 * cell))
-        if y1 < dims[1] - 1:
-            reach = min(reach, lo[1] + (y1 + 1) * cell - y)
-        if z0 > 0:
-            reach = min(reach, z - (lo[2] + z0 * cell))
-        if z1 < dims[2] - 1:
-            reach = min(reach, lo[2] + (z1 + 1) * cell - z)
+        reach = _reach(x, y, z, x0, x1, y0, y1, z0, z1, dims, lo, cell)
         lim = min(reach * reach, tau)
         m = 0
         for ax in range(x0, x1 + 1):

@@ -612,13 +612,6 @@ def _after_dct(y, delta, band, Pp, Pi, Pv, x, res):
 
 
 @njit(cache=True)
-def _block_of(r, dims, block, cdims):
-    n1, n2 = dims[1], dims[2]
-    i, j, k = r // (n1 * n2), (r // n2) % n1, r % n2
-    return ((i // block) * cdims[1] + j // block) * cdims[2] + k // block
-
-
-@njit(cache=True)
 def _restrict(r, dims, block, kblock, cdims, out):
     """out += R r: the sums of r over the block aggregates (``kblock[k]`` = k // block)."""
     n0, n1, n2 = dims[0], dims[1], dims[2]
