@@ -173,3 +173,27 @@ def test_background_wait_for_returns_when_its_job_is_reported(fresh_listener):
     assert bg.done == {"demo-cloud", "distance"}
     bg.close()
     assert bg.proc is None
+
+
+def test_point_areas_kernels_compile_once(tmp_path):
+    """Every gsdf kernel on the point-area path compiles one specialisation (a literal int argument, e.g. a
+    count that starts at 0, gives a second one: seconds of cold compile for nothing)."""
+    code = (
+        "import numpy as np, numba, sys, gsdf\n"
+        "rng = np.random.default_rng(0)\n"
+        "P = rng.normal(size=(400, 3)); P /= np.linalg.norm(P, axis=1)[:, None]\n"
+        "gsdf.point_areas(P, P, k=20)\n"
+        "many = []\n"
+        "for name, mod in list(sys.modules.items()):\n"
+        "    if not name.startswith('gsdf.'):\n"
+        "        continue\n"
+        "    for attr, f in vars(mod).items():\n"
+        "        if isinstance(f, numba.core.registry.CPUDispatcher) and f.__module__ == name \\\n"
+        "                and len(f.signatures) > 1:\n"
+        "            many.append(f'{name}.{attr}: {len(f.signatures)}')\n"
+        "print(';'.join(many))\n"
+    )
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), PYTHONPATH=SRC)
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "", out.stdout

@@ -215,7 +215,7 @@ def _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, row, ordered, cd,
         if m >= k:
             break
         R += 1
-    _keep_k(cd, ci, tmp, hist, m, k, ordered, out, row, lim)
+    _keep_k(cd, ci, tmp, hist, np.int64(m), k, ordered, out, row, lim)
     return cd, ci, tmp
 
 
@@ -375,7 +375,7 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
                 ci[m] = bi[q]
                 m += d <= lim
             if m >= k:
-                _keep_k(cd, ci, tmp, hist, m, k, ordered, out, order[p], lim)
+                _keep_k(cd, ci, tmp, hist, np.int64(m), k, ordered, out, order[p], lim)
                 continue
             tau = np.inf
             if M >= k:
@@ -409,7 +409,7 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
                 m += d <= lim
             i = order[p]
             if m >= k:
-                _keep_k(cd, ci, tmp, hist, m, k, ordered, out, i, lim)
+                _keep_k(cd, ci, tmp, hist, np.int64(m), k, ordered, out, i, lim)
             else:
                 cd, ci, tmp = _knn_one(P, Ps, order, start, cells, dims, lo, cell, k, i, i, ordered, cd, ci, tmp,
                                        hist, out, 3, fbt[f])

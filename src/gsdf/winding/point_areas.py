@@ -295,7 +295,7 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
         if k == 0:
             break
         r2cell = _max_radius2(A, k)
-    if clip_hull and k > 0 and not _cell_inside_hull(Q, cnt, A, k, F, G):
+    if clip_hull and k > 0 and not _cell_inside_hull(Q, np.int64(cnt), A, k, F, G):
         # restrict the cell to the convex hull of p_i and its kept neighbours, so that a point on
         # the border of an open surface only gets the part of its cell that lies on the surface
         Q[cnt, 0] = 0.0
@@ -629,7 +629,7 @@ def _tangent_row(P, N, cand, offset, k, sel, plane, row, keep, dist, keep2, dist
         dist[s] = d0 * d0 + d1 * d1 + d2 * d2 - h * h
     # the min(k, c) smallest, sorted by (distance, index): ties by point index, so the choice does not depend on
     # the order the candidates come in
-    kk = _smallest_sorted(dist, keep, c, min(k, c), dist2, keep2, bucket, count)
+    kk = _smallest_sorted(dist, keep, np.int64(c), min(k, c), dist2, keep2, bucket, count)
     for s in range(kk):
         sel[row, s] = keep2[s]
 
