@@ -109,3 +109,51 @@ def test_face_points_bad_input():
     far = int(np.argmax(np.linalg.norm(V[F].mean(1) - V[0], axis=1)))   # a face far from vertex 0
     with pytest.raises(ValueError, match="share no face"):
         insert_curves(V, F, one(far, [0.3, 0.3, 0.4]))
+
+
+def test_signed_heat_curves_on_a_flat_disk_cut_and_solved():
+    """The signed heat method's curve spelling works for surface winding numbers too: a level-set loop of a
+    circle (a list of (face, barycentric) points from level_set_curves) is cut into the mesh and bounds the
+    disk it draws (area against the circle's own polygon), and gsdf.Curve objects give the same chain as raw
+    polylines."""
+    from gsdf import Curve
+    from gsdf.heat.surface.curves import level_set_curves
+    from gsdf.winding.surface_curves import insert_surface_points
+
+    V, F = grid_mesh(20)
+    V = V - V.mean(0)
+    r = 0.3 * np.ptp(V[:, 0])
+    f = np.linalg.norm(V[:, :2], axis=1) - r
+    curves = level_set_curves(V, F, f)
+    assert len(curves) == 1
+    with pytest.raises(ValueError, match="insert_surface_points"):
+        SurfaceWindingNumbers(V, F).solve(curves)
+    V2, F2, S, parent = insert_surface_points(V, F, curves)
+    res = SurfaceWindingNumbers(V2, F2).solve(list(S))
+    area = lambda X, T: 0.5 * np.linalg.norm(np.cross(X[T[:, 1]] - X[T[:, 0]], X[T[:, 2]] - X[T[:, 0]]), axis=1)  # noqa: E731
+    a2 = area(V2, F2)
+    W = res.face_labels - res.face_labels.min()
+    assert set(np.unique(W)) == {0, 1}
+    P = np.array([b @ V[F[e]] for e, b in curves[0][:-1]])
+    assert abs(a2[W == 1].sum() - shoelace(P)) < 1e-9 * a2.sum()
+    # the inside is the side where f < 0 (level_set_curves puts {f < value} on the left)
+    cen = V2[F2].mean(1)
+    assert np.all(np.linalg.norm(cen[W == 1, :2], axis=1) < r + 1e-9)
+    # gsdf.Curve spellings: a vertex polyline, its oriented edges, and surface points on vertices
+    swn = SurfaceWindingNumbers(V, F)
+    n = int(round(np.sqrt(len(V))))
+    c0 = n // 2 * n + n // 2                                   # a centre vertex and a square loop around it
+    loop = np.array([c0 - n - 1, c0 - n, c0 - n + 1, c0 + 1, c0 + n + 1, c0 + n, c0 + n - 1, c0 - 1, c0 - n - 1])
+    g = swn.chain([loop])
+    assert np.array_equal(swn.chain([Curve(loop)]), g)
+    assert np.array_equal(swn.chain([Curve(np.c_[loop[:-1], loop[1:]])]), g)
+    at_vertices = [(int(v), ()) for v in loop]
+    assert np.array_equal(swn.chain([at_vertices]), g)
+    with pytest.raises(ValueError, match="oriented"):
+        swn.chain([Curve(loop, signed=False)])
+    with pytest.raises(ValueError, match=r"curves\[0\]\[1\].*face index"):
+        swn.chain([[(0, [1.0, 0.0, 0.0]), (10 ** 9, [1.0, 0.0, 0.0])]])
+    with pytest.raises(ValueError, match="oriented"):
+        insert_surface_points(V, F, [Curve(curves[0], signed=False)])
+    with pytest.raises(ValueError, match="non-empty"):
+        insert_surface_points(V, F, [])

@@ -182,12 +182,16 @@ class SurfaceWindingNumbers:
 
     # ------------------------------------------------------------------------------------------ curve input
     def chain(self, curves) -> np.ndarray:
-        """Integer edge chain g (nE,) of curves given as vertex polylines along mesh edges.
+        """Integer edge chain g (nE,) of curves given along mesh edges.
 
-        ``curves`` is a list of vertex-index sequences (a closed curve repeats its first vertex at the end), or
-        an integer array (nE,) that already is a chain. Every pair of consecutive vertices must be joined by a
-        mesh edge.
+        ``curves`` is a list whose items are vertex polylines (a closed curve repeats its first vertex at the
+        end), :class:`gsdf.Curve` objects (vertex polylines, oriented edge sets, or surface points that all lie
+        on vertices), or an integer array (nE,) that already is a chain. Every pair of consecutive vertices must
+        be joined by a mesh edge. Curves with points inside faces or on edges are refused: cut the mesh along
+        them first (:func:`gsdf.winding.surface_curves.insert_surface_points`).
         """
+        from ..heat.sources import Curve, _looks_like_point_list
+
         dec = self.dec
         n = dec.n_vertices
         if isinstance(curves, np.ndarray) and curves.ndim == 1 and curves.shape[0] == dec.n_edges and \
@@ -196,6 +200,8 @@ class SurfaceWindingNumbers:
             if not np.all(g == np.round(g)):
                 raise ValueError("curves: an edge chain must hold integers")
             return g
+        if isinstance(curves, Curve):
+            curves = [curves]
         if isinstance(curves, np.ndarray) and curves.ndim == 2 and curves.dtype != object:
             curves = list(curves)
         if not isinstance(curves, (list, tuple)):
@@ -205,31 +211,78 @@ class SurfaceWindingNumbers:
             raise ValueError("curves: no curves given (empty list)")
         g = np.zeros(dec.n_edges)
         for ci, c in enumerate(curves):
-            C = np.asarray(c)
-            if C.dtype == bool or not (np.issubdtype(C.dtype, np.integer) or
-                                       (np.issubdtype(C.dtype, np.floating) and np.all(C == np.round(C)))):
-                raise ValueError(f"curves[{ci}]: expected integer vertex indices, got dtype {C.dtype}")
-            if C.ndim != 1 or len(C) < 2:
-                raise ValueError(f"curves[{ci}]: expected a polyline of at least 2 vertices, got shape {C.shape}")
-            C = C.astype(np.int64)
-            if C.min() < 0 or C.max() >= n:
-                raise ValueError(f"curves[{ci}]: vertex index out of range for {n} vertices "
-                                 f"(min {C.min()}, max {C.max()})")
-            a, b = C[:-1], C[1:]
-            if np.any(a == b):
-                k = int(np.argmax(a == b))
-                raise ValueError(f"curves[{ci}]: vertex {int(a[k])} repeats at position {k} (zero-length segment)")
-            lo, hi = np.minimum(a, b), np.maximum(a, b)
-            key = lo * n + hi
-            e = np.searchsorted(self._edge_key, key)
-            e = np.minimum(e, len(self._edge_key) - 1)
-            bad = self._edge_key[e] != key
-            if bad.any():
-                k = int(np.argmax(bad))
-                raise ValueError(f"curves[{ci}]: vertices {int(a[k])} and {int(b[k])} (segment {k}) are not joined "
-                                 "by a mesh edge; the curve is not connected where it claims to be (insert curves "
-                                 "through faces with gsdf.winding.surface_curves.insert_curves)")
-            np.add.at(g, e, np.where(a < b, 1.0, -1.0))
+            if isinstance(c, (list, tuple)) and _looks_like_point_list(list(c)):
+                c = Curve(c, name=f"curves[{ci}]")
+            if isinstance(c, Curve):
+                if not c.signed:
+                    raise ValueError(f"curves[{ci}]: surface winding numbers need oriented curves "
+                                     "(Curve(..., signed=True))")
+                if c.kind == "points":
+                    C = self._vertex_points(c, ci)
+                elif c.kind == "edges":
+                    for pi, pl in enumerate(c.polylines()):
+                        g += self._polyline_chain(pl, f"curves[{ci}] (path {pi})")
+                    continue
+                else:
+                    C = c.nodes
+            else:
+                C = np.asarray(c)
+            g += self._polyline_chain(C, f"curves[{ci}]")
+        return g
+
+    def _vertex_points(self, c, ci: int) -> np.ndarray:
+        """The vertex polyline of a surface-point curve whose points all lie on mesh vertices (ValueError for
+        points inside faces or on edges, which must be inserted into the mesh first)."""
+        F, n = self.dec.F, self.dec.n_vertices
+        out = []
+        for q, (e, b) in enumerate(c.nodes):
+            if b.size == 0:                                     # (vertex, ()): a vertex
+                out.append(e)
+                continue
+            if b.size != 3 or not 0 <= e < len(F):
+                raise ValueError(f"curves[{ci}][{q}]: expected (face index < {len(F)}, barycentric (3,)), got "
+                                 f"({e}, {b.tolist()})")
+            k = int(np.argmax(b))
+            if not np.isfinite(b).all() or abs(b[k] - 1.0) > 1e-9 or np.abs(np.delete(b, k)).max() > 1e-9:
+                raise ValueError(f"curves[{ci}][{q}]: point ({e}, {b.tolist()}) lies inside face {e} or on one "
+                                 "of its edges; surface winding numbers need curves along mesh edges: cut the "
+                                 "mesh along the curves first (V2, F2, segments, parent = gsdf.winding."
+                                 "surface_curves.insert_surface_points(V, F, curves)) and solve list(segments) "
+                                 "on (V2, F2)")
+            out.append(int(F[e, k]))
+        return np.asarray(out, dtype=np.int64)
+
+    def _polyline_chain(self, C, name: str) -> np.ndarray:
+        """The edge chain (nE,) of one vertex polyline (ValueError naming ``name`` when it is not one)."""
+        n = self.dec.n_vertices
+        C = np.asarray(C)
+        if C.dtype == object:
+            raise ValueError(f"{name}: expected integer vertex indices or a list of (face, barycentric) points")
+        if C.dtype == bool or not (np.issubdtype(C.dtype, np.integer) or
+                                   (np.issubdtype(C.dtype, np.floating) and np.all(C == np.round(C)))):
+            raise ValueError(f"{name}: expected integer vertex indices, got dtype {C.dtype}")
+        if C.ndim != 1 or len(C) < 2:
+            raise ValueError(f"{name}: expected a polyline of at least 2 vertices, got shape {C.shape}")
+        C = C.astype(np.int64)
+        if C.min() < 0 or C.max() >= n:
+            raise ValueError(f"{name}: vertex index out of range for {n} vertices "
+                             f"(min {C.min()}, max {C.max()})")
+        a, b = C[:-1], C[1:]
+        if np.any(a == b):
+            k = int(np.argmax(a == b))
+            raise ValueError(f"{name}: vertex {int(a[k])} repeats at position {k} (zero-length segment)")
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        key = lo * n + hi
+        e = np.searchsorted(self._edge_key, key)
+        e = np.minimum(e, len(self._edge_key) - 1)
+        bad = self._edge_key[e] != key
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise ValueError(f"{name}: vertices {int(a[k])} and {int(b[k])} (segment {k}) are not joined "
+                             "by a mesh edge; the curve is not connected where it claims to be (insert curves "
+                             "through faces with gsdf.winding.surface_curves.insert_surface_points)")
+        g = np.zeros(self.dec.n_edges)
+        np.add.at(g, e, np.where(a < b, 1.0, -1.0))
         return g
 
     def _hodge_decomposition(self) -> HodgeDecomposition:

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..mesh.connectivity import MeshTopology
 
-__all__ = ["insert_curves", "polylines_to_curves"]
+__all__ = ["insert_curves", "insert_surface_points", "polylines_to_curves", "surface_points_to_curves"]
 
 SNAP = 1e-9
 
@@ -49,6 +49,68 @@ def polylines_to_curves(polylines):
     k = len(index)
     return SWNCurves(np.array(["v"] * k), np.array(index, dtype=np.int64), np.zeros((k, 3)),
                      np.full((k, 2), -1, dtype=np.int64), np.array(segs, dtype=np.int64).reshape(-1, 2))
+
+
+def surface_points_to_curves(curves, F):
+    """Curves as :class:`gsdf.Curve` objects, lists of ``(face, barycentric (3,))`` surface points (the
+    signed heat method's spelling; ``(vertex, ())`` is a vertex) or vertex polylines -> :class:`SWNCurves`
+    (face nodes, vertex nodes; consecutive nodes of a curve joined by a segment). ValueError names the curve
+    and point that is not a valid surface point of the faces ``F`` (m, 3)."""
+    from ..heat.sources import Curve
+    from ..io.swn_curves import SWNCurves
+
+    F = np.asarray(F)
+    m = len(F)
+    kinds, index, params, segs = [], [], [], []
+    if isinstance(curves, Curve):
+        curves = [curves]
+    if not isinstance(curves, (list, tuple)) or len(curves) == 0:
+        raise ValueError("curves: expected a non-empty list of curves")
+    for ci, c in enumerate(curves):
+        c = c if isinstance(c, Curve) else Curve(c, name=f"curves[{ci}]")
+        if not c.signed:
+            raise ValueError(f"curves[{ci}]: surface winding numbers need oriented curves (signed=True)")
+        if c.kind == "edges":
+            paths = [[(int(v), np.zeros(0)) for v in pl] for pl in c.polylines()]
+        elif c.kind == "vertices":
+            paths = [[(int(v), np.zeros(0)) for v in c.nodes]]
+        else:
+            paths = [c.nodes]
+        for path in paths:
+            base = len(kinds)
+            for q, (e, b) in enumerate(path):
+                if b.size == 0:
+                    kinds.append("v"), index.append(e), params.append((0.0, 0.0, 0.0))
+                    continue
+                if b.size != 3 or not 0 <= e < m:
+                    raise ValueError(f"curves[{ci}][{q}]: expected (face index < {m}, barycentric (3,)), "
+                                     f"got ({e}, {b.tolist()})")
+                kinds.append("f"), index.append(e), params.append(tuple(b.tolist()))
+            segs += [(base + k, base + k + 1) for k in range(len(path) - 1)]
+    k = len(kinds)
+    return SWNCurves(np.array(kinds), np.array(index, dtype=np.int64), np.array(params, dtype=np.float64).reshape(k, 3),
+                     np.full((k, 2), -1, dtype=np.int64), np.array(segs, dtype=np.int64).reshape(-1, 2))
+
+
+def insert_surface_points(V, F, curves):
+    """Cut the mesh along curves given as surface points (geometry unchanged), so that surface winding
+    numbers can be solved on it: :func:`insert_curves` of :func:`surface_points_to_curves`. Consecutive points
+    must share a face (a curve crossing an edge has a point on it, as :func:`gsdf.heat.surface.curves.
+    level_set_curves` makes them).
+
+    Returns ``(V2, F2, segments, parent)`` as :func:`insert_curves`; ``SurfaceWindingNumbers(V2, F2)
+    .solve(list(segments))`` then solves for the curves.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]); F = np.array([[0, 1, 2], [1, 3, 2]])
+    >>> curve = [(0, [0.6, 0.2, 0.2]), (0, [0.0, 0.5, 0.5]), (1, [0.2, 0.6, 0.2])]   # crosses edge 1-2 at its middle
+    >>> V2, F2, segs, parent = insert_surface_points(V, F, [curve])
+    >>> len(V2), len(segs)
+    (7, 2)
+    """
+    return insert_curves(V, F, surface_points_to_curves(curves, F))
 
 
 def _area(poly, X) -> float:
