@@ -388,6 +388,14 @@ def summarize(rows):
                 f"cancelled edges or mixed pairs. Hybrid (curves on those cases, old elsewhere): "
                 f"{100 * np.mean(hyb < 0.005):.1f} % ({100 * hyb.mean():.2f} %) against old "
                 f"{100 * np.mean(eo < 0.005):.1f} % ({100 * eo.mean():.2f} %)."]
+        ov = (dbl > 0) | (can > 0)
+        out += ["", "The default by overlap of the generator's parts (edges shared by the region boundary and a loop "
+                "or by two loops, same direction |g| = 2 or cancelled g = 0): "
+                + "; ".join(f"{nm}: {int(m.sum())} cases, {100 * np.mean(eo[m] < 0.005):.1f} % < 0.5 % "
+                            f"({100 * eo[m].mean():.2f} %)" for nm, m in (("no shared edge", ~ov),
+                                                                         ("shared edges", ov),
+                                                                         ("of these cancelled", can > 0)) if m.any())
+                + ". Where parts cancel, the input lacks those edges of both curves and does not say which curve goes on where."]
     P = [r for r in rows if r["lp set"] == "1"]
     if P:
         fail = [r for r in P if _f(r, "err default") >= 0.005]
