@@ -395,7 +395,8 @@ def summarize(rows):
                             f"({100 * eo[m].mean():.2f} %)" for nm, m in (("no shared edge", ~ov),
                                                                          ("shared edges", ov),
                                                                          ("of these cancelled", can > 0)) if m.any())
-                + ". Where parts cancel, the input lacks those edges of both curves and does not say which curve goes on where."]
+                + ". Where parts cancel, the input lacks those edges of both curves and does not say which curve "
+                "goes on where."]
     P = [r for r in rows if r["lp set"] == "1"]
     if P:
         fail = [r for r in P if _f(r, "err default") >= 0.005]
