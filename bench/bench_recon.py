@@ -21,7 +21,9 @@ a subset and ASSERTS the topology promise (CC = 1, genus 0, closed manifold) on 
 bull,camel --table2-only`` runs the Table-2 cases of those meshes only (section ``recon-subset``).
 ``--only-remesh`` writes the before / after table of the edge flips (``remesh=False`` against the default) on
 the full run's Table-2 clouds, with SPSR (section ``recon-remesh``); ``--only-post`` the same for the flips on
-the subdivided mesh (``flip_subdivided=False`` against the default; section ``recon-post``).
+the subdivided mesh (``flip_subdivided=False`` against the default; section ``recon-post``); ``--only-fit`` the
+same for the global least-squares fit of all vertices (``fit=False`` against the default, with the inverted /
+tilted area of both against the truth normals; section ``recon-fit``).
 """
 
 from __future__ import annotations
@@ -252,7 +254,16 @@ def relocation_table(rng):
                  rows)
 
 
-def before_after_table(before_kw, before_label, count, stage):
+def shape_stats(V, F, GT, NG, rng, n=100_000):
+    """% of the area of (V, F) whose face normal points against the truth normal of the nearest truth sample
+    (inverted: pleats) and % tilted more than 30° from it (as bench_recon_diagnose.py)."""
+    A, af = sample_surface(V, F, n, rng)
+    _, i = cKDTree(GT).query(A)
+    c = np.einsum("ij,ij->i", face_normals(V, F)[af], NG[i])
+    return 100 * float((c < 0).mean()), 100 * float((np.abs(c) < np.cos(np.radians(30))).mean())
+
+
+def before_after_table(before_kw, before_label, count, stage, shape=False):
     """The Table-2 clouds of the full run (same rng stream: the draws of the other methods' metric samples
     are skipped), three reconstructions each: ours with ``before_kw`` (before), ours (the default), SPSR given
     the true normals; the metric samples come from one fixed rng per case, the same for all three.
@@ -261,10 +272,12 @@ def before_after_table(before_kw, before_label, count, stage):
     rng = np.random.default_rng(0)
     rows, lower, higher, d_all, ratios = [], 0, 0, [], []
     n_le_before = n_le_after = 0
+    shapes = []
     for mname in MESHES:
         V0, F0 = gsdf.read_mesh(os.path.join(data_dir(), "meshes", mname))
         V0 = normalise(V0)
-        GT, _ = sample_surface(V0, F0, 100_000, rng)
+        GT, gf = sample_surface(V0, F0, 100_000, rng)
+        NG = face_normals(V0, F0)[gf]
         cases = ([(a, b) for a in INLIERS for b in OUTLIERS] if mname == "bunny00.off"
                  else [(8000, 200), (4000, 400), (2000, 400), (1000, 800)])
         for n_in, n_out in cases:
@@ -295,15 +308,28 @@ def before_after_table(before_kw, before_label, count, stage):
                          f"{b[0]:.3f} / {b[1]:.1f}", f"{b[0] - a[0]:+.3f}", f"{c[0]:.3f} / {c[1]:.1f}",
                          "yes" if round(b[0], 2) <= round(c[0], 2) else "no", count(rep),
                          f"{stage(rep):.2f}", f"{ta:.1f} / {tb:.1f}"])
+            if shape:
+                sa, sb, sc = (shape_stats(V, F, GT, NG, np.random.default_rng(2))
+                              for V, F in ((Va, Fa), (Vb, Fb), (Vs, Fs)))
+                shapes.append((sa, sb, sc))
+                rows[-1][-3:-3] = [f"{sa[0]:.1f} / {sb[0]:.1f} / {sc[0]:.1f}", f"{sa[1]:.1f} / {sb[1]:.1f} / {sc[1]:.1f}"]
             print(before_label, rows[-1], flush=True)
     summary = (f"After − before (3 decimals): mean {np.mean(d_all):+.4f}, lower on {int(np.sum(np.array(d_all) < 0))} "
                f"of {len(d_all)}, largest rise {max(d_all):+.4f}; at the table's two decimals lower on {lower}, higher on "
                f"{higher}.  CD ≤ SPSR (two decimals): before {n_le_before} / {len(d_all)}, after {n_le_after} / "
                f"{len(d_all)}.  Whole-call time after / before: median {np.median(ratios):.2f} (range "
                f"{min(ratios):.2f}–{max(ratios):.2f}).")
-    return table(["mesh", "case", f"ours before ({before_label}) CD / HD", "ours after (default) CD / HD",
-                  "after − before", "SPSR CD / HD", "after ≤ SPSR", "flips", "flip stage (s)",
-                  "time before / after (s)"], rows), summary
+    header = ["mesh", "case", f"ours before ({before_label}) CD / HD", "ours after (default) CD / HD",
+              "after − before", "SPSR CD / HD", "after ≤ SPSR", "flips", "flip stage (s)", "time before / after (s)"]
+    if shape:
+        header[-3:-3] = ["inverted % area before / after / SPSR", "tilted > 30° % area before / after / SPSR"]
+        header[-3], header[-2] = "stage report", "stage (s)"
+        sh = np.array(shapes)
+        summary += (f"  Inverted area (mean over cases): before {sh[:, 0, 0].mean():.1f} %, after {sh[:, 1, 0].mean():.1f} "
+                    f"%, SPSR {sh[:, 2, 0].mean():.1f} %; tilted > 30°: before {sh[:, 0, 1].mean():.1f} %, after "
+                    f"{sh[:, 1, 1].mean():.1f} %, SPSR {sh[:, 2, 1].mean():.1f} %.  Topology promise (is_sphere) on "
+                    f"both before and after: HELD on all {len(d_all)} cases (asserted).")
+    return table(header, rows), summary
 
 
 def remesh_table():
@@ -340,6 +366,29 @@ def only_post():
                   "recon); CD×100 / HD×100 with one metric sample per case shared by the three methods.  \"flips\" = "
                   "flips before the subdivision + flips on the subdivided mesh; \"flip stage\" = all flip passes and "
                   "the relocation round between them.\n\n" + text + "\n\n" + summary)
+
+
+def only_fit():
+    """Before / after of the global fit of all vertices (``fit=False`` against the default), into section
+    recon-fit."""
+    up, t0 = _uptime(), time.perf_counter()
+    print(up, flush=True)
+
+    def cg(r):
+        f = r["fit"] or {}
+        return " + ".join(f"{sum(x['cg_iterations'])}" for x in f.values())
+
+    text, summary = before_after_table(dict(fit=False), "fit=False", cg, lambda r: r["timings"]["fit"], shape=True)
+    write_section("recon-fit", "## recon-fit: the global least-squares fit of all vertices (fit=True) before / "
+                  "after on the Table-2 clouds\n\n"
+                  f"Machine: {machine()}. Load at start: `{up}`; at the end: `{_uptime()}`. Command: `PYTHONPATH=src "
+                  "/work/anchors/bin/python bench/bench_recon.py --only-fit` "
+                  f"({time.perf_counter() - t0:.0f} s).  Same clouds as the full run (section recon); CD×100 / HD×100 "
+                  "with one metric sample per case shared by the three methods.  Inverted = % of the area whose face "
+                  "normal points against the normal of the nearest truth sample (pleats), tilted = more than 30° "
+                  "off it (100k area samples, rng 2).  \"stage report\" = CG iterations of the fit before the "
+                  "flips + on the subdivided mesh (4 rounds each); \"stage (s)\" = both fits.\n\n"
+                  + text + "\n\n" + summary)
 
 
 # ------------------------------------------------------------------------------------------- main
@@ -509,6 +558,9 @@ if __name__ == "__main__":
     ap.add_argument("--only-post", action="store_true",
                     help="only the before / after table of the flips on the subdivided mesh (flip_subdivided) on the "
                          "full run's Table-2 clouds, with SPSR; written to section recon-post")
+    ap.add_argument("--only-fit", action="store_true",
+                    help="only the before / after table of the global fit (fit) on the full run's Table-2 clouds, "
+                         "with SPSR and inverted / tilted area; written to section recon-fit")
     ap.add_argument("--size-worker", type=int, default=None)
     ap.add_argument("--only-sizes", default=None, metavar="N,N,...",
                     help="only the time / peak memory vs point count table for these sizes (one process each), "
@@ -520,6 +572,8 @@ if __name__ == "__main__":
         only_remesh()
     elif a.only_post:
         only_post()
+    elif a.only_fit:
+        only_fit()
     elif a.only_sizes:
         only_sizes([int(n) for n in a.only_sizes.split(",")])
     else:

@@ -32,7 +32,7 @@ def test_fit_k_moves_vertices_only_and_keeps_the_sphere_on_a_noisy_cloud():
     P = P + rng.normal(scale=0.004, size=P.shape)                 # noisy sphere
     out = rng.uniform(-1.3, 1.3, (40, 3))                           # plus outliers
     P = np.vstack([P, out])
-    meshes = {k: gsdf.reconstruct_simply_connected(P, fit_k=k, remesh=False) for k in (6, 8, 12)}
+    meshes = {k: gsdf.reconstruct_simply_connected(P, fit_k=k, remesh=False, fit=False) for k in (6, 8, 12)}
     for V, F in meshes.values():
         assert is_sphere(V, F)
     # the same faces for every neighbourhood without the flips (which follow the fit: tests/test_recon_remesh.py)
@@ -52,9 +52,9 @@ def test_default_fit_lowers_the_error_against_an_analytic_ellipsoid():
     # bench/RESULTS.md, section recon.)
     abc = (1.0, 1.0, 0.15)
     P = _ellipsoid_samples(1200, abc, np.random.default_rng(3))
-    Vf, Ff = gsdf.reconstruct_simply_connected(P, relocate=False, subdivide=0)
-    V12, F12 = gsdf.reconstruct_simply_connected(P, fit_k=12)
-    V8, F8 = gsdf.reconstruct_simply_connected(P)
+    Vf, Ff = gsdf.reconstruct_simply_connected(P, relocate=False, subdivide=0, fit=False)
+    V12, F12 = gsdf.reconstruct_simply_connected(P, fit_k=12, fit=False)
+    V8, F8 = gsdf.reconstruct_simply_connected(P, fit=False)
     assert is_sphere(Vf, Ff) and is_sphere(V12, F12) and is_sphere(V8, F8)
     ef, e12, e8 = (_ellipsoid_error(V, F, abc) for V, F in ((Vf, Ff), (V12, F12), (V8, F8)))
     assert e8 < 0.85 * e12 and e12 < 0.7 * ef

@@ -133,8 +133,8 @@ def test_reconstruction_remesh_keeps_vertices_and_sphere_and_lowers_the_error():
     assert is_sphere(V0, F0) and is_sphere(V1, F1)
     assert rep["flips"]["flipped"] > 0 and rep["flips"]["error_after"] < rep["flips"]["error_before"]
     assert _ellipsoid_error(V1, F1, abc) < _ellipsoid_error(V0, F0, abc)
-    Vd, Fd = gsdf.reconstruct_simply_connected(P)                                 # the default pipeline
-    Vn, Fn = gsdf.reconstruct_simply_connected(P, remesh=False)
+    Vd, Fd = gsdf.reconstruct_simply_connected(P, fit=False)                      # the default, without the global fit
+    Vn, Fn = gsdf.reconstruct_simply_connected(P, remesh=False, fit=False)
     assert is_sphere(Vd, Fd)
     assert _ellipsoid_error(Vd, Fd, abc) < _ellipsoid_error(Vn, Fn, abc)
 
@@ -176,15 +176,15 @@ def test_flips_on_the_subdivided_mesh_keep_vertices_and_sphere_and_lower_the_err
     # the 1-to-4 split keeps each parent's diagonals; flipping the subdivided mesh follows the rim closer
     abc = (1.0, 1.0, 0.15)
     P = _ellipsoid(1200, abc, np.random.default_rng(3))
-    V0, F0 = gsdf.reconstruct_simply_connected(P, flip_subdivided=False)
-    V1, F1, rep = gsdf.reconstruct_simply_connected(P, return_report=True)
+    V0, F0 = gsdf.reconstruct_simply_connected(P, flip_subdivided=False, fit=False)
+    V1, F1, rep = gsdf.reconstruct_simply_connected(P, return_report=True, fit=False)
     assert np.array_equal(V0, V1) and F0.shape == F1.shape and not np.array_equal(F0, F1)
     assert is_sphere(V0, F0) and is_sphere(V1, F1)
     assert rep["flips"]["flipped_subdivided"] > 0
     assert _ellipsoid_error(V1, F1, abc) < _ellipsoid_error(V0, F0, abc)
     # without a subdivision there is nothing more to flip: the same mesh either way
-    Va, Fa = gsdf.reconstruct_simply_connected(P, subdivide=0)
-    Vb, Fb = gsdf.reconstruct_simply_connected(P, subdivide=0, flip_subdivided=False)
+    Va, Fa = gsdf.reconstruct_simply_connected(P, subdivide=0, fit=False)
+    Vb, Fb = gsdf.reconstruct_simply_connected(P, subdivide=0, flip_subdivided=False, fit=False)
     assert np.array_equal(Va, Vb) and np.array_equal(Fa, Fb)
 
 
