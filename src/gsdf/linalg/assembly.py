@@ -62,7 +62,7 @@ def _csr_pattern(rows, cols, n_rows, n_cols):
     indices = np.empty(k, np.int32)
     slot = np.empty(k, np.int64)
     mark = np.full(n_cols, -1, np.int64)
-    out = 0
+    out = np.int64(0)                      # not a literal 0: sort_row would compile once more for it
     for i in range(n_rows):
         first = out
         for q in range(start[i], start[i + 1]):

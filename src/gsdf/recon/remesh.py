@@ -138,8 +138,8 @@ def _fit_flips(V, F, S, cen, frame, h, coef, near, slack, sweeps, margin):
         for f1 in range(nf):
             for c in range(3):
                 a, b, cc = F[f1, c], F[f1, (c + 1) % 3], F[f1, (c + 2) % 3]
-                f2 = -1                    # the other face on edge (a, b) traverses b → a
-                d = -1
+                f2 = np.int64(-1)          # the other face on edge (a, b) traverses b → a
+                d = np.int64(-1)           # (not literal -1s: each callee would compile once more for them)
                 for t in range(deg[b]):
                     g = vf[off[b] + t]
                     for c2 in range(3):

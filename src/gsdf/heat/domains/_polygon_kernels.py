@@ -549,7 +549,7 @@ def polygon_csr_pattern(start, corners, n):
     indices = np.empty(cap, np.int32)
     slot = np.empty(cap, np.int64)
     mark = np.full(n, -1, np.int64)
-    out = 0
+    out = np.int64(0)                      # not a literal 0: sort_row would compile once more for it
     for i in range(n):
         first = out
         for q in range(head[i], head[i + 1]):
