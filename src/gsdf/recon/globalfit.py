@@ -53,8 +53,8 @@ Example
 
 from __future__ import annotations
 
+import numba as nb
 import numpy as np
-import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from .._checks import as_faces, as_points, integer, nonnegative, positive
@@ -62,19 +62,110 @@ from .._checks import as_faces, as_points, integer, nonnegative, positive
 __all__ = ["fit_to_samples"]
 
 
-def _edges(F, n):
-    """(e, 2) unique undirected edges of the faces F (lo < hi)."""
-    E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-    E.sort(axis=1)
-    key = np.unique(E[:, 0] * np.int64(n) + E[:, 1])
-    return np.stack([key // n, key % n], axis=1)
+class _Pattern:
+    """The sparsity of the scalar n × n part K of the normal equations (diagonal + mesh edges), as CSR rows with
+    each entry's slot known: ``slot[:n]`` the diagonal, ``slot[n:n+e]`` / ``slot[n+e:]`` edge (lo, hi) / (hi, lo);
+    ``E`` (e, 2) the unique edges (lo ≤ hi), ``fe`` (f, 3) the edge opposite each corner of each face, ``deg``
+    the edge count per vertex (the graph Laplacian's diagonal), ``drow`` / ``dslot`` the rows and slots of all
+    entries on the diagonal (a degenerate face's edge (v, v) puts two more there)."""
+
+    def __init__(self, F, n):
+        f = len(F)
+        H = np.concatenate([F[:, 1], F[:, 2], F[:, 0]]), np.concatenate([F[:, 2], F[:, 0], F[:, 1]])
+        key = np.minimum(*H) * np.int64(n) + np.maximum(*H)
+        ukey, inv = np.unique(key, return_inverse=True)
+        self.E = np.stack([ukey // n, ukey % n], axis=1)
+        self.fe = np.ascontiguousarray(inv.reshape(3, f).T)
+        ne = len(self.E)
+        rows = np.concatenate([np.arange(n), self.E[:, 0], self.E[:, 1]])
+        cols = np.concatenate([np.arange(n), self.E[:, 1], self.E[:, 0]])
+        order = np.argsort(rows, kind="stable")
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))]).astype(np.int64)
+        self.indices = np.ascontiguousarray(cols[order])
+        self.slot = np.empty(len(rows), dtype=np.int64)
+        self.slot[order] = np.arange(len(rows))
+        on = rows == cols
+        self.drow, self.dslot = rows[on], self.slot[on]
+        self.deg = np.bincount(self.E.ravel(), minlength=n).astype(np.float64)
+        self.n, self.ne = n, ne
+
+    def values(self, diag, edge):
+        """CSR values of the symmetric matrix with diagonal ``diag`` (n,) and edge entries ``edge`` (e,)."""
+        v = np.empty(len(self.slot))
+        v[self.slot[:self.n]] = diag
+        v[self.slot[self.n:self.n + self.ne]] = edge
+        v[self.slot[self.n + self.ne:]] = edge
+        return v
+
+    def diagonal(self, vals):
+        return np.bincount(self.drow, weights=vals[self.dslot], minlength=self.n)
 
 
-def _block_index(n):
-    """Row and column indices (n, 3, 3) of the 3 × 3 diagonal blocks of a 3n × 3n matrix."""
-    r = 3 * np.arange(n)[:, None, None] + np.arange(3)[None, :, None]
-    c = 3 * np.arange(n)[:, None, None] + np.arange(3)[None, None, :]
-    return np.broadcast_to(r, (n, 3, 3)), np.broadcast_to(c, (n, 3, 3))
+@nb.njit(cache=True)
+def _apply(indptr, indices, vals, cn, nrm, x, y):
+    """y = (K ⊗ I₃ + blockdiag(cn_v n_v n_vᵀ)) x for x, y (n, 3): K in CSR (indptr, indices, vals)."""
+    for v in nb.prange(len(indptr) - 1):
+        sx = sy = sz = 0.0
+        for p in range(indptr[v], indptr[v + 1]):
+            j = indices[p]
+            a = vals[p]
+            sx += a * x[j, 0]
+            sy += a * x[j, 1]
+            sz += a * x[j, 2]
+        t = cn[v] * (nrm[v, 0] * x[v, 0] + nrm[v, 1] * x[v, 1] + nrm[v, 2] * x[v, 2])
+        y[v, 0] = sx + t * nrm[v, 0]
+        y[v, 1] = sy + t * nrm[v, 1]
+        y[v, 2] = sz + t * nrm[v, 2]
+
+
+@nb.njit(cache=True)
+def _block_jacobi(kd, cn, nrm, r, z):
+    """z = D⁻¹ r with D_v = kd_v I₃ + cn_v n_v n_vᵀ (|n_v| = 1; Sherman–Morrison), r, z (n, 3)."""
+    for v in nb.prange(len(kd)):
+        t = cn[v] / (kd[v] * (kd[v] + cn[v])) * (nrm[v, 0] * r[v, 0] + nrm[v, 1] * r[v, 1] + nrm[v, 2] * r[v, 2])
+        z[v, 0] = r[v, 0] / kd[v] - t * nrm[v, 0]
+        z[v, 1] = r[v, 1] / kd[v] - t * nrm[v, 1]
+        z[v, 2] = r[v, 2] / kd[v] - t * nrm[v, 2]
+
+
+def _normal_equations(P, X, F, S, face, bary, a, foot, nrm, c, membrane, prox):
+    """The round's normal equations (module text) in operator form: CSR values of K = Bᵀ diag(a) B + μ L + ε I
+    on the pattern ``P`` (B: the samples' barycentric rows, (m, n)), the diagonal of K, and the right-hand side
+    (n, 3).  The full matrix is K ⊗ I₃ + blockdiag(c_v n_v n_vᵀ) (:func:`_apply`)."""
+    n = len(X)
+    Ff = F[face]
+    b = a[:, None] * bary
+    diag = membrane * P.deg + prox + np.bincount(Ff.ravel(), weights=(b * bary).ravel(), minlength=n)
+    # the pair of corners across the edge opposite corner 0, 1, 2: (1, 2), (2, 0), (0, 1)
+    pw = b[:, [1, 2, 0]] * bary[:, [2, 0, 1]]
+    edge = np.bincount(P.fe[face].ravel(), weights=pw.ravel(), minlength=P.ne) - membrane
+    vals = P.values(diag, edge)
+    LX = np.empty_like(X)
+    _apply(P.indptr, P.indices, P.values(P.deg, -np.ones(P.ne)), np.zeros(n), nrm, X, LX)
+    rhs = np.stack([np.bincount(Ff.ravel(), weights=(b * S[:, [i]]).ravel(), minlength=n) for i in range(3)], axis=1)
+    rhs += (c * np.einsum("vx,vx->v", nrm, foot))[:, None] * nrm
+    rhs += nrm * (membrane * np.einsum("vx,vx->v", nrm, LX))[:, None]
+    rhs += prox * X
+    return vals, P.diagonal(vals), rhs
+
+
+_STAGES = ("setup", "attach", "surface", "assemble", "solve")
+
+
+class _Clock:
+    """Adds the wall and CPU seconds since the last call to a stage of ``report["seconds"]`` /
+    ``report["cpu_seconds"]``."""
+
+    def __init__(self, report):
+        import time
+        self._pc, self._cpu, self._r = time.perf_counter, time.process_time, report
+        self._t, self._c = self._pc(), self._cpu()
+
+    def __call__(self, stage):
+        t, c = self._pc(), self._cpu()
+        self._r["seconds"][stage] += t - self._t
+        self._r["cpu_seconds"][stage] += c - self._c
+        self._t, self._c = t, c
 
 
 def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float = 5.0, surface: float = 1.0,
@@ -107,7 +198,9 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
     ValueError : bad shapes, NaN / inf, out-of-range faces, fewer than 3 samples, bad option values.
     """
     from ..distance.triangles import TriangleDistance
-    from ..linalg import pcg
+    from ..linalg.iterative import cg_loop
+    from ..spatial.morton import morton_order
+    from ..threads import blas_region
     from .relocate import local_surface
 
     V = as_points(V, "V")
@@ -126,48 +219,56 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
         raise ValueError(f"S: needs at least 3 samples for a local surface, got {len(S)}")
     n, m, h = len(V), len(S), spacing
     X = V.copy()
-    report = {"iterations": 0, "attached": [], "cg_iterations": [], "mean_shift": 0.0, "max_shift": 0.0}
+    report = {"iterations": 0, "attached": [], "cg_iterations": [], "mean_shift": 0.0, "max_shift": 0.0,
+              "seconds": dict.fromkeys(_STAGES, 0.0), "cpu_seconds": dict.fromkeys(_STAGES, 0.0)}
+    clock = _Clock(report)
     if iterations == 0 or len(F) == 0:
         return (X, report) if return_report else X
     k = int(min(k, m))
+    # vertices and samples relabelled along the Z-order curve (the result does not depend on the labels): the
+    # mat-vecs' neighbour reads, the tree queries and the gathers then hit the cache
+    pv = morton_order(V)
+    X = X[pv]
+    rank = np.empty(n, dtype=np.int64)
+    rank[pv] = np.arange(n)
+    F = rank[F]
+    S = S[morton_order(S)]
     tree = cKDTree(S)
-    E = _edges(F, n)
-    ne = len(E)
-    L = sp.csr_matrix((np.r_[np.ones(2 * ne), -np.ones(2 * ne)],
-                       (np.r_[E[:, 0], E[:, 1], E[:, 0], E[:, 1]], np.r_[E[:, 0], E[:, 1], E[:, 1], E[:, 0]])),
-                      shape=(n, n))
-    I3 = sp.identity(3, format="csr")
-    bi, bj = _block_index(n)
-    rows = np.repeat(np.arange(m), 3)
+    P = _Pattern(F, n)
     for _ in range(iterations):
         # (a) attachment: samples to their closest mesh points, vertices to their quadric feet
+        clock("setup")
         d, face, _, bary = TriangleDistance(X, F).query_barycentric(S)
-        a = data * (d <= trim * h)
-        B = sp.csr_matrix((bary.ravel(), (rows, F[face].ravel())), shape=(m, n))
-        As = (B.T @ sp.diags(a) @ B).tocsr()
+        clock("attach")
         foot, nrm, _, rms = local_surface(X, S, h, k=k, tree=tree, return_fit=True)
+        nrm = np.ascontiguousarray(nrm)
+        clock("surface")
+        a = data * (d <= trim * h)
         c = surface * (rms <= fit_tol * h)
-        blk = c[:, None, None] * nrm[:, :, None] * nrm[:, None, :]
-        Pn = sp.csr_matrix((blk.ravel(), (bi.ravel(), bj.ravel())), shape=(3 * n, 3 * n))
-        # (b) the normal equations
-        M = (sp.kron(As + membrane * L + prox * sp.identity(n), I3, format="csr") + Pn).tocsr()
-        eta = nrm * np.einsum("vx,vx->v", nrm, L @ X)[:, None]
-        rhs = B.T @ (a[:, None] * S) + (c * np.einsum("vx,vx->v", nrm, foot))[:, None] * nrm \
-            + membrane * eta + prox * X
-        # 3 × 3 block-Jacobi preconditioner
-        D = np.asarray(M[bi.ravel(), bj.ravel()]).reshape(n, 3, 3)
-        Dinv = np.linalg.inv(D)
+        # (b) the normal equations, K ⊗ I₃ + blockdiag(c n nᵀ), and a 3 × 3 block-Jacobi preconditioner
+        vals, kd, rhs = _normal_equations(P, X, F, S, face, bary, a, foot, nrm, c, membrane, prox)
         cnt = [0]
 
-        def psolve(r, Dinv=Dinv, cnt=cnt):
-            cnt[0] += 1
-            return np.einsum("vij,vj->vi", Dinv, r.reshape(n, 3)).ravel()
+        def matvec(x, vals=vals, c=c, nrm=nrm):
+            y = np.empty_like(x)
+            _apply(P.indptr, P.indices, vals, c, nrm, x.reshape(n, 3), y.reshape(n, 3))
+            return y
 
-        x, _ = pcg(M, rhs.ravel(), M=psolve, x0=X.ravel().copy(), rtol=1e-7, maxiter=2000)
+        def psolve(r, kd=kd, c=c, nrm=nrm, cnt=cnt):
+            cnt[0] += 1
+            z = np.empty_like(r)
+            _block_jacobi(kd, c, nrm, r.reshape(n, 3), z.reshape(n, 3))
+            return z
+
+        clock("assemble")
+        with blas_region():                      # its dot products on one BLAS thread (gsdf.threads)
+            x, _ = cg_loop(matvec, psolve, rhs.ravel(), X.ravel().copy(), rtol=1e-7, maxiter=2000)
+        clock("solve")
         X = x.reshape(n, 3)
         report["iterations"] += 1
         report["attached"].append(int((a > 0).sum()))
         report["cg_iterations"].append(cnt[0])
+    X = X[rank]
     shift = np.linalg.norm(X - V, axis=1)
     report.update(mean_shift=float(shift.mean()), max_shift=float(shift.max()))
     return (X, report) if return_report else X

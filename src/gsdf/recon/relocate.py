@@ -21,6 +21,7 @@ Example
 
 from __future__ import annotations
 
+import numba as nb
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
@@ -30,30 +31,122 @@ from .._checks import as_faces, as_points, integer, nonnegative, positive
 __all__ = ["local_surface", "relocate_vertices", "subdivide_onto_samples"]
 
 
+@nb.njit(cache=True, parallel=True)
+def _weighted_moments(Y, d, spacing):
+    """Per query (rows of the neighbour positions Y (q, k, 3) and distances d (q, k)): the scale h = max(1.5 ×
+    spacing, median of d), the normalised Gaussian weights w (q, k), their centroid c (q, 3) and the weighted
+    covariance C (q, 3, 3) of the neighbours about it."""
+    q, k = d.shape
+    h = np.empty(q)
+    w = np.empty((q, k))
+    c = np.empty((q, 3))
+    C = np.empty((q, 3, 3))
+    for i in nb.prange(q):
+        ds = np.sort(d[i])
+        med = ds[k // 2] if k % 2 == 1 else 0.5 * (ds[k // 2 - 1] + ds[k // 2])
+        hi = max(1.5 * spacing, med)
+        h[i] = hi
+        tot = 0.0
+        for j in range(k):
+            r = d[i, j] / hi
+            w[i, j] = np.exp(-(r * r))
+            tot += w[i, j]
+        tot = max(tot, 1e-300)
+        cx = cy = cz = 0.0
+        for j in range(k):
+            w[i, j] /= tot
+            cx += w[i, j] * Y[i, j, 0]
+            cy += w[i, j] * Y[i, j, 1]
+            cz += w[i, j] * Y[i, j, 2]
+        c[i, 0], c[i, 1], c[i, 2] = cx, cy, cz
+        for a in range(3):
+            for b in range(3):
+                C[i, a, b] = 0.0
+        for j in range(k):
+            rx, ry, rz = Y[i, j, 0] - cx, Y[i, j, 1] - cy, Y[i, j, 2] - cz
+            wj = w[i, j]
+            C[i, 0, 0] += wj * rx * rx
+            C[i, 0, 1] += wj * rx * ry
+            C[i, 0, 2] += wj * rx * rz
+            C[i, 1, 1] += wj * ry * ry
+            C[i, 1, 2] += wj * ry * rz
+            C[i, 2, 2] += wj * rz * rz
+        C[i, 1, 0], C[i, 2, 0], C[i, 2, 1] = C[i, 0, 1], C[i, 0, 2], C[i, 1, 2]
+    return h, w, c, C
+
+
+@nb.njit(cache=True, parallel=True)
+def _quadric_solve(Y, w, c, frame, h):
+    """Per query: the weighted least-squares quadric height z = a0 + a1 x + a2 y + a3 x² + a4 xy + a5 y² of the
+    neighbours Y (q, k, 3) in the frame (rows t1, t2, n) at c, coordinates over h, with a small ridge on the
+    quadratic terms (6 × 6 normal equations, LU with partial pivoting); returns the coefficients (q, 6) and the
+    weighted rms residual (q,)."""
+    q, k = w.shape
+    coef = np.empty((q, 6))
+    rms = np.empty(q)
+    ridge = (1e-9, 1e-9, 1e-9, 1e-2, 1e-2, 1e-2)
+    for i in nb.prange(q):
+        A = np.zeros((6, 7))
+        bas = np.empty((k, 6))
+        zs = np.empty(k)
+        hi = h[i]
+        for j in range(k):
+            rx, ry, rz = Y[i, j, 0] - c[i, 0], Y[i, j, 1] - c[i, 1], Y[i, j, 2] - c[i, 2]
+            x = (rx * frame[i, 0, 0] + ry * frame[i, 0, 1] + rz * frame[i, 0, 2]) / hi
+            y = (rx * frame[i, 1, 0] + ry * frame[i, 1, 1] + rz * frame[i, 1, 2]) / hi
+            z = rx * frame[i, 2, 0] + ry * frame[i, 2, 1] + rz * frame[i, 2, 2]
+            bas[j, 0], bas[j, 1], bas[j, 2], bas[j, 3], bas[j, 4], bas[j, 5] = 1.0, x, y, x * x, x * y, y * y
+            zs[j] = z
+            wj = w[i, j]
+            for a in range(6):
+                wa = wj * bas[j, a]
+                for b in range(6):
+                    A[a, b] += wa * bas[j, b]
+                A[a, 6] += wa * z
+        for a in range(6):
+            A[a, a] += ridge[a]
+        for col in range(6):                 # Gaussian elimination with partial pivoting
+            p = col
+            for r in range(col + 1, 6):
+                if abs(A[r, col]) > abs(A[p, col]):
+                    p = r
+            if p != col:
+                for b in range(7):
+                    A[col, b], A[p, b] = A[p, b], A[col, b]
+            for r in range(col + 1, 6):
+                f = A[r, col] / A[col, col]
+                for b in range(col, 7):
+                    A[r, b] -= f * A[col, b]
+        for a in range(5, -1, -1):
+            v = A[a, 6]
+            for b in range(a + 1, 6):
+                v -= A[a, b] * coef[i, b]
+            coef[i, a] = v / A[a, a]
+        e = 0.0
+        for j in range(k):
+            f = zs[j]
+            for a in range(6):
+                f -= bas[j, a] * coef[i, a]
+            e += w[i, j] * f * f
+        rms[i] = np.sqrt(e)
+    return coef, rms
+
+
 def _fit_quadrics(Q, S, spacing, k, extra, tree):
     """The weighted quadric fits of :func:`local_surface` around each query (the ``k`` nearest samples after
-    skipping ``extra``): centre c (q, 3), frame (q, 3, 3) rows t1, t2, n, scale h (q,), coefficients (q, 6),
-    and the fit's design B (q, k, 6), weights w (q, k), heights z (q, k)."""
-    d, I = tree.query(Q, k=k + extra)
-    d, I = d.reshape(len(Q), -1)[:, extra:], I.reshape(len(Q), -1)[:, extra:]
+    skipping ``extra``): centre c (q, 3), frame (q, 3, 3) rows t1, t2, n, scale h (q,), coefficients (q, 6) and
+    the weighted rms residual of the fit (q,)."""
+    from ..threads import get_num_threads
+
+    d, I = tree.query(Q, k=k + extra, workers=get_num_threads())
+    d = np.ascontiguousarray(d.reshape(len(Q), -1)[:, extra:])
+    I = I.reshape(len(Q), -1)[:, extra:]
     Y = S[I]                                                   # (q, k, 3)
-    h = np.maximum(1.5 * spacing, np.median(d, axis=1))
-    w = np.exp(-(d / h[:, None]) ** 2)
-    w /= np.maximum(w.sum(axis=1, keepdims=True), 1e-300)
-    c = np.einsum("qk,qkx->qx", w, Y)
-    R = Y - c[:, None, :]
-    C = np.einsum("qk,qki,qkj->qij", w, R, R)
-    _, vec = np.linalg.eigh(C)
-    t1, t2, n = vec[:, :, 2], vec[:, :, 1], vec[:, :, 0]
-    x, y, z = (np.einsum("qkx,qx->qk", R, t) for t in (t1, t2, n))
-    # weighted least squares for the quadric height: normal equations (6×6 per query), coordinates over h
-    xs, ys = x / h[:, None], y / h[:, None]
-    B = np.stack([np.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys], axis=2)     # (q, k, 6)
-    A = np.einsum("qk,qka,qkb->qab", w, B, B)
-    A += np.diag([1e-9, 1e-9, 1e-9, 1e-2, 1e-2, 1e-2])[None]
-    rhs = np.einsum("qk,qka,qk->qa", w, B, z)
-    coef = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
-    return c, np.stack([t1, t2, n], axis=1), h, coef, B, w, z
+    h, w, c, C = _weighted_moments(Y, d, float(spacing))
+    _, vec = np.linalg.eigh(C)                                 # ascending: n, t2, t1
+    frame = np.ascontiguousarray(vec[:, :, ::-1].transpose(0, 2, 1))
+    coef, rms = _quadric_solve(Y, w, c, frame, h)
+    return c, frame, h, coef, rms
 
 
 def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False, tree=None,
@@ -89,7 +182,7 @@ def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False,
     if k < 3:
         raise ValueError(f"S: needs at least {3 + extra} samples for a local surface, got {len(S)}")
     tree = cKDTree(S) if tree is None else tree
-    c, frame, h, coef, B, w, z = _fit_quadrics(Q, S, spacing, k, extra, tree)
+    c, frame, h, coef, rms = _fit_quadrics(Q, S, spacing, k, extra, tree)
     t1, t2, n = frame[:, 0], frame[:, 1], frame[:, 2]
     Rq = Q - c
     xq, yq, zq = (np.einsum("qx,qx->q", Rq, t) for t in (t1, t2, n))
@@ -99,8 +192,7 @@ def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False,
     foot = Q + (zf - zq)[:, None] * n
     if not return_fit:
         return foot, n, zq - zf
-    fit = np.einsum("qka,qa->qk", B, coef)
-    return foot, n, zq - zf, np.sqrt(np.einsum("qk,qk->q", w, (z - fit) ** 2))
+    return foot, n, zq - zf, rms
 
 
 def _face_normals(V, F):

@@ -235,7 +235,7 @@ def flip_to_samples(V, F, S, spacing: float, *, k: int = 8, sweeps: int = 10, ma
     elif not isinstance(tree, cKDTree) or tree.n != len(S) or tree.m != 3:
         raise ValueError(f"tree: expected a cKDTree of the {len(S)} samples S, got "
                          f"{type(tree).__name__} of {getattr(tree, 'n', '?')} points")
-    cen, frame, h, coef, _, _, _ = _fit_quadrics(S, S, spacing, int(min(k, len(S))), 0, tree)
+    cen, frame, h, coef, _ = _fit_quadrics(S, S, spacing, int(min(k, len(S))), 0, tree)
     near = tree.query(V)[1].astype(np.int64)
     frame = np.ascontiguousarray(frame)
     report = {}
