@@ -24,6 +24,8 @@ Memory is O(m) for the tree plus O(chunk) per query batch.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from numba import njit, prange
 
@@ -429,6 +431,30 @@ def _pack(T, degenerate):
     return D
 
 
+@njit(cache=True)
+def _refit_boxes(D, start, end, right):
+    """Node boxes (k, 3) lo, hi of a preorder tree (left child i + 1, right child ``right[i]``, −1 for leaves)
+    over the packed triangles ``D`` in tree order (boxes in columns 13:16 / 16:19), as the build computes them."""
+    k = start.shape[0]
+    lo = np.empty((k, 3))
+    hi = np.empty((k, 3))
+    for i in range(k - 1, -1, -1):
+        r = right[i]
+        if r < 0:
+            for d in range(3):
+                lo[i, d] = np.inf
+                hi[i, d] = -np.inf
+            for j in range(start[i], end[i]):
+                for d in range(3):
+                    lo[i, d] = min(lo[i, d], D[j, 13 + d])
+                    hi[i, d] = max(hi[i, d], D[j, 16 + d])
+        else:
+            for d in range(3):
+                lo[i, d] = min(lo[i + 1, d], lo[r, d])
+                hi[i, d] = max(hi[i + 1, d], hi[r, d])
+    return lo, hi
+
+
 class TriangleDistance:
     """Unsigned distance to a triangle mesh or soup, with the tree built once.
 
@@ -489,6 +515,35 @@ class TriangleDistance:
                 d2[s:e], face[s:e], closest[s:e], bary[s:e] if want_bary else scratch[: e - s],
             )
         return d2, face, closest, bary
+
+    def refit(self, V):
+        """Move the vertices (same faces) and keep the tree: its element order and splits stay, the boxes are
+        recomputed bottom-up from the new triangles (O(n), against the build's O(n log n)).  Queries stay exact
+        (every box bounds its triangles); a tree refitted after large moves only prunes less well.  For meshes
+        whose vertices move a little per round (an iterative fit).  ``V`` (n, 3) float: the new positions, as
+        many as before.  Returns ``self``.
+
+        Example
+        -------
+        >>> import numpy as np
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float); F = np.array([[0, 1, 2]])
+        >>> td = TriangleDistance(V, F).refit(V + [0.0, 0.0, 1.0])
+        >>> float(td.query([[0.2, 0.2, 0.0]])[0][0])
+        1.0
+        """
+        V = as_points(V, "V")
+        if V.shape != self.V.shape:
+            raise ValueError(f"V: expected {self.V.shape[0]} vertices (the tree's), got {V.shape[0]}")
+        self.V = V
+        self._frame = Frame.of_mesh(V, self.F)
+        Vf = self._frame.geometry(V)
+        b = self.bvh
+        if getattr(self, "_F_tree", None) is None:
+            self._F_tree = np.ascontiguousarray(self.F[b.order])
+        self._D = _pack(np.ascontiguousarray(Vf[self._F_tree].reshape(-1, 9)), _DEGENERATE)
+        lo, hi = _refit_boxes(self._D, b.start, b.end, b.right)
+        self.bvh = dataclasses.replace(b, lo=lo, hi=hi)
+        return self
 
     def query(self, Q):
         """Unsigned distance from each query point to the nearest triangle.

@@ -235,10 +235,13 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
     S = S[morton_order(S)]
     tree = cKDTree(S)
     P = _Pattern(F, n)
+    td = None
     for _ in range(iterations):
-        # (a) attachment: samples to their closest mesh points, vertices to their quadric feet
+        # (a) attachment: samples to their closest mesh points, vertices to their quadric feet (the triangle
+        # tree of the first round refitted to the moved vertices in the later ones: same answers, no rebuild)
         clock("setup")
-        d, face, _, bary = TriangleDistance(X, F).query_barycentric(S)
+        td = TriangleDistance(X, F) if td is None else td.refit(X)
+        d, face, _, bary = td.query_barycentric(S)
         clock("attach")
         foot, nrm, _, rms = local_surface(X, S, h, k=k, tree=tree, return_fit=True)
         nrm = np.ascontiguousarray(nrm)

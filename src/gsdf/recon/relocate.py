@@ -31,122 +31,199 @@ from .._checks import as_faces, as_points, integer, nonnegative, positive
 __all__ = ["local_surface", "relocate_vertices", "subdivide_onto_samples"]
 
 
+@nb.njit(cache=True)
+def _eigh3(A, V, frame, i):
+    """Eigenvectors of the symmetric 3 × 3 matrix A (overwritten) by cyclic Jacobi rotations (to rounding),
+    written as the rows of frame[i] by descending eigenvalue (t1, t2, n: n the smallest); V: 3 × 3 scratch."""
+    for r in range(3):
+        for s in range(3):
+            V[r, s] = 1.0 if r == s else 0.0
+    for _sweep in range(50):
+        off = A[0, 1] * A[0, 1] + A[0, 2] * A[0, 2] + A[1, 2] * A[1, 2]
+        dia = A[0, 0] * A[0, 0] + A[1, 1] * A[1, 1] + A[2, 2] * A[2, 2]
+        if off <= 1e-36 * dia or off == 0.0:
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            apq = A[p, q]
+            if apq == 0.0:
+                continue
+            theta = (A[q, q] - A[p, p]) / (2.0 * apq)
+            t = 1.0 / (abs(theta) + np.sqrt(theta * theta + 1.0))
+            if theta < 0.0:
+                t = -t
+            cs = 1.0 / np.sqrt(t * t + 1.0)
+            sn = t * cs
+            for r in range(3):                   # A <- A J (columns p, q)
+                arp, arq = A[r, p], A[r, q]
+                A[r, p] = cs * arp - sn * arq
+                A[r, q] = sn * arp + cs * arq
+            for r in range(3):                   # A <- Jᵀ A (rows p, q)
+                apr, aqr = A[p, r], A[q, r]
+                A[p, r] = cs * apr - sn * aqr
+                A[q, r] = sn * apr + cs * aqr
+            A[p, q] = A[q, p] = 0.0
+            for r in range(3):                   # V <- V J
+                vrp, vrq = V[r, p], V[r, q]
+                V[r, p] = cs * vrp - sn * vrq
+                V[r, q] = sn * vrp + cs * vrq
+    # descending order of the eigenvalues A[j, j]
+    o0, o1, o2 = 0, 1, 2
+    if A[o0, o0] < A[o1, o1]:
+        o0, o1 = o1, o0
+    if A[o1, o1] < A[o2, o2]:
+        o1, o2 = o2, o1
+    if A[o0, o0] < A[o1, o1]:
+        o0, o1 = o1, o0
+    for r in range(3):
+        frame[i, 0, r] = V[r, o0]
+        frame[i, 1, r] = V[r, o1]
+        frame[i, 2, r] = V[r, o2]
+
+
+_BLOCK = 512          # queries per parallel task of the fit kernels (scratch allocated once per task)
+
+
 @nb.njit(cache=True, parallel=True)
-def _weighted_moments(Y, d, spacing):
-    """Per query (rows of the neighbour positions Y (q, k, 3) and distances d (q, k)): the scale h = max(1.5 ×
-    spacing, median of d), the normalised Gaussian weights w (q, k), their centroid c (q, 3) and the weighted
-    covariance C (q, 3, 3) of the neighbours about it."""
+def _weighted_moments(S, I, d, spacing):
+    """Per query (its neighbours' rows I (q, k) of S and distances d (q, k), ascending as the k-d tree returns
+    them): the scale h = max(1.5 × spacing, median of d), the normalised Gaussian weights w (q, k), their
+    centroid c (q, 3) and the eigenvectors of the weighted covariance of the neighbours about it, as the rows
+    t1, t2, n of frame (q, 3, 3) by descending eigenvalue (n: the normal of the local plane)."""
     q, k = d.shape
     h = np.empty(q)
     w = np.empty((q, k))
     c = np.empty((q, 3))
-    C = np.empty((q, 3, 3))
-    for i in nb.prange(q):
-        ds = np.sort(d[i])
-        med = ds[k // 2] if k % 2 == 1 else 0.5 * (ds[k // 2 - 1] + ds[k // 2])
-        hi = max(1.5 * spacing, med)
-        h[i] = hi
-        tot = 0.0
-        for j in range(k):
-            r = d[i, j] / hi
-            w[i, j] = np.exp(-(r * r))
-            tot += w[i, j]
-        tot = max(tot, 1e-300)
-        cx = cy = cz = 0.0
-        for j in range(k):
-            w[i, j] /= tot
-            cx += w[i, j] * Y[i, j, 0]
-            cy += w[i, j] * Y[i, j, 1]
-            cz += w[i, j] * Y[i, j, 2]
-        c[i, 0], c[i, 1], c[i, 2] = cx, cy, cz
-        for a in range(3):
-            for b in range(3):
-                C[i, a, b] = 0.0
-        for j in range(k):
-            rx, ry, rz = Y[i, j, 0] - cx, Y[i, j, 1] - cy, Y[i, j, 2] - cz
-            wj = w[i, j]
-            C[i, 0, 0] += wj * rx * rx
-            C[i, 0, 1] += wj * rx * ry
-            C[i, 0, 2] += wj * rx * rz
-            C[i, 1, 1] += wj * ry * ry
-            C[i, 1, 2] += wj * ry * rz
-            C[i, 2, 2] += wj * rz * rz
-        C[i, 1, 0], C[i, 2, 0], C[i, 2, 1] = C[i, 0, 1], C[i, 0, 2], C[i, 1, 2]
-    return h, w, c, C
+    frame = np.empty((q, 3, 3))
+    for blk in nb.prange((q + _BLOCK - 1) // _BLOCK):
+        C = np.empty((3, 3))
+        Vs = np.empty((3, 3))
+        for i in range(blk * _BLOCK, min(q, (blk + 1) * _BLOCK)):
+            med = d[i, k // 2] if k % 2 == 1 else 0.5 * (d[i, k // 2 - 1] + d[i, k // 2])
+            hi = max(1.5 * spacing, med)
+            h[i] = hi
+            tot = 0.0
+            for j in range(k):
+                r = d[i, j] / hi
+                w[i, j] = np.exp(-(r * r))
+                tot += w[i, j]
+            tot = max(tot, 1e-300)
+            cx = cy = cz = 0.0
+            for j in range(k):
+                w[i, j] /= tot
+                s = I[i, j]
+                cx += w[i, j] * S[s, 0]
+                cy += w[i, j] * S[s, 1]
+                cz += w[i, j] * S[s, 2]
+            c[i, 0], c[i, 1], c[i, 2] = cx, cy, cz
+            c00 = c01 = c02 = c11 = c12 = c22 = 0.0
+            for j in range(k):
+                s = I[i, j]
+                rx, ry, rz = S[s, 0] - cx, S[s, 1] - cy, S[s, 2] - cz
+                wj = w[i, j]
+                c00 += wj * rx * rx
+                c01 += wj * rx * ry
+                c02 += wj * rx * rz
+                c11 += wj * ry * ry
+                c12 += wj * ry * rz
+                c22 += wj * rz * rz
+            C[0, 0], C[0, 1], C[0, 2] = c00, c01, c02
+            C[1, 0], C[1, 1], C[1, 2] = c01, c11, c12
+            C[2, 0], C[2, 1], C[2, 2] = c02, c12, c22
+            _eigh3(C, Vs, frame, i)
+    return h, w, c, frame
 
 
 @nb.njit(cache=True, parallel=True)
-def _quadric_solve(Y, w, c, frame, h):
+def _quadric_solve(S, I, w, c, frame, h, Q):
     """Per query: the weighted least-squares quadric height z = a0 + a1 x + a2 y + a3 x² + a4 xy + a5 y² of the
-    neighbours Y (q, k, 3) in the frame (rows t1, t2, n) at c, coordinates over h, with a small ridge on the
-    quadratic terms (6 × 6 normal equations, LU with partial pivoting); returns the coefficients (q, 6) and the
-    weighted rms residual (q,)."""
+    neighbours (rows I (q, k) of S, weights w) in the frame (rows t1, t2, n) at c, coordinates over h, with a
+    small ridge on the quadratic terms (6 × 6 normal equations, LU with partial pivoting).  Returns the
+    coefficients (q, 6), the weighted rms residual (q,), and for the query points Q (q, 3) the signed height
+    z_q − z(x_q, y_q) (q,) and the foot Q − height · n (q, 3)."""
     q, k = w.shape
     coef = np.empty((q, 6))
     rms = np.empty(q)
-    ridge = (1e-9, 1e-9, 1e-9, 1e-2, 1e-2, 1e-2)
-    for i in nb.prange(q):
-        A = np.zeros((6, 7))
+    hgt = np.empty(q)
+    foot = np.empty((q, 3))
+    ridge = np.array([1e-9, 1e-9, 1e-9, 1e-2, 1e-2, 1e-2])
+    for blk in nb.prange((q + _BLOCK - 1) // _BLOCK):
+        A = np.empty((6, 7))
         bas = np.empty((k, 6))
         zs = np.empty(k)
-        hi = h[i]
-        for j in range(k):
-            rx, ry, rz = Y[i, j, 0] - c[i, 0], Y[i, j, 1] - c[i, 1], Y[i, j, 2] - c[i, 2]
+        for i in range(blk * _BLOCK, min(q, (blk + 1) * _BLOCK)):
+            A[:] = 0.0
+            hi = h[i]
+            for j in range(k):
+                s = I[i, j]
+                rx, ry, rz = S[s, 0] - c[i, 0], S[s, 1] - c[i, 1], S[s, 2] - c[i, 2]
+                x = (rx * frame[i, 0, 0] + ry * frame[i, 0, 1] + rz * frame[i, 0, 2]) / hi
+                y = (rx * frame[i, 1, 0] + ry * frame[i, 1, 1] + rz * frame[i, 1, 2]) / hi
+                z = rx * frame[i, 2, 0] + ry * frame[i, 2, 1] + rz * frame[i, 2, 2]
+                bas[j, 0], bas[j, 1], bas[j, 2], bas[j, 3], bas[j, 4], bas[j, 5] = 1.0, x, y, x * x, x * y, y * y
+                zs[j] = z
+                wj = w[i, j]
+                for a in range(6):
+                    wa = wj * bas[j, a]
+                    for b in range(6):
+                        A[a, b] += wa * bas[j, b]
+                    A[a, 6] += wa * z
+            for a in range(6):
+                A[a, a] += ridge[a]
+            for col in range(6):                 # Gaussian elimination with partial pivoting
+                p = col
+                for r in range(col + 1, 6):
+                    if abs(A[r, col]) > abs(A[p, col]):
+                        p = r
+                if p != col:
+                    for b in range(7):
+                        A[col, b], A[p, b] = A[p, b], A[col, b]
+                for r in range(col + 1, 6):
+                    f = A[r, col] / A[col, col]
+                    for b in range(col, 7):
+                        A[r, b] -= f * A[col, b]
+            for a in range(5, -1, -1):
+                v = A[a, 6]
+                for b in range(a + 1, 6):
+                    v -= A[a, b] * coef[i, b]
+                coef[i, a] = v / A[a, a]
+            e = 0.0
+            for j in range(k):
+                f = zs[j]
+                for a in range(6):
+                    f -= bas[j, a] * coef[i, a]
+                e += w[i, j] * f * f
+            rms[i] = np.sqrt(e)
+            rx, ry, rz = Q[i, 0] - c[i, 0], Q[i, 1] - c[i, 1], Q[i, 2] - c[i, 2]
             x = (rx * frame[i, 0, 0] + ry * frame[i, 0, 1] + rz * frame[i, 0, 2]) / hi
             y = (rx * frame[i, 1, 0] + ry * frame[i, 1, 1] + rz * frame[i, 1, 2]) / hi
             z = rx * frame[i, 2, 0] + ry * frame[i, 2, 1] + rz * frame[i, 2, 2]
-            bas[j, 0], bas[j, 1], bas[j, 2], bas[j, 3], bas[j, 4], bas[j, 5] = 1.0, x, y, x * x, x * y, y * y
-            zs[j] = z
-            wj = w[i, j]
-            for a in range(6):
-                wa = wj * bas[j, a]
-                for b in range(6):
-                    A[a, b] += wa * bas[j, b]
-                A[a, 6] += wa * z
-        for a in range(6):
-            A[a, a] += ridge[a]
-        for col in range(6):                 # Gaussian elimination with partial pivoting
-            p = col
-            for r in range(col + 1, 6):
-                if abs(A[r, col]) > abs(A[p, col]):
-                    p = r
-            if p != col:
-                for b in range(7):
-                    A[col, b], A[p, b] = A[p, b], A[col, b]
-            for r in range(col + 1, 6):
-                f = A[r, col] / A[col, col]
-                for b in range(col, 7):
-                    A[r, b] -= f * A[col, b]
-        for a in range(5, -1, -1):
-            v = A[a, 6]
-            for b in range(a + 1, 6):
-                v -= A[a, b] * coef[i, b]
-            coef[i, a] = v / A[a, a]
-        e = 0.0
-        for j in range(k):
-            f = zs[j]
-            for a in range(6):
-                f -= bas[j, a] * coef[i, a]
-            e += w[i, j] * f * f
-        rms[i] = np.sqrt(e)
-    return coef, rms
+            zf = coef[i, 0] + coef[i, 1] * x + coef[i, 2] * y + coef[i, 3] * x * x + coef[i, 4] * x * y \
+                + coef[i, 5] * y * y
+            hgt[i] = z - zf
+            for a in range(3):
+                foot[i, a] = Q[i, a] - (z - zf) * frame[i, 2, a]
+    return coef, rms, hgt, foot
+
+
+def _mls(Q, S, spacing, k, extra, tree):
+    """The weighted quadric fits of :func:`local_surface` around each query (the ``k`` nearest samples after
+    skipping ``extra``): centre c (q, 3), frame (q, 3, 3) rows t1, t2, n, scale h (q,), coefficients (q, 6), the
+    weighted rms residual of the fit (q,), the query's height over the quadric (q,) and its foot (q, 3)."""
+    from ..threads import get_num_threads
+
+    Q = np.ascontiguousarray(Q, dtype=np.float64)
+    S = np.ascontiguousarray(S, dtype=np.float64)
+    d, I = tree.query(Q, k=k + extra, workers=get_num_threads())
+    d = np.ascontiguousarray(d.reshape(len(Q), -1)[:, extra:])
+    I = np.ascontiguousarray(I.reshape(len(Q), -1)[:, extra:])
+    h, w, c, frame = _weighted_moments(S, I, d, float(spacing))
+    coef, rms, hgt, foot = _quadric_solve(S, I, w, c, frame, h, Q)
+    return c, frame, h, coef, rms, hgt, foot
 
 
 def _fit_quadrics(Q, S, spacing, k, extra, tree):
-    """The weighted quadric fits of :func:`local_surface` around each query (the ``k`` nearest samples after
-    skipping ``extra``): centre c (q, 3), frame (q, 3, 3) rows t1, t2, n, scale h (q,), coefficients (q, 6) and
-    the weighted rms residual of the fit (q,)."""
-    from ..threads import get_num_threads
-
-    d, I = tree.query(Q, k=k + extra, workers=get_num_threads())
-    d = np.ascontiguousarray(d.reshape(len(Q), -1)[:, extra:])
-    I = I.reshape(len(Q), -1)[:, extra:]
-    Y = S[I]                                                   # (q, k, 3)
-    h, w, c, C = _weighted_moments(Y, d, float(spacing))
-    _, vec = np.linalg.eigh(C)                                 # ascending: n, t2, t1
-    frame = np.ascontiguousarray(vec[:, :, ::-1].transpose(0, 2, 1))
-    coef, rms = _quadric_solve(Y, w, c, frame, h)
-    return c, frame, h, coef, rms
+    """:func:`_mls` without the queries' feet: (c, frame, h, coef, rms)."""
+    return _mls(Q, S, spacing, k, extra, tree)[:5]
 
 
 def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False, tree=None,
@@ -182,17 +259,11 @@ def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False,
     if k < 3:
         raise ValueError(f"S: needs at least {3 + extra} samples for a local surface, got {len(S)}")
     tree = cKDTree(S) if tree is None else tree
-    c, frame, h, coef, rms = _fit_quadrics(Q, S, spacing, k, extra, tree)
-    t1, t2, n = frame[:, 0], frame[:, 1], frame[:, 2]
-    Rq = Q - c
-    xq, yq, zq = (np.einsum("qx,qx->q", Rq, t) for t in (t1, t2, n))
-    xqs, yqs = xq / h, yq / h
-    zf = coef[:, 0] + coef[:, 1] * xqs + coef[:, 2] * yqs + coef[:, 3] * xqs ** 2 + coef[:, 4] * xqs * yqs \
-        + coef[:, 5] * yqs ** 2
-    foot = Q + (zf - zq)[:, None] * n
+    _, frame, _, _, rms, hgt, foot = _mls(Q, S, spacing, k, extra, tree)
+    n = frame[:, 2]
     if not return_fit:
-        return foot, n, zq - zf
-    return foot, n, zq - zf, rms
+        return foot, n, hgt
+    return foot, n, hgt, rms
 
 
 def _face_normals(V, F):
