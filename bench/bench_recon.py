@@ -189,16 +189,17 @@ def time_vs_size(sizes):
         out = subprocess.run([sys.executable, __file__, "--size-worker", str(n)], capture_output=True, text=True,
                              env=dict(os.environ))
         if out.returncode != 0:
-            rows.append([n, "failed", out.stderr.strip().splitlines()[-1][:60], "", "", ""])
+            rows.append([n, "failed", out.stderr.strip().splitlines()[-1][:60], "", "", "", ""])
             continue
         r = json.loads(out.stdout.strip().splitlines()[-1])
         tm = r["timings"]
         rows.append([n, f"{r['time']:.1f}", f"{r['rss_mb']:.0f}", r["tets"],
                      f"{tm['tetrahedralisation']:.1f} / {tm['core']:.1f} / {tm['grow']:.2f} / {tm['alternation']:.1f}",
+                     f"{tm.get('fit', 0.0):.1f} ({100 * tm.get('fit', 0.0) / r['time']:.0f} %)",
                      f"{r['cc']} / {r['genus']} / {'yes' if r['man'] else 'NO'}"])
         print("size", rows[-1], flush=True)
     return table(["points", "time (s)", "peak RSS (MB)", "tets", "tet / core / grow / alternation (s)",
-                  "CC / genus / manifold"], rows)
+                  "fit (s, % of time)", "CC / genus / manifold"], rows)
 
 
 def _uptime():

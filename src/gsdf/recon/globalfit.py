@@ -79,11 +79,7 @@ class _Pattern:
         ne = len(self.E)
         rows = np.concatenate([np.arange(n), self.E[:, 0], self.E[:, 1]])
         cols = np.concatenate([np.arange(n), self.E[:, 1], self.E[:, 0]])
-        order = np.argsort(rows, kind="stable")
-        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))]).astype(np.int64)
-        self.indices = np.ascontiguousarray(cols[order])
-        self.slot = np.empty(len(rows), dtype=np.int64)
-        self.slot[order] = np.arange(len(rows))
+        self.indptr, self.indices, self.slot = _csr_slots(rows, cols, n)
         on = rows == cols
         self.drow, self.dslot = rows[on], self.slot[on]
         self.deg = np.bincount(self.E.ravel(), minlength=n).astype(np.float64)
@@ -99,6 +95,81 @@ class _Pattern:
 
     def diagonal(self, vals):
         return np.bincount(self.drow, weights=vals[self.dslot], minlength=self.n)
+
+
+@nb.njit(cache=True)
+def _csr_slots(rows, cols, n):
+    """CSR (indptr, indices) of the entries (rows, cols), each row's entries in input order (a counting sort),
+    and the slot of every input entry."""
+    indptr = np.zeros(n + 1, np.int64)
+    for r in rows:
+        indptr[r + 1] += 1
+    for v in range(n):
+        indptr[v + 1] += indptr[v]
+    nxt = indptr[:-1].copy()
+    indices = np.empty(len(rows), np.int64)
+    slot = np.empty(len(rows), np.int64)
+    for e in range(len(rows)):
+        p = nxt[rows[e]]
+        nxt[rows[e]] += 1
+        indices[p] = cols[e]
+        slot[e] = p
+    return indptr, indices, slot
+
+
+@nb.njit(cache=True)
+def _pcg(indptr, indices, vals, cn, nrm, kd, b, x, rtol, maxiter):
+    """Preconditioned conjugate gradients on (K ⊗ I₃ + blockdiag(cn n nᵀ)) x = b (:func:`_apply`) with the
+    block-Jacobi preconditioner of :func:`_block_jacobi`, all vectors (n, 3): the iteration of
+    :func:`gsdf.linalg.iterative.cg_loop` (SciPy's ``cg``: same updates, stop when ‖r‖ < rtol ‖b‖), its vector
+    operations fused into the mat-vec / preconditioner passes.  ``x`` (the start) is updated in place; returns
+    (iterations, converged)."""
+    n = x.shape[0]
+    bn = 0.0
+    for v in range(n):
+        for i in range(3):
+            bn += b[v, i] * b[v, i]
+    atol = rtol * np.sqrt(bn)
+    if bn == 0.0:
+        x[:] = 0.0
+        return 0, True
+    r = np.empty((n, 3))
+    _apply(indptr, indices, vals, cn, nrm, x, r)
+    rn = 0.0
+    for v in range(n):
+        for i in range(3):
+            r[v, i] = b[v, i] - r[v, i]
+            rn += r[v, i] * r[v, i]
+    z = np.empty((n, 3))
+    p = np.empty((n, 3))
+    q = np.empty((n, 3))
+    rho_prev = 1.0
+    for it in range(maxiter):
+        if np.sqrt(rn) < atol:
+            return it, True
+        _block_jacobi(kd, cn, nrm, r, z)
+        rho = 0.0
+        for v in range(n):
+            for i in range(3):
+                rho += r[v, i] * z[v, i]
+        beta = rho / rho_prev if it > 0 else 0.0
+        for v in range(n):
+            for i in range(3):
+                p[v, i] = p[v, i] * beta + z[v, i] if it > 0 else z[v, i]
+        _apply(indptr, indices, vals, cn, nrm, p, q)
+        pq = 0.0
+        for v in range(n):
+            for i in range(3):
+                pq += p[v, i] * q[v, i]
+        alpha = rho / pq
+        rn = 0.0
+        for v in range(n):
+            for i in range(3):
+                x[v, i] += alpha * p[v, i]
+                r[v, i] -= alpha * q[v, i]
+                rn += r[v, i] * r[v, i]
+        rho_prev = rho
+    return maxiter, np.sqrt(rn) < atol
 
 
 @nb.njit(cache=True)
@@ -198,9 +269,7 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
     ValueError : bad shapes, NaN / inf, out-of-range faces, fewer than 3 samples, bad option values.
     """
     from ..distance.triangles import TriangleDistance
-    from ..linalg.iterative import cg_loop
     from ..spatial.morton import morton_order
-    from ..threads import blas_region
     from .relocate import local_surface
 
     V = as_points(V, "V")
@@ -250,27 +319,13 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
         c = surface * (rms <= fit_tol * h)
         # (b) the normal equations, K ⊗ I₃ + blockdiag(c n nᵀ), and a 3 × 3 block-Jacobi preconditioner
         vals, kd, rhs = _normal_equations(P, X, F, S, face, bary, a, foot, nrm, c, membrane, prox)
-        cnt = [0]
-
-        def matvec(x, vals=vals, c=c, nrm=nrm):
-            y = np.empty_like(x)
-            _apply(P.indptr, P.indices, vals, c, nrm, x.reshape(n, 3), y.reshape(n, 3))
-            return y
-
-        def psolve(r, kd=kd, c=c, nrm=nrm, cnt=cnt):
-            cnt[0] += 1
-            z = np.empty_like(r)
-            _block_jacobi(kd, c, nrm, r.reshape(n, 3), z.reshape(n, 3))
-            return z
-
         clock("assemble")
-        with blas_region():                      # its dot products on one BLAS thread (gsdf.threads)
-            x, _ = cg_loop(matvec, psolve, rhs.ravel(), X.ravel().copy(), rtol=1e-7, maxiter=2000)
+        X = X.copy()
+        its, _ = _pcg(P.indptr, P.indices, vals, c, nrm, kd, rhs, X, 1e-7, 2000)
         clock("solve")
-        X = x.reshape(n, 3)
         report["iterations"] += 1
         report["attached"].append(int((a > 0).sum()))
-        report["cg_iterations"].append(cnt[0])
+        report["cg_iterations"].append(int(its))
     X = X[rank]
     shift = np.linalg.norm(X - V, axis=1)
     report.update(mean_shift=float(shift.mean()), max_shift=float(shift.max()))
