@@ -406,3 +406,23 @@ def test_bad_sign_mode_names_the_options():
     with pytest.raises(ValueError, match="pseudonormal") as info:
         signed_distance(V, F, np.zeros((1, 3)), sign="normals")
     assert "winding" in str(info.value)
+
+
+def test_refit_answers_as_a_fresh_tree():
+    """TriangleDistance.refit keeps the tree and recomputes its boxes: the same distances as a tree built on
+    the moved mesh (brute force too), also after moves of several edge lengths; a wrong vertex count is
+    refused."""
+    V, F = icosphere(2)
+    rng = np.random.default_rng(4)
+    Q = rng.normal(size=(400, 3)) * 0.8
+    td = TriangleDistance(V, F)
+    for scale in (0.01, 0.05, 0.4):
+        W = V + rng.normal(scale=scale, size=V.shape)
+        d, face, cl, bary = td.refit(W).query_barycentric(Q)
+        d0, _, cl0, _ = TriangleDistance(W, F).query_barycentric(Q)
+        np.testing.assert_allclose(d, d0, rtol=0, atol=1e-13)
+        np.testing.assert_allclose(cl, cl0, atol=1e-12)
+        np.testing.assert_allclose(d, numpy_mesh_distance(W, F, Q), atol=1e-12)
+        np.testing.assert_allclose(np.einsum("qk,qkx->qx", bary, W[F[face]]), cl, atol=1e-12)
+    with pytest.raises(ValueError, match="V"):
+        td.refit(V[:-1])

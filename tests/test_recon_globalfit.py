@@ -134,3 +134,78 @@ def test_reconstruct_fit_option_validates(bad):
     P = _fibonacci(300)
     with pytest.raises(ValueError, match="fit"):
         gsdf.reconstruct_simply_connected(P, fit=bad)
+
+
+def _scipy_normal_equations(X, F, S, face, bary, a, foot, nrm, c, membrane, prox):
+    """The normal equations assembled the straightforward way (the first implementation of the fit): B from
+    the barycentric rows, Bᵀ diag(a) B, the graph Laplacian from unique edges, ⊗ I₃ by scipy.sparse.kron, the
+    point-to-plane blocks c n nᵀ as a block-diagonal matrix."""
+    import scipy.sparse as sp
+    n, m = len(X), len(S)
+    B = sp.csr_matrix((bary.ravel(), (np.repeat(np.arange(m), 3), F[face].ravel())), shape=(m, n))
+    E = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    E = np.unique(E, axis=0)
+    ne = len(E)
+    L = sp.csr_matrix((np.r_[np.ones(2 * ne), -np.ones(2 * ne)],
+                       (np.r_[E[:, 0], E[:, 1], E[:, 0], E[:, 1]], np.r_[E[:, 0], E[:, 1], E[:, 1], E[:, 0]])),
+                      shape=(n, n))
+    blocks = [sp.csr_matrix(ci * np.outer(v, v)) for ci, v in zip(c, nrm)]
+    M = sp.kron(B.T @ sp.diags(a) @ B + membrane * L + prox * sp.identity(n), sp.identity(3)) + sp.block_diag(blocks)
+    eta = nrm * np.einsum("vx,vx->v", nrm, L @ X)[:, None]
+    rhs = B.T @ (a[:, None] * S) + (c * np.einsum("vx,vx->v", nrm, foot))[:, None] * nrm + membrane * eta + prox * X
+    return M.toarray(), rhs
+
+
+def test_operator_form_matches_the_scipy_assembly():
+    """The kernels of the fit (CSR values of the scalar part on the edge pattern, the mat-vec with the rank-1
+    blocks, the Sherman–Morrison block-Jacobi, the fused CG) against the straightforward scipy assembly, on a
+    small mesh with a degenerate face (an edge (v, v)) and an unreferenced vertex."""
+    from gsdf.distance.triangles import TriangleDistance
+    from gsdf.recon.globalfit import _Pattern, _apply, _block_jacobi, _normal_equations, _pcg
+
+    rng = np.random.default_rng(5)
+    V, F = _icosphere(1)
+    F = np.vstack([F, [[3, 3, 7]]])                        # degenerate face: corners 0 and 1 the same vertex
+    V = np.vstack([V * rng.uniform(0.9, 1.1, (len(V), 1)), [[5.0, 5.0, 5.0]]])      # last vertex unreferenced
+    n = len(V)
+    S = _fibonacci(300) * 1.02
+    _, face, _, bary = TriangleDistance(V, F).query_barycentric(S)
+    hit = rng.random(len(S)) < 0.3                         # some samples on the degenerate face, too
+    face[np.flatnonzero(hit[:40])] = len(F) - 1
+    a = rng.uniform(0, 5, len(S)) * (rng.random(len(S)) < 0.9)
+    nrm = rng.normal(size=(n, 3))
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    foot = V + rng.normal(scale=0.05, size=V.shape)
+    c = rng.uniform(0, 1, n) * (rng.random(n) < 0.8)
+    M, rhs0 = _scipy_normal_equations(V, F, S, face, bary, a, foot, nrm, c, 0.2, 0.01)
+
+    P = _Pattern(F, n)
+    vals, kd, rhs = _normal_equations(P, V, F, S, face, bary, a, foot, nrm, c, 0.2, 0.01)
+    np.testing.assert_allclose(rhs, rhs0, rtol=1e-12, atol=1e-12)
+    x = rng.normal(size=(n, 3))
+    y = np.empty_like(x)
+    _apply(P.indptr, P.indices, vals, c, nrm, x, y)
+    np.testing.assert_allclose(y.ravel(), M @ x.ravel(), rtol=1e-12, atol=1e-12)
+    D = np.stack([M[3 * v:3 * v + 3, 3 * v:3 * v + 3] for v in range(n)])
+    z = np.empty_like(x)
+    _block_jacobi(kd, c, nrm, x, z)
+    np.testing.assert_allclose(z, np.einsum("vij,vj->vi", np.linalg.inv(D), x), rtol=1e-10, atol=1e-12)
+    X = V.copy()
+    its, ok = _pcg(P.indptr, P.indices, vals, c, nrm, kd, rhs, X, 1e-12, 1000)
+    assert ok and 0 < its < 1000
+    np.testing.assert_allclose(X.ravel(), np.linalg.solve(M, rhs0.ravel()), rtol=1e-9, atol=1e-9)
+
+
+def test_fit_does_not_depend_on_the_vertex_and_sample_labels():
+    """The fit relabels vertices and samples along the Z-order curve inside: a permuted input gives the
+    permuted output (to rounding)."""
+    V, F = _icosphere(2)
+    rng = np.random.default_rng(2)
+    W = V * rng.uniform(0.92, 1.08, (len(V), 1))
+    S = _fibonacci(700)
+    X = fit_to_samples(W, F, S, 0.12)
+    p = rng.permutation(len(V))
+    r = np.empty_like(p)
+    r[p] = np.arange(len(p))
+    Y = fit_to_samples(W[p], r[F], S[rng.permutation(len(S))], 0.12)
+    np.testing.assert_allclose(Y, X[p], atol=1e-10)

@@ -154,3 +154,43 @@ def test_reconstruction_relocation_lowers_the_error_and_keeps_the_sphere():
 def test_reconstruction_relocate_must_be_bool():
     with pytest.raises(ValueError, match="relocate"):
         gsdf.reconstruct_simply_connected(_fibonacci(200), relocate="yes")
+
+
+def _local_surface_numpy(Q, S, spacing, k, extra=0):
+    """The straightforward numpy formulation of local_surface (its first implementation: einsum moments,
+    batched eigh, batched 6 × 6 solve), an independent check of the numba kernels."""
+    from scipy.spatial import cKDTree
+    d, I = cKDTree(S).query(Q, k=k + extra)
+    d, I = d[:, extra:], I[:, extra:]
+    Y = S[I]
+    h = np.maximum(1.5 * spacing, np.median(d, axis=1))
+    w = np.exp(-(d / h[:, None]) ** 2)
+    w /= w.sum(axis=1, keepdims=True)
+    c = np.einsum("qk,qkx->qx", w, Y)
+    R = Y - c[:, None, :]
+    _, vec = np.linalg.eigh(np.einsum("qk,qki,qkj->qij", w, R, R))
+    t1, t2, n = vec[:, :, 2], vec[:, :, 1], vec[:, :, 0]
+    x, y, z = (np.einsum("qkx,qx->qk", R, t) / s for t, s in ((t1, h[:, None]), (t2, h[:, None]), (n, 1.0)))
+    B = np.stack([np.ones_like(x), x, y, x * x, x * y, y * y], axis=2)
+    A = np.einsum("qk,qka,qkb->qab", w, B, B) + np.diag([1e-9, 1e-9, 1e-9, 1e-2, 1e-2, 1e-2])[None]
+    coef = np.linalg.solve(A, np.einsum("qk,qka,qk->qa", w, B, z)[:, :, None])[:, :, 0]
+    Rq = Q - c
+    xq, yq, zq = (np.einsum("qx,qx->q", Rq, t) for t in (t1, t2, n))
+    xq, yq = xq / h, yq / h
+    zf = coef @ np.array([1.0, 0, 0, 0, 0, 0]) + coef[:, 1] * xq + coef[:, 2] * yq + coef[:, 3] * xq ** 2 \
+        + coef[:, 4] * xq * yq + coef[:, 5] * yq ** 2
+    rms = np.sqrt(np.einsum("qk,qk->q", w, (z - np.einsum("qka,qa->qk", B, coef)) ** 2))
+    return Q + (zf - zq)[:, None] * n, n, zq - zf, rms
+
+
+@pytest.mark.parametrize("k, extra", [(8, 0), (12, 1), (7, 0)])
+def test_local_surface_kernels_match_the_numpy_formulation(k, extra):
+    rng = np.random.default_rng(k)
+    S = _fibonacci(2000) * np.array([1.0, 0.7, 0.5]) + rng.normal(scale=0.004, size=(2000, 3))
+    Q = S[:300] if extra else S[:300] * rng.uniform(0.95, 1.05, (300, 1))
+    foot, n, hgt, rms = local_surface(Q, S, 0.05, k=k, exclude_self=bool(extra), return_fit=True)
+    foot0, n0, hgt0, rms0 = _local_surface_numpy(Q, S, 0.05, k, extra)
+    np.testing.assert_allclose(foot, foot0, atol=1e-12)
+    np.testing.assert_allclose(np.abs(np.einsum("qx,qx->q", n, n0)), 1.0, atol=1e-12)   # n unoriented
+    np.testing.assert_allclose(np.abs(hgt), np.abs(hgt0), atol=1e-12)
+    np.testing.assert_allclose(rms, rms0, atol=1e-12)
