@@ -213,7 +213,8 @@ def _mls(Q, S, spacing, k, extra, tree):
 
     Q = np.ascontiguousarray(Q, dtype=np.float64)
     S = np.ascontiguousarray(S, dtype=np.float64)
-    d, I = tree.query(Q, k=k + extra, workers=get_num_threads())
+    # threads only for many queries: each query call starts its workers anew
+    d, I = tree.query(Q, k=k + extra, workers=get_num_threads() if len(Q) >= 32768 else 1)
     d = np.ascontiguousarray(d.reshape(len(Q), -1)[:, extra:])
     I = np.ascontiguousarray(I.reshape(len(Q), -1)[:, extra:])
     h, w, c, frame = _weighted_moments(S, I, d, float(spacing))
