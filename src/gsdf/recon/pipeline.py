@@ -442,7 +442,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         Table-2 clouds (bench/RESULTS.md section recon-fit) CD×100 is lower on 29 (mean −0.033, largest rise
         +0.003; e.g. bunny 2K+200 0.277 → 0.250, homer 2K+400 0.242 → 0.202), the area of inverted faces (pleats)
         drops from 8.1 % to 4.4 % and tilted > 30° from 23.6 % to 17.9 % (screened Poisson: 2.1 / 11.6 %), for
-        a median 1.22× the whole call's time (the fit: 7–23 % of it at 1K–100K points, section recon-time).
+        a median 1.22× the whole call's time (the fit: 9–15 % of it at 1K–100K points, section recon-time).
         No vertex then stays at its input coordinates.
     fit_k : int in 3..64 — samples in the moving-least-squares fit that the relocation and the subdivision
         project onto (:func:`.relocate.local_surface`).  Vertex positions only: the faces are the same for
