@@ -901,7 +901,7 @@ def main():
     if "cases" in parts:
         text += ["### Generated cases" + (" (quick)" if a.quick else ""), "", parts["cases"], ""]
         cmp_ = compare_breakings(a.quick) if a.topology != "simply" else ""
-        if a.topology == "simply" and compare_endpoint_rules():
+        if a.topology == "simply" and a.breaking == "random" and compare_endpoint_rules():
             text += ["### Endpoint rule of the jump solve, old vs new (bench/swn_cases_simply*.csv)", "",
                      compare_endpoint_rules(), ""]
         if cmp_:

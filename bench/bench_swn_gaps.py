@@ -239,6 +239,15 @@ staircase (a 2-edge gap closed by the third edge of its triangle, whose level th
 on the same side): on those gaps 0.162 % with one global level, 0.175 % with the path's; the per-gap threshold
 oracle reaches 0.044 % on all paired gaps.
 
+Long gaps: the closing path is a chord, and over a long gap the curve's own bend matters more (a circle with a
+quarter missing is closed along the circle by the global level, inscribed-angle theorem; the chord's level cuts
+it). Without a limit the rule made the long-gap scheme worse (bench_swn.py --breaking long --topology simply, 420
+cases: mean 1.683 % → 1.816 %, < 0.5 % 53.8 → 51.7 %); the library keeps the global level on gaps whose closing
+path has more than 8 edges (GAP_MAX_EDGES): 1.685 % / 54.3 % (section swn-long-simply; limits 5 / 6 / 12 edges:
+1.682 / 1.684 / 1.687 %), and the random-interval cases (gaps of at most 5 edges) are unchanged by any limit of
+5–12 edges (0.267 %; 3 edges: 0.281 %). Capping the shift's size instead (|shift| <= 0.05 … 0.15) lost most of
+the gain on the random cases (0.307 … 0.278 %): the gain is in the large shifts.
+
 Also measured and not kept (scratch runs through the library kernel, 110–140 of the cases, every 3rd / 4th per
 mesh; mean error of the rule above on those: 0.194 % / 0.262 %): the faces beside the path labelled by its side
 (the closed curve's labels) instead of rounded — same error (0.194 %); the level of the curve edges at the gap's
