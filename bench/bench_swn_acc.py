@@ -178,7 +178,7 @@ def run(per_mesh, time_limit):
             row["no leftovers"] = final(np.where(loops != 0, gb - loops, r.bounding))
             row["region restored"] = final(np.where(region, gb, r.bounding))
             row["both"] = final(np.where(gb != 0, gb - loops, 0.0))
-            wf = r.corner_values.mean(1) + r.offset
+            wf = r.corner_values.mean(1) + r.label_shift + r.offset
             s = mode_offset(sw, wf, gb, r.bounding)
             row["mode offset"] = row["solver"][0] if s is None else \
                 B.mislabeled(np.round(wf - s).astype(int), truth, A)

@@ -71,7 +71,7 @@ def replay(case_csv, out_csv, cases=None):
                 r = sw.solve(gb, method="lp", time_limit=120)
                 row = {"case": cid, "group": want[cid], "loops": nb, "deleted": frac,
                        "err": B.mislabeled(r.face_labels, truth, A),
-                       "err best offset": best_offset(r.corner_values.mean(1) + r.offset, truth, A),
+                       "err best offset": best_offset(r.corner_values.mean(1) + r.label_shift + r.offset, truth, A),
                        "t": time.perf_counter() - t0}
                 ends = sw.dec.chain_endpoints(gb)
                 bnd = np.where(sw.topology.boundary_edges, 0.0, parts["region"])

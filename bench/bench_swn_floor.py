@@ -134,7 +134,7 @@ def floor_part(per_mesh, meshes=None, label=""):
             gv[d.edges[gone].ravel()] = True
             touch = gv[d.F].any(1) & ~adj
             zone = B.gap_zones(mc, g, gb)
-            wf = r.corner_values.mean(1)
+            wf = r.corner_values.mean(1) + r.label_shift
             best = min(B.mislabeled(np.round(wf - s).astype(int), truth, A) for s in np.linspace(-.5, .5, 101))
             rc = mc.swn.solve(shortest_path_closure(mc.swn, g, gb), method="lp")
             recs.append(dict(case=cid, mesh=name, faces=d.n_faces, err=A[bad].sum() / tot,

@@ -143,7 +143,7 @@ def run_cases(per_mesh, csv_path, breaking, time_limit):
                     row[f"err {k}"] = B.mislabeled(r.face_labels, truth, A)
                     row[f"t {k}"] = r.timings["total"]
                     if k in ORACLE:
-                        w = r.corner_values.mean(1) + r.offset
+                        w = r.corner_values.mean(1) + r.label_shift + r.offset
                         row[f"oracle {k}"] = min(B.mislabeled(np.round(w - s).astype(int), truth, A)
                                                  for s in np.linspace(-0.5, 0.5, 51))
                 wr.writerow(row)
@@ -201,7 +201,7 @@ def ns_diagnose(per_mesh, breaking, time_limit):
                 ro = sw.solve(gb, method="lp", time_limit=time_limit, cycle_choice="lp")   # the oracle's own LP
             finally:
                 del sw._residual_full
-            w = r.corner_values.mean(1) + r.offset
+            w = r.corner_values.mean(1) + r.label_shift + r.offset
             best = min(B.mislabeled(np.round(w - s).astype(int), truth, A) for s in np.linspace(-0.5, 0.5, 51))
             row = dict(case=cid, err=e, oracle_err=B.mislabeled(ro.face_labels, truth, A),
                        obj=r.lp_objective, oracle_obj=ro.lp_objective, best_offset=best,
