@@ -201,9 +201,10 @@ def _fill_cavities(K, w):
     return w, int(cav.sum())
 
 
-def _seeds(K, w, allowed, n_regions):
-    """One seed tet per region: the tet of largest w in the largest-volume face-connected component of
-    {w > ½} among the tets the region may use (a bubble around an outlier can hold the global maximum)."""
+def _seeds(K, w, allowed, n_regions, key=None):
+    """One seed tet per region: the tet of largest ``key`` (default w) in the largest-volume face-connected
+    component of {w > ½} among the tets the region may use (a bubble around an outlier can hold the global
+    maximum)."""
     import scipy.sparse as sp
     ft = K.face_tets
     inside = w > 0.5
@@ -222,7 +223,8 @@ def _seeds(K, w, allowed, n_regions):
             continue
         vol = np.bincount(comp[cand], K.volumes[cand])
         best = np.flatnonzero(comp[cand] == np.argmax(vol))
-        seeds.append(int(cand[best[np.argmax(w[cand[best]])]]))
+        kb = (w if key is None else key)[cand[best]]
+        seeds.append(int(cand[best[np.argmax(kb)]]))
     return np.array(seeds, dtype=np.int64)
 
 
@@ -390,7 +392,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
                                  relocate: bool = True, reach: bool = True, remesh: bool = True, subdivide: int = 1,
                                  flip_subdivided: bool = True, fit: bool = True, fit_k: int = 8,
                                  band: float = 10.0,
-                                 outlier_gap: float = 3.0, progress=None, return_report: bool = False):
+                                 outlier_gap: float = 3.0, orientation: str = "spectral", order: str = "depth",
+                                 progress=None,
+                                 return_report: bool = False):
     """Reconstruct one closed, edge- and vertex-manifold, genus-0 triangle mesh from a point cloud.
 
     Parameters
@@ -495,6 +499,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     """
     outliers = choice(outliers, "outliers", ("auto", "none"))
     sign = choice(sign, "sign", ("tangent", "winding"))
+    orientation = choice(orientation, "orientation", ("spectral", "mst"))
+    order = choice(order, "order", ("depth", "seed"))
     max_iterations = integer(max_iterations, "max_iterations", lo=1)
     subdivide = integer(subdivide, "subdivide", lo=0, hi=3)
     fit_k = integer(fit_k, "fit_k", lo=3, hi=64)
@@ -534,7 +540,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     bad = np.linalg.norm(Ni, axis=1) == 0
     if bad.any():
         Ni[bad] = _pca_normals(Xi)[bad]
-    Ni = orient_normals(Xi, Ni)
+    Ni = orient_normals(Xi, Ni, method=orientation)
     timings["orientation"] = time.perf_counter() - t
     # --- tetrahedralisation
     t = time.perf_counter()
@@ -622,15 +628,24 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         timings["core"] += time.perf_counter() - t
         t = time.perf_counter()
         say(f"growing the ball (round {it + 1})")
-        seeds = _seeds(K, w, allowed, n_regions)
-        # order: w, clamped at 1 (inside the field is a plateau), minus a small distance to the region's seed,
-        # so the front grows concentrically instead of fractally (notes 2(b).6)
         cen = K.V[K.T].mean(axis=1)
-        sd = np.full(K.n_tets, 0.0)
-        for r, sdt in enumerate(seeds):
-            m = allowed == r
-            sd[m] = np.linalg.norm(cen[m] - cen[sdt], axis=1)
-        prio = np.minimum(w, 1.0) - 0.05 * sd
+        if order == "depth":
+            # order: depth, the centroid's distance to the nearest sample, scaled by min(w, 1): the deepest tets
+            # first, like a watershed, so that where the inside set has a tunnel (a bridge, a thin part whose
+            # Delaunay tets touch across) the fronts meet — and the growth must leave its cut — at the thinnest
+            # place, not across a thick body (notes 2(b).6; bench/RESULTS.md section recon-thin)
+            depth = cKDTree(Xi[use]).query(cen)[0]
+            prio = np.minimum(w, 1.0) * depth
+            seeds = _seeds(K, w, allowed, n_regions, key=prio)
+        else:
+            seeds = _seeds(K, w, allowed, n_regions)
+            # order: w, clamped at 1 (inside the field is a plateau), minus a small distance to the region's
+            # seed, so the front grows concentrically instead of fractally (notes 2(b).6)
+            sd = np.full(K.n_tets, 0.0)
+            for r, sdt in enumerate(seeds):
+                m = allowed == r
+                sd[m] = np.linalg.norm(cen[m] - cen[sdt], axis=1)
+            prio = np.minimum(w, 1.0) - 0.05 * sd
         label, rejected = grow_regions(K, w, 0.5, seeds=seeds, allowed=allowed, priority=prio)
         if sculpt:
             label, n_add, n_cut = _sculpt(K, label, allowed, wn, dS, n_p, use, spacing)
