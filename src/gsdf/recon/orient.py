@@ -87,7 +87,7 @@ def _hull_sign(P, N, members):
 
 
 def orient_normals(P: np.ndarray, N: np.ndarray, k: int = 10, link: float = 6.0, method: str = "spectral",
-                   sharpness: float = 4.0, crossing: float = 0.0) -> np.ndarray:
+                   sharpness: float = 4.0, crossing: float = 0.0, weak: float = 0.25) -> np.ndarray:
     """Consistently orient unit normals ``N`` (n, 3) of points ``P``.
 
     Both methods work on the kNN graph (components closer than ``link`` × the median spacing linked through
@@ -101,7 +101,7 @@ def orient_normals(P: np.ndarray, N: np.ndarray, k: int = 10, link: float = 6.0,
       parallel but their outward signs opposite, so n_i·n_j would say "flip").  The relaxation is the top
       eigenvector of the normalised signed adjacency, then local majority votes: one bad edge cannot flip a
       whole subtree as in a spanning tree — every sign is decided by all its edges.  On the 32 Table-2 clouds
-      (PCA normals of the pre-filtered points) it flips 2.1 % of the sample normals against the truth, the
+      (PCA normals of the pre-filtered points) it flips 2.2 % of the sample normals against the truth, the
       spanning tree 3.7 % (camel 8K+200: 138 against 679; bench/RESULTS.md section recon-thin).
       The second (crossing) term, off by default, is the sign relation across a thin part: for consistently
       oriented normals of a smooth closed surface −(n_i·d̂)(n_j·d̂) ≥ 0, and it is large exactly across thin
@@ -148,6 +148,25 @@ def orient_normals(P: np.ndarray, N: np.ndarray, k: int = 10, link: float = 6.0,
     for c in range(ncomp):
         members = np.flatnonzero(comp == c)
         flip[members] = _spectral_signs(A[members][:, members])
+    if weak > 0:
+        # points whose signs rest on little weight (every edge leaves the tangent plane: an outlier moved along
+        # the normal, with edges to the sheet below it only) take the sign of their neighbours with weight,
+        # as in a spanning tree (Hoppe's n_i·n_j), strongest first
+        strength = np.asarray(abs(A).sum(axis=1)).ravel()
+        lo = strength < weak * np.median(strength)
+        if lo.any() and (~lo).any():
+            B = sp.csr_matrix((dot, (rows, cols)), shape=(n, n))
+            B = (B + B.T).tocsr()
+            done = ~lo
+            for _ in range(10):
+                vote = B[:, done] @ flip[done]
+                todo = lo & ~done & (np.abs(vote) > 0)
+                if not todo.any():
+                    break
+                flip[todo] = np.where(vote[todo] >= 0, 1.0, -1.0)
+                done = done | todo
+    for c in range(ncomp):
+        members = np.flatnonzero(comp == c)
         flip[members] *= _hull_sign(P, N * flip[:, None], members)
     return N * flip[:, None]
 
