@@ -716,7 +716,10 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
             prio = np.minimum(w, 1.0) * depth
             if sculpt:
                 prio = prio * np.clip(wn, 0.0, 1.0)
-            seeds = _seeds(K, w, allowed, n_regions, key=prio, n_samples=n_p)
+            # the seed: the deepest tet of the component touching the most samples; with several clusters
+            # (cross-section rings, say, whose depth field is no body's) the tet of largest w, as in the
+            # concentric order (vessel clouds with clusters=True: CD×100 1.38 with the deepest, 0.66 with it)
+            seeds = _seeds(K, w, allowed, n_regions, key=prio if n_regions == 1 else None, n_samples=n_p)
         else:
             seeds = _seeds(K, w, allowed, n_regions, n_samples=n_p)
             # order: w, clamped at 1 (inside the field is a plateau), minus a small distance to the region's
