@@ -23,7 +23,9 @@ bull,camel --table2-only`` runs the Table-2 cases of those meshes only (section 
 the full run's Table-2 clouds, with SPSR (section ``recon-remesh``); ``--only-post`` the same for the flips on
 the subdivided mesh (``flip_subdivided=False`` against the default; section ``recon-post``); ``--only-fit`` the
 same for the global least-squares fit of all vertices (``fit=False`` against the default, with the inverted /
-tilted area of both against the truth normals; section ``recon-fit``).
+tilted area of both against the truth normals; section ``recon-fit``); ``--only-thin`` the same for the choice of
+the surface before the fitting (``orientation="mst", order="seed", rescue=False`` against the default; section
+``recon-thin``).
 """
 
 from __future__ import annotations
