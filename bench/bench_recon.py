@@ -23,7 +23,9 @@ bull,camel --table2-only`` runs the Table-2 cases of those meshes only (section 
 the full run's Table-2 clouds, with SPSR (section ``recon-remesh``); ``--only-post`` the same for the flips on
 the subdivided mesh (``flip_subdivided=False`` against the default; section ``recon-post``); ``--only-fit`` the
 same for the global least-squares fit of all vertices (``fit=False`` against the default, with the inverted /
-tilted area of both against the truth normals; section ``recon-fit``).
+tilted area of both against the truth normals; section ``recon-fit``); ``--only-thin`` the same for the choice of
+the surface before the fitting (``orientation="mst", order="seed", rescue=False`` against the default; section
+``recon-thin``).
 """
 
 from __future__ import annotations
@@ -264,7 +266,7 @@ def shape_stats(V, F, GT, NG, rng, n=100_000):
     return 100 * float((c < 0).mean()), 100 * float((np.abs(c) < np.cos(np.radians(30))).mean())
 
 
-def before_after_table(before_kw, before_label, count, stage, shape=False):
+def before_after_table(before_kw, before_label, count, stage, shape=False, labels=None):
     """The Table-2 clouds of the full run (same rng stream: the draws of the other methods' metric samples
     are skipped), three reconstructions each: ours with ``before_kw`` (before), ours (the default), SPSR given
     the true normals; the metric samples come from one fixed rng per case, the same for all three.
@@ -325,6 +327,8 @@ def before_after_table(before_kw, before_label, count, stage, shape=False):
     if shape:
         header[-3:-3] = ["inverted % area before / after / SPSR", "tilted > 30° % area before / after / SPSR"]
         header[-3], header[-2] = "stage report", "stage (s)"
+    if labels is not None:
+        header[-3], header[-2] = labels
         sh = np.array(shapes)
         summary += (f"  Inverted area (mean over cases): before {sh[:, 0, 0].mean():.1f} %, after {sh[:, 1, 0].mean():.1f} "
                     f"%, SPSR {sh[:, 2, 0].mean():.1f} %; tilted > 30°: before {sh[:, 0, 1].mean():.1f} %, after "
@@ -389,6 +393,33 @@ def only_fit():
                   "normal points against the normal of the nearest truth sample (pleats), tilted = more than 30° "
                   "off it (100k area samples, rng 2).  \"stage report\" = CG iterations of the fit before the "
                   "flips + on the subdivided mesh (4 rounds each); \"stage (s)\" = both fits.\n\n"
+                  + text + "\n\n" + summary)
+
+
+THIN_BEFORE = dict(orientation="mst", order="seed", rescue=False)
+
+
+def only_thin():
+    """Before / after of the changes to the surface chosen before the fitting (issue 13, missed thin parts and
+    spurious sheets): ``orientation="mst", order="seed", rescue=False`` (the earlier pipeline, fit=True)
+    against the default, into section recon-thin."""
+    up, t0 = _uptime(), time.perf_counter()
+    print(up, flush=True)
+    text, summary = before_after_table(THIN_BEFORE, "mst / seed / no rescue",
+                                       lambda r: f"{r['dense_rescued']}", lambda r: r["timings"]["orientation"],
+                                       shape=True, labels=("kept by the dense / on-surface tests", "stage (s)"))
+    write_section("recon-thin", "## recon-thin: spectral orientation, depth-ordered growth, on-surface rescue — "
+                  "before / after on the Table-2 clouds\n\n"
+                  f"Machine: {machine()}. Load at start: `{up}`; at the end: `{_uptime()}`. Command: `PYTHONPATH=src "
+                  "/work/anchors/bin/python bench/bench_recon.py --only-thin` "
+                  f"({time.perf_counter() - t0:.0f} s).  Same clouds as the full run (section recon); CD×100 / HD×100 "
+                  "with one metric sample per case shared by the three methods; both with the global fit (fit=True). "
+                  "Before = `orientation=\"mst\", order=\"seed\", rescue=False` (the pipeline of section recon-fit); "
+                  "after = the default (`orientation=\"spectral\"`: normals oriented by the top eigenvector of the "
+                  "signed kNN adjacency with edges across thin parts damped; `order=\"depth\"`: the growth in "
+                  "order of depth; `rescue=True`: dropped points on the kept points' surface kept).  Inverted / "
+                  "tilted as in section recon-fit.  \"kept by the dense / on-surface tests\" = points the planar "
+                  "test drops that the default keeps; \"stage (s)\" = the orientation.\n\n"
                   + text + "\n\n" + summary)
 
 
@@ -562,6 +593,9 @@ if __name__ == "__main__":
     ap.add_argument("--only-fit", action="store_true",
                     help="only the before / after table of the global fit (fit) on the full run's Table-2 clouds, "
                          "with SPSR and inverted / tilted area; written to section recon-fit")
+    ap.add_argument("--only-thin", action="store_true",
+                    help="only the before / after table of the orientation / growth order / rescue changes on the full "
+                         "run's Table-2 clouds, with SPSR and inverted / tilted area; written to section recon-thin")
     ap.add_argument("--size-worker", type=int, default=None)
     ap.add_argument("--only-sizes", default=None, metavar="N,N,...",
                     help="only the time / peak memory vs point count table for these sizes (one process each), "
@@ -575,6 +609,8 @@ if __name__ == "__main__":
         only_post()
     elif a.only_fit:
         only_fit()
+    elif a.only_thin:
+        only_thin()
     elif a.only_sizes:
         only_sizes([int(n) for n in a.only_sizes.split(",")])
     else:
