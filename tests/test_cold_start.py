@@ -180,9 +180,9 @@ _TWO_DTYPES = {"gsdf.linalg.ldl._numeric", "gsdf.linalg.ldl._solve", "gsdf.linal
                "gsdf.spatial.binned._bigger"}
 
 
-@pytest.mark.parametrize("job", ["point-areas", "polygon-heat"])
+@pytest.mark.parametrize("job", ["point-areas", "polygon-heat", "reconstruct"])
 def test_kernels_compile_once(tmp_path, job):
-    """Every gsdf kernel on the point-area path and on the polygon signed heat path compiles one specialisation
+    """Every gsdf kernel on the point-area, polygon signed heat and reconstruction paths compiles one specialisation
     (a literal int argument, e.g. a count that starts at 0, gives a second one: seconds of cold compile for
     nothing)."""
     work = {
@@ -196,6 +196,10 @@ def test_kernels_compile_once(tmp_path, job):
                         "i[:-1, 1:].ravel()], 1)\n"
                         "loop = np.concatenate([i[2, 2:6], i[2:6, 6], i[6, 6:2:-1], i[6:1:-1, 2]])\n"
                         "PolygonMeshSignedHeatSolver(V, Q).compute_distance([loop])\n",
+        "reconstruct": "rng = np.random.default_rng(0)\n"
+                       "P = rng.normal(size=(600, 3)) * [1.0, 0.7, 0.5]\n"
+                       "P /= np.linalg.norm(P / [1.0, 0.7, 0.5], axis=1)[:, None]\n"
+                       "gsdf.reconstruct_simply_connected(P)\n",
     }[job]
     code = (
         "import numpy as np, numba, sys, gsdf\n" + work +

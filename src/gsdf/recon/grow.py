@@ -145,7 +145,7 @@ def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, eligi
     cap = 4 * m + seeds.shape[0] + 1
     keys = np.empty(cap)
     vals = np.empty(cap, dtype=np.int64)
-    size = 0
+    size = np.int64(0)                  # not a literal 0: the heap kernels would compile once more for it
     rejected = 0
     # resume: queue the eligible unlabelled neighbours of the regions given
     for t in range(m):
@@ -178,7 +178,7 @@ def _grow(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, eligi
         if not ok:
             rejected += 1
             continue
-        ns, s0, s1 = _faces_towards(tet_faces, tet_face_sign, face_tets, label, t, r, True)
+        ns, s0, s1 = _faces_towards(tet_faces, tet_face_sign, face_tets, label, t, r, np.bool_(True))
         if ns == 0 or ns == 4:
             rejected += 1
             continue
@@ -231,7 +231,7 @@ def _carve(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, remo
     cap = 8 * m + 1
     keys = np.empty(cap)
     vals = np.empty(cap, dtype=np.int64)
-    size = 0
+    size = np.int64(0)
     for t in range(m):
         if label[t] >= 0 and removable[t]:
             for k in range(4):
@@ -245,7 +245,7 @@ def _carve(T, tet_edges, tet_faces, tet_face_sign, face_tets, pair_to_edge, remo
         r = label[t]
         if r < 0:
             continue
-        nc, c0, c1 = _faces_towards(tet_faces, tet_face_sign, face_tets, label, t, r, False)
+        nc, c0, c1 = _faces_towards(tet_faces, tet_face_sign, face_tets, label, t, r, np.bool_(False))
         if nc == 0 or nc == 4:
             continue
         if nc == 1:
