@@ -387,23 +387,21 @@ def build_volume_rows(E, leaf_size, threads=1):
     order = np.arange(n, dtype=np.int64)
     root = _root_bounds(E)
     if threads > 1 and n > PARALLEL_ELEMENTS:
-        from concurrent.futures import ThreadPoolExecutor
+        from ..threads import run_tasks
 
         cutoff = max(leaf_size + 1, n // 64)
-        with ThreadPoolExecutor(max_workers=threads) as pool:
-            kt, top_i, top_b, ntask, task_i, task_b = _parallel_top(E, order, root, leaf_size, cutoff, pool)
-            # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
-            sub_i = np.empty((2 * n, 4), np.int64)
-            sub_b = np.empty((2 * n, 6))
-            counts = np.empty(ntask, np.int64)
+        kt, top_i, top_b, ntask, task_i, task_b = _parallel_top(E, order, root, leaf_size, cutoff, threads)
+        # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
+        sub_i = np.empty((2 * n, 4), np.int64)
+        sub_b = np.empty((2 * n, 6))
+        counts = np.empty(ntask, np.int64)
 
-            def grow_task(t):
-                s, e = task_i[t, 0], task_i[t, 1]
-                counts[t] = _grow(E, order, s, e, task_b[t], leaf_size, 0, sub_i, sub_b, 2 * s)[0]
+        def grow_task(t):
+            s, e = task_i[t, 0], task_i[t, 1]
+            counts[t] = _grow(E, order, s, e, task_b[t], leaf_size, 0, sub_i, sub_b, 2 * s)[0]
 
-            # largest subtrees first, so the threads finish together
-            todo = np.argsort(task_i[:ntask, 0] - task_i[:ntask, 1], kind="stable")
-            list(pool.map(grow_task, todo))
+        # largest subtrees first, so the threads finish together; each thread takes the next one in turn
+        run_tasks(grow_task, np.argsort(task_i[:ntask, 0] - task_i[:ntask, 1], kind="stable"), threads)
         start, end, right, lo, hi = _splice(kt, top_i, top_b, task_i[:ntask], counts, sub_i, sub_b)
     else:
         k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, root, leaf_size, 0, np.empty((2 * n, 4), np.int64),
@@ -413,9 +411,9 @@ def build_volume_rows(E, leaf_size, threads=1):
     return order, start, end, right, _skips(right), lo, hi
 
 
-def _parallel_top(E, order, root, leaf_size, cutoff, pool):
+def _parallel_top(E, order, root, leaf_size, cutoff, threads):
     """The top of the tree down to nodes of at most ``cutoff`` elements (the tasks), as :func:`_grow` with
-    that cutoff returns it, with the two halves below the root grown at the same time on ``pool``'s threads
+    that cutoff returns it, with the two halves below the root grown at the same time on two threads
     (the top levels were ~25 % of the build on one thread while the other waited). The same tree as one
     :func:`_grow`: the root's split, then each child's subtree, numbered root, left's nodes, right's."""
     n = E.shape[0]
@@ -424,8 +422,15 @@ def _parallel_top(E, order, root, leaf_size, cutoff, pool):
                                       np.empty((4, 6)), 0)
     if k0 != 3 or nt0 != 2:  # root is a leaf (cannot happen above PARALLEL_ELEMENTS), or not split in two
         return _grow(E, order, 0, n, root, leaf_size, cutoff, np.empty((256, 4), np.int64), np.empty((256, 6)), 0)
-    halves = list(pool.map(lambda h: _grow(E, order, ti0[h, 0], ti0[h, 1], tb0[h], leaf_size, cutoff,
-                                           np.empty((128, 4), np.int64), np.empty((128, 6)), 0), (0, 1)))
+    from ..threads import run_tasks
+
+    halves = [None, None]
+
+    def half(h):
+        halves[h] = _grow(E, order, ti0[h, 0], ti0[h, 1], tb0[h], leaf_size, cutoff, np.empty((128, 4), np.int64),
+                          np.empty((128, 6)), 0)
+
+    run_tasks(half, (0, 1), min(2, threads))
     (kl, il, bl, ntl, tl, tbl), (kr, ir, br, ntr, tr, tbr) = halves
     kt = 1 + kl + kr
     top_i = np.empty((kt, 4), np.int64)
