@@ -6,7 +6,8 @@ Times each stage of the build with time.perf_counter (wall) and time.process_tim
 validation + frame, the element rows, the tree (root bounds, top levels, subtree tasks, splice), the moments,
 the wide lanes. Medians over ``--repeat`` builds after one warm-up build; "total" is a plain
 FastWindingNumber(V, F) timed the same way (its stages are not the sum of parts exactly: the profiled run
-repeats the calls with timers between them). Prints one table per mesh.
+repeats the calls with timers between them; "threads in f" is the wall / CPU of f's run_tasks calls, the
+thread-parallel parts). Prints one table per mesh.
 """
 
 from __future__ import annotations
@@ -70,27 +71,20 @@ def install():
     _wrap(fast, "_tree_moments", "moments")
     _wrap(fast, "widen", "lanes: widen")
     _wrap(fast, "_pack_wide", "lanes (all)")
-    _wrap(fast, "_lanes", "lanes: _lanes (serial call)")
     _wrap(fast, "run_ranges", "lanes: run_ranges")
     _wrap(fast, "_node_moments_list", "moments: nodes above")
-    import concurrent.futures as cf
+    from gsdf import threads
 
-    base = cf.ThreadPoolExecutor
-    if not getattr(base, "_profiled", False):
-        class Pool(base):
-            _profiled = True
+    def labelled(fn):
+        def wrapped(*a, **k):
+            with stage("threads in " + sys._getframe(1).f_code.co_name):
+                return fn(*a, **k)
 
-            def __enter__(self):
-                self._stage = stage("pool in " + sys._getframe(1).f_code.co_name)
-                self._stage.__enter__()
-                return super().__enter__()
+        wrapped.__wrapped__ = fn
+        return wrapped
 
-            def __exit__(self, *exc):
-                r = super().__exit__(*exc)
-                self._stage.__exit__(*exc)
-                return r
-
-        cf.ThreadPoolExecutor = Pool
+    for mod in (threads, fast):
+        mod.run_tasks = labelled(mod.run_tasks)
 
 
 def main(argv=None):
@@ -127,7 +121,7 @@ def main(argv=None):
 
 
 def uninstall():
-    for mod in (fast, fast.Frame, binned, bvh):
+    for mod in (fast, fast.Frame, binned, bvh, sys.modules["gsdf.threads"]):
         for name, val in list(vars(mod).items()):
             if hasattr(val, "__wrapped__") and callable(val) and getattr(val, "__name__", "") == "wrapped":
                 setattr(mod, name, val.__wrapped__)
