@@ -64,7 +64,7 @@ def install():
     _wrap(fast.Frame, "of_mesh", "frame")
     _wrap(fast, "_triangle_elements", "elements")
     _wrap(binned, "_root_bounds", "tree: root bounds")
-    _wrap(binned, "_parallel_top", "tree: top (root + halves)")
+    _wrap(binned, "_parallel_grow", "tree: top + subtrees")
     _wrap(binned, "_splice", "tree: splice")
     _wrap(binned, "_skips", "tree: skips")
     _wrap(fast, "build_volume_bvh", "tree (all)")
