@@ -487,18 +487,17 @@ def _parallel_grow(E, order, root, leaf_size, cutoff, threads, sub_i, sub_b):
 @njit(cache=True)
 def _root_bounds(E):
     """Box lo, hi and centroid lo, hi (12) of all rows of E."""
-    n = E.shape[0]
+    # running bounds in scalars (not in ``root``: its stores and reloads chained every row, 0.85 ms at 89k)
+    lx = ly = lz = cx0 = cy0 = cz0 = np.inf
+    hx = hy = hz = cx1 = cy1 = cz1 = -np.inf
+    for i in range(E.shape[0]):
+        lx, ly, lz = min(lx, E[i, 3]), min(ly, E[i, 4]), min(lz, E[i, 5])
+        hx, hy, hz = max(hx, E[i, 6]), max(hy, E[i, 7]), max(hz, E[i, 8])
+        cx0, cy0, cz0 = min(cx0, E[i, 0]), min(cy0, E[i, 1]), min(cz0, E[i, 2])
+        cx1, cy1, cz1 = max(cx1, E[i, 0]), max(cy1, E[i, 1]), max(cz1, E[i, 2])
     root = np.empty(12)
-    for d in range(3):
-        root[d] = root[6 + d] = np.inf
-        root[3 + d] = root[9 + d] = -np.inf
-    for i in range(n):
-        for d in range(3):
-            c = E[i, d]
-            root[d] = min(root[d], E[i, 3 + d])
-            root[3 + d] = max(root[3 + d], E[i, 6 + d])
-            root[6 + d] = min(root[6 + d], c)
-            root[9 + d] = max(root[9 + d], c)
+    root[0], root[1], root[2], root[3], root[4], root[5] = lx, ly, lz, hx, hy, hz
+    root[6], root[7], root[8], root[9], root[10], root[11] = cx0, cy0, cz0, cx1, cy1, cz1
     return root
 
 

@@ -318,7 +318,7 @@ def _area_normal(T, j):
 
 
 
-def _tree_moments(V, F, order, start, end, right, lo, hi):
+def _tree_moments(V, F, order, start, end, right, lo, hi, also=None):
     """Leaf rows and Taylor moments of every node of a triangle tree, children before parents.
 
     Returns T (m, 10): per triangle in tree order its 9 corner coordinates, then 1.0 (0.0 for a zero-area
@@ -331,6 +331,9 @@ def _tree_moments(V, F, order, start, end, right, lo, hi):
         c0 += c0_c,   C1_ab += C1_c,ab + δ_a c0_c,b,
         S_ab,c += S_c,ab,c + δ_a C1_c,bc + δ_b C1_c,ac + δ_a δ_b c0_c,c      (S_ab,c = Σ (C_t + d dᵀ)_ab n_c)
     so the build costs O(m + k) instead of the O(m log m) of summing every node's triangles.
+
+    ``also``: an optional callable of other work (the wide view of the tree) run as one more task on the
+    same threads, so it costs no serial time of its own.
     """
     m = order.shape[0]
     k = start.shape[0]
@@ -339,13 +342,21 @@ def _tree_moments(V, F, order, start, end, right, lo, hi):
     W = np.empty((k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
     threads = numba.get_num_threads()
     if m < PARALLEL_BUILD_FACES or threads == 1:
+        if also is not None:
+            also()
         _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, 0, k)
         return T, D
     # whole subtrees on Python threads (leaves, then their parents, while the rows are in cache), then the
     # few nodes above them on this thread
     roots, above = _split_top(start, end, right, 8 * threads)
-    run_tasks(lambda r: _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, r, _subtree_end(right, r)),
-              roots, threads)
+
+    def task(r):
+        if r < 0:
+            also()
+        else:
+            _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, r, _subtree_end(right, r))
+
+    run_tasks(task, ([-1] if also is not None else []) + roots, threads)
     _node_moments_list(start, end, right, lo, hi, D, W, np.array(sorted(above, reverse=True), np.int64))
     return T, D
 
@@ -558,11 +569,12 @@ WIDTH = 4
 _WF = 4 + COMPACT_WIDTH - 1  # fields per child slot: centre (3), β²r², the 23 compact coefficients
 
 
-def _pack_wide(D, tree, beta2, order, width=WIDTH):
+def _pack_wide(D, tree, beta2, order, width=WIDTH, wt=None):
     """Per wide node, the far-field data of its children as (w, _WF, width) float64 (one lane per child, so
     the lane loop of :func:`_eval_triangles_wide` reads contiguous memory), plus the child links and the
-    element ranges of the leaf children (w, width) int64."""
-    wt = widen(tree, width)
+    element ranges of the leaf children (w, width) int64. ``wt``: the tree's :func:`widen` view, if done."""
+    if wt is None:
+        wt = widen(tree, width)
     kids, child, depth = wt.kids, wt.child, wt.depth
     if tree.right[0] >= 0:
         # a first node whose one child is the root, so the root's own far field is tried too (a query far
@@ -798,9 +810,12 @@ class FastWindingNumber(_FastWindingBase):
         # "β = 2 gives ~1e-3".
         # the (k, 40) moments D are folded into the lanes and dropped (18 MB at 89k faces, a third of the object;
         # tests rebuild them with _tree_moments)
-        self._T, D = _tree_moments(V, F, t.order, t.start, t.end, t.right, t.lo, t.hi)
-        # the walk tests the WIDTH children of a node together (see _eval_triangles_wide)
-        self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(D, t, self.beta ** 2, self.order)
+        wide = []  # the walk tests the WIDTH children of a node together (see _eval_triangles_wide): the wide
+        # view of the tree, built on the moments' threads
+        self._T, D = _tree_moments(V, F, t.order, t.start, t.end, t.right, t.lo, t.hi,
+                                   lambda: wide.append(widen(t, WIDTH)))
+        self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(D, t, self.beta ** 2, self.order, WIDTH,
+                                                                        wide[0])
 
     def _kernel(self, q, out):
         with _single_thread(q.shape[0] < SERIAL_QUERIES):
