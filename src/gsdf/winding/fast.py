@@ -760,7 +760,6 @@ def _single_thread(serial: bool):
 
 class _FastWindingBase:
     tree: BVH
-    _D: np.ndarray
 
     def __call__(self, Q, progress=None) -> np.ndarray:
         """Winding numbers at query points ``Q`` (q, 3); evaluated in parallel chunks."""
