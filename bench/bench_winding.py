@@ -55,8 +55,10 @@ builds / query sets run on the calling thread (a parallel launch waits for worke
 Build (src/gsdf/spatial/binned.py, winding/fast.py): the tree moves element rows instead of indexing them,
 bins all three axes in one pass and sweeps every split position in nodes of ≤ 24 triangles; the node
 moments are summed bottom-up (children shifted to the parent's centre), O(m + k) instead of O(m log m),
-and folded straight into the 4-wide lanes; from 20k faces the two halves below the root, the lower
-subtrees, leaf moments and lanes use the threads. "gsdf pre s" is this whole build."""
+and folded straight into the 4-wide lanes; from 20k faces the element rows, the two halves below the root
+and the lower subtrees (pipelined), the leaf moments (with the wide view beside them) and the lanes use the
+threads of one persistent pool (gsdf.threads.run_tasks). "gsdf pre s" is this whole build
+(bench/profile_fwn_build.py prints it stage by stage)."""
 
 
 def queries_in_box(X, n, rng, pad=0.1):

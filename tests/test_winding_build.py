@@ -167,12 +167,14 @@ def test_bottom_up_moments_equal_direct_sums():
     D = fast._node_moments(t.start, t.end, X, AN, M, np.empty((len(X), 0)), fast.NODE_WIDTH)
     far = np.maximum(np.abs(t.lo - D[:, :3]), np.abs(t.hi - D[:, :3]))
     D[:, 3] = (far ** 2).sum(axis=1)
-    np.testing.assert_allclose(f._D, D, rtol=1e-11, atol=1e-13 * np.abs(D).max())
+    T, Df = fast._tree_moments(Vn, F, t.order, t.start, t.end, t.right, t.lo, t.hi)  # the build's (not kept)
+    np.testing.assert_array_equal(T, f._T)
+    np.testing.assert_allclose(Df, D, rtol=1e-11, atol=1e-13 * np.abs(D).max())
     # the lanes hold the compact fold of those moments
     lane = f._W[1:, 4:, :].transpose(0, 2, 1).reshape(-1, fast.COMPACT_WIDTH - 1)
     kids = widen(t, fast.WIDTH).kids.ravel()   # lane rows 1: are the wide view's nodes (row 0 holds the root)
     ok = kids >= 0
-    np.testing.assert_allclose(lane[ok], fast._fold_moments(f._D)[kids[ok], :23], rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(lane[ok], fast._fold_moments(Df)[kids[ok], :23], rtol=1e-12, atol=1e-14)
 
 
 @pytest.mark.parametrize("order", [1, 2])

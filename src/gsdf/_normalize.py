@@ -79,7 +79,7 @@ class Frame:
         """Frame of the vertices referenced by the faces/edges ``F`` (unreferenced vertices do not count)."""
         used = np.zeros(V.shape[0], dtype=bool)
         used[F.ravel()] = True
-        return cls.of(V[used])
+        return cls.of(V if used.all() else V[used])  # (no copy when every vertex is used)
 
     def _map(self, X: np.ndarray, name: str, row0: int = 0, far_ok: bool = False) -> np.ndarray:
         """``(X − c) / s``; rows whose frame coordinates overflow are refused, or with ``far_ok`` put at

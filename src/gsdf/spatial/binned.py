@@ -378,8 +378,8 @@ def build_volume_rows(E, leaf_size, threads=1):
 
     With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
     of the tree is split down to nodes of about n/64 elements (the root on the calling thread, then its two
-    halves at once, :func:`_parallel_top`), whose subtrees are then
-    grown on ``threads`` Python threads (:func:`_grow` releases the GIL; the subtrees own disjoint rows) and
+    halves at once), whose subtrees are grown on ``threads`` Python threads as soon as their half is done
+    (:func:`_parallel_grow`; :func:`_grow` releases the GIL; the subtrees own disjoint rows) and
     spliced into the preorder arrays by :func:`_splice` (the same tree as the serial build). Both builds are
     the one compiled kernel :func:`_grow` driven from here: no parallel numba kernel (a parfor over the tasks
     cost ~6 s of compilation on a cold start, issue 17, for a build of 0.05-0.3 s)."""
@@ -387,23 +387,12 @@ def build_volume_rows(E, leaf_size, threads=1):
     order = np.arange(n, dtype=np.int64)
     root = _root_bounds(E)
     if threads > 1 and n > PARALLEL_ELEMENTS:
-        from concurrent.futures import ThreadPoolExecutor
-
         cutoff = max(leaf_size + 1, n // 64)
-        with ThreadPoolExecutor(max_workers=threads) as pool:
-            kt, top_i, top_b, ntask, task_i, task_b = _parallel_top(E, order, root, leaf_size, cutoff, pool)
-            # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
-            sub_i = np.empty((2 * n, 4), np.int64)
-            sub_b = np.empty((2 * n, 6))
-            counts = np.empty(ntask, np.int64)
-
-            def grow_task(t):
-                s, e = task_i[t, 0], task_i[t, 1]
-                counts[t] = _grow(E, order, s, e, task_b[t], leaf_size, 0, sub_i, sub_b, 2 * s)[0]
-
-            # largest subtrees first, so the threads finish together
-            todo = np.argsort(task_i[:ntask, 0] - task_i[:ntask, 1], kind="stable")
-            list(pool.map(grow_task, todo))
+        # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
+        sub_i = np.empty((2 * n, 4), np.int64)
+        sub_b = np.empty((2 * n, 6))
+        kt, top_i, top_b, ntask, task_i, counts = _parallel_grow(E, order, root, leaf_size, cutoff, threads,
+                                                                 sub_i, sub_b)
         start, end, right, lo, hi = _splice(kt, top_i, top_b, task_i[:ntask], counts, sub_i, sub_b)
     else:
         k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, root, leaf_size, 0, np.empty((2 * n, 4), np.int64),
@@ -413,20 +402,71 @@ def build_volume_rows(E, leaf_size, threads=1):
     return order, start, end, right, _skips(right), lo, hi
 
 
-def _parallel_top(E, order, root, leaf_size, cutoff, pool):
-    """The top of the tree down to nodes of at most ``cutoff`` elements (the tasks), as :func:`_grow` with
-    that cutoff returns it, with the two halves below the root grown at the same time on ``pool``'s threads
-    (the top levels were ~25 % of the build on one thread while the other waited). The same tree as one
-    :func:`_grow`: the root's split, then each child's subtree, numbered root, left's nodes, right's."""
+def _parallel_grow(E, order, root, leaf_size, cutoff, threads, sub_i, sub_b):
+    """The tree on ``threads`` Python threads: the top down to nodes of at most ``cutoff`` elements (the
+    tasks), as :func:`_grow` with that cutoff returns it, and every task's subtree, grown into rows
+    2·start .. of ``sub_i`` / ``sub_b``. Returns (kt, top_i, top_b, ntask, task_i, counts) for :func:`_splice`.
+
+    The root is split on the calling thread; then the two halves below it are grown at the same time, and a
+    thread whose half is done takes the largest task published so far (its own half's or the other's)
+    instead of waiting for the other half (the halves differ by up to 1.6× in size on the CGAL meshes, and
+    the top levels were ~25 % of the build). One :func:`_grow` kernel throughout, so the same tree as the
+    serial build: the root's split, then each child's subtree, numbered root, left's nodes, right's."""
     n = E.shape[0]
     # the root alone: nodes of at most n − 1 elements (its two children) become tasks
     k0, i0, b0, nt0, ti0, tb0 = _grow(E, order, 0, n, root, leaf_size, n - 1, np.empty((4, 4), np.int64),
                                       np.empty((4, 6)), 0)
+    import heapq
+    import threading
+
+    from ..threads import run_tasks
+
     if k0 != 3 or nt0 != 2:  # root is a leaf (cannot happen above PARALLEL_ELEMENTS), or not split in two
-        return _grow(E, order, 0, n, root, leaf_size, cutoff, np.empty((256, 4), np.int64), np.empty((256, 6)), 0)
-    halves = list(pool.map(lambda h: _grow(E, order, ti0[h, 0], ti0[h, 1], tb0[h], leaf_size, cutoff,
-                                           np.empty((128, 4), np.int64), np.empty((128, 6)), 0), (0, 1)))
-    (kl, il, bl, ntl, tl, tbl), (kr, ir, br, ntr, tr, tbr) = halves
+        kt, top_i, top_b, ntask, task_i, task_b = _grow(E, order, 0, n, root, leaf_size, cutoff,
+                                                        np.empty((256, 4), np.int64), np.empty((256, 6)), 0)
+        counts = np.empty(ntask, np.int64)
+
+        def grow_task(t):
+            s, e = task_i[t, 0], task_i[t, 1]
+            counts[t] = _grow(E, order, s, e, task_b[t], leaf_size, 0, sub_i, sub_b, 2 * s)[0]
+
+        run_tasks(grow_task, np.argsort(task_i[:ntask, 0] - task_i[:ntask, 1], kind="stable"), threads)
+        return kt, top_i, top_b, ntask, task_i, counts
+    halves = [None, None]
+    counts_h = [None, None]
+    pending = []  # heap of (−elements, half, task): the largest published task first
+    cond = threading.Condition()
+    state = [0, 0]  # halves claimed, halves published
+
+    def worker(_):
+        with cond:
+            h = state[0]
+            state[0] += 1
+        if h < 2:
+            res = _grow(E, order, ti0[h, 0], ti0[h, 1], tb0[h], leaf_size, cutoff, np.empty((128, 4), np.int64),
+                        np.empty((128, 6)), 0)
+            halves[h] = res
+            nt, ti = res[3], res[4]
+            counts_h[h] = np.empty(nt, np.int64)
+            with cond:
+                for t in range(nt):
+                    heapq.heappush(pending, (int(ti[t, 0] - ti[t, 1]), h, t))
+                state[1] += 1
+                cond.notify_all()
+        while True:
+            with cond:
+                # a thread only waits for a half that a running thread has claimed: no deadlock
+                while not pending and state[1] < 2:
+                    cond.wait()
+                if not pending:
+                    return
+                _, h, t = heapq.heappop(pending)
+            ti, tb = halves[h][4], halves[h][5]
+            s = ti[t, 0]
+            counts_h[h][t] = _grow(E, order, s, ti[t, 1], tb[t], leaf_size, 0, sub_i, sub_b, 2 * s)[0]
+
+    run_tasks(worker, range(threads), threads)
+    (kl, il, bl, ntl, tl, _), (kr, ir, br, ntr, tr, _) = halves
     kt = 1 + kl + kr
     top_i = np.empty((kt, 4), np.int64)
     top_b = np.empty((kt, 6))
@@ -441,25 +481,23 @@ def _parallel_top(E, order, root, leaf_size, cutoff, pool):
     task_i = np.concatenate((tl[:ntl], tr[:ntr]))
     task_i[:ntl, 2] += 1
     task_i[ntl:, 2] += 1 + kl
-    task_b = np.concatenate((tbl[:ntl], tbr[:ntr]))
-    return kt, top_i, top_b, ntl + ntr, task_i, task_b
+    return kt, top_i, top_b, ntl + ntr, task_i, np.concatenate(counts_h)
 
 
 @njit(cache=True)
 def _root_bounds(E):
     """Box lo, hi and centroid lo, hi (12) of all rows of E."""
-    n = E.shape[0]
+    # running bounds in scalars (not in ``root``: its stores and reloads chained every row, 0.85 ms at 89k)
+    lx = ly = lz = cx0 = cy0 = cz0 = np.inf
+    hx = hy = hz = cx1 = cy1 = cz1 = -np.inf
+    for i in range(E.shape[0]):
+        lx, ly, lz = min(lx, E[i, 3]), min(ly, E[i, 4]), min(lz, E[i, 5])
+        hx, hy, hz = max(hx, E[i, 6]), max(hy, E[i, 7]), max(hz, E[i, 8])
+        cx0, cy0, cz0 = min(cx0, E[i, 0]), min(cy0, E[i, 1]), min(cz0, E[i, 2])
+        cx1, cy1, cz1 = max(cx1, E[i, 0]), max(cy1, E[i, 1]), max(cz1, E[i, 2])
     root = np.empty(12)
-    for d in range(3):
-        root[d] = root[6 + d] = np.inf
-        root[3 + d] = root[9 + d] = -np.inf
-    for i in range(n):
-        for d in range(3):
-            c = E[i, d]
-            root[d] = min(root[d], E[i, 3 + d])
-            root[3 + d] = max(root[3 + d], E[i, 6 + d])
-            root[6 + d] = min(root[6 + d], c)
-            root[9 + d] = max(root[9 + d], c)
+    root[0], root[1], root[2], root[3], root[4], root[5] = lx, ly, lz, hx, hy, hz
+    root[6], root[7], root[8], root[9], root[10], root[11] = cx0, cy0, cz0, cx1, cy1, cz1
     return root
 
 

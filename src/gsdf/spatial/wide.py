@@ -65,7 +65,7 @@ def widen(tree: BVH, width: int = 4) -> WideBVH:
     return WideBVH(kids, child, int(depth))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # nogil: the triangle winding build runs it beside the moments' threads
 def _collapse(right, start, end, width):
     k = right.shape[0]
     cap = max(1, k)

@@ -54,7 +54,7 @@ from .._checks import as_mesh, as_points, integer
 from .._normalize import Frame
 from ..spatial.bvh import BVH, build_bvh, build_volume_bvh
 from ..spatial.wide import widen
-from ..threads import run_ranges
+from ..threads import run_ranges, run_tasks
 from ._query import map_queries
 from .exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w
 
@@ -294,18 +294,26 @@ def _leaf_triangles(T, s, e, qx, qy, qz):
     return acc
 
 
-@njit(cache=True)  # serial: ~5 ns per face, less than a parallel launch
 def _triangle_elements(V, F):
-    """(m, 9) rows [centroid, box lo, box hi] of the triangles F of V: the input of the tree build."""
+    """(m, 9) rows [centroid, box lo, box hi] of the triangles F of V: the input of the tree build. ~10 ns
+    per face, most of it the first touch of E's pages: on the threads from PARALLEL_BUILD_FACES faces."""
     m = F.shape[0]
     E = np.empty((m, 9))
-    for t in range(m):
+    if m >= PARALLEL_BUILD_FACES and numba.get_num_threads() > 1:
+        run_ranges(lambda i0, i1: _triangle_elements_range(V, F, E, i0, i1), m, 8192, 1)
+    else:
+        _triangle_elements_range(V, F, E, 0, m)
+    return E
+
+
+@njit(cache=True, nogil=True)  # one serial, GIL-free kernel: faces i0..i1 (ranges on Python threads)
+def _triangle_elements_range(V, F, E, i0, i1):
+    for t in range(i0, i1):
         for d in range(3):
             a, b, c = V[F[t, 0], d], V[F[t, 1], d], V[F[t, 2], d]
             E[t, d] = (a + b + c) / 3.0
             E[t, 3 + d] = min(a, min(b, c))
             E[t, 6 + d] = max(a, max(b, c))
-    return E
 
 
 @njit(cache=True, inline="always")
@@ -318,7 +326,7 @@ def _area_normal(T, j):
 
 
 
-def _tree_moments(V, F, order, start, end, right, lo, hi):
+def _tree_moments(V, F, order, start, end, right, lo, hi, also=None):
     """Leaf rows and Taylor moments of every node of a triangle tree, children before parents.
 
     Returns T (m, 10): per triangle in tree order its 9 corner coordinates, then 1.0 (0.0 for a zero-area
@@ -331,24 +339,32 @@ def _tree_moments(V, F, order, start, end, right, lo, hi):
         c0 += c0_c,   C1_ab += C1_c,ab + δ_a c0_c,b,
         S_ab,c += S_c,ab,c + δ_a C1_c,bc + δ_b C1_c,ac + δ_a δ_b c0_c,c      (S_ab,c = Σ (C_t + d dᵀ)_ab n_c)
     so the build costs O(m + k) instead of the O(m log m) of summing every node's triangles.
+
+    ``also``: an optional callable of other work (the wide view of the tree) run as one more task on the
+    same threads, so it costs no serial time of its own.
     """
     m = order.shape[0]
     k = start.shape[0]
     T = np.empty((m, 10))
-    D = np.zeros((k, NODE_WIDTH))
+    D = np.empty((k, NODE_WIDTH))  # every entry written (leaves, parents, _finish_moment): no zero pass
     W = np.empty((k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
     threads = numba.get_num_threads()
     if m < PARALLEL_BUILD_FACES or threads == 1:
+        if also is not None:
+            also()
         _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, 0, k)
         return T, D
     # whole subtrees on Python threads (leaves, then their parents, while the rows are in cache), then the
     # few nodes above them on this thread
     roots, above = _split_top(start, end, right, 8 * threads)
-    from concurrent.futures import ThreadPoolExecutor
 
-    with ThreadPoolExecutor(max_workers=threads) as pool:
-        list(pool.map(lambda r: _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, r,
-                                                 _subtree_end(right, r)), roots))
+    def task(r):
+        if r < 0:
+            also()
+        else:
+            _subtree_moments(V, F, order, start, end, right, lo, hi, T, D, W, r, _subtree_end(right, r))
+
+    run_tasks(task, ([-1] if also is not None else []) + roots, threads)
     _node_moments_list(start, end, right, lo, hi, D, W, np.array(sorted(above, reverse=True), np.int64))
     return T, D
 
@@ -505,22 +521,25 @@ def _parent_moment(start, end, right, D, W, i):
         cnt = end[i] - start[i]
         cx, cy, cz = W[i, 4] / cnt, W[i, 5] / cnt, W[i, 6] / cnt
     D[i, 0], D[i, 1], D[i, 2] = cx, cy, cz
+    # row i is uninitialised: the left child's terms are stored, the right child's added (no zero pass)
     for h in range(2):
         ch = l if h == 0 else r
         dl0, dl1, dl2 = D[ch, 0] - cx, D[ch, 1] - cy, D[ch, 2] - cz
         for a in range(3):
-            D[i, _C0 + a] += D[ch, _C0 + a]
+            D[i, _C0 + a] = D[i, _C0 + a] + D[ch, _C0 + a] if h else D[ch, _C0 + a]
             da = dl0 if a == 0 else (dl1 if a == 1 else dl2)
             for b in range(3):
-                D[i, _C1 + 3 * a + b] += D[ch, _C1 + 3 * a + b] + da * D[ch, _C0 + b]
+                t = D[ch, _C1 + 3 * a + b] + da * D[ch, _C0 + b]
+                D[i, _C1 + 3 * a + b] = D[i, _C1 + 3 * a + b] + t if h else t
         for pa in range(3):  # the pairs pa <= pb in the row order xx yy zz xy xz yz, q their column
             da = dl0 if pa == 0 else (dl1 if pa == 1 else dl2)
             for pb in range(pa, 3):
                 q = pa if pa == pb else pa + pb + 2
                 db = dl0 if pb == 0 else (dl1 if pb == 1 else dl2)
                 for c in range(3):
-                    D[i, _S + 6 * c + q] += (D[ch, _S + 6 * c + q] + da * D[ch, _C1 + 3 * pb + c]
-                                             + db * D[ch, _C1 + 3 * pa + c] + da * db * D[ch, _C0 + c])
+                    t = (D[ch, _S + 6 * c + q] + da * D[ch, _C1 + 3 * pb + c]
+                         + db * D[ch, _C1 + 3 * pa + c] + da * db * D[ch, _C0 + c])
+                    D[i, _S + 6 * c + q] = D[i, _S + 6 * c + q] + t if h else t
 
 
 @njit(cache=True)
@@ -558,11 +577,12 @@ WIDTH = 4
 _WF = 4 + COMPACT_WIDTH - 1  # fields per child slot: centre (3), β²r², the 23 compact coefficients
 
 
-def _pack_wide(D, tree, beta2, order, width=WIDTH):
+def _pack_wide(D, tree, beta2, order, width=WIDTH, wt=None):
     """Per wide node, the far-field data of its children as (w, _WF, width) float64 (one lane per child, so
     the lane loop of :func:`_eval_triangles_wide` reads contiguous memory), plus the child links and the
-    element ranges of the leaf children (w, width) int64."""
-    wt = widen(tree, width)
+    element ranges of the leaf children (w, width) int64. ``wt``: the tree's :func:`widen` view, if done."""
+    if wt is None:
+        wt = widen(tree, width)
     kids, child, depth = wt.kids, wt.child, wt.depth
     if tree.right[0] >= 0:
         # a first node whose one child is the root, so the root's own far field is tried too (a query far
@@ -577,12 +597,13 @@ def _pack_wide(D, tree, beta2, order, width=WIDTH):
     # compact columns kept per order (the unused orders' coefficients are zero: one kernel evaluates every order)
     keep = (3, 10, COMPACT_WIDTH - 1)[order]
     w = kids.shape[0]
-    W = np.zeros((w, _WF, width))
-    LS = np.zeros((w, width), np.int64)
-    LE = np.zeros((w, width), np.int64)
+    W = np.empty((w, _WF, width))  # every entry written by _lanes (empty slots too): no zero pass
+    LS = np.empty((w, width), np.int64)
+    LE = np.empty((w, width), np.int64)
     start, end = tree.start, tree.end
     if end[0] - start[0] >= PARALLEL_BUILD_FACES and numba.get_num_threads() > 1:
-        run_ranges(lambda i0, i1: _lanes(D, kids, start, end, beta2, keep, W, LS, LE, i0, i1), w, 2048)
+        # wide nodes cost the same: one range per thread
+        run_ranges(lambda i0, i1: _lanes(D, kids, start, end, beta2, keep, W, LS, LE, i0, i1), w, 2048, 1)
     else:
         _lanes(D, kids, start, end, beta2, keep, W, LS, LE, 0, w)
     return W, np.ascontiguousarray(child), LS, LE, depth * (width - 1) + 2
@@ -590,10 +611,10 @@ def _pack_wide(D, tree, beta2, order, width=WIDTH):
 
 @njit(cache=True, nogil=True)  # one serial, GIL-free kernel: wide nodes i0..i1 (ranges on Python threads)
 def _lanes(D, kids, start, end, beta2, keep, W, LS, LE, i0, i1):
-    """Fill wide nodes i0..i1 of the (w, _WF, width) lanes W (zeroed by the caller): lane c of wide node n
-    holds child kids[n, c]'s centre, β²r² and its compact far-field row (:func:`_fold_into`, columns <
-    ``keep``), and LS, LE (w, width) the element ranges of the children. An empty slot (kid −1) is never far
-    (β²r² = ∞), has zero coefficients and an empty range. ~100 ns per wide node (9 ms at 89k faces, run on
+    """Fill wide nodes i0..i1 of the (w, _WF, width) lanes W (every entry; the caller need not zero them):
+    lane c of wide node n holds child kids[n, c]'s centre, β²r² and its compact far-field row
+    (:func:`_fold_into`, columns < ``keep``), and LS, LE (w, width) the element ranges of the children. An
+    empty slot (kid −1) is never far (β²r² = ∞), has zero centre and coefficients and an empty range. ~100 ns per wide node (9 ms at 89k faces, run on
     the threads from PARALLEL_BUILD_FACES faces)."""
     width = kids.shape[1]
     row = np.empty(COMPACT_WIDTH - 1)
@@ -601,7 +622,11 @@ def _lanes(D, kids, start, end, beta2, keep, W, LS, LE, i0, i1):
         for c in range(width):
             b = kids[n, c]
             if b < 0:
+                for j in range(_WF):
+                    W[n, j, c] = 0.0
                 W[n, 3, c] = np.inf
+                LS[n, c] = 0
+                LE[n, c] = 0
                 continue
             W[n, 0, c] = D[b, 0]
             W[n, 1, c] = D[b, 1]
@@ -735,7 +760,6 @@ def _single_thread(serial: bool):
 
 class _FastWindingBase:
     tree: BVH
-    _D: np.ndarray
 
     def __call__(self, Q, progress=None) -> np.ndarray:
         """Winding numbers at query points ``Q`` (q, 3); evaluated in parallel chunks."""
@@ -791,9 +815,14 @@ class FastWindingNumber(_FastWindingBase):
         # It bounds the paper's r (farthest element point) and, measured on the CGAL meshes
         # (bench/bench_winding.py), brings the RMS error at β = 2 from ~1.3e-3 to ~7e-4 — the paper's
         # "β = 2 gives ~1e-3".
-        self._T, self._D = _tree_moments(V, F, t.order, t.start, t.end, t.right, t.lo, t.hi)
-        # the walk tests the WIDTH children of a node together (see _eval_triangles_wide)
-        self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(self._D, t, self.beta ** 2, self.order)
+        # the (k, 40) moments D are folded into the lanes and dropped (18 MB at 89k faces, a third of the object;
+        # tests rebuild them with _tree_moments)
+        wide = []  # the walk tests the WIDTH children of a node together (see _eval_triangles_wide): the wide
+        # view of the tree, built on the moments' threads
+        self._T, D = _tree_moments(V, F, t.order, t.start, t.end, t.right, t.lo, t.hi,
+                                   lambda: wide.append(widen(t, WIDTH)))
+        self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(D, t, self.beta ** 2, self.order, WIDTH,
+                                                                        wide[0])
 
     def _kernel(self, q, out):
         with _single_thread(q.shape[0] < SERIAL_QUERIES):
