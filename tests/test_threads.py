@@ -1,5 +1,8 @@
 """gsdf.threads: one setting for numba and BLAS threads; validation of --threads and GSDF_NUM_THREADS."""
 
+import threading
+import time
+
 import numba
 import numpy as np
 import pytest
@@ -142,3 +145,73 @@ def test_cli_default_blas_one_thread(clean):
     assert os.environ["OPENBLAS_NUM_THREADS"] == "1"
     assert all(k == 1 for k in _blas_threads())
     assert threads._setting is None  # numba keeps its default
+
+
+# --- the persistent worker pool (threads.run_tasks / run_ranges) ---
+
+
+def test_run_tasks_every_item_once():
+    from gsdf.threads import run_tasks
+
+    seen = []
+    lock = threading.Lock()
+
+    def take(i):
+        with lock:
+            seen.append(i)
+
+    run_tasks(take, range(1000), threads=3)
+    assert sorted(seen) == list(range(1000))
+
+
+def test_run_tasks_exception_propagates_and_pool_survives():
+    from gsdf.threads import run_tasks
+
+    def boom(i):
+        if i == 5:
+            raise RuntimeError("item 5")
+
+    with pytest.raises(RuntimeError, match="item 5"):
+        run_tasks(boom, range(50), threads=2)
+    out = np.zeros(10)
+
+    def fill(i):
+        out[i] = i + 1
+
+    run_tasks(fill, range(10), threads=2)
+    assert out.tolist() == list(range(1, 11))
+
+
+def test_run_tasks_concurrent_callers_and_nesting_finish():
+    """Several user threads (a threaded Dask worker) and a call from inside a task share one pool: every
+    call finishes (a queued submission of a busy pool is cancelled, not waited for)."""
+    from gsdf.threads import run_ranges, run_tasks
+
+    def job(seed):
+        total = np.zeros(1)
+        lock = threading.Lock()
+
+        def inner(s, e):
+            with lock:
+                total[0] += np.arange(s, e).sum()
+
+        def outer(i):  # nested: a task that itself fans out
+            run_ranges(inner, 2000, grain=100)
+
+        run_tasks(outer, range(4), threads=2)
+        return total[0]
+
+    expected = 4 * np.arange(2000).sum()
+    results = [None] * 8
+
+    def run(k):
+        results[k] = job(k)
+
+    callers = [threading.Thread(target=run, args=(k,), daemon=True) for k in range(8)]
+    for t in callers:
+        t.start()
+    deadline = time.monotonic() + 60
+    for t in callers:
+        t.join(timeout=max(0.0, deadline - time.monotonic()))
+    assert not any(t.is_alive() for t in callers), "run_tasks hung (a call waited on a queued submission)"
+    assert results == [expected] * 8

@@ -219,8 +219,11 @@ def run_tasks(fn, items, threads: int | None = None) -> None:
     try:
         work()
     finally:
+        # a submission still queued (the pool busy with another caller's items, or a nested call) is
+        # cancelled: this thread has done its share, and waiting for it could wait on the other caller
+        futures = [f for f in futures if not f.cancel()]
         for f in futures:
-            f.exception()  # wait for every worker before returning (or re-raising)
+            f.exception()  # wait for every started worker before returning (or re-raising)
     for f in futures:
         f.result()
 
