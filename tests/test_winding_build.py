@@ -72,13 +72,17 @@ def test_volume_build_is_the_same_tree_on_one_or_more_threads():
 
 
 def _sweep_reference(E, n):
-    """The exhaustive sweep of binned._split_sweep in numpy: stable sorts, prefix / suffix boxes, n r³ costs,
-    the cheapest position (ties: the more balanced one, then the first axis / position)."""
+    """The exhaustive sweep of binned._split_sweep in numpy: stable sorts along the two longest axes of the
+    centroid box (all three when the shortest is within binned.TIE of the next), prefix / suffix boxes, n r³ costs, the cheapest
+    position (ties: the more balanced one, then the first axis / position)."""
     def cube(lo, hi):
         d2 = 0.25 * ((hi - lo) ** 2).sum(axis=1)
         return d2 * np.sqrt(d2)
     best = (np.inf, 0, n // 2)
-    for a in range(3):
+    ext = np.ptp(E[:n, 0:3], axis=0)
+    lo, mid = np.sort(ext)[:2]
+    shortest = -1 if lo >= (1 - binned.TIE) * mid else 2 - int(np.argmin(ext[::-1]))
+    for a in [a for a in range(3) if a != shortest]:
         p = np.argsort(E[:n, a], kind="stable")
         lo, hi = E[p, 3:6], E[p, 6:9]
         pre = np.arange(1, n) * cube(np.minimum.accumulate(lo)[:-1], np.maximum.accumulate(hi)[:-1])

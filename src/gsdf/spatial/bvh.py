@@ -60,8 +60,8 @@ def build_bvh(centroids: np.ndarray, elem_lo: np.ndarray, elem_hi: np.ndarray, l
     """Build a BVH over elements with the given centroids and bounding boxes (all (n, 3) float64).
 
     ``split="median"`` halves each node at the median centroid of its longest centroid axis (balanced tree).
-    ``split="volume"`` picks, among 3 × 32 binned centroid planes (every position of the sorted elements in
-    nodes of at most 24), the split minimising n_L·vol(box_L) + n_R·vol(box_R) (box = child's element
+    ``split="volume"`` picks, among 2 × 32 binned centroid planes on the two longest axes of the node's
+    centroid box (every position of the sorted elements in nodes of at most 24), the split minimising n_L·vol(box_L) + n_R·vol(box_R) (box = child's element
     bounding box, volume taken as the cube of its half-diagonal so flat boxes still count); built by
     :func:`gsdf.spatial.binned.build_volume`. A node is opened by a uniformly distributed query with
     probability ∝ the volume of its far-field ball, so this keeps the far-field walk short on thin or
