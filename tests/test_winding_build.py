@@ -98,8 +98,8 @@ def _sweep_reference(E, n):
 def test_small_node_sweep_matches_a_reference_sort_and_cost():
     rng = np.random.default_rng(7)
     S = binned.SMALL
-    scratch = (np.empty((3, S), np.int64), np.empty(S), np.empty((6, S)), np.empty((2, S)), np.empty((S, 9)),
-               np.empty(S, np.int64), np.empty(24))
+    scratch = (np.empty((3, S), np.int64), np.empty(S), np.empty((2, S)), np.empty((S, 9)), np.empty(S, np.int64),
+               np.empty(24))
     for trial in range(300):
         n = int(rng.integers(2, S + 1))
         c = rng.random((n, 3))
