@@ -52,6 +52,15 @@ def test_volume_build_structure_and_rows_in_tree_order():
     assert np.array_equal(t2.order, t.order) and np.array_equal(t2.right, t.right)
 
 
+def test_element_rows_come_with_the_root_bounds():
+    for m in (500, fast.PARALLEL_BUILD_FACES + 5000):       # one pass, and ranges on the threads
+        V, F = _soup(m=m, seed=3)
+        E, root = fast._triangle_elements_root(V, F)
+        np.testing.assert_array_equal(root, binned._root_bounds(E))
+        t = build_volume_bvh(E.copy(), 4, root)
+        assert np.array_equal(t.order, build_volume_bvh(E.copy(), 4).order)
+
+
 def test_volume_build_coincident_centroids_and_tiny_inputs():
     P = np.zeros((200, 3))                                     # every centroid in one point
     t = build_bvh(P, P - 1, P + 1, 4, split="volume")

@@ -398,9 +398,10 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, node_i, node_b, base):
     return count, node_i, node_b, ntask, task_i, task_b
 
 
-def build_volume_rows(E, leaf_size, threads=1):
+def build_volume_rows(E, leaf_size, threads=1, root=None):
     """:func:`build_volume` on one (n, 9) float64 array of rows [centroid, box lo, box hi], which it reorders
-    in place (to tree order: row j is then element ``order[j]``).
+    in place (to tree order: row j is then element ``order[j]``). ``root``: the rows' bounds (12: box lo, hi,
+    centroid lo, hi), or None to compute them.
 
     With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
     of the tree is split down to nodes of about n/64 elements (the root on the calling thread, then its two
@@ -411,7 +412,7 @@ def build_volume_rows(E, leaf_size, threads=1):
     cost ~6 s of compilation on a cold start, issue 17, for a build of 0.05-0.3 s)."""
     n = E.shape[0]
     order = np.arange(n, dtype=np.int64)
-    root = _root_bounds(E)
+    root = _root_bounds(E) if root is None else np.ascontiguousarray(root, dtype=np.float64)
     if threads > 1 and n > PARALLEL_ELEMENTS:
         cutoff = max(leaf_size + 1, n // 64)
         # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short

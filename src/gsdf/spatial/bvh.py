@@ -92,10 +92,11 @@ def build_bvh(centroids: np.ndarray, elem_lo: np.ndarray, elem_hi: np.ndarray, l
     return BVH(*arrays)
 
 
-def build_volume_bvh(E: np.ndarray, leaf_size: int = 4) -> BVH:
+def build_volume_bvh(E: np.ndarray, leaf_size: int = 4, root: np.ndarray | None = None) -> BVH:
     """Volume-split BVH (as ``build_bvh(..., split="volume")``) over elements given as one (n, 9) float64
     C-contiguous array of rows [centroid, box lo, box hi]. ``E`` is reordered in place into tree order (row
-    ``j`` becomes element ``order[j]``), which saves the callers a gather.
+    ``j`` becomes element ``order[j]``), which saves the callers a gather. ``root``: the rows' bounds (12:
+    box lo, hi, centroid lo, hi) if the caller has them (saves a pass over the rows), else computed.
 
     Example
     -------
@@ -112,7 +113,7 @@ def build_volume_bvh(E: np.ndarray, leaf_size: int = 4) -> BVH:
         raise ValueError("cannot build a tree over zero elements")
     if leaf_size < 1:
         raise ValueError(f"leaf_size must be >= 1, got {leaf_size}")
-    return BVH(*build_volume_rows(E, int(leaf_size), numba.get_num_threads()))
+    return BVH(*build_volume_rows(E, int(leaf_size), numba.get_num_threads(), root))
 
 
 def build_point_bvh(P: np.ndarray, leaf_size: int = 8) -> BVH:
