@@ -10,8 +10,9 @@ build cheap (on the 75k-face bunny it is several times faster than splitting by 
   sequentially;
 * one pass over a node bins its elements along the two longest axes of its centroid box at once (32 bins
   per axis over the node's centroid box), and the candidate planes are the 2 × 31 bin boundaries (the
-  shortest axis, across a surface patch, rarely holds the best plane: binning it too cost a third more for
-  the same trees within ±1 % of the nodes opened per query on the CGAL meshes);
+  shortest axis, across a surface patch, rarely holds the best plane: binning and sweeping it too made the
+  serial build of refined_elephant ~20 % slower, 44.7 vs 36.7 ms, for trees whose queries open the same
+  number of nodes within ±1 % on the CGAL meshes);
 * the partition pass also collects the two children's centroid boxes, and the children's element boxes
   come out of the bins, so no node is read again for its bounds;
 * a node of at most :data:`SMALL` elements instead tries every split of its elements sorted along each of
