@@ -53,9 +53,9 @@ together in one unrolled loop that LLVM turns into 4-lane SIMD (AVX2 doubles), t
 descended. The query points of a chunk are grouped by a counting sort on coarse Morton cells, and small
 builds / query sets run on the calling thread (a parallel launch waits for workers under load).
 Build (src/gsdf/spatial/binned.py, winding/fast.py): the tree moves element rows instead of indexing them,
-bins all three axes in one pass and sweeps every split position in nodes of ≤ 24 triangles; the node
-moments are summed bottom-up (children shifted to the parent's centre), O(m + k) instead of O(m log m),
-and folded straight into the 4-wide lanes; from 20k faces the element rows, the two halves below the root
+bins the two longest axes of each node's centroid box in one pass and sweeps every split position along
+them in nodes of ≤ 24 triangles; the node moments are summed bottom-up (children shifted to the parent's
+centre), O(m + k) instead of O(m log m), and folded straight into the 4-wide lanes; from 20k faces the element rows, the two halves below the root
 and the lower subtrees (pipelined), the leaf moments (with the wide view beside them) and the lanes use the
 threads of one persistent pool (gsdf.threads.run_tasks). "gsdf pre s" is this whole build
 (bench/profile_fwn_build.py prints it stage by stage)."""

@@ -66,7 +66,7 @@ def install():
     """Timers around the build's stages (module attributes looked up at call time)."""
     _wrap(fast, "as_mesh", "validate")
     _wrap(fast.Frame, "of_mesh", "frame")
-    _wrap(fast, "_triangle_elements", "elements")
+    _wrap(fast, "_triangle_elements_root", "elements")
     _wrap(binned, "_root_bounds", "tree: root bounds")
     _wrap(binned, "_parallel_grow", "tree: top + subtrees")
     _wrap(binned, "_splice", "tree: splice")

@@ -52,6 +52,15 @@ def test_volume_build_structure_and_rows_in_tree_order():
     assert np.array_equal(t2.order, t.order) and np.array_equal(t2.right, t.right)
 
 
+def test_element_rows_come_with_the_root_bounds():
+    for m in (500, fast.PARALLEL_BUILD_FACES + 5000):       # one pass, and ranges on the threads
+        V, F = _soup(m=m, seed=3)
+        E, root = fast._triangle_elements_root(V, F)
+        np.testing.assert_array_equal(root, binned._root_bounds(E))
+        t = build_volume_bvh(E.copy(), 4, root)
+        assert np.array_equal(t.order, build_volume_bvh(E.copy(), 4).order)
+
+
 def test_volume_build_coincident_centroids_and_tiny_inputs():
     P = np.zeros((200, 3))                                     # every centroid in one point
     t = build_bvh(P, P - 1, P + 1, 4, split="volume")
@@ -72,13 +81,17 @@ def test_volume_build_is_the_same_tree_on_one_or_more_threads():
 
 
 def _sweep_reference(E, n):
-    """The exhaustive sweep of binned._split_sweep in numpy: stable sorts, prefix / suffix boxes, n r³ costs,
-    the cheapest position (ties: the more balanced one, then the first axis / position)."""
+    """The exhaustive sweep of binned._split_sweep in numpy: stable sorts along the two longest axes of the
+    centroid box (all three when the shortest is within binned.TIE of the next), prefix / suffix boxes, n r³ costs, the cheapest
+    position (ties: the more balanced one, then the first axis / position)."""
     def cube(lo, hi):
         d2 = 0.25 * ((hi - lo) ** 2).sum(axis=1)
         return d2 * np.sqrt(d2)
     best = (np.inf, 0, n // 2)
-    for a in range(3):
+    ext = np.ptp(E[:n, 0:3], axis=0)
+    lo, mid = np.sort(ext)[:2]
+    shortest = -1 if lo >= (1 - binned.TIE) * mid else 2 - int(np.argmin(ext[::-1]))
+    for a in [a for a in range(3) if a != shortest]:
         p = np.argsort(E[:n, a], kind="stable")
         lo, hi = E[p, 3:6], E[p, 6:9]
         pre = np.arange(1, n) * cube(np.minimum.accumulate(lo)[:-1], np.maximum.accumulate(hi)[:-1])
@@ -94,8 +107,8 @@ def _sweep_reference(E, n):
 def test_small_node_sweep_matches_a_reference_sort_and_cost():
     rng = np.random.default_rng(7)
     S = binned.SMALL
-    scratch = (np.empty((3, S), np.int64), np.empty(S), np.empty((6, S)), np.empty((2, S)), np.empty((S, 9)),
-               np.empty(S, np.int64), np.empty(24))
+    scratch = (np.empty((3, S), np.int64), np.empty(S), np.empty((2, S)), np.empty((S, 9)), np.empty(S, np.int64),
+               np.empty(24))
     for trial in range(300):
         n = int(rng.integers(2, S + 1))
         c = rng.random((n, 3))

@@ -8,14 +8,18 @@ build cheap (on the 75k-face bunny it is several times faster than splitting by 
 * elements are *moved*, not indexed: a working array holds each element's centroid and box (9 numbers) in
   the current order, and a node's partition swaps these rows, so every pass over a node reads memory
   sequentially;
-* one pass over a node bins its elements along all three axes at once (32 bins per axis over the node's
-  centroid box), and the candidate planes are the 3 × 31 bin boundaries;
+* one pass over a node bins its elements along the two longest axes of its centroid box at once (32 bins
+  per axis over the node's centroid box), and the candidate planes are the 2 × 31 bin boundaries (the
+  shortest axis, across a surface patch, rarely holds the best plane: binning and sweeping it too made the
+  serial build of refined_elephant ~20 % slower, 44.7 vs 36.7 ms, for trees whose queries open the same
+  number of nodes within ±1 % on the CGAL meshes);
 * the partition pass also collects the two children's centroid boxes, and the children's element boxes
   come out of the bins, so no node is read again for its bounds;
-* a node of at most :data:`SMALL` elements instead tries every split of its elements sorted along each axis
-  (stable, by ranks): there the 3 × 32 bins cost more than the elements, and an exhaustive sweep never finds a
-  worse split than the bins. Its prefix / suffix boxes are running bounds, their costs a loop of their own
-  (the square roots vectorise).
+* a node of at most :data:`SMALL` elements instead tries every split of its elements sorted along each of
+  the same two axes (stable, by ranks): there the bins cost more than the elements, and an exhaustive sweep
+  never finds a worse split than the bins. Its prefix / suffix boxes are running bounds, each position's
+  cost computed as the bound is extended (storing the bounds for a loop of vectorised square roots took
+  ~25 % longer on nodes of 6).
 
 Example
 -------
@@ -34,11 +38,15 @@ import numpy as np
 from numba import njit
 
 NBINS = 32
-#: Nodes with at most this many elements are split by an exhaustive sweep instead of bins (3 × 32 bins cost
-#: about as much as sorting and sweeping 24 elements along 3 axes).
+#: Nodes with at most this many elements are split by an exhaustive sweep instead of bins (2 × 32 bins cost
+#: about as much as sorting and sweeping 24 elements along 2 axes).
 SMALL = 24
 MINBINS = 8
 BINDIV = 1
+#: The shortest axis of a node's centroid box is skipped only when it is shorter than the next by more than
+#: this fraction: near-ties (as in a symmetric shape) would be decided by rounding, and a translated or
+#: scaled copy of the input would get another tree.
+TIE = 1e-6
 #: Trees over more elements grow their lower subtrees in parallel when numba has more than one thread.
 PARALLEL_ELEMENTS = 20_000
 
@@ -51,53 +59,69 @@ def _cube_half_diag(lx, ly, lz, hx, hy, hz):
     return d2 * np.sqrt(d2)
 
 
+@njit(cache=True, inline="always")
+def _axes(dx, dy, dz):
+    """(a0, a1, a2, na): the axes of a box with extents dx, dy, dz to bin or sweep, the first ``na`` of them:
+    the two longest (ascending), or all three (0, 1, 2) when the shortest is within :data:`TIE` of the next."""
+    lo = min(dx, min(dy, dz))
+    mid = dx + dy + dz - lo - max(dx, max(dy, dz))
+    if lo >= (1.0 - TIE) * mid:
+        return 0, 1, 2, 3
+    if dx == lo:
+        return 1, 2, 0, 2
+    return (0, 1, 2, 2) if dz == lo else (0, 2, 1, 2)
+
+
 @njit(cache=True)
 def _split_binned(E, order, s, e, b, nb, bins, run, cost, sc, out):
-    """Split E[s:e] (rows: centroid, box lo, box hi) at the best of the 3 × 31 bin planes; partitions the
-    rows (and ``order``) in place and returns the split index, or −1 when the centroids all coincide.
+    """Split E[s:e] (rows: centroid, box lo, box hi) at the best of the 2 × 31 bin planes on the two longest
+    axes of its centroid box (3 × 31 when its shortest axis is nearly as long, see :func:`_axes`); partitions
+    the rows (and ``order``) in place and returns the split index, or −1 when the centroids all coincide.
 
     ``b`` holds the node's box lo, hi and centroid lo, hi (12); ``nb`` ≤ bins.shape[1] bins per axis. On return
     ``out`` holds the left child's box (6) and centroid box (6), then the right child's. Scratch: bins (3, NBINS,
-    7), run (14, NBINS), cost (NBINS,), sc (3,).
+    7) (one row per binned axis), run (14, NBINS), cost (NBINS,), sc (3,).
     """
-    for a in range(3):
+    a0, a1, a2, na = _axes(b[9] - b[6], b[10] - b[7], b[11] - b[8])
+    for t in range(na):
+        a = a0 if t == 0 else (a1 if t == 1 else a2)
         ext = b[9 + a] - b[6 + a]
-        sc[a] = nb / ext if ext > 0.0 else 0.0
+        sc[t] = nb / ext if ext > 0.0 else 0.0
         for k in range(nb):
-            bins[a, k, 0] = 0.0
+            bins[t, k, 0] = 0.0
             for d in range(3):
-                bins[a, k, 1 + d] = np.inf
-                bins[a, k, 4 + d] = -np.inf
-    c0, c1, c2 = b[6], b[7], b[8]
+                bins[t, k, 1 + d] = np.inf
+                bins[t, k, 4 + d] = -np.inf
+    c0, c1, c2 = b[6 + a0], b[6 + a1], b[6 + a2]
     s0, s1, s2 = sc[0], sc[1], sc[2]
-    for j in range(s, e):  # one pass, three axes
-        for a in range(3):
-            k = min(nb - 1, int((E[j, a] - (c0 if a == 0 else (c1 if a == 1 else c2)))
-                                * (s0 if a == 0 else (s1 if a == 1 else s2))))
-            bins[a, k, 0] += 1.0
+    for j in range(s, e):  # one pass, all axes
+        for t in range(na):
+            k = min(nb - 1, int((E[j, a0] - c0) * s0) if t == 0 else
+                    (int((E[j, a1] - c1) * s1) if t == 1 else int((E[j, a2] - c2) * s2)))
+            bins[t, k, 0] += 1.0
             for d in range(3):
-                bins[a, k, 1 + d] = min(bins[a, k, 1 + d], E[j, 3 + d])
-                bins[a, k, 4 + d] = max(bins[a, k, 4 + d], E[j, 6 + d])
+                bins[t, k, 1 + d] = min(bins[t, k, 1 + d], E[j, 3 + d])
+                bins[t, k, 4 + d] = max(bins[t, k, 4 + d], E[j, 6 + d])
     best = np.inf
-    best_axis = -1
+    best_t = -1
     best_bin = -1
-    for a in range(3):
-        if sc[a] == 0.0:
+    for t in range(na):  # the row of bins of axis a0, a1, a2
+        if sc[t] == 0.0:
             continue
         # run[0:7, k]: count and box of bins 0..k (left of plane k + 1); run[7:14, k]: of bins k..nb−1
         for d in range(7):
-            run[d, 0] = bins[a, 0, d]
-            run[7 + d, nb - 1] = bins[a, nb - 1, d]
+            run[d, 0] = bins[t, 0, d]
+            run[7 + d, nb - 1] = bins[t, nb - 1, d]
         for k in range(1, nb):
-            run[0, k] = run[0, k - 1] + bins[a, k, 0]
+            run[0, k] = run[0, k - 1] + bins[t, k, 0]
             for d in range(3):
-                run[1 + d, k] = min(run[1 + d, k - 1], bins[a, k, 1 + d])
-                run[4 + d, k] = max(run[4 + d, k - 1], bins[a, k, 4 + d])
+                run[1 + d, k] = min(run[1 + d, k - 1], bins[t, k, 1 + d])
+                run[4 + d, k] = max(run[4 + d, k - 1], bins[t, k, 4 + d])
         for k in range(nb - 2, 0, -1):
-            run[7, k] = run[7, k + 1] + bins[a, k, 0]
+            run[7, k] = run[7, k + 1] + bins[t, k, 0]
             for d in range(3):
-                run[8 + d, k] = min(run[8 + d, k + 1], bins[a, k, 1 + d])
-                run[11 + d, k] = max(run[11 + d, k + 1], bins[a, k, 4 + d])
+                run[8 + d, k] = min(run[8 + d, k + 1], bins[t, k, 1 + d])
+                run[11 + d, k] = max(run[11 + d, k + 1], bins[t, k, 4 + d])
         # cost of plane k (left = bins 0..k−1, right = bins k..nb−1): its own loop, so the roots vectorise
         for k in range(1, nb):
             cost[k] = (run[0, k - 1] * _cube_half_diag(run[1, k - 1], run[2, k - 1], run[3, k - 1],
@@ -109,10 +133,11 @@ def _split_binned(E, order, s, e, b, nb, bins, run, cost, sc, out):
                 continue
             if cost[k] < best:
                 best = cost[k]
-                best_axis = a
+                best_t = t
                 best_bin = k
-    if best_axis < 0:
+    if best_t < 0:
         return -1
+    best_axis = a0 if best_t == 0 else (a1 if best_t == 1 else a2)
     # children's element boxes: unions of the bins on either side of the plane
     for d in range(3):
         out[d] = out[12 + d] = np.inf
@@ -122,11 +147,11 @@ def _split_binned(E, order, s, e, b, nb, bins, run, cost, sc, out):
     for k in range(nb):
         o = 0 if k < best_bin else 12
         for d in range(3):
-            out[o + d] = min(out[o + d], bins[best_axis, k, 1 + d])
-            out[o + 3 + d] = max(out[o + 3 + d], bins[best_axis, k, 4 + d])
+            out[o + d] = min(out[o + d], bins[best_t, k, 1 + d])
+            out[o + 3 + d] = max(out[o + 3 + d], bins[best_t, k, 4 + d])
     # partition (Hoare: advance from both ends, swap misplaced pairs) collecting the children's centroid boxes
     cmin = b[6 + best_axis]
-    scale = sc[best_axis]
+    scale = sc[best_t]
     i = s
     j = e - 1
     while True:
@@ -149,17 +174,26 @@ def _split_binned(E, order, s, e, b, nb, bins, run, cost, sc, out):
 
 
 @njit(cache=True)
-def _split_sweep(E, order, s, e, perm, key, run, pre, tmp, tmpo, out):
+def _split_sweep(E, order, s, e, perm, key, pre, tmp, tmpo, out):
     """Split E[s:e] (at most :data:`SMALL` rows) at the cheapest of all positions of its elements sorted by
-    centroid along x, y or z; reorders the rows and returns the split index. ``out`` gets the children's boxes
-    (their centroid boxes are not needed: small nodes are split by this sweep again).
+    centroid along either of the two longest axes of their centroid box (as :func:`_split_binned`; sweeping
+    the third as well cost half as much again for the same trees); reorders the rows and returns the split
+    index. ``out`` gets the children's boxes (their centroid boxes are not needed: small nodes are split by
+    this sweep again).
 
-    Scratch: perm (3, SMALL) int64, key (SMALL,), run (6, SMALL), pre (2, SMALL), tmp (SMALL, 9), tmpo (SMALL,)."""
+    Scratch: perm (3, SMALL) int64, key (SMALL,), pre (2, SMALL), tmp (SMALL, 9), tmpo (SMALL,)."""
     n = e - s
     best = np.inf
     best_axis = 0
     best_pos = n // 2
-    for a in range(3):
+    l0 = l1 = l2 = np.inf
+    h0 = h1 = h2 = -np.inf
+    for j in range(s, e):
+        l0, l1, l2 = min(l0, E[j, 0]), min(l1, E[j, 1]), min(l2, E[j, 2])
+        h0, h1, h2 = max(h0, E[j, 0]), max(h1, E[j, 1]), max(h2, E[j, 2])
+    a0, a1, a2, na = _axes(h0 - l0, h1 - l1, h2 - l2)
+    for t in range(na):
+        a = a0 if t == 0 else (a1 if t == 1 else a2)
         p = perm[a]
         key[0] = E[s, a]
         ordered = True  # rows already sorted along a (as a sweep's children are along its axis): identity
@@ -179,8 +213,8 @@ def _split_sweep(E, order, s, e, perm, key, run, pre, tmp, tmpo, out):
             for j in range(i + 1, n):
                 r += key[j] < v
             p[r] = i
-        # running bounds of the first i + 1 sorted elements (run[0:6, i]) and of the last n − i (run[0:6, i]
-        # again, second pass); their costs in a separate loop, which vectorises the square roots
+        # pre[0, i]: (i + 1) r³ of the box of the first i + 1 sorted elements (running bounds); pre[1, i]:
+        # (n − i) r³ of the rest
         pl0 = pl1 = pl2 = np.inf
         ph0 = ph1 = ph2 = -np.inf
         for i in range(n - 1):
@@ -191,24 +225,18 @@ def _split_sweep(E, order, s, e, perm, key, run, pre, tmp, tmpo, out):
             ph0 = max(ph0, E[r, 6])
             ph1 = max(ph1, E[r, 7])
             ph2 = max(ph2, E[r, 8])
-            run[0, i], run[1, i], run[2, i], run[3, i], run[4, i], run[5, i] = pl0, pl1, pl2, ph0, ph1, ph2
-        # pre[0, i]: (i + 1) r³ of the first i + 1 sorted elements' box
-        for i in range(n - 1):
-            pre[0, i] = (i + 1) * _cube_half_diag(run[0, i], run[1, i], run[2, i], run[3, i], run[4, i], run[5, i])
-        rl0 = rl1 = rl2 = np.inf
-        rh0 = rh1 = rh2 = -np.inf
+            pre[0, i] = (i + 1) * _cube_half_diag(pl0, pl1, pl2, ph0, ph1, ph2)
+        pl0 = pl1 = pl2 = np.inf
+        ph0 = ph1 = ph2 = -np.inf
         for i in range(n - 1, 0, -1):  # left = first i sorted, right = the rest
             r = s + p[i]
-            rl0 = min(rl0, E[r, 3])
-            rl1 = min(rl1, E[r, 4])
-            rl2 = min(rl2, E[r, 5])
-            rh0 = max(rh0, E[r, 6])
-            rh1 = max(rh1, E[r, 7])
-            rh2 = max(rh2, E[r, 8])
-            run[0, i], run[1, i], run[2, i], run[3, i], run[4, i], run[5, i] = rl0, rl1, rl2, rh0, rh1, rh2
-        # pre[1, i]: (n − i) r³ of the rest
-        for i in range(1, n):
-            pre[1, i] = (n - i) * _cube_half_diag(run[0, i], run[1, i], run[2, i], run[3, i], run[4, i], run[5, i])
+            pl0 = min(pl0, E[r, 3])
+            pl1 = min(pl1, E[r, 4])
+            pl2 = min(pl2, E[r, 5])
+            ph0 = max(ph0, E[r, 6])
+            ph1 = max(ph1, E[r, 7])
+            ph2 = max(ph2, E[r, 8])
+            pre[1, i] = (n - i) * _cube_half_diag(pl0, pl1, pl2, ph0, ph1, ph2)
         for i in range(1, n):
             c = pre[0, i - 1] + pre[1, i]
             # equal costs (coincident or flat elements): the more balanced split, so duplicates give no chains
@@ -318,7 +346,6 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, node_i, node_b, base):
     b = np.empty(12)
     perm = np.empty((3, SMALL), np.int64)
     key = np.empty(SMALL)
-    run = np.empty((6, SMALL))
     pre = np.empty((2, SMALL))
     tmp = np.empty((SMALL, 9))
     tmpo = np.empty(SMALL, np.int64)
@@ -353,7 +380,7 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, node_i, node_b, base):
             ntask += 1
             continue
         if e - s <= SMALL:
-            m = _split_sweep(E, order, s, e, perm, key, run, pre, tmp, tmpo, out)
+            m = _split_sweep(E, order, s, e, perm, key, pre, tmp, tmpo, out)
         else:
             m = _split_binned(E, order, s, e, b, min(NBINS, max(MINBINS, (e - s) // BINDIV)), bins, run_b, cost, sc, out)
             if m < 0:  # every centroid in one point: halve (any order is as good as another)
@@ -372,9 +399,10 @@ def _grow(E, order, s0, e0, b0, leaf_size, cutoff, node_i, node_b, base):
     return count, node_i, node_b, ntask, task_i, task_b
 
 
-def build_volume_rows(E, leaf_size, threads=1):
+def build_volume_rows(E, leaf_size, threads=1, root=None):
     """:func:`build_volume` on one (n, 9) float64 array of rows [centroid, box lo, box hi], which it reorders
-    in place (to tree order: row j is then element ``order[j]``).
+    in place (to tree order: row j is then element ``order[j]``). ``root``: the rows' bounds (12: box lo, hi,
+    centroid lo, hi), or None to compute them.
 
     With ``threads`` > 1 (numba's current thread count) and more than :data:`PARALLEL_ELEMENTS` rows, the top
     of the tree is split down to nodes of about n/64 elements (the root on the calling thread, then its two
@@ -385,7 +413,7 @@ def build_volume_rows(E, leaf_size, threads=1):
     cost ~6 s of compilation on a cold start, issue 17, for a build of 0.05-0.3 s)."""
     n = E.shape[0]
     order = np.arange(n, dtype=np.int64)
-    root = _root_bounds(E)
+    root = _root_bounds(E) if root is None else np.ascontiguousarray(root, dtype=np.float64)
     if threads > 1 and n > PARALLEL_ELEMENTS:
         cutoff = max(leaf_size + 1, n // 64)
         # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short

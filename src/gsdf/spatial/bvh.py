@@ -60,8 +60,8 @@ def build_bvh(centroids: np.ndarray, elem_lo: np.ndarray, elem_hi: np.ndarray, l
     """Build a BVH over elements with the given centroids and bounding boxes (all (n, 3) float64).
 
     ``split="median"`` halves each node at the median centroid of its longest centroid axis (balanced tree).
-    ``split="volume"`` picks, among 3 × 32 binned centroid planes (every position of the sorted elements in
-    nodes of at most 24), the split minimising n_L·vol(box_L) + n_R·vol(box_R) (box = child's element
+    ``split="volume"`` picks, among 2 × 32 binned centroid planes on the two longest axes of the node's
+    centroid box (every position of the sorted elements in nodes of at most 24), the split minimising n_L·vol(box_L) + n_R·vol(box_R) (box = child's element
     bounding box, volume taken as the cube of its half-diagonal so flat boxes still count); built by
     :func:`gsdf.spatial.binned.build_volume`. A node is opened by a uniformly distributed query with
     probability ∝ the volume of its far-field ball, so this keeps the far-field walk short on thin or
@@ -92,10 +92,11 @@ def build_bvh(centroids: np.ndarray, elem_lo: np.ndarray, elem_hi: np.ndarray, l
     return BVH(*arrays)
 
 
-def build_volume_bvh(E: np.ndarray, leaf_size: int = 4) -> BVH:
+def build_volume_bvh(E: np.ndarray, leaf_size: int = 4, root: np.ndarray | None = None) -> BVH:
     """Volume-split BVH (as ``build_bvh(..., split="volume")``) over elements given as one (n, 9) float64
     C-contiguous array of rows [centroid, box lo, box hi]. ``E`` is reordered in place into tree order (row
-    ``j`` becomes element ``order[j]``), which saves the callers a gather.
+    ``j`` becomes element ``order[j]``), which saves the callers a gather. ``root``: the rows' bounds (12:
+    box lo, hi, centroid lo, hi) if the caller has them (saves a pass over the rows), else computed.
 
     Example
     -------
@@ -112,7 +113,7 @@ def build_volume_bvh(E: np.ndarray, leaf_size: int = 4) -> BVH:
         raise ValueError("cannot build a tree over zero elements")
     if leaf_size < 1:
         raise ValueError(f"leaf_size must be >= 1, got {leaf_size}")
-    return BVH(*build_volume_rows(E, int(leaf_size), numba.get_num_threads()))
+    return BVH(*build_volume_rows(E, int(leaf_size), numba.get_num_threads(), root))
 
 
 def build_point_bvh(P: np.ndarray, leaf_size: int = 8) -> BVH:
