@@ -25,7 +25,8 @@ the subdivided mesh (``flip_subdivided=False`` against the default; section ``re
 same for the global least-squares fit of all vertices (``fit=False`` against the default, with the inverted /
 tilted area of both against the truth normals; section ``recon-fit``); ``--only-thin`` the same for the choice of
 the surface before the fitting (``orientation="mst", order="seed", rescue=False`` against the default; section
-``recon-thin``).
+``recon-thin``); ``--only-side`` the same for the one-sided rescue of dropped points (``side_rescue=False``
+against the default; section ``recon-side``).
 """
 
 from __future__ import annotations
@@ -423,6 +424,27 @@ def only_thin():
                   + text + "\n\n" + summary)
 
 
+def only_side():
+    """Before / after of the one-sided rescue of dropped points (``side_rescue=False`` against the default),
+    into section recon-side."""
+    up, t0 = _uptime(), time.perf_counter()
+    print(up, flush=True)
+    text, summary = before_after_table(dict(side_rescue=False), "side_rescue=False",
+                                       lambda r: f"{r['side_rescued']}", lambda r: r["timings"]["side_rescue"],
+                                       shape=True, labels=("points kept by the side rescue", "stage (s)"))
+    write_section("recon-side", "## recon-side: one-sided rescue of dropped points at the tips of thin parts — "
+                  "before / after on the Table-2 clouds\n\n"
+                  f"Machine: {machine()}. Load at start: `{up}`; at the end: `{_uptime()}`. Command: `NUMBA_NUM_THREADS=2 "
+                  "PYTHONPATH=src /work/anchors/bin/python bench/bench_recon.py --only-side` "
+                  f"({time.perf_counter() - t0:.0f} s).  Same clouds as the full run (section recon); CD×100 / HD×100 "
+                  "with one metric sample per case shared by the three methods.  Before = `side_rescue=False` (the "
+                  "pipeline of section recon-thin); after = the default (`side_rescue=True`: after the orientation, "
+                  "dropped points whose 5th neighbour is within 4 spacings and whose height over the quadric of the "
+                  "12 nearest kept points on their nearest kept point's side — oriented normals with a positive "
+                  "cosine — is at most 2.5 spacings are kept, with the quadric's normal).  Inverted / tilted as in "
+                  "section recon-fit; \"stage (s)\" = the side rescue.\n\n" + text + "\n\n" + summary)
+
+
 # ------------------------------------------------------------------------------------------- main
 def main(quick: bool, relocation: bool = False, only_relocation: bool = False, only_meshes=None, table2_only: bool = False):
     rng = np.random.default_rng(0)
@@ -596,6 +618,9 @@ if __name__ == "__main__":
     ap.add_argument("--only-thin", action="store_true",
                     help="only the before / after table of the orientation / growth order / rescue changes on the full "
                          "run's Table-2 clouds, with SPSR and inverted / tilted area; written to section recon-thin")
+    ap.add_argument("--only-side", action="store_true",
+                    help="only the before / after table of the one-sided rescue (side_rescue) on the full run's "
+                         "Table-2 clouds, with SPSR and inverted / tilted area; written to section recon-side")
     ap.add_argument("--size-worker", type=int, default=None)
     ap.add_argument("--only-sizes", default=None, metavar="N,N,...",
                     help="only the time / peak memory vs point count table for these sizes (one process each), "
@@ -611,6 +636,8 @@ if __name__ == "__main__":
         only_fit()
     elif a.only_thin:
         only_thin()
+    elif a.only_side:
+        only_side()
     elif a.only_sizes:
         only_sizes([int(n) for n in a.only_sizes.split(",")])
     else:

@@ -595,7 +595,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         on their neighbours' surface keep their exact coordinates and the rest are relocated (``relocate``).
     report : dict, only with ``return_report=True``: ``iterations``, ``f0_sizes`` and ``inlier_counts`` per
         alternation round, ``outliers`` (n,) bool (pre-filtered, or farther than ``outlier_gap`` spacings
-        from the returned surface; duplicates are not flagged), ``surface_fraction`` (share of distinct
+        from the returned surface; duplicates are not flagged), ``side_rescued`` (points kept by the side rescue), ``surface_fraction`` (share of distinct
         points with a flat, dense neighbourhood), ``gamma_ratio``, ``fit`` (None without ``fit``; else the
         :func:`.globalfit.fit_to_samples` reports ``before_flips`` and ``subdivided``), ``relocation`` (vertices moved / damped /
         reverted, ``free_input_points``; None without ``relocate``), ``flips`` (``flipped``, summed face fit
@@ -675,6 +675,8 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     if bad.any():
         Ni[bad] = _pca_normals(Xi)[bad]
     Ni = orient_normals(Xi, Ni, method=orientation)
+    timings["orientation"] = time.perf_counter() - t
+    t = time.perf_counter()
     n_side = 0
     if rescue and side_rescue and outliers == "auto" and n_planar >= 0.75 * len(X):
         Nfull = np.zeros((len(X), 3))
@@ -685,7 +687,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
             Nfull[add] = Nadd[add]
             inl = inl | add
             Xi, Ni = X[inl], Nfull[inl]
-    timings["orientation"] = time.perf_counter() - t
+    timings["side_rescue"] = time.perf_counter() - t
     # --- tetrahedralisation
     t = time.perf_counter()
     say("tetrahedralisation")
