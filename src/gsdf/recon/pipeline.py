@@ -580,8 +580,9 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         order="seed", rescue=False`` on the 32 Table-2 clouds.
     side_rescue : bool — with ``rescue``, after the orientation also keep the dropped points within 2.5
         spacings of the quadric of the kept points on their nearest kept point's side (:func:`_on_side`: the
-        tips of thin parts, where the quadric of both sides runs between them).  Default on: on the 32 Table-2
-        clouds (bench/RESULTS.md section recon-side) CD ≤ screened Poisson on more cases, mean CD lower.
+        tips of thin parts, whose quadric extrapolates).  Default on: on the 32 Table-2 clouds (bench/RESULTS.md
+        section recon-side) CD ≤ screened Poisson on 28 instead of 23, mean CD×100 −0.002 (lower on 21, largest
+        rise +0.005), same time.
     fit_side : bool — the global fit's vertex quadrics one-sided (:func:`.globalfit.fit_to_samples` with the
         oriented sample normals: only samples whose normal has a positive cosine with the vertex normal).  Off
         by default: mixed on the Table-2 clouds (section recon-side).
