@@ -466,8 +466,9 @@ within 0.03):
   quadrics at points on the surface has the same error two-sided and one-sided (median 0.04 spacings); only
   sheets ≲ 2 spacings apart mix (tests/test_recon_side.py).  The one-sided vertex quadric in the global fit
   (`fit_side=True`, normals oriented, cosine > 0 with the vertex normal) lowers camel 4K+400's missed count 2 443
-  → 2 146 and thin t2r 0.0319 → 0.0300, but over the 32 clouds (with the side rescue) it is mixed: CD ≤ SPSR on
-  26 vs 27, mean CD×100 0.3107 vs 0.3109 — left as an option, off.
+  → 2 146 and thin t2r 0.0319 → 0.0300 (without the side rescue), but over the 32 clouds (with the side rescue at
+  height 2) it is mixed: CD ≤ SPSR on 26 vs 27, mean CD×100 0.3107 vs 0.3109, mean HD×100 4.52 vs 4.82 — left as
+  an option, off.
 * **The misses sit at the tips of thin parts whose samples the pre-filter drops**: 66–81 % of the missed truth
   samples have a dropped clean sample as their nearest input sample (dropped clean samples: camel 4K+400 62 of
   4 000, bull 47, armadillo 29).  Their 5th neighbour is at 3–4 spacings and they stand 1–4 spacings off the
@@ -477,10 +478,17 @@ within 0.03):
   0.176 / 0.178 / 0.195 / 0.143 (oracle on top of it: camel 0.173, bull 4K 0.173, bull 2K 0.245 vs 0.243).
 * **Tried and not kept**: the two-sided rescue with a looser height (2 / 3 spacings: CD ≤ SPSR on 25 / 26 of 32,
   mean 0.3114 / 0.3117, against 28 and 0.3109 one-sided at 2.5; one-sided at 2 / 3: 27 / 27); dropping the global
-  fit's attachments of samples to faces facing against their normal (camel 4K+400 0.185 → 0.191: where the mesh
-  lacks a side they are its only pull); the global fit's weights (8 clouds, mean CD×100 0.1964 at the defaults:
+  fit's attachments of samples to faces facing against their normal (with the one-sided quadric, camel 4K+400
+  0.187 → 0.191, bull 4K+400 0.180 → 0.189: where the mesh lacks a side they are its only pull); the global fit's weights (8 clouds, mean CD×100 0.1964 at the defaults:
   membrane 0.1 / 0.05 → 0.1964 / 0.1965, data 10 → 0.1958, surface 0 / 0.3 / 3 → 0.2140 / 0.1976 / 0.1977; one
-  fit round only before or only after the subdivision → 0.1985).
+  fit round only before or only after the subdivision → 0.1985; fit_tol 0.05 / 0.1 / 0.4 / 1 → 0.2042 / 0.2002 /
+  0.1984 / 0.2006: looser lets the quadric pull thin parts in, camel 4K+400 thin t2r 0.0235 → 0.0250 at 1).
+* **Option, off**: `side_drop=3` drops kept points more than 3 spacings off the one-sided quadric of their
+  neighbours (leave-one-out; kept outliers off a sheet: on bunny 1K+400 10 of the 53 kept points farther than 2
+  spacings from the truth, no clean sample).  On the 32 clouds: mean CD×100 0.3109 → 0.3077 (fandisk 1K+800
+  0.779 → 0.718, camel 1K+800 0.793 → 0.754, bunny 1K+400 0.433 → 0.412, 1K+200 0.348 → 0.337), but bull 1K+800
+  0.688 → 0.706, armadillo 1K+800 1.039 → 1.051, bull 2K+400 0.243 → 0.247, and CD ≤ SPSR on 27 instead of 28
+  (armadillo 4K+400 0.195 → 0.196 against 0.188).
 * **What is left** on the 4 misses: on camel 4K+400, bull 4K+400 and 2K+400 the global fit trades t2r for
   recon→truth (camel: fit=False → default t2r 0.0424 → 0.0499, r2t 0.0925 → 0.0784; bull 2K+400 0.0868 → 0.0964,
   0.1448 → 0.1106; SPSR 0.0350 / 0.0759 on camel).  Bunny 1K+400 is outlier handling: the planar test explains

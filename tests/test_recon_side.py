@@ -10,7 +10,7 @@ import gsdf
 from gsdf.mesh.topology import is_sphere
 from gsdf.recon.globalfit import fit_to_samples
 from gsdf.recon.orient import orient_normals
-from gsdf.recon.pipeline import _dense, _on_side, _on_surface, _pca_normals, _prefilter
+from gsdf.recon.pipeline import _dense, _off_side, _on_side, _on_surface, _pca_normals, _prefilter
 from gsdf.recon.relocate import local_surface
 from .test_recon_thin import _ellipsoid, _with_outliers
 
@@ -97,7 +97,7 @@ def test_side_rescue_keeps_thin_cylinder_samples_the_first_rescue_leaves_and_no_
     assert np.mean(np.einsum("ij,ij->i", Nadd[add], N[keep][j]) > 0) >= 0.8
 
 
-@pytest.mark.parametrize("kw", [{"side_rescue": False}, {}, {"fit_side": True}])
+@pytest.mark.parametrize("kw", [{"side_rescue": False}, {}, {"fit_side": True}, {"side_drop": 3.0}])
 def test_side_options_keep_the_promise(kw):
     X, Nn = _ellipsoid(1500, (1.0, 0.5, 0.12), seed=5)               # a thin, flat ellipsoid
     P = _with_outliers(X, Nn, 200, seed=6)
@@ -108,8 +108,21 @@ def test_side_options_keep_the_promise(kw):
     assert float(np.median(unsigned_distance(V, F, X))) < 0.01 * float(np.linalg.norm(X.max(0) - X.min(0)))
 
 
-@pytest.mark.parametrize("name", ["side_rescue", "fit_side"])
-def test_side_options_validate(name):
+@pytest.mark.parametrize("name, bad", [("side_rescue", "yes"), ("fit_side", "yes"), ("side_drop", -1.0),
+                                       ("side_drop", True), ("side_drop", float("nan"))])
+def test_side_options_validate(name, bad):
     P = np.random.default_rng(0).normal(size=(200, 3))
     with pytest.raises(ValueError, match=name):
-        gsdf.reconstruct_simply_connected(P, **{name: "yes"})
+        gsdf.reconstruct_simply_connected(P, **{name: bad})
+
+
+def test_off_side_flags_points_off_a_thin_slab_not_its_samples():
+    """Points 4 spacings above the top sheet of a slab whose sheets are 1.5 spacings apart: off their side's
+    quadric (flagged); the slab's own samples are on it (none flagged) — the two-sided quadric would put both
+    sheets' samples 0.75 spacings off."""
+    S, NS = _slab(0.015)
+    O = np.array([[0.0, 0.0, 0.0075 + 0.04], [0.03, -0.02, 0.0075 + 0.05]])
+    X = np.concatenate([S, O])
+    N = np.concatenate([NS, np.tile([0, 0, 1.0], (2, 1))])
+    off = _off_side(X, N, 3.0)
+    assert off[len(S):].all() and not off[:len(S)].any()
