@@ -482,7 +482,10 @@ within 0.03):
   0.187 → 0.191, bull 4K+400 0.180 → 0.189: where the mesh lacks a side they are its only pull); the global fit's weights (8 clouds, mean CD×100 0.1964 at the defaults:
   membrane 0.1 / 0.05 → 0.1964 / 0.1965, data 10 → 0.1958, surface 0 / 0.3 / 3 → 0.2140 / 0.1976 / 0.1977; one
   fit round only before or only after the subdivision → 0.1985; fit_tol 0.05 / 0.1 / 0.4 / 1 → 0.2042 / 0.2002 /
-  0.1984 / 0.2006: looser lets the quadric pull thin parts in, camel 4K+400 thin t2r 0.0235 → 0.0250 at 1).
+  0.1984 / 0.2006: looser lets the quadric pull thin parts in, camel 4K+400 thin t2r 0.0235 → 0.0250 at 1); the
+  side rescue with a density factor of 5 spacings (26 of 32, mean 0.3114) or 5 rounds (same points as 3).
+  Open3D's screened Poisson is not deterministic (its threads): its CD varies by ~0.001 between runs, so the
+  count ≤ SPSR moves by one at the rounding edge (homer 4K+400: ours 0.156, SPSR 0.1549–0.155).
 * **Option, off**: `side_drop=3` drops kept points more than 3 spacings off the one-sided quadric of their
   neighbours (leave-one-out; kept outliers off a sheet: on bunny 1K+400 10 of the 53 kept points farther than 2
   spacings from the truth, no clean sample).  On the 32 clouds: mean CD×100 0.3109 → 0.3077 (fandisk 1K+800
