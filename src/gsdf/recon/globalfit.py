@@ -250,7 +250,7 @@ class _Clock:
 
 def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float = 5.0, surface: float = 1.0,
                    membrane: float = 0.2, prox: float = 0.01, trim: float = 3.0, k: int = 8,
-                   fit_tol: float = 0.2, return_report: bool = False):
+                   fit_tol: float = 0.2, normals=None, side_cos: float = 0.0, return_report: bool = False):
     """Move all vertices of a mesh onto its samples by alternating attachment and a global least-squares solve.
 
     See the module text for the energy.  The faces are not changed, so the topology is the input's.
@@ -266,6 +266,9 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
     trim : float > 0 — samples farther than this × ``spacing`` from the mesh get no weight in a round.
     k : int ≥ 3 — samples per local quadric; fit_tol : float > 0 — in spacings, the rms residual above which a
         vertex's quadric is not trusted (two sheets of a thin part, a crease): no surface term there.
+    normals : (s, 3) float or None — oriented (outward) sample normals: each vertex's quadric is then fitted to
+        the samples on its side only, those whose normal has cosine > ``side_cos`` with the vertex normal of the
+        current mesh (:func:`.relocate.local_surface` with normals).  None: the k nearest samples.
     return_report : bool — also return ``{"iterations", "attached" (per round), "cg_iterations" (per round),
         "mean_shift", "max_shift"}``.
 
@@ -310,7 +313,13 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
     rank = np.empty(n, dtype=np.int64)
     rank[pv] = np.arange(n)
     F = rank[F]
-    S = S[morton_order(S)]
+    ps = morton_order(S)
+    S = S[ps]
+    if normals is not None:
+        NS = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+        if NS.shape != (m, 3):
+            raise ValueError(f"normals: expected ({m}, 3), got {NS.shape}")
+        NS = NS[ps]
     tree = cKDTree(S)
     P = _Pattern(F, n)
     td = None
@@ -321,7 +330,16 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
         td = TriangleDistance(X, F) if td is None else td.refit(X)
         d, face, _, bary = td.query_barycentric(S)
         clock("attach")
-        foot, nrm, _, rms = local_surface(X, S, h, k=k, tree=tree, return_fit=True)
+        if normals is None:
+            foot, nrm, _, rms = local_surface(X, S, h, k=k, tree=tree, return_fit=True)
+        else:                                       # area-weighted vertex normals of the current mesh
+            Nf = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+            Nv = np.zeros_like(X)
+            for j in range(3):
+                np.add.at(Nv, F[:, j], Nf)
+            Nv /= np.maximum(np.linalg.norm(Nv, axis=1), 1e-300)[:, None]
+            foot, nrm, _, rms = local_surface(X, S, h, k=k, tree=tree, return_fit=True, normals=NS,
+                                              query_normals=Nv, side_cos=side_cos)
         nrm = np.ascontiguousarray(nrm)
         clock("surface")
         a = data * (d <= trim * h)

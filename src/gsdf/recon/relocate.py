@@ -84,11 +84,12 @@ _BLOCK = 512          # queries per parallel task of the fit kernels (scratch al
 
 
 @nb.njit(cache=True, parallel=True)
-def _weighted_moments(S, I, d, spacing):
+def _weighted_moments(S, I, d, cnt, spacing):
     """Per query (its neighbours' rows I (q, k) of S and distances d (q, k), ascending as the k-d tree returns
-    them): the scale h = max(1.5 × spacing, median of d), the normalised Gaussian weights w (q, k), their
-    centroid c (q, 3) and the eigenvectors of the weighted covariance of the neighbours about it, as the rows
-    t1, t2, n of frame (q, 3, 3) by descending eigenvalue (n: the normal of the local plane)."""
+    them; only the first cnt[i] of row i count, the others get weight 0): the scale h = max(1.5 × spacing,
+    median of those distances), the normalised Gaussian weights w (q, k), their centroid c (q, 3) and the
+    eigenvectors of the weighted covariance of the neighbours about it, as the rows t1, t2, n of frame
+    (q, 3, 3) by descending eigenvalue (n: the normal of the local plane)."""
     q, k = d.shape
     h = np.empty(q)
     w = np.empty((q, k))
@@ -98,13 +99,14 @@ def _weighted_moments(S, I, d, spacing):
         C = np.empty((3, 3))
         Vs = np.empty((3, 3))
         for i in range(blk * _BLOCK, min(q, (blk + 1) * _BLOCK)):
-            med = d[i, k // 2] if k % 2 == 1 else 0.5 * (d[i, k // 2 - 1] + d[i, k // 2])
+            m = cnt[i]
+            med = d[i, m // 2] if m % 2 == 1 else 0.5 * (d[i, m // 2 - 1] + d[i, m // 2])
             hi = max(1.5 * spacing, med)
             h[i] = hi
             tot = 0.0
             for j in range(k):
                 r = d[i, j] / hi
-                w[i, j] = np.exp(-(r * r))
+                w[i, j] = np.exp(-(r * r)) if j < m else 0.0
                 tot += w[i, j]
             tot = max(tot, 1e-300)
             cx = cy = cz = 0.0
@@ -205,19 +207,43 @@ def _quadric_solve(S, I, w, c, frame, h, Q):
     return coef, rms, hgt, foot
 
 
-def _mls(Q, S, spacing, k, extra, tree):
+_SIDE_POOL = 3         # one-sided fits pick their k samples among the nearest _SIDE_POOL × k
+
+
+def _one_sided(I, d, NS, Nq, k, side_cos):
+    """The first ``k`` columns of the neighbour lists (I, d) (q, K), K ≥ k ascending, with the samples facing
+    the query's side first: those whose oriented normal NS[I] has cosine > ``side_cos`` with the query's
+    normal Nq (q, 3), in ascending distance; returns (I, d, cnt) with cnt (q,) the number of such samples
+    among the k (rows with fewer than 3 keep all k nearest, cnt = k: too few to fit one side)."""
+    ok = np.einsum("qkx,qx->qk", NS[I], Nq) > side_cos
+    order = np.argsort(~ok, axis=1, kind="stable")[:, :k]
+    Is = np.take_along_axis(I, order, axis=1)
+    ds = np.take_along_axis(d, order, axis=1)
+    cnt = np.minimum(ok.sum(axis=1), k)
+    few = cnt < 3
+    Is[few], ds[few], cnt[few] = I[few, :k], d[few, :k], k
+    return np.ascontiguousarray(Is), np.ascontiguousarray(ds), cnt.astype(np.int64)
+
+
+def _mls(Q, S, spacing, k, extra, tree, NS=None, Nq=None, side_cos=0.0):
     """The weighted quadric fits of :func:`local_surface` around each query (the ``k`` nearest samples after
-    skipping ``extra``): centre c (q, 3), frame (q, 3, 3) rows t1, t2, n, scale h (q,), coefficients (q, 6), the
+    skipping ``extra``; with sample normals NS and query normals Nq, the ``k`` nearest on the query's side,
+    :func:`_one_sided`): centre c (q, 3), frame (q, 3, 3) rows t1, t2, n, scale h (q,), coefficients (q, 6), the
     weighted rms residual of the fit (q,), the query's height over the quadric (q,) and its foot (q, 3)."""
     from ..threads import get_num_threads
 
     Q = np.ascontiguousarray(Q, dtype=np.float64)
     S = np.ascontiguousarray(S, dtype=np.float64)
+    kq = k if NS is None else min(_SIDE_POOL * k, len(S) - extra)
     # threads only for many queries: each query call starts its workers anew
-    d, I = tree.query(Q, k=k + extra, workers=get_num_threads() if len(Q) >= 32768 else 1)
+    d, I = tree.query(Q, k=kq + extra, workers=get_num_threads() if len(Q) >= 32768 else 1)
     d = np.ascontiguousarray(d.reshape(len(Q), -1)[:, extra:])
     I = np.ascontiguousarray(I.reshape(len(Q), -1)[:, extra:])
-    h, w, c, frame = _weighted_moments(S, I, d, float(spacing))
+    if NS is None:
+        cnt = np.full(len(Q), k, dtype=np.int64)
+    else:
+        I, d, cnt = _one_sided(I, d, NS, Nq, k, side_cos)
+    h, w, c, frame = _weighted_moments(S, I, d, cnt, float(spacing))
     coef, rms, hgt, foot = _quadric_solve(S, I, w, c, frame, h, Q)
     return c, frame, h, coef, rms, hgt, foot
 
@@ -228,7 +254,7 @@ def _fit_quadrics(Q, S, spacing, k, extra, tree):
 
 
 def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False, tree=None,
-                  return_fit: bool = False):
+                  return_fit: bool = False, normals=None, query_normals=None, side_cos: float = 0.0):
     """Project queries onto the moving-least-squares quadric of their nearest samples.
 
     For each query q: the ``k`` nearest samples get Gaussian weights exp(−(d / h)²) with h = max(1.5 ×
@@ -246,6 +272,11 @@ def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False,
     tree : cKDTree of ``S`` or None (built here).
     return_fit : bool — also return the weighted rms residual of the quadric fit (q,): large where the
         neighbours are not one smooth sheet (creases, both sides of a thin part).
+    normals, query_normals : (s, 3), (q, 3) float or None — oriented normals of the samples and of the
+        queries (say a mesh's vertex normals), both or neither.  Given: a one-sided fit — the ``k`` samples are
+        the nearest among the 3 ``k`` nearest whose normal has cosine > ``side_cos`` with the query's (the
+        query's side of a thin part only; the far side's normals point the other way); a query with fewer
+        than 3 such samples keeps its ``k`` nearest.
 
     Returns
     -------
@@ -260,7 +291,16 @@ def local_surface(Q, S, spacing: float, k: int = 12, exclude_self: bool = False,
     if k < 3:
         raise ValueError(f"S: needs at least {3 + extra} samples for a local surface, got {len(S)}")
     tree = cKDTree(S) if tree is None else tree
-    _, frame, _, _, rms, hgt, foot = _mls(Q, S, spacing, k, extra, tree)
+    NS = Nq = None
+    if (normals is None) != (query_normals is None):
+        raise ValueError("normals, query_normals: give both or neither")
+    if normals is not None:
+        NS = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+        Nq = np.asarray(query_normals, dtype=np.float64).reshape(-1, 3)
+        if NS.shape != S.shape or Nq.shape != Q.shape:
+            raise ValueError(f"normals, query_normals: expected shapes {S.shape} and {Q.shape}, got {NS.shape} "
+                             f"and {Nq.shape}")
+    _, frame, _, _, rms, hgt, foot = _mls(Q, S, spacing, k, extra, tree, NS, Nq, float(side_cos))
     n = frame[:, 2]
     if not return_fit:
         return foot, n, hgt
