@@ -27,6 +27,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from .._checks import as_faces, as_points, integer, nonnegative, positive
+from ..linalg.eig3 import jacobi_eig3
 
 __all__ = ["local_surface", "relocate_vertices", "subdivide_onto_samples"]
 
@@ -35,37 +36,7 @@ __all__ = ["local_surface", "relocate_vertices", "subdivide_onto_samples"]
 def _eigh3(A, V, frame, i):
     """Eigenvectors of the symmetric 3 × 3 matrix A (overwritten) by cyclic Jacobi rotations (to rounding),
     written as the rows of frame[i] by descending eigenvalue (t1, t2, n: n the smallest); V: 3 × 3 scratch."""
-    for r in range(3):
-        for s in range(3):
-            V[r, s] = 1.0 if r == s else 0.0
-    for _sweep in range(50):
-        off = A[0, 1] * A[0, 1] + A[0, 2] * A[0, 2] + A[1, 2] * A[1, 2]
-        dia = A[0, 0] * A[0, 0] + A[1, 1] * A[1, 1] + A[2, 2] * A[2, 2]
-        if off <= 1e-36 * dia or off == 0.0:
-            break
-        for p, q in ((0, 1), (0, 2), (1, 2)):
-            apq = A[p, q]
-            if apq == 0.0:
-                continue
-            theta = (A[q, q] - A[p, p]) / (2.0 * apq)
-            t = 1.0 / (abs(theta) + np.sqrt(theta * theta + 1.0))
-            if theta < 0.0:
-                t = -t
-            cs = 1.0 / np.sqrt(t * t + 1.0)
-            sn = t * cs
-            for r in range(3):                   # A <- A J (columns p, q)
-                arp, arq = A[r, p], A[r, q]
-                A[r, p] = cs * arp - sn * arq
-                A[r, q] = sn * arp + cs * arq
-            for r in range(3):                   # A <- Jᵀ A (rows p, q)
-                apr, aqr = A[p, r], A[q, r]
-                A[p, r] = cs * apr - sn * aqr
-                A[q, r] = sn * apr + cs * aqr
-            A[p, q] = A[q, p] = 0.0
-            for r in range(3):                   # V <- V J
-                vrp, vrq = V[r, p], V[r, q]
-                V[r, p] = cs * vrp - sn * vrq
-                V[r, q] = sn * vrp + cs * vrq
+    jacobi_eig3(A, V)
     # descending order of the eigenvalues A[j, j]
     o0, o1, o2 = 0, 1, 2
     if A[o0, o0] < A[o1, o1]:

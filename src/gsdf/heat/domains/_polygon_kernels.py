@@ -21,6 +21,7 @@ import numpy as np
 from numba import njit
 
 from ...linalg.assembly import sort_row
+from ...linalg.eig3 import jacobi_eig3
 
 
 @njit(cache=True)
@@ -28,34 +29,8 @@ def _jacobi3(S):
     """Eigenvalues (3,) and eigenvectors (columns of a 3×3) of a symmetric 3×3 matrix by cyclic Jacobi
     rotations (accurate to a few ulps of the largest eigenvalue, also for repeated and zero eigenvalues)."""
     A = S.copy()
-    U = np.eye(3)
-    for _ in range(30):
-        off = A[0, 1] * A[0, 1] + A[0, 2] * A[0, 2] + A[1, 2] * A[1, 2]
-        diag = A[0, 0] * A[0, 0] + A[1, 1] * A[1, 1] + A[2, 2] * A[2, 2]
-        if off <= 1e-36 * diag or off == 0.0:
-            break
-        for p, q in ((0, 1), (0, 2), (1, 2)):
-            apq = A[p, q]
-            if apq == 0.0:
-                continue
-            theta = (A[q, q] - A[p, p]) / (2.0 * apq)
-            t = (1.0 if theta >= 0 else -1.0) / (abs(theta) + np.sqrt(theta * theta + 1.0))
-            c = 1.0 / np.sqrt(t * t + 1.0)
-            s = t * c
-            for k in range(3):                       # A <- Jᵀ A J (columns, then rows)
-                akp, akq = A[k, p], A[k, q]
-                A[k, p] = c * akp - s * akq
-                A[k, q] = s * akp + c * akq
-            for k in range(3):
-                apk, aqk = A[p, k], A[q, k]
-                A[p, k] = c * apk - s * aqk
-                A[q, k] = s * apk + c * aqk
-            A[p, q] = 0.0
-            A[q, p] = 0.0
-            for k in range(3):
-                ukp, ukq = U[k, p], U[k, q]
-                U[k, p] = c * ukp - s * ukq
-                U[k, q] = s * ukp + c * ukq
+    U = np.empty((3, 3))
+    jacobi_eig3(A, U)
     lam = np.empty(3)
     for k in range(3):
         lam[k] = A[k, k]
