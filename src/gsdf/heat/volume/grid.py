@@ -386,7 +386,10 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     if abs(system.penalty_sum) > 1e-12 * system.delta * int(np.prod(shape)):   # |P·1| against tr(P)
         # best constant (L annihilates constants); a penalty of differences only (P·1 = 0) leaves it free
         x0 += (rhs.sum() - system.matvec(x0).sum()) / system.penalty_sum
-    x, _ = cg_loop(system.matvec, system.precondition, rhs, x0, rtol=tol, maxiter=maxiter, warn="step III")
+    from ...threads import blas_region
+
+    with blas_region():   # once around the loop: the DCT stage's own blas_region blocks then set nothing
+        x, _ = cg_loop(system.matvec, system.precondition, rhs, x0, rtol=tol, maxiter=maxiter, warn="step III")
     return x
 
 
