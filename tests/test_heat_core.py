@@ -23,13 +23,14 @@ def test_surface_core_matches_pre_core_solvers(name, build, curves, kw):
     phi = build().compute_distance(curves, **kw)
     ref = REF[name]
     scale = max(1.0, float(np.abs(ref).max()))
-    # the soft penalty is solved by preconditioned CG to a relative residual of 1e-4 (GridPoisson.penalty_tol):
-    # agreement with the frozen run holds to that tolerance, not to rounding (issue 17). The hard constraints
+    # the soft penalty is solved by preconditioned CG to a relative residual of 1e-3 (GridPoisson.penalty_tol):
+    # agreement with the frozen run holds to that tolerance (φ within 4.2e-4 of its range), not to rounding
+    # (issue 17). The hard constraints
     # through points inside faces are a saddle system with a -1e-12 I block (FactorizedPoisson.constrained): rounding
     # in the BLAS kernels under SuperLU is amplified there, so the same code gives phi differing by up to
     # 1.7e-7 with OpenBLAS's SkylakeX kernels against the Haswell/Zen ones the fixture was made with
     # (OPENBLAS_CORETYPE=SkylakeX vs Haswell, measured 2026-12-03); elsewhere they agree to 3e-14.
-    tol = 1e-4 if name == "grid_mesh_soft" else 1e-6 if name in SADDLE_CASES else 1e-8
+    tol = 1e-3 if name == "grid_mesh_soft" else 1e-6 if name in SADDLE_CASES else 1e-8
     assert np.abs(phi - ref).max() <= tol * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
 
 
@@ -144,8 +145,8 @@ def test_volume_core_matches_pre_core_solvers(name, kw, monkeypatch):
     from gsdf.heat.volume import signed_heat_volume
 
     kw = dict(kw)
-    if "points" in kw and kw.get("domain", "grid") == "grid":
-        kw["step1"] = "yukawa"  # the frozen run's Step I (clouds on grids default to the screened grid solve)
+    if kw.get("domain", "grid") == "grid":
+        kw["step1"] = "yukawa"  # the frozen run's Step I (grids default to the screened grid solve since)
     if "points" in kw:
         # the frozen run estimated cloud areas from 8·k candidates; the default is 2·k since issue 17 (lower
         # error on the benchmark clouds): the default stays within 1e-4, the old areas reproduce the run exactly
@@ -158,13 +159,14 @@ def test_volume_core_matches_pre_core_solvers(name, kw, monkeypatch):
     phi = np.asarray(signed_heat_volume(**kw).values).ravel()
     ref = REF[name]
     scale = max(1.0, float(np.abs(ref).max()))
-    # the soft penalty is solved by preconditioned CG to a relative residual of 1e-4 (GridPoisson.penalty_tol):
-    # agreement with the frozen run holds to that tolerance, not to rounding (issue 17). The hard constraints
+    # the soft penalty is solved by preconditioned CG to a relative residual of 1e-3 (GridPoisson.penalty_tol):
+    # agreement with the frozen run holds to that tolerance (φ within 4.2e-4 of its range), not to rounding
+    # (issue 17). The hard constraints
     # through points inside faces are a saddle system with a -1e-12 I block (FactorizedPoisson.constrained): rounding
     # in the BLAS kernels under SuperLU is amplified there, so the same code gives phi differing by up to
     # 1.7e-7 with OpenBLAS's SkylakeX kernels against the Haswell/Zen ones the fixture was made with
     # (OPENBLAS_CORETYPE=SkylakeX vs Haswell, measured 2026-12-03); elsewhere they agree to 3e-14.
-    tol = 1e-4 if name == "grid_mesh_soft" else 1e-6 if name in SADDLE_CASES else 1e-8
+    tol = 1e-3 if name == "grid_mesh_soft" else 1e-6 if name in SADDLE_CASES else 1e-8
     assert np.abs(phi - ref).max() <= tol * scale, f"{name}: max diff {np.abs(phi - ref).max():.3g}"
 
 
@@ -264,8 +266,8 @@ def test_grid_default_is_the_fast_penalty_and_none_is_hard():
     from gsdf.heat.volume import signed_heat_volume
 
     kw = dict(volume_cases())["grid_mesh_soft"]
-    phi = np.asarray(signed_heat_volume(**kw).values).ravel()
-    # to the CG tolerance (relative residual 1e-4), see test_volume_core_matches_pre_core_solvers
-    assert np.abs(phi - REF["grid_mesh_soft"]).max() <= 1e-4 * max(1.0, float(np.abs(REF["grid_mesh_soft"]).max()))
+    phi = np.asarray(signed_heat_volume(**kw, step1="yukawa").values).ravel()   # the frozen run's Step I
+    # to the CG tolerance (relative residual 1e-3), see test_volume_core_matches_pre_core_solvers
+    assert np.abs(phi - REF["grid_mesh_soft"]).max() <= 1e-3 * max(1.0, float(np.abs(REF["grid_mesh_soft"]).max()))
     with pytest.raises(ValueError, match="soft_weight"):
         signed_heat_volume(**kw, soft_weight="bogus")

@@ -86,12 +86,15 @@ class GridDomain(HeatDomain):
     rho, tol : penalty and tolerance (× h) of the augmented Lagrangian of the hard constraints;
     progress : ``progress(stage, fraction)`` for step I;
     step1 : {"auto", "yukawa", "heat"} — Step I by the Yukawa tree sum, or by the screened solve on the grid
-        (:func:`~gsdf.heat.volume.screened.screened_heat`, ~1 ms at 32³ instead of 10–30 ms). "auto": "heat"
-        for point clouds on cubic cells when t ≥ h²/2 and the farthest node is within
-        :data:`~gsdf.heat.volume.screened.MAX_DECAY` decay lengths of the sources, else "yukawa". Measured at
-        32³ (bench/bench_heat_volume_speed.py): the grid solve's mean error is lower than the tree sum's on
-        9 of its 10 inputs (kitten 0.008568 vs 0.008617, oni 0.02423 vs 0.02430, hippo1 0.15521 vs 0.15537)
-        but higher on couplingdown (0.013037 vs 0.013015), so meshes keep the tree.
+        (:func:`~gsdf.heat.volume.screened.screened_heat`, ~1 ms at 32³ instead of 10–60 ms). "auto": "heat"
+        on cubic cells when t ≥ h²/2, every source lies in the box padded by
+        :data:`~gsdf.heat.volume.screened.PAD` cells (the splat clamps the others to it) and the farthest node
+        is within :data:`~gsdf.heat.volume.screened.MAX_DECAY` decay lengths of the sources, else "yukawa".
+        Measured on the 10 inputs of bench/bench_heat_volume_speed.py (7 meshes and soups, 3 clouds): at 32³
+        the grid solve's mean error is lower than the tree sum's on 9 of 10 (fandisk 0.015075 vs 0.015237,
+        holes 0.565574 vs 0.565918, kitten 0.008569 vs 0.008618), higher on couplingdown (0.013035 vs
+        0.013013, +0.2 %); at 64³ on five meshes it is lower on 3 and higher on fandisk (+1.2 %) and the
+        broken bunny (+0.04 %); the whole solve takes 0.25–0.5 of the time at 32³ and 0.35–0.5 at 64³.
     """
 
     heat_form = "direct"
@@ -162,11 +165,13 @@ class GridDomain(HeatDomain):
     # ---- operators
     def diffuse(self, S: Sources) -> np.ndarray:
         from ...field import grid_points
-        from ..volume.screened import MAX_DECAY, _cubic, screened_heat, screened_reach
+        from ..volume.screened import MAX_DECAY, PAD, _cubic, screened_heat, screened_reach
         from ..volume.yukawa import YukawaTree, grid_nearest_distance
 
         use_grid = self.step1 == "heat"
-        if self.step1 == "auto" and S.kind == "points" and _cubic(self.spacing) and self.t >= 0.5 * self.h ** 2:
+        margin = PAD * self.spacing
+        if (self.step1 == "auto" and _cubic(self.spacing) and self.t >= 0.5 * self.h ** 2
+                and (S.B >= self.lo - margin).all() and (S.B <= self.hi + margin).all()):
             # the farthest node's distance to the sources, bounded from the nodes of a grid twice as coarse
             # (8× fewer nodes to transform): each fine node is within half a coarse cell diagonal of one
             cs = 2.0 * self.spacing

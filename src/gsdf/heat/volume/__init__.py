@@ -114,7 +114,7 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     points : (P, N), optional
         Oriented point cloud; normals need not be unit length. Point areas are estimated (§3.1 of Barill 2018).
     domain : {"grid", "tet"}
-        Regular grid (§8.2; step I by the Yukawa tree walk, or for clouds by one screened solve on the grid —
+        Regular grid (§8.2; step I by one screened solve on the grid, or by the Yukawa tree walk —
         option ``step1`` "auto" / "yukawa" / "heat", :mod:`gsdf.heat.volume.screened`) or tetrahedral mesh (§8.1: Delaunay of the input
         points and an octree-like lattice graded toward them, h = the grid spacing near the input; see
         :mod:`gsdf.heat.volume.tet` for its options ``step1``, ``mesher``, ``levels``, …).
