@@ -134,3 +134,35 @@ def test_cell_inside_hull_is_sufficient():
     Ah = voronoi_cell(half)
     assert not _cell_inside_hull(half, len(half), Ah, len(Ah), F, G)
     assert not _cell_inside_hull(L[:2].copy(), 2, A, len(A), F, G)  # too few sites to enclose anything
+
+
+def test_rows_on_threads_equal_one_call(monkeypatch):
+    """From PARALLEL_POINTS points the cells are split into ranges run on two threads: the same rows as one call
+    on one thread, the ranges covering every cell once; point areas likewise equal their one-thread values."""
+    import numba
+
+    from gsdf.spatial import knn
+    from gsdf.winding import point_areas as pa
+
+    rng = np.random.default_rng(3)
+    P = np.vstack([np.column_stack([rng.random((3000, 2)), 0.01 * rng.random(3000)]),
+                   0.05 * rng.normal(size=(600, 3)) + 0.5])
+    N = np.tile([0.0, 0.0, 1.0], (len(P), 1))
+    grid = SelfKNN(P, 41)
+    old = numba.get_num_threads()
+    try:
+        numba.set_num_threads(2)
+        ranges = knn._cell_ranges(grid._grid[2], len(P))
+        assert len(ranges) > 2 and ranges[0][0] == 0 and ranges[-1][1] == len(grid._grid[2]) - 1
+        assert all(a[1] == b[0] for a, b in zip(ranges[:-1], ranges[1:]))
+        threaded, a2 = grid.rows(), pa.point_areas(P, N, candidates=2)
+        numba.set_num_threads(1)
+        assert knn._cell_ranges(grid._grid[2], len(P)) == [(0, len(grid._grid[2]) - 1)]
+        single, a1 = grid.rows(), pa.point_areas(P, N, candidates=2)
+    finally:
+        numba.set_num_threads(old)
+    assert np.array_equal(threaded, single)
+    assert np.array_equal(np.sort(single, axis=1), np.sort(brute_knn(P, 41), axis=1))
+    assert np.array_equal(a1, a2)
+    monkeypatch.setattr(knn, "PARALLEL_POINTS", 10 ** 9)
+    assert knn._cell_ranges(grid._grid[2], len(P)) == [(0, len(grid._grid[2]) - 1)]

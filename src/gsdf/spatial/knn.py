@@ -13,7 +13,7 @@ than k rescans the next cube out to the k-th distance among its block's points, 
 Rows come out in no particular order unless ``ordered`` (sorted by distance, ties by index: the rows of
 ``cKDTree.query``, so a caller gets bit-identical results from either; the sort costs ~15 % at k = 41).
 Cost: O(n log n) bucketing plus O(n m) for m ≈ 1.5-2 k candidates per point on a surface sample, on the calling
-thread.
+thread below :data:`PARALLEL_POINTS` points and on gsdf's threads from it.
 
 Example
 -------
@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..threads import run_tasks
+
 __all__ = ["SelfKNN", "knn_self"]
 
 MAX_CELLS = 1 << 22  # dense cell table; coarser cells above this
@@ -44,8 +46,8 @@ class SelfKNN:
     ``rows(s, e)`` gives (e − s, k) int64: the same sets as ``cKDTree(P).query(P[s:e], k)[1]`` (ties at the
     k-th distance by smallest index), each row in no particular order, the point itself among them.
     ``k`` must be in [1, n]. ``ordered``: each row sorted by distance, ties by index. The kernel is serial and
-    GIL-free: under 0.1 ms per 1k points a parallel launch does not pay on a loaded machine (and compiles 5×
-    longer).
+    GIL-free (no numba parallel loop, which compiles 5× longer): ``rows()`` of the whole cloud runs ranges of
+    cells on gsdf's persistent threads from :data:`PARALLEL_POINTS` points.
     """
 
     def __init__(self, P, k: int, ordered: bool = False):
@@ -86,10 +88,33 @@ class SelfKNN:
             return np.tile(np.arange(self.k, dtype=np.int64), (e - s, 1))
         out = np.empty((e - s, self.k), np.int64)
         if s == 0 and e == self.n:  # every row: cell by cell, the candidates of a cell gathered once
-            _knn_by_cell(self.P, *self._grid, self.k, self.ordered, out)
+            start = self._grid[2]
+            ranges = _cell_ranges(start, self.n)
+            run_tasks(lambda r: _knn_by_cell(self.P, *self._grid, self.k, self.ordered, r[0], r[1], out), ranges)
         else:
             _knn_kernel(self.P, *self._grid, self.k, int(s), self.ordered, out)
         return out
+
+
+#: From this many points the cells are split into ranges of about equal point counts, run on the threads of
+#: :func:`gsdf.threads.run_tasks` (4 per thread, taken in turn, so a descheduled worker delays one range); below,
+#: one call on the calling thread. k = 41 on CGAL's hippo1 (6.1k points): 5.6 ms on one thread.
+PARALLEL_POINTS = 1024
+
+
+def _cell_ranges(start, n: int) -> list:
+    """[(c0, c1), ...] covering every cell: one range below PARALLEL_POINTS points or with one thread, else about
+    4 per thread of equal point counts (cells split at the point-count quantiles)."""
+    import numba
+
+    threads = numba.get_num_threads()
+    ncell = start.shape[0] - 1
+    if n < PARALLEL_POINTS or threads <= 1:
+        return [(0, ncell)]
+    parts = 4 * threads
+    cuts = np.searchsorted(start, (np.arange(1, parts) * n) // parts, side="right") - 1
+    cuts = np.unique(np.concatenate([[0], np.clip(cuts, 0, ncell), [ncell]]))
+    return [(int(a), int(b)) for a, b in zip(cuts[:-1], cuts[1:]) if b > a]
 
 
 def knn_self(P, k: int) -> np.ndarray:
@@ -329,8 +354,9 @@ def _reach(x, y, z, x0, x1, y0, y1, z0, z1, dims, lo, cell):
 
 
 @njit(cache=True, nogil=True)
-def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
-    """Every row of out (original point order): per nonempty cell, the points of its 3×3×3 block are gathered
+def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, c0, c1, out):
+    """The rows of out (original point order) of the points in cells c0 <= cell < c1 (GIL-free: ranges of cells
+    run on threads, each writing its own rows): per nonempty cell, the points of its 3×3×3 block are gathered
     once (coordinates contiguous); each of the cell's points keeps those closer than its reach (the nearest
     face of the block with cells beyond it). A point keeping fewer than k falls back to the 5×5×5 cube (R = 2
     of :func:`_knn_one`, gathered once per cell that has such points), bounded by the k-th distance among the
@@ -349,7 +375,7 @@ def _knn_by_cell(P, Ps, order, start, cells, dims, lo, cell, k, ordered, out):
     hist = np.empty(NBUCKET + 1, np.int64)
     fb = np.empty(64, np.int64)       # the cell's points that fall back, and their bounds
     fbt = np.empty(64)
-    for cid in range(start.shape[0] - 1):
+    for cid in range(c0, c1):
         s, e = start[cid], start[cid + 1]
         if e == s:
             continue

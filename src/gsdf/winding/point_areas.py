@@ -328,10 +328,13 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
 # ----------------------------------------------------------------------------------------------
 
 
-#: Below this many points the two kernels run as one call on the calling thread: together ~1-3 ms of serial
-#: work at 1.4k-6k points (CGAL's oni / kitten / hippo1), while running them on two threads on a loaded
-#: machine waited for the second thread: 10-25 ms at load 5-6 (issue 17).
-SERIAL_POINTS = 16_384
+#: Below this many points the two kernels run as one call on the calling thread; from it, ranges of 256 or more
+#: points on the threads of :func:`gsdf.threads.run_ranges` (about 4 per thread, taken in turn). Measured in
+#: the volume signed heat method at 32³ (bench/bench_heat_volume_speed.py's clouds, interleaved rounds idle /
+#: under two busy processes): hippo1 (6.1k points) 32.2 → 26.3 ms idle, 56.7 → 41.0 ms loaded; kitten (5.2k)
+#: 32.0 → 27.7 / 43.0 → 41.3; oni (1.4k) 20.2 → 19.5 / 39.1 → 37.9 (an older pool that started threads per
+#: call waited 10-25 ms for a descheduled thread at load 5-6; issue 17).
+SERIAL_POINTS = 1024
 
 
 def _candidate_search(P, k):
@@ -446,7 +449,7 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
         sel = np.full((e - s, kk + 1), -1, np.int64)
         plane = np.zeros((e - s, 3))
         part = out[s:e]
-        grain = SERIAL_POINTS if n < SERIAL_POINTS else 512  # small clouds: one call on this thread
+        grain = SERIAL_POINTS if n < SERIAL_POINTS else 256  # small clouds: one call on this thread
         run_ranges(lambda r0, r1: _tangent_neighbours(P, N, cand, s, kk, sel, plane, r0, r1), e - s, grain)
         run_ranges(lambda r0, r1: _voronoi_areas(P, N, plane, sel, s, boundary == "hull", part, r0, r1), e - s, grain)
     a = frame.area(out)
