@@ -189,6 +189,9 @@ def _cell_penalty(Ap, Ai, Av, w, dims):
     m = Ap.shape[0] - 1
     slot = np.full(N, -1, np.int64)          # node -> its row of the accumulator (the nodes A touches)
     nodes = np.empty(min(N, Ai.shape[0]) + 1, np.int64)
+    # per entry: 9 i + 3 j + k relative to its row's first entry (so two entries' code difference is their
+    # offset in the 27-point stencil); two integer divisions per entry, the kernel's main cost
+    code = np.empty(Ai.shape[0], np.int64)
     nb = 0
     for r in range(m):
         s, e = Ap[r], Ap[r + 1]
@@ -197,10 +200,17 @@ def _cell_penalty(Ap, Ai, Av, w, dims):
         if e - s > 8:                        # a cell has 8 nodes: duplicates, not a trilinear row
             return None
         lo0 = lo1 = lo2 = N
-        hi0 = hi1 = hi2 = -1
+        hi0 = hi1 = hi2 = -N
+        i0 = j0 = k0 = 0
         for p in range(s, e):                # the row's nodes must span at most one cell on every axis
             c = Ai[p]
-            i, j, k = c // s0, (c // n2) % n1, c % n2
+            q = c // n2
+            k = c - q * n2
+            i = q // n1
+            j = q - i * n1
+            if p == s:
+                i0, j0, k0 = i, j, k
+            code[p] = (i - i0) * 9 + (j - j0) * 3 + (k - k0)
             lo0, hi0 = min(lo0, i), max(hi0, i)
             lo1, hi1 = min(lo1, j), max(hi1, j)
             lo2, hi2 = min(lo2, k), max(hi2, k)
@@ -213,23 +223,17 @@ def _cell_penalty(Ap, Ai, Av, w, dims):
                 nodes[nb] = c
                 nb += 1
     acc = np.zeros((nb, 27))                 # offset (di + 1) * 9 + (dj + 1) * 3 + (dk + 1)
-    code = np.empty(8, np.int64)             # per entry of a row: 9 i + 3 j + k, relative to its first entry
     for r in range(m):
         s, e = Ap[r], Ap[r + 1]
         if e == s:
             continue
-        c0 = Ai[s]
-        i0, j0, k0 = c0 // s0, (c0 // n2) % n1, c0 % n2
-        for p in range(s, e):
-            c = Ai[p]
-            code[p - s] = (c // s0 - i0) * 9 + ((c // n2) % n1 - j0) * 3 + (c % n2 - k0)
         wr = w[r]
         for p in range(s, e):
             va = wr * Av[p]
             row = slot[Ai[p]]
-            ca = code[p - s]
+            ca = code[p]
             for q in range(s, e):
-                acc[row, code[q - s] - ca + 13] += va * Av[q]
+                acc[row, code[q] - ca + 13] += va * Av[q]
     cnt = np.zeros(N + 1, np.int64)
     for t in range(nb):
         c = nodes[t]
