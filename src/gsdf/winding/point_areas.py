@@ -20,6 +20,7 @@ from scipy.spatial import cKDTree
 
 from .._checks import as_normals, as_points, integer
 from .._normalize import Frame
+from ..linalg.eig3 import jacobi_eig3
 from ..spatial.knn import SelfKNN
 from ..threads import run_ranges
 
@@ -460,39 +461,11 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
 
 @njit(cache=True)
 def _smallest_eigenvector3(C):
-    """Eigenvector of the smallest eigenvalue of a symmetric 3×3 matrix ``C`` (overwritten). Cyclic Jacobi
-    rotations (each zeroes one off-diagonal entry; the off-diagonal mass falls quadratically, so a few sweeps reach rounding level): as accurate as LAPACK's
-    ``eigh`` on a 3×3 and, called once per point, much cheaper than the LAPACK call from numba. Returns
-    ``(w_mid, w_max, vx, vy, vz)``."""
-    V = np.zeros((3, 3))  # the identity (np.eye compiles one more overload)
-    V[0, 0] = V[1, 1] = V[2, 2] = 1.0
-    for _sweep in range(12):
-        off = C[0, 1] * C[0, 1] + C[0, 2] * C[0, 2] + C[1, 2] * C[1, 2]
-        diag = C[0, 0] * C[0, 0] + C[1, 1] * C[1, 1] + C[2, 2] * C[2, 2]
-        if off <= 1e-36 * diag or off == 0.0:
-            break
-        for p, q in ((0, 1), (0, 2), (1, 2)):
-            apq = C[p, q]
-            if apq == 0.0:
-                continue
-            # the rotation angle that zeroes C[p, q]: t = tan θ, the smaller root of t² + 2τt − 1 = 0
-            tau = (C[q, q] - C[p, p]) / (2.0 * apq)
-            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + np.sqrt(1.0 + tau * tau))
-            c = 1.0 / np.sqrt(1.0 + t * t)
-            sn = t * c
-            for r in range(3):  # C ← C J (columns p, q)
-                crp, crq = C[r, p], C[r, q]
-                C[r, p] = c * crp - sn * crq
-                C[r, q] = sn * crp + c * crq
-            for r in range(3):  # C ← Jᵀ C (rows p, q)
-                cpr, cqr = C[p, r], C[q, r]
-                C[p, r] = c * cpr - sn * cqr
-                C[q, r] = sn * cpr + c * cqr
-            C[p, q] = C[q, p] = 0.0
-            for r in range(3):  # V ← V J: its columns are the eigenvectors
-                vrp, vrq = V[r, p], V[r, q]
-                V[r, p] = c * vrp - sn * vrq
-                V[r, q] = sn * vrp + c * vrq
+    """Eigenvector of the smallest eigenvalue of a symmetric 3×3 matrix ``C`` (overwritten), by the cyclic Jacobi
+    rotations of :func:`gsdf.linalg.eig3.jacobi_eig3` (as accurate as LAPACK's ``eigh`` on a 3×3 and, called once
+    per point, much cheaper than the LAPACK call from numba). Returns ``(w_mid, w_max, vx, vy, vz)``."""
+    V = np.empty((3, 3))
+    jacobi_eig3(C, V)
     a, b, d = C[0, 0], C[1, 1], C[2, 2]
     lo = 0 if (a <= b and a <= d) else (1 if b <= d else 2)
     hi = 0 if (a > b and a > d) else (1 if b > d else 2)
