@@ -93,8 +93,10 @@ class GridDomain(HeatDomain):
         Measured on the 10 inputs of bench/bench_heat_volume_speed.py (7 meshes and soups, 3 clouds): at 32³
         the grid solve's mean error is lower than the tree sum's on 9 of 10 (fandisk 0.015075 vs 0.015237,
         holes 0.565574 vs 0.565918, kitten 0.008569 vs 0.008618), higher on couplingdown (0.013035 vs
-        0.013013, +0.2 %); at 64³ on five meshes it is lower on 3 and higher on fandisk (+1.2 %) and the
-        broken bunny (+0.04 %); the whole solve takes 0.25–0.5 of the time at 32³ and 0.35–0.5 at 64³.
+        0.013013, +0.2 %), and the whole solve takes 0.25–0.5 of the time. At 64³ (t = h²) the farthest nodes
+        lie beyond MAX_DECAY on those inputs, so "auto" keeps the tree there; forced (``step1="heat"``) the
+        grid solve's error is within −0.2 … +1.2 % of the tree's on five meshes at 0.3–0.5 of the time
+        (bench/bench_volume_choices.py, RESULTS section "volume-choices").
     """
 
     heat_form = "direct"
