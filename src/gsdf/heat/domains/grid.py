@@ -54,9 +54,9 @@ class GridPoisson(PoissonSolver):
 
     #: CG's relative residual for the soft penalty. On the 10 inputs of bench/bench_heat_volume_speed.py at 32³,
     #: 1e-3 instead of 1e-4 takes 1-3 fewer iterations (4-9 instead of 7-12; ~1 ms each) and moves the mean
-    #: error by at most 3e-5 of its value (holes 0.565918 vs 0.565893, hippo1 0.155215 vs 0.155208, bunny00
-    #: 0.015270 vs 0.015274, the others within 2e-6): far under the discretization error, which 1e-4 → 1e-5 did
-    #: not change either. signedheat3d stops its Step III at 1e-2.
+    #: error by at most 2.6e-4 of its value (the broken bunny 0.015171 → 0.015167, lower; holes 0.565549 →
+    #: 0.565574): far under the discretization error, which 1e-4 → 1e-5 did not change either
+    #: (bench/bench_volume_choices.py, RESULTS section "volume-choices"). signedheat3d stops its Step III at 1e-2.
     penalty_tol = 1e-3
 
     def penalized(self, A, w, b):
