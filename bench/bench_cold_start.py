@@ -30,9 +30,9 @@ def inputs(d: str) -> dict:
     """bunny00.off and a level-set loop on it (heat-surface), the bundled torus cloud (tori)."""
     import numpy as np
 
-    from gsdf.heat.surface.curves import level_set_curves
+    from gsdf.contour._surface_curves import level_set_curves
     from gsdf.io import read_mesh
-    from gsdf.io.curves import write_curves
+    from gsdf.io._curves import write_curves
 
     bunny = os.path.join(data_dir(), "meshes", "bunny00.off")
     V, F = read_mesh(bunny)

@@ -1,7 +1,7 @@
 """Fast winding numbers of small triangle meshes: the median-split tree against the volume-split tree.
 
 The question (issue 17, cold start): could small meshes use the median-split tree of
-:func:`gsdf.spatial.bvh.build_bvh` (compiled anyway for distances and point clouds), so that a small first
+:func:`gsdf.spatial._bvh.build_bvh` (compiled anyway for distances and point clouds), so that a small first
 run does not compile the volume-split build? This measures what it would cost on the small inputs of
 bench_winding.py and the demo's soup: RMS error against the exact winding number (10⁴ queries in the
 padded box), build time and query time (10⁵ / 10⁶ queries), both trees in the same run (best of 3, the
@@ -28,8 +28,8 @@ from common import data_dir, machine, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf import data  # noqa: E402
-from gsdf.spatial.bvh import build_bvh  # noqa: E402
-from gsdf.winding import fast  # noqa: E402
+from gsdf.spatial._bvh import build_bvh  # noqa: E402
+from gsdf.winding import _fast as fast  # noqa: E402
 
 MESHES = ["rotor.off", "couplingdown.off", "elephant-with-holes.off", "holes.off", "mech-holes-shark.off",
           "fandisk.off", "blade.off", "cheese.off", "ChineseDragon-10kv.off"]

@@ -23,8 +23,8 @@ from common import batch_mean, data_dir, machine, median_time, table, write_sect
 
 import gsdf  # noqa: E402
 from gsdf.heat import SurfaceSignedHeatSolver  # noqa: E402
-from gsdf.heat.surface.curves import level_set_curves, region_boundary_curves  # noqa: E402
-from gsdf.heat.surface.meshes import grid_mesh, sphere_mesh  # noqa: E402
+from gsdf.contour._surface_curves import level_set_curves, region_boundary_curves  # noqa: E402
+from gsdf.data._shapes import grid_mesh, sphere_mesh  # noqa: E402
 
 try:
     import potpourri3d as pp3d
@@ -34,7 +34,7 @@ except ImportError:  # pragma: no cover
 
 def eps(V, F, phi, exact):
     """Normalized L2 error of §9.1 (vertex areas, range of the true distance)."""
-    from gsdf.mesh.geometry import face_areas
+    from gsdf.mesh._geometry import face_areas
 
     A = np.bincount(F.ravel(), weights=np.repeat(face_areas(V, F) / 3, 3), minlength=len(V))
     return float(np.sqrt((A * (phi - exact) ** 2).sum() / A.sum()) / (exact.max() - exact.min()))
@@ -167,7 +167,7 @@ def sphere(subs):
 
 # ------------------------------------------------------------------------------------------ broken curves (§9.5.3)
 def clean(V, F):
-    from gsdf.mesh.geometry import face_areas
+    from gsdf.mesh._geometry import face_areas
 
     a = face_areas(V, F)
     ok = (a > 1e-12 * a.mean()) & (F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])
@@ -178,7 +178,7 @@ def eigenfunctions(V, F, k):
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from gsdf.heat.surface.operators import TriangleMeshOperators
+    from gsdf.heat.triangle._operators import TriangleMeshOperators
 
     ops = TriangleMeshOperators(V, F)
     C = ops.cotan_laplacian()
@@ -223,7 +223,7 @@ class WindingRepair:
     def __init__(self, ops):
         import scipy.sparse as sp
 
-        from gsdf.heat.surface.l1 import edge_face_pairs
+        from gsdf.heat.triangle._l1 import edge_face_pairs
         from gsdf.linalg import Factorization
 
         self.ops = ops
@@ -524,7 +524,7 @@ def robustness():
     # slivers (§9.4, Fig. 22): a jittered grid triangulated Delaunay in x/8-shrunk coordinates, i.e. long obtuse
     # slivers in the true metric; the curve is the boundary of the faces whose centroid is within 0.5 of a
     # point (a polyline along edges, kept unflippable), exact SDF to that polygon
-    from gsdf.heat.surface.meshes import anisotropic_mesh, polygon_sdf_2d
+    from gsdf.data._shapes import anisotropic_mesh, polygon_sdf_2d
 
     for n in (64, 128):
         V, F = anisotropic_mesh(n, stretch=8)
@@ -652,8 +652,8 @@ def time_step_study(levels):
     """Observed order of ε under refinement for t = c·h² (c = 1, 4, 16) and t ∝ h, per constraint mode, on the
     §9.5.1 planar setup (barycentric level-set star) and on the paper's setup (star inserted as mesh edges); plus
     the far-field direction error of the diffused field Y at fixed c (what limits the order at t = h²)."""
-    from gsdf.heat.surface.meshes import polygon_sdf_2d
-    from gsdf.heat.surface.sources import build_sources
+    from gsdf.data._shapes import polygon_sdf_2d
+    from gsdf.heat.triangle._sources import build_sources
 
     res, hs, far = {}, {"bary": [], "edges": []}, {}
     for n in levels:
@@ -1125,7 +1125,7 @@ def main():
                "of the --speed cases: the vector heat operator M + tL∇ (complex Hermitian; CR edges on triangle "
                "meshes, vertices on polygon meshes) and the Poisson operator with the curve vertices eliminated "
                "(real SPD). SuperLU in symmetric mode with one BLAS thread (gsdf.threads.blas_region); CHOLMOD = "
-               "cholespy (the complex system as its 2n real form); LDLᴴ, ND = gsdf.linalg.ldl (serial numba, BFS "
+               "cholespy (the complex system as its 2n real form); LDLᴴ, ND = gsdf.linalg._ldl (serial numba, BFS "
                "nested dissection), which gsdf uses up to gsdf.linalg.LDL_MAX_UNKNOWNS real unknowns (complex count 2; SuperLU with the "
                "RCM + MMD ordering above; polygon meshes: MMD alone). Fastest per system: "
                + "; ".join(f"{lab}: " + ", ".join(f"{k} {n}×" for k, n in c.items()) for lab, c in count.items())

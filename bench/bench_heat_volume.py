@@ -25,9 +25,9 @@ from common import data_dir, machine, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf.heat.volume import signed_heat_volume, volume_grid_box  # noqa: E402
-from gsdf.heat.volume.sources import mesh_sources  # noqa: E402
-from gsdf.heat.volume.yukawa import YukawaTree, grid_nearest_distance  # noqa: E402
-from gsdf.field import grid_points  # noqa: E402
+from gsdf.heat.volume._sources import mesh_sources  # noqa: E402
+from gsdf.heat._yukawa import YukawaTree, grid_nearest_distance  # noqa: E402
+from gsdf.grid import grid_points  # noqa: E402
 
 
 def broken_bunny(frac=0.3, seed=0):

@@ -196,7 +196,7 @@ def worker(args):
     times, phi, fallbacks = [], None, []
     for _ in range(repeat):
         if who == "gsdf":  # every run builds its grid operators, as the anchor's new solver object does
-            from gsdf.heat.volume import grid as _grid
+            from gsdf.heat.grid import _poisson as _grid
 
             _grid._dct_matrix.cache_clear()  # (the Step III operators are built per solve)
         t = time.perf_counter()
@@ -231,7 +231,7 @@ def worker(args):
         fi = signed_heat_volume(resolution=shape, bbox_min=lo, bbox_max=hi, t_scale="input", **kw)
     if ref is not None:
         import gsdf
-        from gsdf.field import grid_points
+        from gsdf.grid import grid_points
 
         Q = grid_points(lo, hi, shape)
         phi_ref = gsdf.signed_distance(*ref, Q) if is_mesh else gsdf.signed_distance_points(*ref, Q)

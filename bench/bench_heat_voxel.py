@@ -28,8 +28,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import machine, write_section  # noqa: E402
 
 from gsdf.heat import region_boundary_curves  # noqa: E402
-from gsdf.heat.domains._digital import digital_surface, integral_invariant_normals  # noqa: E402
-from gsdf.heat.domains.voxel import VoxelSurfaceSignedHeatSolver  # noqa: E402
+from gsdf.heat.voxel._digital import digital_surface, integral_invariant_normals  # noqa: E402
+from gsdf.heat.voxel._domain import VoxelSurfaceSignedHeatSolver  # noqa: E402
 
 SIZES = [int(s) for s in os.environ.get("VOXEL_SIZES", "16,32,64,128").split(",")]
 
@@ -96,8 +96,8 @@ def plane(N, nrm, mdir, radius=3.0, exact=False, t_coef=1.0):
 def icosphere(subdivisions, R=1.0, z_rel=0.3):
     """Baseline: the triangle-mesh (Crouzeix–Raviart) signed heat method on an icosphere, curve z = z_rel·R."""
     from gsdf.heat import SurfaceSignedHeatSolver
-    from gsdf.heat.surface.curves import level_set_curves
-    from gsdf.heat.surface.meshes import sphere_mesh
+    from gsdf.contour._surface_curves import level_set_curves
+    from gsdf.data._shapes import sphere_mesh
 
     V, F = sphere_mesh(subdivisions, R)
     s = SurfaceSignedHeatSolver(V, F)

@@ -39,7 +39,7 @@ def main():
     import potpourri3d as pp3d
 
     from gsdf.heat import SurfaceSignedHeatSolver
-    from gsdf.linalg.ldl import LDLFactorization
+    from gsdf.linalg._ldl import LDLFactorization
 
     start = os.popen("uptime").read().strip()
     rows = []

@@ -4,7 +4,7 @@ For the two systems a surface / polygon signed heat solve factorizes (the comple
 real Dirichlet Poisson matrix) of each of the 16 + 6 meshes of ``bench_heat_surface.py --speed``: time of each
 ordering, time of the LDLᴴ with it (symbolic + numeric), one solve, and the fill (entries of L below the
 diagonal); SuperLU's multiple minimum degree (``splu(permc_spec="MMD_AT_PLUS_A")``, its ``perm_c`` through the
-same symbolic factorization) as the reference fill. The rule of :func:`gsdf.linalg.ordering.fill_reducing_ordering`
+same symbolic factorization) as the reference fill. The rule of :func:`gsdf.linalg._ordering.fill_reducing_ordering`
 comes from this table (RESULTS section "ldl-ordering").
 
 Run: ``PYTHONPATH=src /work/anchors/bin/python bench/bench_ldl_ordering.py [--quick]`` (``--quick``: 6 + 3
@@ -26,18 +26,18 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import machine, table, write_section  # noqa: E402
 
 import bench_heat_surface as bhs  # noqa: E402
-from gsdf.linalg.direct import LDL_MAX_UNKNOWNS, Factorization  # noqa: E402
-from gsdf.linalg.ldl import LDLFactorization, fill_count  # noqa: E402
-from gsdf.linalg.ordering import order_csr  # noqa: E402
+from gsdf.linalg._direct import LDL_MAX_UNKNOWNS, Factorization  # noqa: E402
+from gsdf.linalg._ldl import LDLFactorization, fill_count  # noqa: E402
+from gsdf.linalg._ordering import order_csr  # noqa: E402
 
 
-RULE = ("`LDLFactorization(ordering=\"auto\")` (gsdf.linalg.ldl): AMD; on systems of at most AUTO_ND_MAX_N = "
+RULE = ("`LDLFactorization(ordering=\"auto\")` (gsdf.linalg._ldl): AMD; on systems of at most AUTO_ND_MAX_N = "
         "10,000 unknowns whose AMD factor is flop-heavy (Σ_j c_j² ≥ 12 · nnz(A) · log2 n, c_j = column counts "
         "of L) nested dissection is computed too and kept when its flop count is below 0.9× AMD's. Measured "
         "reason: AMD's ordering + factorization wins on the triangle-mesh systems (fill 0.5–0.9× ND's, "
         "ordering 1.5–4× faster); ND wins only on regular quad grids, where the factor is flop-heavy; trying ND "
         "on large meshes (up to 160 ms of ordering on bunny00) costs more than it can save. The backend limit "
-        "(gsdf.linalg.direct.LDL_MAX_UNKNOWNS) went from 64k to 300k real unknowns: with AMD the LDL beats "
+        "(gsdf.linalg._direct.LDL_MAX_UNKNOWNS) went from 64k to 300k real unknowns: with AMD the LDL beats "
         "SuperLU (its factorization column) on every system here, the largest included.")
 
 
@@ -111,7 +111,7 @@ def main():
     text = (f"Machine: {machine()}; uptime at start: {start}; at end: {os.popen('uptime').read().strip()} "
             "(shared machine: other helpers' jobs ran alongside; every ratio compares two runs of the same process).\n\n"
             "Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_ldl_ordering.py`. Times: best of 3, ms. "
-            "AMD = gsdf.linalg.ordering.approximate_minimum_degree, ND = nested_dissection (BFS level-structure "
+            "AMD = gsdf.linalg._ordering.approximate_minimum_degree, ND = nested_dissection (BFS level-structure "
             "separators); the MMD column is SuperLU's multiple minimum degree (perm_c of "
             "`splu(..., permc_spec='MMD_AT_PLUS_A')`) counted by the same symbolic factorization.\n\n"
             f"**Rule:** AMD is faster (ordering + factorization) on {amd_wins} of {len(used)} systems the LDL "

@@ -46,8 +46,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import data_dir, machine, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
-from gsdf.recon.compare import reconstruct_heat, reconstruct_pat, reconstruct_winding  # noqa: E402
-from gsdf.mesh.topology import mesh_topology  # noqa: E402
+from gsdf.recon._compare import reconstruct_heat, reconstruct_pat, reconstruct_winding  # noqa: E402
+from gsdf.mesh._topology import mesh_topology  # noqa: E402
 
 MESHES = ["bunny00.off", "armadillo.off", "bull.off", "camel.off", "fandisk.off", "homer.off"]
 INLIERS = [8000, 4000, 2000, 1000]
@@ -464,7 +464,7 @@ within 0.03):
 * **The two sides rarely meet in a vertex's quadric.**  On a randomly sampled cylinder of radius 3.2
   nearest-neighbour spacings (camel legs: 0.023 thick = 4 spacings, radius 2), the foot of the k = 8 and k = 12
   quadrics at points on the surface has the same error two-sided and one-sided (median 0.04 spacings); only
-  sheets ≲ 2 spacings apart mix (tests/test_recon_side.py).  The one-sided vertex quadric in the global fit
+  sheets ≲ 2 spacings apart mix (tests/recon/test_side.py).  The one-sided vertex quadric in the global fit
   (`fit_side=True`, normals oriented, cosine > 0 with the vertex normal) lowers camel 4K+400's missed count 2 443
   → 2 146 and thin t2r 0.0319 → 0.0300 (without the side rescue), but over the 32 clouds (with the side rescue at
   height 2) it is mixed: CD ≤ SPSR on 26 vs 27, mean CD×100 0.3107 vs 0.3109, mean HD×100 4.52 vs 4.82 — left as

@@ -52,9 +52,9 @@ def _median(f, n=3):
 
 
 def hermitian():
-    import gsdf.heat.core as CORE
-    import gsdf.heat.surface.polygon as PM
-    import gsdf.heat.surface.solver as SM
+    import gsdf.heat._core as CORE
+    import gsdf.heat.polygon._solver as PM
+    import gsdf.heat.triangle._solver as SM
     from bench_heat_surface import _cube_sphere
 
     mats = []
@@ -87,9 +87,9 @@ def hermitian():
 
 
 def tet_step3():
-    import gsdf.heat.domains.tet as T
+    import gsdf.heat.tet._domain as T
 
-    got, undo = _grab(T, "SPDSolver")  # the tet domain's Poisson solves (through gsdf.heat.core)
+    got, undo = _grab(T, "SPDSolver")  # the tet domain's Poisson solves (through gsdf.heat._core)
     V, F = gsdf.read_mesh(os.path.join(data_dir(), "meshes", "mech-holes-shark.off"))
     signed_heat_volume(mesh=(V, F), resolution=32, domain="tet")
     undo()
@@ -112,7 +112,7 @@ def tet_step3():
 
 
 def t_scale_study(res=48):
-    from gsdf.tori import shapes as S
+    from gsdf.data import _shapes as S
 
     X = S.grid(res)
     rows, tot = [], {"grid": [], "input": []}

@@ -33,7 +33,7 @@ deleted by the same scheme) as nonbounding loops; they leave the truth unchanged
   from a random root, with edges that touch a forbidden vertex weighted (1 + 2·touches)× so a loop crosses the
   boundary rather than hugging it vertex by vertex; forbidden edges are preferred into the cotree, so the
   leftover (generator) edges are free ones. The candidates are the loops of that tree whose homology class
-  (pairing with the closed forms dual to the library's tree–cotree basis, gsdf.dec.cycles.TreeCotree) is
+  (pairing with the closed forms dual to the library's tree–cotree basis, gsdf.dec._cycles.TreeCotree) is
   nonzero and independent of the loops already drawn; one is picked at random. When a loop has no candidate,
   the case's loop set is drawn again from new roots (a *resample*, counted per case); after MAX_SETS = 6 failed
   sets the region itself is drawn again (same kind, then broken again) from the case's stream
@@ -93,8 +93,8 @@ sys.path.insert(0, HERE)
 from common import data_dir, machine, write_section  # noqa: E402
 
 from gsdf.io import read_mesh  # noqa: E402
-from gsdf.mesh.connectivity import MeshTopology  # noqa: E402
-from gsdf.winding.surface import SurfaceWindingNumbers  # noqa: E402
+from gsdf.mesh._connectivity import MeshTopology  # noqa: E402
+from gsdf.swn._solver import SurfaceWindingNumbers  # noqa: E402
 
 AUTHOR = "/work/shared/data/swn"
 CSV = os.path.join(HERE, "swn_cases.csv")
@@ -318,9 +318,9 @@ class MeshCases:
 
     def homology_class(self, z):
         """Integer homology class (b1,) of a closed edge chain z: its pairings with the closed 1-forms dual to the
-        library's tree–cotree basis (gsdf.dec.cycles.TreeCotree.closed_form of the unit periods)."""
+        library's tree–cotree basis (gsdf.dec._cycles.TreeCotree.closed_form of the unit periods)."""
         if self._cocycles is None:
-            from gsdf.dec.cycles import TreeCotree
+            from gsdf.dec._cycles import TreeCotree
 
             tc = TreeCotree(self.dec)
             self._cocycles = np.array([tc.closed_form(np.eye(tc.n_generators)[i])
@@ -843,8 +843,8 @@ def scaling(time_limit, sizes):
 
 # ----------------------------------------------------------------------------------------------- authors
 def author_data():
-    from gsdf.io.swn_curves import read_swn_curves
-    from gsdf.winding.surface_curves import insert_curves
+    from gsdf.io._swn_curves import read_swn_curves
+    from gsdf.swn._insert import insert_curves
 
     rows = ["| mesh / curves | faces after insertion | b1 | endpoints | labels (area share), full LP | "
             "nonbounding share of the input | full LP total | reduced LP: labels agree / total |",
@@ -866,7 +866,7 @@ def author_data():
         nb = float(np.abs(r.residual[r.chain != 0]).sum() / max(np.abs(r.chain).sum(), 1))
         rows.append(f"| {mesh} / {cur} | {len(F2)} | {swn.betti_1} | {int(r.endpoints.sum())} | {share} | "
                     f"{nb:.2f} | {r.timings['total']:.2f} s | {agree:.1f} % / {rr.timings['total']:.2f} s |")
-        from gsdf.heat.surface.render import render_function_png
+        from gsdf.view._raster import render_function_png
 
         m = len(F2)
         png = os.path.join(HERE, f"swn_author_{os.path.splitext(cur)[0]}.png")
@@ -879,7 +879,7 @@ def author_data():
 def offsets_diagnostic(per_mesh=10, breaking="random"):
     """How much of the error is the rounding offset: error with the offset of the solver vs the best offset in
     hindsight (an oracle over 101 offsets), full LP, on fresh cases of five meshes."""
-    from gsdf.winding.surface import circular_mean
+    from gsdf.swn._solver import circular_mean
 
     meshes = dict(mesh_list())
     rows = {"solver offset (level on the curves)": [], "area circular mean of w": [], "oracle offset": []}

@@ -46,7 +46,7 @@ sys.path.insert(0, HERE)
 import bench_swn as B  # noqa: E402
 from common import machine, write_section  # noqa: E402
 
-from gsdf.dec.lp import solve_highs  # noqa: E402
+from gsdf.linalg._dual_l1 import solve_highs  # noqa: E402
 
 NOTES = """\
 Reading (branch swnacc2):
@@ -90,7 +90,7 @@ Reading (branch swnacc2):
 
 def joint_residual(swn, mu=1.0):
     """The full residual LP plus the bounding part (diagnosis only): face shifts x (Jv = d + x_A − x_B as in
-    :func:`gsdf.dec.lp.dual_graph_l1`) and face labels y whose jumps are Jb = y_A − y_B, with Jv + Jb = g on the
+    :func:`gsdf.linalg._dual_l1.dual_graph_l1`) and face labels y whose jumps are Jb = y_A − y_B, with Jv + Jb = g on the
     input's interior edges and cost μ·ℓ|Jb| off the input (the gaps the bounding part must close)."""
 
     def residual(gamma, g, eps, time_limit, algorithm="highs-ds"):

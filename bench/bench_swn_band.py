@@ -1,6 +1,6 @@
 """The banded residual LP against HiGHS on the benchmark's own cases (issue 12): same mislabeled area?
 
-``lp_algorithm="auto"`` uses the band (gsdf.dec.band_lp) from 12k faces on. This replays the bench_swn.py cases
+``lp_algorithm="auto"`` uses the band (gsdf.linalg._band_lp) from 12k faces on. This replays the bench_swn.py cases
 (same generator, ids and seeds) of the not simply connected meshes near that size, solves each with
 ``lp_algorithm="band"`` and ``"highs-ipm"`` (the previous rule there) and writes their errors and LP times to
 section swn-band of RESULTS.md.

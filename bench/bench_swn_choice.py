@@ -43,7 +43,7 @@ sys.path.insert(0, HERE)
 import bench_swn as B  # noqa: E402
 from common import machine, write_section  # noqa: E402
 
-from gsdf.winding.surface import SurfaceWindingNumbers  # noqa: E402
+from gsdf.swn._solver import SurfaceWindingNumbers  # noqa: E402
 
 NOTES = """\
 Why (section swn-ns-diagnose-quick): on closed surfaces with broken nonbounding loops the LP's cycle often

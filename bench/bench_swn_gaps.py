@@ -56,7 +56,7 @@ import bench_swn as B  # noqa: E402
 from bench_swn_floor import gap_pieces, shortest_path_closure  # noqa: E402
 from common import machine, table, write_section  # noqa: E402
 
-from gsdf.winding.surface import SurfaceWindingNumbers  # noqa: E402
+from gsdf.swn._solver import SurfaceWindingNumbers  # noqa: E402
 
 
 def wrap(x):

@@ -47,7 +47,7 @@ sys.path.insert(0, HERE)
 import bench_swn as B  # noqa: E402
 from common import machine, write_section  # noqa: E402
 
-from gsdf.winding.surface import SurfaceWindingNumbers  # noqa: E402
+from gsdf.swn._solver import SurfaceWindingNumbers  # noqa: E402
 
 NOTES = """\
 What was checked and what was wrong (cases replayed by their bench_swn.py ids):
@@ -57,7 +57,7 @@ What was checked and what was wrong (cases replayed by their bench_swn.py ids):
   objective Σ ℓ_e κ_e |Jv_e| with κ = ε = 1e-2 on input edges and 1 elsewhere, "no extra loops" 0 ≤ g·Jv ≤ g². The
   Hodge step (γ = ω − δβ for open curves; no boundary condition = harmonic forms tangent to the boundary =
   absolute cohomology, dual to the relative homology of §2.3.2: an arc between boundary circles is nonbounding, a
-  loop around a hole bounds) agrees with a tree–cotree homology basis (`gsdf.dec.cycles`, b1 generators whose
+  loop around a hole bounds) agrees with a tree–cotree homology basis (`gsdf.dec._cycles`, b1 generators whose
   period matrix on the harmonic basis has full rank). The same truths with unbroken boundaries plus unbroken
   generators are solved exactly (torus, annulus, shark: 0.00 %, one ambiguous homologous choice 1.3 %).
 - **Defect: the final jump solve (step ⑤).** w was solved with jumps g − Jv on *every* edge, i.e. also −Jv where
@@ -67,7 +67,7 @@ What was checked and what was wrong (cases replayed by their bench_swn.py ids):
   across the gap; imposing −Jv across the gap then cut the region's outside along that path (author-annulus:31 of
   the long-gap run: 40 % mislabeled vs 7 % naive; with the fix and the best offset both ≈ 2 %). The thesis solves
   "with jumps encoded by Γ ∖ Jv … the bounding components of Γ … taken as a subset of Γ": jumps g − Jv on the
-  input's edges only, which is now the solver (test `tests/test_swn_lp.py::test_final_solve_jumps_only_across_the_input`).
+  input's edges only, which is now the solver (test `tests/swn/test_lp.py::test_final_solve_jumps_only_across_the_input`).
 - **Option `homology="integer"`** (not the default): the input is an integer chain, so its nonbounding part is an
   integer class; γ's periods on the tree–cotree basis are rounded first (class 0 → no LP: bounding curves with
   gaps are left alone, and the median time drops to the jump solve). Measured a tie with the real class below.
@@ -78,7 +78,7 @@ What was checked and what was wrong (cases replayed by their bench_swn.py ids):
   input edge is nonbounding when Jv explains at least half of its jump (g − round(Jv), the rule §6.4.1's
   filter `bounding_segments` already used), and a remainder that still has a harmonic part is decomposed again
   (at most 3 passes; a second pass is needed where the first left pieces of a loop below ½). "lp, fractional
-  bounding" is the former reading. Tests: `tests/test_swn_lp.py::test_bounding_part_is_a_subset_of_the_input`.
+  bounding" is the former reading. Tests: `tests/swn/test_lp.py::test_bounding_part_is_a_subset_of_the_input`.
   `--only ns-diagnose` sorts the remaining misses with broken nonbounding loops by cause.
 - **What is left:** (a) the LP's choice between homologous loops (thesis Fig. 6.10: e.g. author-torus:2, same
   error with the best offset); (b) the rounding offset after a partial correction (author-double-torus:2:
@@ -155,7 +155,7 @@ def run_cases(per_mesh, csv_path, breaking, time_limit):
 
 def _lp_without(swn, forbid):
     """The full residual LP of ``swn`` with the jump forced to 0 on the edges ``forbid`` (diagnosis only)."""
-    from gsdf.dec.lp import dual_graph_l1
+    from gsdf.linalg._dual_l1 import dual_graph_l1
 
     def residual(gamma, g, eps, time_limit, algorithm="highs-ds", ends=None):
         dec, topo = swn.dec, swn.topology
@@ -323,8 +323,8 @@ def speed(sizes, time_limit, max_faces=None):
     linear solves (step ① jump solve + Hodge decomposition + step ⑤ final solve) once per size. Forms slower
     than a few minutes at 134k faces in earlier runs are skipped above their size cap (``--max-faces`` lifts it);
     objectives must agree to 1e-7 (relative)."""
-    from gsdf.dec.band_lp import banded_l1
-    from gsdf.dec.lp import dual_graph_l1
+    from gsdf.linalg._band_lp import banded_l1
+    from gsdf.linalg._dual_l1 import dual_graph_l1
 
     dual_graph_l1(2, [[0, 1]], [0.5], [1.0], algorithm="network")        # load the numba kernels once
     banded_l1(3, [[0, 1], [1, 2], [2, 0]], [1.0, 0.0, 0.0], [2.0, 1.0, 5.0], seeds=[0])
@@ -375,10 +375,10 @@ def speed(sizes, time_limit, max_faces=None):
 
 SPEED_NOTES = """One decomposition per solve (`bounding="fractional"`), so that every form solves the same LP; the
 default `bounding="subset"` runs up to three (bench_swn.py `--only scaling` times those). "band" (the default from
-12k faces on, `lp_algorithm="auto"`): gsdf.dec.band_lp — the face-form LP on a band of faces around the curves and
+12k faces on, `lp_algorithm="auto"`): gsdf.linalg._band_lp — the face-form LP on a band of faces around the curves and
 their shortest-path completions, every outside piece one cell, then a proof of optimality on all faces (a maximum
 flow: a circulation satisfying complementary slackness exists), growing the band over the certificate's minimum
-cut until proven. "network simplex": the face-form LP's dual min-cost circulation on all faces (gsdf.dec.netflow).
+cut until proven. "network simplex": the face-form LP's dual min-cost circulation on all faces (gsdf.linalg._netflow).
 The objectives are compared to 1e-7 (relative)."""
 
 

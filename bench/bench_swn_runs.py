@@ -8,7 +8,7 @@ structure are measured here against the library's default (full LP, ``cycle_choi
 - **"curves"** (no LP): complete the runs by shortest paths between their endpoints (arriving → leaving, least
   total length: a min-cost assignment over Dijkstra distances that avoid the input's edges), so the completed
   chain Z = g + completion is closed and has an *integer* homology class h (its coordinates on the tree–cotree
-  generator loops, read by pairing Z with the closed forms dual to them; :class:`gsdf.dec.cycles.TreeCotree`).
+  generator loops, read by pairing Z with the closed forms dual to them; :class:`gsdf.dec._cycles.TreeCotree`).
   Split Z into closed curves, straight through crossings: at a vertex where two curves cross transversally (four
   distinct edges, opposite ones in the rotation order one arriving and one leaving) each curve goes on through the
   opposite edge; at any other shared vertex ("ambiguous": an edge used twice, three curves, curves touching) the
@@ -58,7 +58,7 @@ sys.path.insert(0, HERE)
 import bench_swn as B  # noqa: E402
 from common import machine, write_section  # noqa: E402
 
-from gsdf.winding import surface as S  # noqa: E402
+from gsdf.swn import _solver as S  # noqa: E402
 
 FIELDS = ["case", "mesh", "group", "loops", "deleted", "lp set", "err old", "err default", "err completed",
           "err curves", "err curves oracle", "class", "curves", "class curves", "branch vertices",
@@ -424,7 +424,7 @@ Result: **no variant beats the default; the library is unchanged** (branch swnns
 (a completion that links two different curves only adds a small null-homologous loop), but the curves that carry it
 cannot be recovered from the input alone on these cases, and with the right integer class the LP still picks the
 same cycles. Where the input's crossings are clean the curve rule does what it should: on a 48 × 24 torus with a
-broken meridian running through a broken 5 × 18 patch (tests/test_swn_lp.py, the xfail test) the default leaves
+broken meridian running through a broken 5 × 18 patch (tests/swn/test_lp.py, the xfail test) the default leaves
 12 of the 18 meridian edges in the bounding part and mislabels 4.3 %, the curve rule 0.11 %.
 
 Why the curve rule fails here (the counts above; scratch diagnosis of torus:3/10, torus-fine:14, knot1:5/9/24,

@@ -78,7 +78,7 @@ from bench_swn import MeshCases  # noqa: E402
 from common import data_dir, machine, table, write_section  # noqa: E402
 
 from gsdf.heat import SurfaceSignedHeatSolver  # noqa: E402
-from gsdf.heat.sources import Curve  # noqa: E402
+from gsdf.curves import Curve  # noqa: E402
 from gsdf.io import read_mesh  # noqa: E402
 
 MESHES = ["cow", "dino", "bull", "camel", "fandisk", "homer", "retinal", "triceratops", "bear_bis", "blobby",

@@ -26,11 +26,10 @@ sys.path.insert(0, HERE)
 from common import data_dir, machine, median_time, table, write_section  # noqa: E402
 from load import BusyLoad, uptime  # noqa: E402
 
-from gsdf.tori import shapes as S  # noqa: E402
-from gsdf.tori.baselines import (SignedHopfCole, SmoothedSignedPlanarDistance,  # noqa: E402
-                                 WindingNumberPipeline, _conv_kernel)
+from gsdf.data import _shapes as S  # noqa: E402
+from gsdf.tori._baselines import SignedHopfCole, SmoothedSignedPlanarDistance, WindingNumberPipeline, _conv_kernel
 from gsdf.heat.volume import signed_heat_volume  # noqa: E402
-from gsdf.tori.pat import PointsAsTori, _pat_kernel  # noqa: E402
+from gsdf.tori._pat import PointsAsTori, _pat_kernel  # noqa: E402
 
 METHODS = ["PAT (learned)", "PAT (jet)", "SSPD", "SHC", "WN pipeline", "SHM (grid)"]
 
@@ -218,7 +217,7 @@ def _closed(V, F, lo, hi):
 
 def real_clouds(args):
     import gsdf
-    from gsdf.tori.render import render_png
+    from gsdf.view._trace import render_png
 
     root = os.path.join(data_dir(), "points_3")
     rows = []
@@ -306,7 +305,7 @@ def speed(args):
         tcpu = float(np.median(cpu))
         pat2 = PointsAsTori.__new__(PointsAsTori)
         pat2.__dict__.update(pat.__dict__)
-        from gsdf.tori.blend import NeighbourBlend
+        from gsdf.tori._blend import NeighbourBlend
         pat2._blend = NeighbourBlend(pat.P, pat.C, pat.r_eval, pat.k_eval, pat.k_fallback, tree=pat._blend.knn,
                                      kd_eps=0.5)
         tq2, _ = median_time(lambda: pat2.signed_distance(Q), repeat=2)

@@ -31,14 +31,14 @@ from common import machine, table, write_section  # noqa: E402
 from load import BusyLoad, uptime  # noqa: E402
 
 import gsdf  # noqa: E402
-from gsdf.field import grid_points  # noqa: E402
-from gsdf.heat.domains.grid import GridPoisson  # noqa: E402
-from gsdf.heat.volume import grid as G  # noqa: E402
+from gsdf.grid import grid_points  # noqa: E402
+from gsdf.heat.grid._domain import GridPoisson  # noqa: E402
+from gsdf.heat.grid import _poisson as G  # noqa: E402
 from gsdf.heat.volume import signed_heat_volume  # noqa: E402
-from gsdf.heat.volume import sources as S  # noqa: E402
-from gsdf.linalg import iterative  # noqa: E402
-from gsdf.spatial import knn  # noqa: E402
-from gsdf.winding import point_areas as pa  # noqa: E402
+from gsdf.heat.volume import _sources as S  # noqa: E402
+from gsdf.linalg import _iterative as iterative  # noqa: E402
+from gsdf.spatial import _knn as knn  # noqa: E402
+from gsdf.winding import _point_areas as pa  # noqa: E402
 
 MESHES_64 = ["holes.off", "elephant-with-holes.off", "fandisk.off", "couplingdown.off", "bunny00 −30 % faces"]
 CLOUDS = ["hippo1.ply", "kitten.xyz", "oni.pwn"]

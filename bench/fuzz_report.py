@@ -32,9 +32,9 @@ import gsdf  # noqa: E402
 import gsdf.contour  # noqa: E402,F401
 import gsdf.distance  # noqa: E402,F401
 import gsdf.ops  # noqa: E402,F401
-import gsdf.ops.morphology  # noqa: E402,F401
+import gsdf.ops._morphology  # noqa: E402,F401
 import gsdf.tori  # noqa: E402,F401
-from gsdf.winding.point_areas import estimate_normals, point_areas  # noqa: E402
+from gsdf.winding._point_areas import estimate_normals, point_areas  # noqa: E402
 
 TMP = tempfile.mkdtemp(prefix="gsdf-fuzz-")
 
@@ -147,8 +147,8 @@ def cloud_variants():
 
 def _mesh_calls():
     from gsdf.distance import brute_force_distance, closest_point_triangle
-    from gsdf.mesh.geometry import face_normals
-    from gsdf.mesh.pseudonormals import pseudonormals
+    from gsdf.mesh._geometry import face_normals
+    from gsdf.mesh._pseudonormals import pseudonormals
 
     return {
         "winding_number[direct]": lambda V, F, Q: gsdf.winding_number(V, F, Q, method="direct"),
@@ -163,7 +163,7 @@ def _mesh_calls():
             Q, *[np.asarray(V)[k: k + len(np.atleast_2d(Q))] for k in range(3)]),
         "face_normals": lambda V, F, Q: face_normals(np.asarray(V, float), np.asarray(F)),
         "pseudonormals": lambda V, F, Q: pseudonormals(V, F),
-        "voxelize[mesh]": lambda V, F, Q: gsdf.ops.voxelize(mesh=(V, F), resolution=12)[0],
+        "voxelize[mesh]": lambda V, F, Q: gsdf.ops._voxelize(mesh=(V, F), resolution=12)[0],
         "mesh_boolean": lambda V, F, Q: gsdf.ops.mesh_boolean(V, F, np.asarray(V) + 0.3 * np.ptp(np.asarray(V, float), 0),
                                                               F, "union"),
     }
@@ -179,7 +179,7 @@ def _cloud_calls():
         "estimate_normals": lambda P, N, Q: estimate_normals(P, orient_towards=[0, 0, 0]),
         "PointsAsTori": lambda P, N, Q: gsdf.PointsAsTori(P, N, k=16).signed_distance(Q),
         "PointsAsTori.gradient": lambda P, N, Q: gsdf.PointsAsTori(P, N, k=16).gradient(Q),
-        "voxelize[points]": lambda P, N, Q: gsdf.ops.voxelize(points=(P, N), resolution=10)[0],
+        "voxelize[points]": lambda P, N, Q: gsdf.ops._voxelize(points=(P, N), resolution=10)[0],
     }
 
 
@@ -218,11 +218,11 @@ def _option_cases():
         "PAT curvature_cap": lambda x: gsdf.PointsAsTori(P, P, k=16, curvature_cap=x)(Q0),
         "PAT kd_eps": lambda x: gsdf.PointsAsTori(P, P, k=16, kd_eps=x)(np.random.default_rng(0).uniform(-3, 3, (5000, 3))),
         "PAT estimator": lambda x: gsdf.PointsAsTori(P, P, k=16, estimator=x)(Q0),
-        "voxelize resolution": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=x)[0],
-        "voxelize pad": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=8, pad=x)[0],
-        "voxelize beta": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=8, beta=x)[0],
-        "voxelize chunk": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=8, chunk=x)[0],
-        "voxelize bbox_min": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=8, bbox_min=x)[0],
+        "voxelize resolution": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=x)[0],
+        "voxelize pad": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=8, pad=x)[0],
+        "voxelize beta": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=8, beta=x)[0],
+        "voxelize chunk": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=8, chunk=x)[0],
+        "voxelize bbox_min": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=8, bbox_min=x)[0],
         "extract_isosurface resolution": lambda x: gsdf.contour.extract_isosurface(
             lambda q: np.linalg.norm(q, axis=1), [-1] * 3, [1] * 3, resolution=x, level=0.5)[0],
         "extract_isosurface level": lambda x: gsdf.contour.extract_isosurface(
@@ -248,8 +248,8 @@ def _option_cases():
         "mesh_boolean op": lambda x: gsdf.ops.mesh_boolean(V, F, V + 0.3, F, x),
         "mesh_boolean beta": lambda x: gsdf.ops.mesh_boolean(V, F, V + 0.3, F, "union", beta=x),
         "mesh_boolean bisection_steps": lambda x: gsdf.ops.mesh_boolean(V, F, V + 0.3, F, "union", bisection_steps=x),
-        "offset_surface distance": lambda x: gsdf.ops.morphology.offset_surface(_grid_field(), x),
-        "dilate_erode radius": lambda x: gsdf.ops.morphology.dilate_erode(_grid_field(), x),
+        "offset_surface distance": lambda x: gsdf.ops._morphology.offset_surface(_grid_field(), x),
+        "dilate_erode radius": lambda x: gsdf.ops._morphology.dilate_erode(_grid_field(), x),
         "GridField.isosurface level": lambda x: _grid_field().isosurface(x),
         "GridField.isosurface close": lambda x: _grid_field().isosurface(0.0, close=x),
     }
@@ -260,7 +260,8 @@ def _option_cases():
 
 
 def _grid_field():
-    from gsdf.field import GridField, grid_points
+    from gsdf.field import GridField
+    from gsdf.grid import grid_points
 
     shape = (12, 12, 12)
     lo, hi = np.full(3, -1.0), np.full(3, 1.0)

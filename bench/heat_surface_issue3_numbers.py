@@ -1,5 +1,5 @@
 """Numbers of issue 3 items 1-2 (intrinsic Delaunay with sources inside faces; nonorientable transport), on the
-test geometry of tests/test_heat_surface_intrinsic.py / test_heat_surface_normals.py. Run from the repo root:
+test geometry of tests/heat/test_intrinsic.py / test_heat_surface_normals.py. Run from the repo root:
 
     python3 bench/heat_surface_issue3_numbers.py
 """
@@ -12,7 +12,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from test_heat_surface_intrinsic import _circle, _eps
 from test_heat_surface_normals import folded_mobius, _circle_on_strip, _eps as _eps2
 from gsdf.heat import SurfaceSignedHeatSolver
-from gsdf.heat.surface.meshes import anisotropic_mesh, grid_mesh
+from gsdf.data._shapes import anisotropic_mesh, grid_mesh
 c = np.array([0.03, 0.02])
 for name, (V, F) in (("sliver 32 (stretch 8)", anisotropic_mesh(32, stretch=8)),
                      ("clean jittered Delaunay 32", grid_mesh(32, jitter=0.25, delaunay=True, seed=3))):

@@ -82,7 +82,7 @@ def main(argv=None):
 
         from gsdf import data
         from gsdf.io import read_mesh
-        from gsdf.winding.fast import FastWindingNumber
+        from gsdf.winding._fast import FastWindingNumber
 
         t = time.perf_counter()
         V, F = read_mesh(data.path("broken_soup.obj"))

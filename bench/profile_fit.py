@@ -1,4 +1,4 @@
-"""Where the time of the global fit (gsdf.recon.globalfit.fit_to_samples) goes, per stage, on the fit inputs of
+"""Where the time of the global fit (gsdf.recon._globalfit.fit_to_samples) goes, per stage, on the fit inputs of
 real reconstructions (bunny00 surface samples, as in bench_recon.py --only-sizes).
 
 ``--capture N,N,...`` runs ``reconstruct_simply_connected`` on N bunny samples (same draw as bench_recon's size
@@ -28,7 +28,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 def capture(sizes, out):
     import gsdf
-    import gsdf.recon.globalfit as gf
+    import gsdf.recon._globalfit as gf
     from bench_recon import normalise, sample_surface
     from common import data_dir
 
@@ -134,7 +134,7 @@ def _line(label, tw, tc, wall, cpu, its):
 
 
 def compare(d, repeat, rev, only=None, write=False):
-    from gsdf.recon.globalfit import fit_to_samples
+    from gsdf.recon._globalfit import fit_to_samples
 
     out = []
 
@@ -189,7 +189,7 @@ def compare(d, repeat, rev, only=None, write=False):
 
 
 def profile(d, repeat, only=None):
-    from gsdf.recon.globalfit import fit_to_samples
+    from gsdf.recon._globalfit import fit_to_samples
 
     files = sorted(glob.glob(os.path.join(d, "*.npz")), key=lambda f: (int(f.split("bunny")[1].split("_")[0]), f))
     if only:

@@ -26,8 +26,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import data_dir  # noqa: E402
 
 import gsdf  # noqa: E402
-from gsdf.spatial import binned, bvh  # noqa: E402
-from gsdf.winding import fast  # noqa: E402
+from gsdf.spatial import _binned as binned, _bvh as bvh  # noqa: E402
+from gsdf.winding import _fast as fast  # noqa: E402
 
 MESHES = ["refined_elephant.off", "armadillo.off", "man.off", "bunny00.off"]
 

@@ -31,7 +31,7 @@ from load import BusyLoad, uptime  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf.heat import SurfaceSignedHeatSolver  # noqa: E402
-from gsdf.heat.surface.curves import region_boundary_curves  # noqa: E402
+from gsdf.contour._surface_curves import region_boundary_curves  # noqa: E402
 
 try:
     import potpourri3d as pp3d
@@ -60,12 +60,12 @@ def timed(name, fn):
 
 def instrument():
     """Wrap the stages in their modules' namespaces (where the callers look them up)."""
-    import gsdf.heat.core as core
-    import gsdf.heat.domains.triangle as tri
-    import gsdf.heat.surface.operators as ops
-    import gsdf.heat.surface.solver as solver
-    import gsdf.linalg.direct as direct
-    import gsdf.linalg.ldl as ldl
+    import gsdf.heat._core as core
+    import gsdf.heat.triangle._domain as tri
+    import gsdf.heat.triangle._operators as ops
+    import gsdf.heat.triangle._solver as solver
+    import gsdf.linalg._direct as direct
+    import gsdf.linalg._ldl as ldl
 
     ops.unique_edges = timed("ops.unique_edges", ops.unique_edges)
     ops.coo_to_csr = timed("coo_to_csr", ops.coo_to_csr)
@@ -181,8 +181,8 @@ def main():
     args = ap.parse_args()
     rows, stats = [], {}
     instrument()
-    from gsdf.heat.surface.meshes import sphere_mesh
-    from gsdf.heat.surface.curves import level_set_curves
+    from gsdf.data._shapes import sphere_mesh
+    from gsdf.contour._surface_curves import level_set_curves
     Vw, Fw = sphere_mesh(2)
     SurfaceSignedHeatSolver(Vw, Fw).compute_distance(level_set_curves(Vw, Fw, Vw[:, 2] - 0.1))
     start = uptime()

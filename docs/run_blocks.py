@@ -6,7 +6,7 @@ as ``python -m gsdf.cli.main ...``, all in document order, in ``DIR`` (default: 
 fenced as ```` ```text ```` or ```` ```console ```` are shown, not run. The first failure prints the page, the
 block number and its first line, and exits with status 1.
 
-tests/test_docs.py runs every guide page this way in a temporary folder; ``--cwd docs/guide/img`` regenerates
+tests/docs/test_docs.py runs every guide page this way in a temporary folder; ``--cwd docs/guide/img`` regenerates
 the pictures the pages show.
 """
 

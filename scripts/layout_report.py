@@ -66,7 +66,7 @@ def module_graph(src: pathlib.Path) -> dict[str, set[str]]:
 
 
 def package_of(mod: str) -> str:
-    """gsdf.heat.volume.grid -> gsdf.heat; top-level modules (gsdf.field) are their own package."""
+    """gsdf.heat.grid._poisson -> gsdf.heat; top-level modules (gsdf.field) are their own package."""
     parts = mod.split(".")
     return ".".join(parts[:2])
 

@@ -16,8 +16,8 @@ from hypothesis.extra import numpy as hnp  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf.contour import extract_isosurface  # noqa: E402
-from gsdf.ops import voxelize  # noqa: E402
-from gsdf.winding.point_areas import estimate_normals, point_areas  # noqa: E402
+from gsdf.ops import _voxelize as voxelize  # noqa: E402
+from gsdf.winding._point_areas import estimate_normals, point_areas  # noqa: E402
 
 # ---- strategies ----------------------------------------------------------------------------------------
 
@@ -289,8 +289,9 @@ def test_isosurface_of_a_sphere(r, res, s):
 
 @given(st.integers(2, 7), st.integers(0, 2 ** 32 - 1), st.floats(0.3, 0.7))
 def test_voxel_and_capped_meshes_are_closed_and_manifold(n, seed, fill):
-    from gsdf.field import GridField, grid_points
-    from gsdf.mesh.topology import manifold_report
+    from gsdf.field import GridField
+    from gsdf.grid import grid_points
+    from gsdf.mesh._topology import manifold_report
     from gsdf.ops import voxels_to_mesh
 
     occ = np.random.default_rng(seed).random((n, n, n)) < fill

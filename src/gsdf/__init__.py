@@ -6,7 +6,7 @@ Re-exports only; see ``docs/architecture.md`` for the layout. Names are resolved
 
 from importlib import import_module
 
-from ._jit import configure_cache as _configure_cache
+from gsdf._jit import configure_cache as _configure_cache
 
 __version__ = "0.1.0"
 
@@ -20,34 +20,33 @@ _EXPORTS = {
     "winding_number": "winding", "winding_number_2d": "winding", "winding_number_points": "winding",
     "FastWindingNumber": "winding", "ExactWindingNumber": "winding", "FastWindingNumberPoints": "winding",
     "fast_winding_number": "winding", "fast_winding_number_points": "winding",
-    "point_areas": "winding.point_areas", "estimate_normals": "winding.point_areas",
+    "point_areas": "winding", "estimate_normals": "winding",
     # surface winding numbers (thesis ch. 6)
-    "SurfaceWindingNumbers": "winding.surface", "surface_winding_number": "winding.surface",
+    "SurfaceWindingNumbers": "swn", "surface_winding_number": "swn",
     # distance
     "TriangleDistance": "distance", "PointCloudDistance": "distance", "unsigned_distance": "distance",
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",
     # fields, contouring, operations
     "Field": "field", "GridField": "field", "SurfaceField": "field", "load_field": "field",
-    "signed_distance_grid": "distance.grid",
+    "signed_distance_grid": "ops",
     "extract_isosurface": "contour", "refine_on_edges": "contour", "slice_contours": "contour",
     "write_svg": "contour",
     "voxelize": "ops", "winding_grid": "ops", "save_voxels": "ops", "voxels_to_mesh": "ops",
     "mesh_boolean": "ops",
     # the signed heat method on surfaces (Feng & Crane 2024)
     "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
-    "level_set_curves": "heat", "region_boundary_curves": "heat",
-    "VoxelSurfaceSignedHeatSolver": "heat.domains.voxel",
-    "level_set_curves": "heat", "region_boundary_curves": "heat", "Curve": "heat.sources",
-    "read_curves": "io.curves", "write_curves": "io.curves",
+    "level_set_curves": "contour", "region_boundary_curves": "contour",
+    "VoxelSurfaceSignedHeatSolver": "heat",
+    "Curve": "curves", "read_curves": "io", "write_curves": "io",
     # the signed heat method in volumes (grids, tets) and morphology
     "signed_heat_volume": "heat.volume", "YukawaTree": "heat.volume",
-    "TetField": "field", "marching_tetrahedra": "field",
-    "offset_surface": "ops.morphology", "dilate_erode": "ops.morphology", "erode_dilate": "ops.morphology",
+    "TetField": "field", "marching_tetrahedra": "contour",
+    "offset_surface": "ops", "dilate_erode": "ops", "erode_dilate": "ops",
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
     "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
-    "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "tori",
+    "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "view",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
-    "reconstruct_simply_connected": "recon", "mesh_topology": "mesh.topology",
+    "reconstruct_simply_connected": "recon", "mesh_topology": "mesh",
     # dataset batches (issue 16)
     "run_batch": "batch", "sdf_samples": "batch",
     # one thread setting for numba kernels and BLAS (gsdf.threads)

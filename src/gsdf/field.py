@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._checks import as_points, positive
+from gsdf._checks import as_points
+from gsdf.contour._tets import locate_in_tets, marching_tetrahedra
+from gsdf.grid import grid_points
 
 
 class Field:
@@ -15,7 +17,7 @@ class Field:
       ``field.isolines(level)`` → list of (k, 3) polylines for fields on surfaces (:class:`SurfaceField`);
     * ``field.save(path)`` — format by extension, one of ``type(field).SAVE_EXTENSIONS``; any other extension is a
       ``ValueError`` listing those (the requested name is never changed). The file is written atomically
-      (:mod:`gsdf.io.safe_write`).
+      (:mod:`gsdf.io._safe_write`).
 
     Examples
     --------
@@ -43,7 +45,7 @@ class Field:
             For an extension outside ``SAVE_EXTENSIONS`` (the message lists them), a directory, a parent that is
             not a folder, or a failed write.
         """
-        from .io.safe_write import atomic_output, extension_of
+        from gsdf.io._safe_write import atomic_output, extension_of
 
         with atomic_output(path, extensions=self.SAVE_EXTENSIONS) as tmp:
             self._write(tmp, extension_of(path))
@@ -125,15 +127,15 @@ class GridField(Field):
         With ``close=True`` a level set that reaches the box is capped on the box faces (the grid is padded
         with one layer of nodes above the level and the cap vertices are projected back onto the box); the
         result is welded (cap and surface share their seam vertices) and checked: with ``report=True``
-        ``(V, F, report)`` is returned, ``report`` from :func:`gsdf.mesh.topology.manifold_report` (closed,
+        ``(V, F, report)`` is returned, ``report`` from :func:`gsdf.mesh._topology.manifold_report` (closed,
         edge- and vertex-manifold, welded). Where the level set touches itself at a grid node (a pinch), that
         vertex is split per fan, so the mesh stays vertex-manifold and the report says it is not welded.
         Raises ValueError if the level is outside the range of the field.
         """
         from skimage.measure import marching_cubes
 
-        from ._checks import finite
-        from .mesh.topology import manifold_report, split_nonmanifold_vertices, weld
+        from gsdf._checks import finite
+        from gsdf.mesh._topology import manifold_report, split_nonmanifold_vertices, weld
 
         level = finite(level, "level")
         for name, flag in (("close", close), ("report", report)):
@@ -244,27 +246,6 @@ def _load_npz(path, keys, what: str) -> dict:
     except Exception as exc:  # numpy/zipfile raise ValueError, EOFError, BadZipFile, zlib.error, TokenError,
         # NotImplementedError ... for broken headers, archives and compressed data: all mean a malformed file
         raise ValueError(f"{p}: not a gsdf {what} .npz file ({exc})") from exc
-
-
-def grid_points(bbox_min, bbox_max, shape) -> np.ndarray:
-    """Positions of the nodes of a regular grid, shape (prod(shape), 3), C order."""
-    from ._memory import check_bytes, grid_bytes
-
-    # the node positions (24 B) and, in every caller, at least one float per node and its meshgrid copies
-    check_bytes(grid_bytes(shape, 56), f"a {'x'.join(str(int(s)) for s in shape)} grid of nodes (lower the resolution)")
-    axes = [np.linspace(bbox_min[d], bbox_max[d], int(shape[d])) for d in range(3)]
-    X, Y, Z = np.meshgrid(*axes, indexing="ij")
-    return np.column_stack((X.ravel(), Y.ravel(), Z.ravel()))
-
-
-def grid_shape(bbox_min, bbox_max, resolution) -> tuple[int, int, int]:
-    """Grid node counts: ``resolution`` nodes along the longest axis, the same spacing on the others."""
-    r = int(resolution)
-    if r < 2:
-        raise ValueError(f"resolution must be at least 2, got {resolution}")
-    ext = np.asarray(bbox_max, float) - np.asarray(bbox_min, float)
-    h = positive(ext.max(), "bounding box size") / (r - 1)
-    return tuple(int(max(2, np.ceil(e / h - 1e-9) + 1)) for e in ext)
 
 
 def _write_vtk_structured_points(path, values, origin, spacing) -> None:
@@ -380,7 +361,7 @@ class TetField(Field):
     def isosurface(self, level: float = 0.0, report: bool = False):
         """Marching tetrahedra at ``level``: a welded triangle mesh ``(V, F)``, oriented so that normals point
         toward increasing values (outward for a signed distance); ``report=True`` adds its
-        :func:`gsdf.mesh.topology.manifold_report` (see :func:`marching_tetrahedra`)."""
+        :func:`gsdf.mesh._topology.manifold_report` (see :func:`marching_tetrahedra`)."""
         return marching_tetrahedra(self.vertices, self.tets, self.values, level, report=report)
 
     def isosurfaces(self, levels):
@@ -436,7 +417,7 @@ class SurfaceField(Field):
     SAVE_EXTENSIONS = (".npz", ".npy", ".ply", ".vtk", ".vtu")
 
     def __init__(self, vertices, faces, values):
-        from ._checks import as_mesh
+        from gsdf._checks import as_mesh
 
         self.vertices, self.faces = as_mesh(vertices, faces)
         v = np.asarray(values)
@@ -468,7 +449,7 @@ class SurfaceField(Field):
         if len(Q) == 0:
             return np.zeros(0)
         if self._distance is None:
-            from .distance.triangles import TriangleDistance
+            from gsdf.distance._triangles import TriangleDistance
 
             self._distance = TriangleDistance(self.vertices, self.faces)
         _, face, _, bary = self._distance.query_barycentric(Q)
@@ -524,7 +505,7 @@ class SurfaceField(Field):
         """``.npz``: vertices, faces, values (reload with :meth:`load`); ``.npy``: the values (n,) alone; ``.ply``:
         the mesh with vertex property ``values``; ``.vtk``/``.vtu``: triangles with point data ``values``."""
         if ext == ".ply":
-            from .io.mesh_io import write_mesh
+            from gsdf.io._mesh import write_mesh
 
             write_mesh(path, self.vertices, self.faces, vertex_data={"values": self.values})
         elif ext in (".vtk", ".vtu"):
@@ -579,126 +560,3 @@ def _chain_segments(u: np.ndarray, v: np.ndarray, n: int) -> list:
                 chain.append(int(v[seg]))
             chains.append(np.array(chain, dtype=np.int64))
     return chains
-
-
-def locate_in_tets(X, T, Q, k: int = 16, chunk: int = 1 << 15):
-    """Tet containing each query (−1 if none) among arbitrary tets, and its barycentric coordinates.
-
-    Candidates are the ``k`` tets with the nearest centroids (then 4k, 16k for queries not found yet); a tet
-    contains q when all four barycentric coordinates are ≥ −1e-10. Vectorized over chunks of queries.
-    """
-    from scipy.spatial import cKDTree
-
-    X = np.asarray(X, float)
-    T = np.asarray(T, np.int64)
-    Q = np.asarray(Q, float)
-    A = X[T[:, 1:]] - X[T[:, :1]]
-    det = np.linalg.det(A)
-    ok = np.abs(det) > 1e-14 * np.abs(A).max(axis=(1, 2)) ** 3
-    Ainv = np.zeros_like(A)
-    Ainv[ok] = np.linalg.inv(A[ok])  # λ_{1..3} = (q − x0) · Ainv (row vector convention)
-    kd = cKDTree(X[T].mean(axis=1))
-    s = np.full(len(Q), -1, np.int64)
-    bary = np.zeros((len(Q), 4))
-    todo = np.arange(len(Q))
-    for kk in (k, 4 * k, 16 * k):
-        kk = min(kk, len(T))
-        for c in range(0, len(todo), chunk):
-            qi = todo[c:c + chunk]
-            _, cand = kd.query(Q[qi], k=kk, workers=-1)
-            cand = cand.reshape(len(qi), kk)
-            b3 = np.einsum("qkj,qkji->qki", (Q[qi][:, None, :] - X[T[cand, 0]]), Ainv[cand])
-            b = np.concatenate([1.0 - b3.sum(axis=2, keepdims=True), b3], axis=2)
-            good = (b.min(axis=2) >= -1e-10) & ok[cand]
-            hit = good.any(axis=1)
-            j = np.argmax(good, axis=1)
-            s[qi[hit]] = cand[hit, j[hit]]
-            bary[qi[hit]] = b[hit, j[hit]]
-        todo = todo[s[todo] < 0]
-        if len(todo) == 0 or kk == len(T):
-            break
-    return s, bary
-
-
-def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
-    """Level set of a piecewise-linear function on a tet mesh (vectorized marching tetrahedra).
-
-    Each tet with vertices on both sides contributes one triangle (1 vertex apart) or a quad split in two
-    (2 and 2); crossing points are shared per mesh edge. Where the level passes exactly through mesh nodes,
-    crossing points of different edges coincide: they are welded, zero-area triangles dropped, and a vertex
-    where separate sheets touch is split per fan, so the result is edge- and vertex-manifold (closed away from
-    the mesh boundary). Two cases stay open, and the report says so: flat (zero-volume) tets, which a
-    Delaunay of cospherical points such as a regular grid contains, and tet faces lying wholly on the level
-    (three nodes exactly at ``level``). Triangles are oriented along the gradient of ``values``. ``report=True`` returns
-    ``(V, F, report)`` with :func:`gsdf.mesh.topology.manifold_report`.
-
-    Examples
-    --------
-    >>> import numpy as np, gsdf
-    >>> X = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
-    >>> T = np.array([[0, 1, 2, 3]])
-    >>> V, F = gsdf.marching_tetrahedra(X, T, X[:, 0] - 0.5)     # the plane x = 1/2 cuts one triangle
-    >>> V.shape, F.shape, np.allclose(V[:, 0], 0.5)
-    ((3, 3), (1, 3), True)
-    """
-    from ._checks import finite
-
-    X = np.asarray(X, float)
-    T = np.asarray(T, np.int64)
-    s = np.asarray(values, float) - finite(level, "level")
-    if not (s.min() < 0 < s.max()):
-        raise ValueError(f"level {level} is outside the field's range [{s.min() + level:.6g}, {s.max() + level:.6g}]: no surface")
-    # values within round-off of the level are put exactly on it, and a node on the level counts as above it
-    # (a symbolic +0 perturbation): crossings at such a node then coincide exactly and are welded below
-    s = np.where(np.abs(s) <= 1e-12 * float(np.abs(s).max()), 0.0, s)
-    pos = s[T] >= 0
-    npos = pos.sum(axis=1)
-    tris, tet_of = [], []
-    # one vertex apart: lone vertex and the three others
-    for k, lone_is_pos in ((1, True), (3, False)):
-        sel = npos == k
-        if not sel.any():
-            continue
-        P = pos[sel] if lone_is_pos else ~pos[sel]
-        order = np.argsort(~P, axis=1, kind="stable")  # lone vertex first
-        Ts = np.take_along_axis(T[sel], order, axis=1)
-        a = Ts[:, 0]
-        tris.append(np.stack([np.stack([a, Ts[:, 1]], 1), np.stack([a, Ts[:, 2]], 1), np.stack([a, Ts[:, 3]], 1)], 1))
-        tet_of.append(np.flatnonzero(sel))
-    sel = npos == 2
-    if sel.any():
-        order = np.argsort(~pos[sel], axis=1, kind="stable")  # two positive first
-        Ts = np.take_along_axis(T[sel], order, axis=1)
-        a, b, c, d = Ts.T
-        e_ac, e_ad, e_bd, e_bc = (np.stack(p, 1) for p in ((a, c), (a, d), (b, d), (b, c)))
-        tris.append(np.stack([e_ac, e_ad, e_bd], 1))
-        tris.append(np.stack([e_ac, e_bd, e_bc], 1))
-        tet_of += [np.flatnonzero(sel)] * 2
-    E = np.concatenate(tris)  # (k, 3 corners, 2 endpoints)
-    tet_of = np.concatenate(tet_of)
-    Es = np.sort(E.reshape(-1, 2), axis=1)
-    uniq, inv = np.unique(Es, axis=0, return_inverse=True)
-    sa, sb = s[uniq[:, 0]], s[uniq[:, 1]]
-    t = sa / (sa - sb)
-    V = X[uniq[:, 0]] + t[:, None] * (X[uniq[:, 1]] - X[uniq[:, 0]])
-    V[t == 1.0] = X[uniq[t == 1.0, 1]]  # a crossing at a node is that node, bitwise (so it welds)
-    F = inv.reshape(-1, 3)
-    # orient along the gradient of the linear interpolant of each triangle's tet
-    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    Tt = T[tet_of]
-    M = X[Tt[:, 1:]] - X[Tt[:, :1]]  # (k, 3, 3) rows p_i - p_0
-    ds = s[Tt[:, 1:]] - s[Tt[:, :1]]
-    ok = np.abs(np.linalg.det(M)) > 0
-    up = np.zeros_like(n)
-    up[ok] = np.linalg.solve(M[ok], ds[ok][:, :, None])[:, :, 0]
-    flip = (n * up).sum(axis=1) < 0
-    F[flip] = F[flip][:, [0, 2, 1]]
-    keep = np.linalg.norm(n, axis=1) > 0
-    from .mesh.topology import manifold_report, split_nonmanifold_vertices, weld
-
-    V, F = weld(V, F[keep].astype(np.int64))
-    rep = manifold_report(V, F)
-    if not rep["vertex_manifold"]:
-        V, F = split_nonmanifold_vertices(V, F)
-        rep = manifold_report(V, F)
-    return (V, F, rep) if report else (V, F)

@@ -28,11 +28,11 @@ Which calls to wrap (for heat/ and linalg/; wired by the lead after the heat ref
 - ``gsdf.linalg``: every ``splu`` / ``cholespy.CholeskySolverD`` / ``scipy.sparse.linalg.factorized`` call
   and every ``solve`` of a stored factorization -> ``with threads.blas_region(): ...``. One wrapper inside
   the factorization object's ``__init__`` and ``solve`` covers all heat users;
-- ``gsdf.heat.surface.solver`` / ``polygon`` / ``pointcloud``: nothing beyond the linalg wrappers (the
+- ``gsdf.heat.triangle._solver`` / ``polygon`` / ``pointcloud``: nothing beyond the linalg wrappers (the
   numba kernels there follow :func:`numba_threads` automatically once the setting is applied);
-- ``gsdf.heat.volume.grid``: the DCT Poisson solves (scipy.fft workers) -> pass
+- ``gsdf.heat.grid._poisson``: the DCT Poisson solves (scipy.fft workers) -> pass
   ``workers=threads.get_num_threads()``; the CG loops' sparse mat-vecs are single-threaded already;
-- ``gsdf.heat.volume.tet``: the P1 Poisson factorization / CG -> ``blas_region``;
+- ``gsdf.heat.tet._mesh``: the P1 Poisson factorization / CG -> ``blas_region``;
 - ``gsdf.linalg`` LPs (HiGHS): ``blas_region``.
 
 Example

@@ -2,13 +2,13 @@
 
 Modules (one job each):
 
-- :mod:`~gsdf.batch.tasks` — the per-item tasks, plain functions of one input (``sdf_samples``, ``occupancy``,
+- :mod:`~gsdf.batch._tasks` — the per-item tasks, plain functions of one input (``sdf_samples``, ``occupancy``,
   ``sdf_grid``, ``surface``), their options and array names;
-- :mod:`~gsdf.batch.inputs` — INPUTS (folder, glob, manifest file, list) to items with mirrored output paths;
-- :mod:`~gsdf.batch.manifest` — the JSON-lines manifest and the content hashes that make runs resumable;
-- :mod:`~gsdf.batch.worker` — one item on a worker: threads, hash, read, compute, atomic ``.npz`` write;
-- :mod:`~gsdf.batch.executors` — local processes or a Dask cluster behind one submit / wait interface;
-- :mod:`~gsdf.batch.run` — the driver :func:`run_batch`: resume, retries, Ctrl-C, the manifest.
+- :mod:`~gsdf.batch._inputs` — INPUTS (folder, glob, manifest file, list) to items with mirrored output paths;
+- :mod:`~gsdf.batch._manifest` — the JSON-lines manifest and the content hashes that make runs resumable;
+- :mod:`~gsdf.batch._worker` — one item on a worker: threads, hash, read, compute, atomic ``.npz`` write;
+- :mod:`~gsdf.batch._executors` — local processes or a Dask cluster behind one submit / wait interface;
+- :mod:`~gsdf.batch._run` — the driver :func:`run_batch`: resume, retries, Ctrl-C, the manifest.
 
 Example
 -------
@@ -19,12 +19,22 @@ Example
 ...               scheduler="tcp://scheduler:8786")                             # doctest: +SKIP
 """
 
-from .executors import DaskExecutor, LocalExecutor
-from .inputs import Item, collect_inputs
-from .manifest import file_sha256, read_manifest
-from .run import BatchInterrupted, BatchResult, run_batch
-from .tasks import TASKS, Geometry, check_options, load_geometry, occupancy, run_task, sdf_grid, sdf_samples, surface
-from .worker import process_item, write_npz_atomic
+from gsdf.batch._executors import DaskExecutor, LocalExecutor
+from gsdf.batch._inputs import Item, collect_inputs
+from gsdf.batch._manifest import file_sha256, read_manifest
+from gsdf.batch._run import BatchInterrupted, BatchResult, run_batch
+from gsdf.batch._tasks import (
+    TASKS,
+    Geometry,
+    check_options,
+    load_geometry,
+    occupancy,
+    run_task,
+    sdf_grid,
+    sdf_samples,
+    surface,
+)
+from gsdf.batch._worker import process_item, write_npz_atomic
 
 __all__ = ["run_batch", "BatchResult", "BatchInterrupted", "collect_inputs", "Item", "read_manifest",
            "file_sha256", "TASKS", "Geometry", "load_geometry", "check_options", "run_task", "sdf_samples",

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 
-from .. import threads as _gsdf_threads
+from gsdf import threads as _gsdf_threads
 
 _BLAS_ENV = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
              "VECLIB_MAXIMUM_THREADS", _gsdf_threads.ENV_VAR)

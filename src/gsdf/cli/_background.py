@@ -24,8 +24,8 @@ class BackgroundWarmup:
     """
 
     def __init__(self, jobs):
-        from .._jit import install_compile_notice, on_first_compile
-        from ..threads import get_num_threads
+        from gsdf._jit import install_compile_notice, on_first_compile
+        from gsdf.threads import get_num_threads
 
         self.jobs, self.proc, self.done = list(jobs), None, set()
         self._reader, self._changed = None, threading.Condition()
@@ -38,7 +38,7 @@ class BackgroundWarmup:
     def _start(self):
         import subprocess
 
-        from ..threads import get_num_threads
+        from gsdf.threads import get_num_threads
 
         # this process's thread count: kernels that pick a serial or a parallel driver by it pick the same
         cmd = [sys.executable, "-m", "gsdf.cli.main", "--threads", str(get_num_threads()), "warmup", "--only",
@@ -79,7 +79,7 @@ class BackgroundWarmup:
             self._changed.wait_for(lambda: job in self.done, timeout)
 
     def close(self, timeout: float = 120.0):
-        from .._jit import cancel_first_compile
+        from gsdf._jit import cancel_first_compile
 
         cancel_first_compile(self._start)  # warm cache: nothing was started, and nothing will be
         if self.proc is None:

@@ -1,6 +1,6 @@
 """Shared helpers of the subcommands: loading inputs, progress bars, clean error reporting, safe outputs.
 
-Output policy (the same for every subcommand; see :mod:`gsdf.io.safe_write`):
+Output policy (the same for every subcommand; see :mod:`gsdf.io._safe_write`):
 
 * an output that is one of the command's inputs (same file after resolving symlinks / hard links) is always
   refused, before any work is done;
@@ -28,8 +28,8 @@ import os
 import click
 import numpy as np
 
-from ..io.geometry import Geometry, load_geometry  # noqa: F401  (the CLI commands import them from here)
-from ..io.safe_write import atomic_output, check_output_path, same_file
+from gsdf.io._geometry import Geometry, load_geometry  # noqa: F401  (the CLI commands import them from here)
+from gsdf.io._safe_write import atomic_output, check_output_path, same_file
 
 def progress_bar(total: int, desc: str, enabled: bool = True):
     """A tqdm bar and an ``update(done, total)`` callback for the library's ``progress`` hooks."""
@@ -153,7 +153,7 @@ def ensure_parent(path: str) -> None:
 
 
 def bbox_of(X: np.ndarray, pad: float) -> tuple[np.ndarray, np.ndarray]:
-    from ..mesh.geometry import bounding_box
+    from gsdf.mesh._geometry import bounding_box
 
     return bounding_box(X, pad)
 

@@ -6,7 +6,7 @@ import sys
 
 import click
 
-from ._common import report_errors
+from gsdf.cli._common import report_errors
 
 TASK_OPTIONS = ("n_samples", "n_points", "sign", "method", "resolution", "heat_resolution", "bisection", "pad",
                 "uniform_fraction", "sigmas", "seed", "dtype", "beta", "normalize", "estimate_normals")
@@ -74,8 +74,8 @@ Examples:
 @report_errors
 def batch(inputs, task, out, workers, dask_local, scheduler, scheduler_timeout, threads, resume, retry_failed,
           max_retries, quiet, **task_options):
-    from ..batch import BatchInterrupted, run_batch
-    from ..batch.tasks import task_defaults
+    from gsdf.batch import BatchInterrupted, run_batch
+    from gsdf.batch._tasks import task_defaults
 
     chosen = [f"--{n}" for n, v in (("workers", workers), ("dask-local", dask_local), ("scheduler", scheduler))
               if v is not None]

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from ._common import check_output, no_clobber_option, output_file, report_errors
+from gsdf.cli._common import check_output, no_clobber_option, output_file, report_errors
 
 
 @click.command("boolean", help="""Boolean of meshes A and B, robust to holes and soups (Barill et al. 2018, Figs. 12-15).
@@ -27,8 +27,8 @@ Example:
 @no_clobber_option
 @report_errors
 def boolean(a, b, op, output, exact, beta):
-    from ..io import MESH_WRITE_FORMATS, read_mesh, write_mesh
-    from ..ops import mesh_boolean
+    from gsdf.io import MESH_WRITE_FORMATS, read_mesh, write_mesh
+    from gsdf.ops import mesh_boolean
 
     check_output(output, MESH_WRITE_FORMATS)
     VA, FA = read_mesh(a)

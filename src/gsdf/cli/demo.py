@@ -8,7 +8,7 @@ import time
 import click
 import numpy as np
 
-from ._common import Geometry, bbox_of, no_clobber_option, output_file, report_errors
+from gsdf.cli._common import Geometry, bbox_of, no_clobber_option, output_file, report_errors
 
 
 @click.command("demo", help="""Run gsdf on the bundled examples and say where the outputs went.
@@ -26,15 +26,15 @@ Example:
 @no_clobber_option
 @report_errors
 def demo(output_dir, resolution):
-    from .. import data
-    from ..contour import extract_isosurface, slice_contours, write_svg
-    from ..io import read_mesh, read_points, write_mesh
-    from ..io.image import field_to_rgb, write_field_slice_png, write_png
-    from ..winding import winding_number
-    from ..winding.point_areas import point_areas
-    from .sdf import signed_distance_grid
+    from gsdf import data
+    from gsdf.contour import extract_isosurface, slice_contours, write_svg
+    from gsdf.io import read_mesh, read_points, write_mesh
+    from gsdf.view._png import field_to_rgb, write_field_slice_png, write_png
+    from gsdf.winding import winding_number
+    from gsdf.winding._point_areas import point_areas
+    from gsdf.cli.sdf import signed_distance_grid
 
-    from ._background import BackgroundWarmup
+    from gsdf.cli._background import BackgroundWarmup
 
     def save(name, writer):
         with output_file(os.path.join(output_dir, name)) as tmp:
@@ -81,7 +81,7 @@ def demo(output_dir, resolution):
     click.echo(f"[cloud] {cloud.describe()}")
     A = point_areas(P, N)
     click.echo(f"        point areas sum to {A.sum():.4f} (torus area 4π²Rr = {4 * np.pi**2 * 0.4:.4f})")
-    from ..winding import FastWindingNumberPoints
+    from gsdf.winding import FastWindingNumberPoints
 
     fwp = FastWindingNumberPoints(P, N, areas=A)
     plo, phi = bbox_of(P, 0.05)

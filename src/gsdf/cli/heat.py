@@ -6,12 +6,20 @@ import os
 
 import click
 
-from ._common import check_output, load_geometry, no_clobber_option, normals_option, output_file, parse_floats, \
-    quiet_option, report_errors
+from gsdf.cli._common import (
+    check_output,
+    load_geometry,
+    no_clobber_option,
+    normals_option,
+    output_file,
+    parse_floats,
+    quiet_option,
+    report_errors,
+)
 
 
 def _stage_progress(enabled: bool):
-    """A ``progress(stage, fraction)`` callback (gsdf.heat.core) drawing one tqdm bar (percent) per stage."""
+    """A ``progress(stage, fraction)`` callback (gsdf.heat._core) drawing one tqdm bar (percent) per stage."""
     from tqdm import tqdm
 
     state = {"stage": None, "bar": None}
@@ -72,9 +80,9 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
          estimate_normals, quiet):
     import numpy as np
 
-    from ..heat.volume import signed_heat_volume
+    from gsdf.heat.volume import signed_heat_volume
 
-    from ..field import GridField, TetField
+    from gsdf.field import GridField, TetField
 
     check_output(output, TetField.SAVE_EXTENSIONS if tet else GridField.SAVE_EXTENSIONS)
     levels = parse_floats(offsets, "--offsets")
@@ -99,7 +107,7 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
     where = f"a {len(field.vertices)}-node tet mesh" if tet else f"{field.shape} grid nodes"
     click.echo(f"{geo.describe()}\nsigned heat field on {where} -> {os.path.abspath(output)}")
     if levels:
-        from ..io import write_mesh
+        from gsdf.io import write_mesh
 
         X = geo.X
         scale = float(np.linalg.norm(X.max(axis=0) - X.min(axis=0))) if relative else 1.0

@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from ._common import check_output, no_clobber_option, output_file, parse_view, quiet_option, report_errors
+from gsdf.cli._common import check_output, no_clobber_option, output_file, parse_view, quiet_option, report_errors
 
 
 @click.command("heat-surface", help="""Signed distance to curves on the surface MESH (signed heat method).
@@ -52,9 +52,9 @@ Example:
 @report_errors
 def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output, level_set, t_coef, soft_weight,
                  png, view, quiet, swn=False):
-    from ..heat import SurfaceSignedHeatSolver
-    from ..io import read_mesh, write_mesh
-    from ..io.curves import read_curves
+    from gsdf.heat import SurfaceSignedHeatSolver
+    from gsdf.io import read_mesh, write_mesh
+    from gsdf.io._curves import read_curves
 
     check_output(output, (".ply",))  # only PLY stores the distance per vertex
     check_output(png, (".png",), "--png")
@@ -72,7 +72,7 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
         V, F = read_mesh(mesh)
         src = read_curves(curves_path, F)
         if swn:
-            from ..winding.surface import SurfaceWindingNumbers, bounding_segments
+            from gsdf.swn._solver import SurfaceWindingNumbers, bounding_segments
 
             if not all(isinstance(c, np.ndarray) and c.ndim == 1 for c in src.curves) or not src.curves:
                 raise ValueError(f"{curves_path}: --swn needs curves along mesh vertices ('v' nodes or OBJ 'l' lines)")
@@ -97,7 +97,7 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
     if F.shape[1] == 4:
         F = np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])       # the PNG renders triangles
     if png:
-        from ..heat.surface.render import render_function_png
+        from gsdf.view._raster import render_function_png
 
         with output_file(png, what="--png") as tmp:
             render_function_png(tmp, V, F, phi, view=d)
@@ -108,13 +108,13 @@ def _heat_voxels(path, curves_path, spacing, normal_radius, cut, level_set, t_co
     """--voxels: the signed heat method on the digital surface of a binary volume (§8.5)."""
     import re
 
-    from ..heat.domains.voxel import VoxelSurfaceSignedHeatSolver
-    from ..heat.surface.curves import region_boundary_curves
-    from ..io.curves import read_curves
+    from gsdf.heat.voxel._domain import VoxelSurfaceSignedHeatSolver
+    from gsdf.contour._surface_curves import region_boundary_curves
+    from gsdf.io._curves import read_curves
 
     origin = np.zeros(3)
     if path.lower().endswith(".npz"):
-        from ..ops.voxelize import load_voxels
+        from gsdf.ops._voxelize import load_voxels
 
         occ, lo, hi = load_voxels(path)
         origin, size = lo, (hi - lo) / np.array(occ.shape)

@@ -4,27 +4,27 @@ from __future__ import annotations
 
 import click
 
-from .. import __version__
-from .batch import batch
-from .boolean import boolean
-from .demo import demo
-from .heat import heat
-from .heat_surface import heat_surface
-from .reconstruct import reconstruct
-from .render import render
-from .sdf import sdf
-from .slice import slice_cmd
-from .surface import surface
-from .swn import swn
-from .tori import tori
-from .voxelize import voxelize
-from .warmup import warmup
-from .winding import winding
+from gsdf import __version__
+from gsdf.cli.batch import batch
+from gsdf.cli.boolean import boolean
+from gsdf.cli.demo import demo
+from gsdf.cli.heat import heat
+from gsdf.cli.heat_surface import heat_surface
+from gsdf.cli.reconstruct import reconstruct
+from gsdf.cli.render import render
+from gsdf.cli.sdf import sdf
+from gsdf.cli.slice import slice_cmd
+from gsdf.cli.surface import surface
+from gsdf.cli.swn import swn
+from gsdf.cli.tori import tori
+from gsdf.cli.voxelize import voxelize
+from gsdf.cli.warmup import warmup
+from gsdf.cli.winding import winding
 
 
 def _threads_option(ctx, param, value):
     """``--threads N`` (else ``GSDF_NUM_THREADS``): validated here, so bad values are usage errors."""
-    from .. import threads
+    from gsdf import threads
 
     try:
         if value is not None:
@@ -43,7 +43,7 @@ class _Main(click.Group):
         except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort):
             raise
         except Exception as exc:
-            from .._jit import compile_error_message
+            from gsdf._jit import compile_error_message
 
             message = compile_error_message(exc)
             if message is None:
@@ -67,10 +67,10 @@ def main(threads):
     refused, listing the ones it can), atomically (temporary file + rename), never onto an input of the
     command; an existing output file is replaced unless --no-clobber is given.
     """
-    from .._jit import install_compile_notice
+    from gsdf._jit import install_compile_notice
 
     install_compile_notice()  # one line on stderr when a kernel compiles (first use after install)
-    from .. import threads as _threads
+    from gsdf import threads as _threads
 
     if threads is not None:
         _threads.set_num_threads(threads)

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from ._common import check_output, no_clobber_option, output_file, quiet_option, report_errors
+from gsdf.cli._common import check_output, no_clobber_option, output_file, quiet_option, report_errors
 
 _METHODS = ("simply-connected", "winding", "heat", "pat")
 
@@ -43,8 +43,8 @@ Examples:
 def reconstruct(cloud, out, method, outliers, clusters, max_iterations, resolution, png, quiet):
     import numpy as np
 
-    from ..io import read_points, write_mesh
-    from ..mesh.topology import mesh_topology
+    from gsdf.io import read_points, write_mesh
+    from gsdf.mesh._topology import mesh_topology
 
     check_output(out, (".ply", ".obj", ".off", ".stl"))
     check_output(png, (".png",), "--png")
@@ -56,13 +56,13 @@ def reconstruct(cloud, out, method, outliers, clusters, max_iterations, resoluti
 
     click.echo(f"{cloud}: {len(P)} points{' with normals' if N is not None else ''}; method {method}")
     if method == "simply-connected":
-        from ..recon import reconstruct_simply_connected
+        from gsdf.recon import reconstruct_simply_connected
         V, F, rep = reconstruct_simply_connected(P, N, outliers=outliers, clusters=clusters,
                                                  max_iterations=max_iterations, progress=say, return_report=True)
         click.echo(f"  {rep['iterations']} round(s); {int(rep['outliers'].sum())} points judged outliers; "
                    f"{rep['n_tets']} tets; {rep['timings']['total']:.2f} s")
     else:
-        from ..recon import compare
+        from gsdf.recon import _compare as compare
         fn = {"winding": compare.reconstruct_winding, "heat": compare.reconstruct_heat,
               "pat": compare.reconstruct_pat}[method]
         say(f"{method} level set")
@@ -76,7 +76,7 @@ def reconstruct(cloud, out, method, outliers, clusters, max_iterations, resoluti
         write_mesh(tmp, V, F)
     click.echo(f"mesh -> {os.path.abspath(out)}")
     if png is not None:
-        from ..heat.surface.render import render_function_png
+        from gsdf.view._raster import render_function_png
         with output_file(png, (".png",), what="--png") as tmp:
             render_function_png(tmp, V, F, np.asarray(V)[:, 1], view=(0.3, 0.2, 1.0))
         click.echo(f"preview -> {os.path.abspath(png)}")

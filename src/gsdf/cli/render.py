@@ -6,7 +6,7 @@ import os
 
 import click
 
-from ._common import check_output, no_clobber_option, normals_option, output_file, parse_floats, report_errors
+from gsdf.cli._common import check_output, no_clobber_option, normals_option, output_file, parse_floats, report_errors
 
 
 @click.command("render", help="""Sphere-trace a level set of the Points as Tori SDF of POINTS into a PNG.
@@ -30,10 +30,10 @@ Example:
 def render(points, out, level, size, view, up, estimate_normals):
     import numpy as np
 
-    from ..io.image import write_png
-    from ..tori import PointsAsTori
-    from ..tori.render import sphere_trace
-    from .tori import _load_cloud
+    from gsdf.view._png import write_png
+    from gsdf.tori import PointsAsTori
+    from gsdf.view._trace import sphere_trace
+    from gsdf.cli.tori import _load_cloud
 
     check_output(out, (".png",))
     v, u = parse_floats(view, "--view"), parse_floats(up, "--up")

@@ -5,16 +5,24 @@ from __future__ import annotations
 import os
 
 import click
-import numpy as np
 
-from ._common import beta_option, check_output, load_geometry, no_clobber_option, normals_option, output_file, \
-    progress_bar, quiet_option, report_errors
+from gsdf.cli._common import (
+    beta_option,
+    check_output,
+    load_geometry,
+    no_clobber_option,
+    normals_option,
+    output_file,
+    progress_bar,
+    quiet_option,
+    report_errors,
+)
 
 
 def signed_distance_grid(geo, resolution: int, pad: float, sign: str = "winding", beta=None, quiet=True):
     """Signed distance on the nodes of a grid around the loaded input ``geo`` (:func:`gsdf.signed_distance_grid`
     with a progress bar); returns a :class:`gsdf.GridField`."""
-    from ..distance.grid import signed_distance_grid as grid_sdf
+    from gsdf.ops._distance_grid import signed_distance_grid as grid_sdf
 
     if sign == "pseudonormal" and not geo.is_mesh:
         raise ValueError("--sign pseudonormal needs a mesh, not a point cloud")
@@ -55,14 +63,14 @@ Example:
 @no_clobber_option
 @report_errors
 def sdf(input, output, resolution, pad, sign, png, surface_out, beta, estimate_normals, quiet):
-    from ..field import GridField
-    from ..io import MESH_WRITE_FORMATS
+    from gsdf.field import GridField
+    from gsdf.io import MESH_WRITE_FORMATS
 
     check_output(output, GridField.SAVE_EXTENSIONS)
     check_output(png, (".png",), "--png")
     check_output(surface_out, MESH_WRITE_FORMATS, "--surface")
     geo = load_geometry(input, estimate_normals)
-    from ._background import BackgroundWarmup
+    from gsdf.cli._background import BackgroundWarmup
 
     # cold cache, >= 2 threads, winding sign of a mesh: the distance kernels compile in a second process while
     # this one compiles the fast winding numbers (computed first for this reason)
@@ -72,13 +80,13 @@ def sdf(input, output, resolution, pad, sign, png, surface_out, beta, estimate_n
         field.save(tmp)
     click.echo(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")
     if png:
-        from ..io.image import write_field_slice_png
+        from gsdf.view._png import write_field_slice_png
 
         with output_file(png, what="--png") as tmp:
             write_field_slice_png(tmp, field)
         click.echo(f"slice image -> {os.path.abspath(png)}")
     if surface_out:
-        from ..io import write_mesh
+        from gsdf.io import write_mesh
 
         Vs, Fs = field.isosurface(0.0)
         with output_file(surface_out, what="--surface") as tmp:

@@ -7,8 +7,19 @@ import os
 import click
 import numpy as np
 
-from ._common import bbox_of, beta_option, check_output, counting, load_geometry, no_clobber_option, \
-    normals_option, output_file, parse_floats, quiet_option, report_errors
+from gsdf.cli._common import (
+    bbox_of,
+    beta_option,
+    check_output,
+    counting,
+    load_geometry,
+    no_clobber_option,
+    normals_option,
+    output_file,
+    parse_floats,
+    quiet_option,
+    report_errors,
+)
 
 
 @click.command("slice", help="""Slice INPUT into closed contours of its winding-number solid, written as SVG.
@@ -35,7 +46,7 @@ Example:
 @no_clobber_option
 @report_errors
 def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, estimate_normals, quiet):
-    from ..contour import slice_contours, write_svg
+    from gsdf.contour import slice_contours, write_svg
 
     check_output(output, (".svg",))
     geo = load_geometry(input, estimate_normals)

@@ -6,8 +6,18 @@ import os
 
 import click
 
-from ._common import bbox_of, beta_option, check_output, counting, load_geometry, no_clobber_option, \
-    normals_option, output_file, quiet_option, report_errors
+from gsdf.cli._common import (
+    bbox_of,
+    beta_option,
+    check_output,
+    counting,
+    load_geometry,
+    no_clobber_option,
+    normals_option,
+    output_file,
+    quiet_option,
+    report_errors,
+)
 
 
 @click.command("surface", help="""Extract the surface of INPUT as the winding number's 1/2 level set.
@@ -34,8 +44,8 @@ Example:
 @no_clobber_option
 @report_errors
 def surface(input, output, resolution, level, bisection, pad, beta, estimate_normals, quiet):
-    from ..contour import extract_isosurface
-    from ..io import MESH_WRITE_FORMATS, write_mesh
+    from gsdf.contour import extract_isosurface
+    from gsdf.io import MESH_WRITE_FORMATS, write_mesh
 
     check_output(output, MESH_WRITE_FORMATS)
     geo = load_geometry(input, estimate_normals)

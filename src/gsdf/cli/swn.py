@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from ._common import check_output, no_clobber_option, output_file, parse_view, quiet_option, report_errors
+from gsdf.cli._common import check_output, no_clobber_option, output_file, parse_view, quiet_option, report_errors
 
 
 def write_swn_obj(path, V, F, corner_values, face_labels) -> None:
@@ -69,10 +69,10 @@ Example:
 @no_clobber_option
 @report_errors
 def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
-    from ..io import read_mesh
-    from ..io.swn_curves import read_swn_curves
-    from ..winding.surface import SurfaceWindingNumbers
-    from ..winding.surface_curves import insert_curves
+    from gsdf.io import read_mesh
+    from gsdf.io._swn_curves import read_swn_curves
+    from gsdf.swn._solver import SurfaceWindingNumbers
+    from gsdf.swn._insert import insert_curves
 
     check_output(output, (".ply", ".obj"))
     check_output(png, (".png",), "--png")
@@ -86,7 +86,7 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     V2, F2, segs, _ = insert_curves(V, F, c)
     say("building operators")
     solver = SurfaceWindingNumbers(V2, F2)
-    from ._common import progress_bar
+    from gsdf.cli._common import progress_bar
 
     bar, update = progress_bar(5, "swn steps", enabled=not quiet)
     try:
@@ -104,7 +104,7 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
                f"method {method}: labels (area) {share}; nonbounding share of the input {nb:.2f}; "
                f"{res.timings['total']:.2f} s -> {os.path.abspath(output)}")
     if png:
-        from ..heat.surface.render import render_function_png
+        from gsdf.view._raster import render_function_png
 
         m = len(F2)
         with output_file(png, (".png",), what="--png") as tmp:

@@ -7,21 +7,28 @@ import os
 import click
 import numpy as np
 
-from ._common import check_output, no_clobber_option, normals_option, output_file, parse_floats, quiet_option, \
-    report_errors
+from gsdf.cli._common import (
+    check_output,
+    no_clobber_option,
+    normals_option,
+    output_file,
+    parse_floats,
+    quiet_option,
+    report_errors,
+)
 
 GRID_EXTENSIONS = (".npz", ".npy", ".vtk", ".vti", ".vtu")
 
 
 def _load_cloud(path, estimate_normals):
-    from ..io import read_points
+    from gsdf.io import read_points
 
     P, N = read_points(path)
     if N is None:
         if not estimate_normals:
             raise ValueError(f"{path}: the point cloud has no normals; Points as Tori needs oriented normals "
                              "(pass --estimate-normals for PCA normals oriented away from the centroid)")
-        from ..winding.point_areas import estimate_normals as pca
+        from gsdf.winding._point_areas import estimate_normals as pca
 
         N = pca(P, orient_towards=P.mean(axis=0))
     return P, N
@@ -54,8 +61,8 @@ Examples:
 @no_clobber_option
 @report_errors
 def tori(points, out, estimator, grid, offsets, pad, k, estimate_normals, quiet):
-    from ..io import MESH_WRITE_FORMATS
-    from ..tori import PointsAsTori
+    from gsdf.io import MESH_WRITE_FORMATS
+    from gsdf.tori import PointsAsTori
 
     check_output(out, GRID_EXTENSIONS + MESH_WRITE_FORMATS)
     ext = os.path.splitext(out)[1].lower()
@@ -78,7 +85,8 @@ def tori(points, out, estimator, grid, offsets, pad, k, estimate_normals, quiet)
     m = pad * np.linalg.norm(hi - lo) + max(abs(v) for v in levels)
     lo, hi = lo - m, hi + m
     if ext in GRID_EXTENSIONS:
-        from ..field import GridField, grid_points, grid_shape
+        from gsdf.field import GridField
+        from gsdf.grid import grid_points, grid_shape
 
         shape = grid_shape(lo, hi, res)
         hi = lo + (np.array(shape) - 1) * (hi - lo).max() / (res - 1)
@@ -87,8 +95,8 @@ def tori(points, out, estimator, grid, offsets, pad, k, estimate_normals, quiet)
             field.save(tmp)
         click.echo(f"signed distance grid {field.shape} -> {os.path.abspath(out)}")
         return
-    from ..contour import extract_isosurface
-    from ..io import write_mesh
+    from gsdf.contour import extract_isosurface
+    from gsdf.io import write_mesh
 
     for v, path in zip(levels, mesh_paths):
         V, F = extract_isosurface(pat.signed_distance, lo, hi, res, level=v, inside="below")

@@ -6,8 +6,17 @@ import os
 
 import click
 
-from ._common import beta_option, check_output, load_geometry, no_clobber_option, normals_option, output_file, \
-    progress_bar, quiet_option, report_errors
+from gsdf.cli._common import (
+    beta_option,
+    check_output,
+    load_geometry,
+    no_clobber_option,
+    normals_option,
+    output_file,
+    progress_bar,
+    quiet_option,
+    report_errors,
+)
 
 
 @click.command("voxelize", help="""Voxelize INPUT: a voxel is inside where the winding number at its centre is >= 1/2.
@@ -31,8 +40,8 @@ Example:
 @no_clobber_option
 @report_errors
 def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, quiet):
-    from ..io import MESH_WRITE_FORMATS
-    from ..ops import save_voxels, voxelize as run, voxels_to_mesh
+    from gsdf.io import MESH_WRITE_FORMATS
+    from gsdf.ops import save_voxels, _voxelize as run, voxels_to_mesh
 
     check_output(output, (".npz",))
     check_output(mesh_out, MESH_WRITE_FORMATS, "--mesh-out")
@@ -49,7 +58,7 @@ def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, q
     click.echo(f"{geo.describe()}\n{int(occ.sum())} of {occ.size} voxels inside, grid {occ.shape} -> "
                f"{os.path.abspath(output)}")
     if mesh_out:
-        from ..io import write_mesh
+        from gsdf.io import write_mesh
 
         Vv, Fv = voxels_to_mesh(occ, lo, hi)
         with output_file(mesh_out, what="--mesh-out") as tmp:

@@ -18,7 +18,7 @@ import time
 
 import click
 
-from ._common import report_errors
+from gsdf.cli._common import report_errors
 
 # name -> what it compiles; the command lines are built by _job_commands (they need the temp files)
 JOBS = {
@@ -37,7 +37,7 @@ _PARTIAL = {"demo-cloud": "the point-cloud half of gsdf demo",
 
 
 def _surface_command():
-    from .surface import surface   # the command itself, not the group (gsdf.cli.main imports this module)
+    from gsdf.cli.surface import surface  # the command itself, not the group (gsdf.cli.main imports this module)
 
     return surface
 
@@ -50,10 +50,10 @@ def _write_inputs(d: str) -> dict:
     """Tiny inputs in ``d``: the bundled soup and cloud, a manifold sphere with a curve, query points."""
     import numpy as np
 
-    from .. import data
-    from ..heat.surface.meshes import sphere_mesh
-    from ..io import write_mesh
-    from ..io.curves import write_curves
+    from gsdf import data
+    from gsdf.data._shapes import sphere_mesh
+    from gsdf.io import write_mesh
+    from gsdf.io._curves import write_curves
 
     V, F = sphere_mesh(2)
     sphere = os.path.join(d, "sphere.obj")
@@ -103,8 +103,8 @@ def _warm_distance(mesh_path: str) -> None:
     """Compile the unsigned-distance kernels (tree build, packing, nearest-triangle search) on a mesh."""
     import numpy as np
 
-    from ..distance.triangles import TriangleDistance
-    from ..io import read_mesh
+    from gsdf.distance._triangles import TriangleDistance
+    from gsdf.io import read_mesh
 
     V, F = read_mesh(mesh_path)
     TriangleDistance(V, F).query(np.random.default_rng(0).uniform(V.min(0), V.max(0), (500, 3)))
@@ -165,7 +165,7 @@ def warm(jobs=None, processes=None, echo=None) -> list[tuple[str, float, str]]:
     from concurrent.futures import ProcessPoolExecutor, as_completed
     import multiprocessing
 
-    from ..threads import get_num_threads
+    from gsdf.threads import get_num_threads
 
     names = list(JOBS) if jobs is None else list(jobs)
     for n in names:

@@ -7,16 +7,25 @@ import os
 import click
 import numpy as np
 
-from ._common import beta_option, check_output, load_geometry, no_clobber_option, normals_option, output_file, \
-    progress_bar, quiet_option, report_errors
+from gsdf.cli._common import (
+    beta_option,
+    check_output,
+    load_geometry,
+    no_clobber_option,
+    normals_option,
+    output_file,
+    progress_bar,
+    quiet_option,
+    report_errors,
+)
 
 VALUE_EXTENSIONS = (".npy", ".txt", ".csv")
 
 
 def read_queries(path: str) -> np.ndarray:
     """Query points (q, 3), q > 0, finite: an .npy array or any point file :func:`gsdf.read_points` reads."""
-    from .._checks import as_points
-    from ..io import read_points
+    from gsdf._checks import as_points
+    from gsdf.io import read_points
 
     if path.lower().endswith(".npy"):
         if not os.path.exists(path):
@@ -62,7 +71,7 @@ Example:
 @no_clobber_option
 @report_errors
 def winding(input, queries, output, exact, order, beta, estimate_normals, quiet):
-    from ..winding import FastWindingNumber, FastWindingNumberPoints, winding_number, winding_number_points
+    from gsdf.winding import FastWindingNumber, FastWindingNumberPoints, winding_number, winding_number_points
 
     check_output(output, VALUE_EXTENSIONS)
     geo = load_geometry(input, estimate_normals)

@@ -5,7 +5,10 @@ numbers) and Fig. 3 / §4 (slicing the 3D winding number field into stacks of po
 printer's toolpath software fills).
 """
 
-from .isosurface import extract_isosurface, refine_on_edges
-from .slicing import slice_contours, write_slices_svg, write_svg
+from gsdf.contour._isosurface import extract_isosurface, refine_on_edges
+from gsdf.contour._slicing import slice_contours, write_slices_svg, write_svg
+from gsdf.contour._surface_curves import level_set_curves, region_boundary_curves
+from gsdf.contour._tets import locate_in_tets, marching_tetrahedra
 
-__all__ = ["extract_isosurface", "refine_on_edges", "slice_contours", "write_svg", "write_slices_svg"]
+__all__ = ["extract_isosurface", "refine_on_edges", "slice_contours", "write_svg", "write_slices_svg",
+           "level_set_curves", "region_boundary_curves", "marching_tetrahedra", "locate_in_tets"]

@@ -1,28 +1,22 @@
-"""Discrete exterior calculus: operators on triangle (and tet) meshes, Hodge decomposition, the dual-graph L1 LP.
+"""Discrete exterior calculus on triangle and tet meshes.
 
-Modules
--------
-triangle : d0, d1, diagonal Hodge stars (cotan, clamped), jump ("reduced") coordinates of an integer edge chain,
-           the jump Laplace solve, the Darboux derivative — on triangle meshes.
-hodge    : Hodge decomposition of a 1-form on any cell complex given d0, d1 and positive diagonal stars
-           (exact, coexact, harmonic parts) and a harmonic basis (dimension = first Betti number).
-lp       : the L1 linear program on a dual graph (per-cell shifts, least weighted L1 jump), solved by HiGHS.
-netflow  : network simplex for min-cost circulations; the L1 program through its dual circulation.
-band_lp  : the L1 program on a band of cells, proven optimal on all cells by a max-flow certificate.
+``_triangle``: d0, d1, diagonal Hodge stars (cotan, clamped), jump ("reduced") coordinates of an integer edge chain,
+the jump Laplace solve, the Darboux derivative. ``_tet``: the same on tet complexes. ``_hodge``: Hodge
+decomposition of a 1-form on any cell complex given d0, d1 and positive diagonal stars (exact, coexact, harmonic
+parts) and a harmonic basis (dimension = first Betti number). ``_cycles``: tree–cotree homology bases.
 
-Names are imported lazily (PEP 562) so ``import gsdf.dec.lp`` does not pay for the others.
+Names are imported lazily (PEP 562).
 """
+
 
 from __future__ import annotations
 
 import importlib
 
 _LAZY = {
-    "TriangleDEC": "triangle",
-    "JumpCoordinates": "triangle",
-    "HodgeDecomposition": "hodge",
-    "dual_graph_l1": "lp",
-    "DualL1Result": "lp",
+    "TriangleDEC": "_triangle",
+    "JumpCoordinates": "_triangle",
+    "HodgeDecomposition": "_hodge",
 }
 
 __all__ = sorted(_LAZY)

@@ -1,8 +1,8 @@
 """Unsigned and signed distance to triangle meshes/soups and point clouds."""
 
-from .points import PointCloudDistance, point_cloud_distance
-from .signed import SIGN_MODES, signed_distance, signed_distance_points
-from .triangles import TriangleDistance, brute_force_distance, closest_point_triangle, unsigned_distance
+from gsdf.distance._points import PointCloudDistance, point_cloud_distance
+from gsdf.distance._signed import SIGN_MODES, signed_distance, signed_distance_points
+from gsdf.distance._triangles import TriangleDistance, brute_force_distance, closest_point_triangle, unsigned_distance
 
 __all__ = [
     "TriangleDistance",

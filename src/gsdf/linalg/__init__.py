@@ -20,12 +20,20 @@ Example
 array([1., 1.])
 """
 
-from .direct import (BlockHermitianFactorization, CholeskyFactorization, Factorization, HermitianFactorization,
-                     LDL_MAX_UNKNOWNS, cached_factorization, cholesky, spd_factorization)
-from .ldl import LDLFactorization
-from .iterative import SPDSolver, amg_preconditioner, pcg
-from .lp import solve_lp
-from .saddle import saddle_matrix
+from gsdf.linalg._direct import (
+    BlockHermitianFactorization,
+    CholeskyFactorization,
+    Factorization,
+    HermitianFactorization,
+    LDL_MAX_UNKNOWNS,
+    cached_factorization,
+    cholesky,
+    spd_factorization,
+)
+from gsdf.linalg._ldl import LDLFactorization
+from gsdf.linalg._iterative import SPDSolver, amg_preconditioner, pcg
+from gsdf.linalg._lp import solve_lp
+from gsdf.linalg._saddle import saddle_matrix
 
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
            "cholesky", "cached_factorization", "saddle_matrix", "solve_lp", "SPDSolver", "pcg",

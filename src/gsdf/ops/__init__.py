@@ -5,8 +5,10 @@ winding number at voxel centers (Fig. 11) and booleans that trim each operand ag
 the other instead of intersecting triangles (Figs. 12-15).
 """
 
-from .boolean import mesh_boolean, trim_mesh
-from .voxelize import (
+from gsdf.ops._boolean import mesh_boolean, trim_mesh
+from gsdf.ops._distance_grid import signed_distance_grid
+from gsdf.ops._morphology import dilate_erode, erode_dilate, offset_surface
+from gsdf.ops._voxelize import (
     load_voxels,
     save_voxels,
     voxel_centers,
@@ -26,4 +28,8 @@ __all__ = [
     "voxels_to_mesh",
     "mesh_boolean",
     "trim_mesh",
+    "signed_distance_grid",
+    "offset_surface",
+    "dilate_erode",
+    "erode_dilate",
 ]

@@ -7,7 +7,6 @@ kept), :mod:`.topology` (closed / manifold / χ / genus checks), :mod:`.compare`
 signed-heat and Points-as-Tori reconstructions on the same API shape).
 """
 
-from .pipeline import reconstruct_simply_connected
-from ..mesh.topology import is_sphere, mesh_topology
+from gsdf.recon._pipeline import reconstruct_simply_connected
 
-__all__ = ["reconstruct_simply_connected", "mesh_topology", "is_sphere"]
+__all__ = ["reconstruct_simply_connected"]

@@ -1,7 +1,8 @@
 """Generalized winding numbers: exact direct sums, fast tree-based approximations, point areas."""
-from .exact import winding_number, winding_number_2d, winding_number_points
-from .hierarchical import ExactWindingNumber
-from .fast import (
+from gsdf.winding._exact import winding_number, winding_number_2d, winding_number_points
+from gsdf.winding._hierarchical import ExactWindingNumber
+from gsdf.winding._point_areas import estimate_normals, point_areas
+from gsdf.winding._fast import (
     FastWindingNumber,
     FastWindingNumberPoints,
     fast_winding_number,
@@ -17,4 +18,6 @@ __all__ = [
     "FastWindingNumberPoints",
     "fast_winding_number",
     "fast_winding_number_points",
+    "point_areas",
+    "estimate_normals",
 ]

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..spatial.morton import cell_order, gather_rows
-from ..threads import apply_env
+from gsdf.spatial._morton import cell_order, gather_rows
+from gsdf.threads import apply_env
 
 CHUNK = 1 << 20
 
@@ -17,7 +17,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
     Only one float64 copy of one chunk exists at a time, so 10^8 float32 queries need ~chunk×24 bytes of
     scratch beyond the output. ``progress(done, total)`` is called after each chunk when given.
     ``coherent=True`` evaluates each chunk grouped by cells of a coarse Morton grid
-    (:func:`gsdf.spatial.morton.cell_order`: tree walks of neighbouring queries then share cached nodes) and
+    (:func:`gsdf.spatial._morton.cell_order`: tree walks of neighbouring queries then share cached nodes) and
     scatters the results back. ``frame`` (a :class:`gsdf._normalize.Frame`) maps each
     validated chunk into the geometry's normalised frame first (the kernel's geometry lives there).
     """

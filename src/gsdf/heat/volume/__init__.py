@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._checks import as_mesh, as_points, choice, integer, positive
-from ..._normalize import Frame
-from ...field import grid_shape
-from .memory import check_memory
-from .sources import Sources, mesh_sources, point_sources
-from .yukawa import YukawaTree
+from gsdf._checks import as_mesh, as_points, choice, integer, positive
+from gsdf._normalize import Frame
+from gsdf.grid import grid_shape
+from gsdf.heat.volume._memory import check_memory
+from gsdf.heat.volume._sources import Sources, mesh_sources, point_sources
+from gsdf.heat._yukawa import YukawaTree
 
 __all__ = ["signed_heat_volume", "YukawaTree", "mesh_sources", "point_sources", "Sources", "volume_grid_box", "input_spacing"]
 
@@ -115,9 +115,9 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
         Oriented point cloud; normals need not be unit length. Point areas are estimated (§3.1 of Barill 2018).
     domain : {"grid", "tet"}
         Regular grid (§8.2; step I by one screened solve on the grid, or by the Yukawa tree walk —
-        option ``step1`` "auto" / "yukawa" / "heat", :mod:`gsdf.heat.volume.screened`) or tetrahedral mesh (§8.1: Delaunay of the input
+        option ``step1`` "auto" / "yukawa" / "heat", :mod:`gsdf.heat.grid._screened`) or tetrahedral mesh (§8.1: Delaunay of the input
         points and an octree-like lattice graded toward them, h = the grid spacing near the input; see
-        :mod:`gsdf.heat.volume.tet` for its options ``step1``, ``mesher``, ``levels``, …).
+        :mod:`gsdf.heat.tet._mesh` for its options ``step1``, ``mesher``, ``levels``, …).
     resolution : int or (3,) ints
         Grid nodes along the longest side (cubic cells), or exact node counts per axis.
     bbox_min, bbox_max : (3,) float, optional
@@ -154,7 +154,7 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     max_memory : int, optional
         Byte limit of the solve (default 80 % of available memory); larger grids are refused before any work.
     progress : callable, optional
-        ``progress(stage, fraction)`` (:mod:`gsdf.heat.core`; the older ``(stage, done, total)`` also works).
+        ``progress(stage, fraction)`` (:mod:`gsdf.heat._core`; the older ``(stage, done, total)`` also works).
 
     Returns
     -------
@@ -173,7 +173,7 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     >>> bool(d[0] < -0.8 and abs(d[1] - 0.1) < 0.05)
     True
     """
-    from ...threads import blas_region
+    from gsdf.threads import blas_region
 
     # BLAS on one thread (or the explicit gsdf.threads setting) for the whole run: the CG loops of step III
     # call BLAS dot / norm on 10⁴–10⁶-vectors, where OpenBLAS's threads cost more than they save (32³ grid:
@@ -192,7 +192,7 @@ def _signed_heat_volume(mesh, points, domain, resolution, bbox_min, bbox_max, t_
     t_scale = choice(t_scale, "t_scale", {"grid", "input"})
     import inspect
 
-    from .solve import solve_grid, solve_tet
+    from gsdf.heat.volume._solve import solve_grid, solve_tet
 
     # options of the domain's solver (documented there); anything else is refused by name, not as a TypeError
     own = {"src", "X", "lo", "hi", "shape", "bbox_min", "bbox_max", "frame", "faces", "t_coef", "level_set_constraint",
@@ -217,12 +217,12 @@ def _signed_heat_volume(mesh, points, domain, resolution, bbox_min, bbox_max, t_
     if t_scale == "input" and kwargs.get("t") is None:
         kwargs["t"] = t_coef * input_spacing(X, F) ** 2
     if domain == "tet":
-        from .solve import solve_tet
+        from gsdf.heat.volume._solve import solve_tet
 
         return solve_tet(src, X, lo, hi, shape, t_coef=t_coef, level_set_constraint=level_set_constraint,
                          soft_weight=soft_weight, max_memory=max_memory, progress=progress, theta=theta, faces=F,
                          frame=frame, **kwargs)
-    from .solve import solve_grid
+    from gsdf.heat.volume._solve import solve_grid
 
     check_memory(int(np.prod(shape)), max_memory)
     return solve_grid(src, lo, hi, shape, t_coef=t_coef, level_set_constraint=level_set_constraint,

@@ -1,0 +1,349 @@
+"""The batch driver: items in, one task per item on an executor, the manifest out — resumable and interruptible.
+
+:func:`run_batch` validates everything before any work (inputs, options, output folder, executor), skips items
+whose output exists and whose recorded input hash and options still match, keeps a bounded window of items in
+flight (2 per worker slot), gathers them as they complete, appends each record to the manifest, resubmits
+items lost to a dead worker up to ``max_retries`` times, and on Ctrl-C cancels what is in flight, records those
+items as ``cancelled`` and raises :class:`BatchInterrupted` carrying the partial result.
+"""
+
+from __future__ import annotations
+
+import collections
+import datetime
+import os
+import re
+import statistics
+import tempfile
+import time
+import uuid
+from dataclasses import dataclass, field
+
+from gsdf.batch._inputs import collect_inputs
+from gsdf.batch._manifest import MANIFEST_NAME, ManifestWriter, file_sha256, params_sha256, read_manifest
+from gsdf.batch._tasks import check_options, task_name
+from gsdf.batch._worker import process_item
+
+LOCK_NAME = ".gsdf-batch.lock"
+_PART = re.compile(r"^\..+\.npz\..+\.part$")
+STATUSES = ("done", "failed", "skipped", "cancelled")
+
+
+class BatchInterrupted(KeyboardInterrupt):
+    """Ctrl-C during :func:`run_batch`: in-flight items were cancelled and recorded; ``.result`` holds the rest."""
+
+    def __init__(self, result):
+        super().__init__("batch interrupted")
+        self.result = result
+
+
+@dataclass
+class BatchResult:
+    """What :func:`run_batch` did: one record per item of this run (``status`` in done / failed / skipped /
+    cancelled / pending), the output folder and manifest, the executor used and the wall time."""
+
+    out: str
+    manifest: str
+    records: list = field(default_factory=list)
+    executor: str = ""
+    seconds: float = 0.0
+    interrupted: bool = False
+
+    @property
+    def counts(self) -> dict:
+        c = collections.Counter(r["status"] for r in self.records)
+        return {s: c.get(s, 0) for s in STATUSES + ("pending",) if s != "pending" or c.get(s)}
+
+    @property
+    def failed(self) -> list:
+        return [r for r in self.records if r["status"] == "failed"]
+
+    def summary(self, max_failures: int = 10) -> str:
+        """A plain-text table: items per status, throughput, per-item times, the first failures."""
+        c = self.counts
+        lines = [f"{'status':<10} {'items':>7}"] + [f"{k:<10} {v:>7}" for k, v in c.items()]
+        lines.append(f"{'total':<10} {len(self.records):>7}")
+        ran = [r for r in self.records if r["status"] in ("done", "failed") and "seconds" in r]
+        if not ran:
+            lines.append("nothing to run: every output is up to date")
+        elif self.seconds > 0:
+            rate = 60.0 * len(ran) / self.seconds
+            lines.append(f"wall {self.seconds:.1f} s on {self.executor}: {rate:.1f} items/min")
+        done = [r["seconds"]["total"] for r in ran if r["status"] == "done"]
+        if done:
+            lines.append(f"per item (done): median {statistics.median(done):.2f} s, max {max(done):.2f} s, "
+                         f"sum {sum(done):.1f} s")
+        again = [r for r in self.records if r["status"] == "skipped" and r.get("previous") == "failed"]
+        if again:
+            lines.append(f"{len(again)} skipped item(s) had failed before with the same input and options "
+                         "(retry_failed / --retry-failed to run them again)")
+        for r in self.failed[:max_failures]:
+            lines.append(f"failed: {r['input']}: {r.get('error')}")
+        if len(self.failed) > max_failures:
+            lines.append(f"... and {len(self.failed) - max_failures} more failures (see {self.manifest})")
+        lines.append(f"outputs in {self.out}; manifest {self.manifest}")
+        return "\n".join(lines)
+
+
+def _count(name, value, lo=1):
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"{name}: expected a positive integer, got {value!r}")
+    if value < lo:
+        raise ValueError(f"{name}: must be >= {lo}, got {value}")
+    return value
+
+
+def _prepare_output(out) -> str:
+    if not isinstance(out, (str, os.PathLike)) or not os.fspath(out):
+        raise ValueError(f"out: expected a folder path, got {out!r}")
+    out = os.path.abspath(os.fspath(out))
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise ValueError(f"out: {out} exists and is not a folder")
+    try:
+        os.makedirs(out, exist_ok=True)
+        fd, probe = tempfile.mkstemp(dir=out, prefix=".gsdf-write-test.")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise ValueError(f"out: cannot write to the output folder {out} ({exc.strerror or exc})") from None
+    return out
+
+
+def _lock(out):
+    """An exclusive lock on the output folder (two runs must not write one manifest); None where unsupported."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows
+        return None
+    fh = open(os.path.join(out, LOCK_NAME), "a")
+    try:
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        fh.close()
+        raise ValueError(f"out: another gsdf batch is writing to {out}") from None
+    return fh
+
+
+def _remove_stale_parts(out) -> None:
+    """Temporary ``.NAME.npz.*.part`` files of workers killed mid-write (we hold the folder's lock)."""
+    for base, _, files in os.walk(out):
+        for f in files:
+            if _PART.match(f):
+                try:
+                    os.unlink(os.path.join(base, f))
+                except OSError:
+                    pass
+
+
+def _executor(workers, dask_local, scheduler, threads, scheduler_timeout):
+    from gsdf.batch._executors import DaskExecutor, LocalExecutor
+
+    if scheduler is not None:
+        return DaskExecutor.connect(scheduler, timeout=scheduler_timeout, threads=threads)
+    if dask_local is not None:
+        return DaskExecutor.local(dask_local, threads=threads)
+    return LocalExecutor(workers or 1, threads=threads)
+
+
+def _now() -> str:
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+
+
+def run_batch(inputs, task, out, options=None, *, workers=None, dask_local=None, scheduler=None, executor=None,
+              resume: bool = True, retry_failed: bool = False, max_retries: int = 2, threads=None, progress=None,
+              scheduler_timeout: float = 10.0, poll: float = 0.5) -> BatchResult:
+    """Run ``task`` on every input and write one ``.npz`` per item plus ``manifest.jsonl`` into ``out``.
+
+    Parameters
+    ----------
+    inputs : str, os.PathLike or list of paths
+        A folder, glob, manifest file (txt / CSV / JSON, CSV and JSON with per-item options) or list of paths;
+        see :func:`gsdf.batch.collect_inputs`.
+    task : {"sdf-samples", "occupancy", "sdf-grid", "surface"}
+        See :mod:`gsdf.batch._tasks` for each task's options and arrays.
+    out : str or os.PathLike
+        Output folder (created); outputs mirror the inputs' folder layout.
+    options : dict, optional
+        Task options for every item (per-item options from a manifest override them).
+    workers : int, optional
+        Local worker processes (default 1). At most one of ``workers``, ``dask_local``, ``scheduler``.
+    dask_local : int, optional
+        Start a Dask ``LocalCluster`` with this many worker processes.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``).
+    executor : LocalExecutor or DaskExecutor, optional
+        An executor built by the caller (kept open afterwards); excludes the three options above.
+    resume : bool
+        Skip items whose output exists and whose input hash and options match their ``done`` record, and items
+        that failed by themselves (a malformed or degenerate input) with the same input and options.
+    retry_failed : bool
+        With ``resume``, run such failed items again (failures of a worker are always retried).
+    max_retries : int
+        Resubmissions of an item whose worker died, before it is recorded as failed.
+    threads : int, optional
+        BLAS/numba threads per item (default: the cores divided by the concurrent workers).
+    progress : callable, optional
+        ``progress(record, counts)`` after every item (``counts``: status -> items so far, and ``total``).
+    scheduler_timeout : float
+        Seconds to wait for an unreachable scheduler before a ValueError.
+
+    Returns
+    -------
+    BatchResult
+        ``.records``, ``.counts``, ``.summary()``.
+
+    Raises
+    ------
+    ValueError
+        Nothing to do, bad options, conflicting executor options, an unwritable output folder, an unreachable
+        scheduler — before any item runs.
+    BatchInterrupted
+        On Ctrl-C, after cancelling and recording the items in flight (``.result`` holds the partial result).
+
+    Examples
+    --------
+    >>> r = run_batch("meshes/", "sdf-samples", "out/", {"n_samples": 250000}, workers=2)   # doctest: +SKIP
+    >>> print(r.summary())                                                                   # doctest: +SKIP
+    """
+    task = task_name(task)
+    user_options = dict(options or {})
+    check_options(task, user_options, "options")
+    given = [n for n, v in (("workers", workers), ("dask_local", dask_local), ("scheduler", scheduler),
+                            ("executor", executor)) if v is not None]
+    if len(given) > 1:
+        raise ValueError(f"conflicting options: {' and '.join(given)} (choose one executor)")
+    _count("workers", workers)
+    _count("dask_local", dask_local)
+    _count("threads", threads)
+    _count("max_retries", max_retries, lo=0)
+    items = collect_inputs(inputs)
+    jobs_options = [check_options(task, {**user_options, **it.options}, it.path) for it in items]
+    out = _prepare_output(out)
+    lock = _lock(out)
+    try:
+        _remove_stale_parts(out)
+        manifest = os.path.join(out, MANIFEST_NAME)
+        state = read_manifest(manifest) if resume else {}
+        run_id = uuid.uuid4().hex[:12]
+        result = BatchResult(out, manifest)
+        todo = collections.deque()
+        for it, opts in zip(items, jobs_options):
+            job = {"task": task, "input": it.path, "output": it.output, "out_dir": out, "options": opts,
+                   "params_sha256": params_sha256(task, opts), "attempts": 1, "run": run_id, "threads": threads}
+            prev = state.get(it.output)
+            if _reusable(prev, job, out, retry_failed):
+                result.records.append({**{k: job[k] for k in ("task", "input", "output", "run")},
+                                       "status": "skipped", "previous": prev["status"],
+                                       "input_sha256": prev["input_sha256"], "error": prev.get("error")})
+            else:
+                todo.append(job)
+        if progress is not None:
+            for r in result.records:
+                progress(r, _tally(result.records, len(items)))
+        own = executor is None
+        t0 = time.perf_counter()
+        if todo:
+            ex = _executor(workers, dask_local, scheduler, threads, scheduler_timeout) if own else executor
+            result.executor = ex.describe()
+            try:
+                with ManifestWriter(manifest) as writer:
+                    _drive(ex, todo, writer, result, len(items), max_retries, progress, poll)
+            finally:
+                if own:
+                    ex.close(cancel=result.interrupted)
+        result.seconds = time.perf_counter() - t0
+        if result.interrupted:
+            raise BatchInterrupted(result)
+        return result
+    finally:
+        if lock is not None:
+            lock.close()
+
+
+def _reusable(prev, job, out, retry_failed) -> bool:
+    """An earlier record stands: same options, same input bytes, and either a done output still on disk or
+    a failure of the item itself (not of its worker) that ``retry_failed`` does not ask to redo."""
+    if not prev or prev.get("params_sha256") != job["params_sha256"] or not prev.get("input_sha256"):
+        return False
+    if prev.get("status") == "done":
+        ok = os.path.isfile(os.path.join(out, job["output"]))
+    else:
+        ok = prev.get("status") == "failed" and prev.get("failure") == "item" and not retry_failed
+    return ok and prev["input_sha256"] == file_sha256(job["input"])
+
+
+def _tally(records, total) -> dict:
+    c = collections.Counter(r["status"] for r in records)
+    return {**{s: c.get(s, 0) for s in STATUSES}, "total": total}
+
+
+def _hint(ex) -> str:
+    if ex.kind != "local":
+        return ""
+    return ("; if every item fails like this from a script, run it under `if __name__ == \"__main__\":` "
+            "(workers are spawned and import the main module)")
+
+
+def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
+    inflight = {}  # future -> job
+
+    def finish(rec, report=True):
+        rec.setdefault("time", _now())
+        writer.write(rec)
+        result.records.append(rec)
+        if report and progress is not None:
+            progress(rec, _tally(result.records, total))
+
+    try:
+        while todo or inflight:
+            window = max(2, 2 * ex.n_slots)  # a Dask cluster may grow or shrink during the run
+            while todo and len(inflight) < window:
+                job = todo.popleft()
+                if job["threads"] is None:  # the executor's share of the cores (or, remote, per worker)
+                    job = {**job, "threads": ex.threads, "threads_by_worker": getattr(ex, "threads_by_worker", None)}
+                inflight[ex.submit(process_item, job)] = job
+            done = ex.wait(inflight, timeout=poll)
+            deaths = []
+            for fut in done:
+                job = inflight.pop(fut)
+                try:
+                    rec = fut.result()
+                except Exception as exc:  # the item did not return: its worker died (or the pool broke)
+                    if ex.is_worker_death(exc):
+                        deaths.append((job, exc))
+                        continue
+                    rec = {**{k: job[k] for k in ("task", "input", "output", "options", "params_sha256",
+                                                  "attempts", "run")},
+                           "status": "failed", "failure": "worker", "error": f"{type(exc).__name__}: {exc}"}
+                finish(rec)
+            if deaths:
+                if ex.kind == "local":  # the broken pool fails every item in flight: collect them all
+                    ex.wait_all(inflight, timeout=30.0)
+                    for fut in list(inflight):
+                        job = inflight.pop(fut)
+                        try:
+                            finish(fut.result(timeout=0))
+                        except Exception as exc:  # broken with the pool (or stuck in it): resubmit
+                            deaths.append((job, exc))
+                    ex.recover()
+                for job, exc in deaths:
+                    if job["attempts"] > max_retries:
+                        finish({**{k: job[k] for k in ("task", "input", "output", "options", "params_sha256",
+                                                       "attempts", "run")},
+                                "status": "failed", "failure": "worker",
+                                "error": f"worker died {job['attempts']} time(s) running this item "
+                                         f"({type(exc).__name__}: {exc}){_hint(ex)}"})
+                    else:
+                        todo.appendleft({**job, "attempts": job["attempts"] + 1})
+    except KeyboardInterrupt:
+        result.interrupted = True
+        ex.cancel(list(inflight))
+        for job in inflight.values():
+            finish({**{k: job[k] for k in ("task", "input", "output", "options", "params_sha256", "attempts",
+                                           "run")}, "status": "cancelled", "error": "interrupted (Ctrl-C)"},
+                   report=False)
+        for job in todo:
+            result.records.append({**{k: job[k] for k in ("task", "input", "output", "run")},
+                                   "status": "pending"})

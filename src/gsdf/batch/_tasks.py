@@ -1,0 +1,454 @@
+"""The per-item tasks of a batch: plain functions of one input (a path or a loaded :class:`Geometry`).
+
+Each task returns a dict of numpy arrays, exactly what ``gsdf batch`` writes to the item's ``.npz``:
+
+=================  ============================================================================================
+task               arrays (``F`` = the ``dtype`` option, float32 by default)
+=================  ============================================================================================
+``sdf-samples``    ``points`` (n, 3) F, ``sdf`` (n,) F (negative inside)
+``occupancy``      ``points`` (n, 3) F, ``occupancy`` (n,) bool (inside), ``winding`` (n,) F
+``sdf-grid``       ``sdf`` (R, R, R) F (negative inside), node (i, j, k) at ``bbox_min + (i, j, k) * spacing``;
+                   ``bbox_min``, ``bbox_max`` (3,) float64, ``spacing`` (3,) float64
+``surface``        ``vertices`` (nv, 3) F, ``faces`` (nf, 3) int64 (outward oriented)
+every task         ``center`` (3,) float64 and ``scale`` () float64: stored coordinates are
+                   ``(x_input - center) / scale`` and stored distances ``d_input / scale`` (identity for
+                   ``normalize="none"``)
+=================  ============================================================================================
+
+Normalisation frames (``normalize``): ``"sphere"`` maps the input into the unit ball (centre of the bounding
+box, scale = the largest vertex distance from it), ``"cube"`` into [-1, 1]³ (scale = half the longest box side),
+``"none"`` keeps the input's coordinates. Sampling boxes and noise scales are always defined in the frame
+(the sphere frame for ``"none"``), so the same input gives the same samples, up to the stored transform.
+
+Signs come from the generalized winding number at 1/2 (Barill et al. 2018 §4; robust to holes, flips and
+soups) or from the signed heat method's zero level set (Feng & Crane 2024 §8.2). Random sampling is seeded
+from ``seed`` and the input's content (its vertex/face arrays), so results do not depend on which worker or
+machine ran the item.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import os
+
+import numpy as np
+
+from gsdf._checks import choice, integer, positive
+from gsdf.io._geometry import Geometry, load_geometry
+
+NORMALIZE = ("none", "sphere", "cube")
+DTYPES = {"float32": np.float32, "float64": np.float64}
+
+
+def _geometry(source, estimate_normals=False) -> Geometry:
+    if isinstance(source, Geometry):
+        return source
+    if isinstance(source, (str, os.PathLike)):
+        return load_geometry(source, estimate_normals)
+    raise ValueError(f"source: expected a path or a gsdf.batch.Geometry, got {type(source).__name__}")
+
+
+def frame(X, normalize: str = "none"):
+    """Centre and scale of the normalisation frame of positions ``X`` (n, 3).
+
+    Returns ``(center (3,), scale, stored_center (3,), stored_scale)``: the frame used for sampling, and the
+    transform applied to stored outputs (identity for ``"none"``).
+    """
+    normalize = choice(normalize, "normalize", NORMALIZE)
+    lo, hi = X.min(axis=0), X.max(axis=0)
+    c = 0.5 * (lo + hi)
+    if normalize == "cube":
+        s = 0.5 * float((hi - lo).max())
+    else:
+        s = float(np.sqrt(((X - c) ** 2).sum(axis=1).max()))
+    if not s > 0:
+        raise ValueError("the input is degenerate: all its points coincide (no extent to normalise)")
+    if normalize == "none":
+        return c, s, np.zeros(3), 1.0
+    return c, s, c, s
+
+
+def _rng(geo: Geometry, seed: int, salt: str) -> np.random.Generator:
+    key = hashlib.sha256(geo.digest() + salt.encode()).digest()
+    return np.random.default_rng([int(seed), int.from_bytes(key[:8], "little")])
+
+
+def surface_points(geo: Geometry, n: int, rng: np.random.Generator) -> np.ndarray:
+    """``n`` random points on the input: area-weighted on triangles, or drawn from the cloud's points."""
+    if not geo.is_mesh:
+        return geo.X[rng.integers(0, len(geo.X), n)]
+    from gsdf.mesh._geometry import face_areas
+
+    A = face_areas(geo.X, geo.F)
+    total = float(A.sum())
+    if not total > 0 or not np.isfinite(total):
+        raise ValueError("the mesh is degenerate: its triangles have zero total area (nothing to sample)")
+    cdf = np.cumsum(A) / total
+    f = np.minimum(np.searchsorted(cdf, rng.random(n), side="right"), len(A) - 1)
+    r1, r2 = rng.random(n), rng.random(n)
+    s = np.sqrt(r1)  # uniform on the triangle: (1 - √r1, √r1 (1 - r2), √r1 r2)
+    T = geo.X[geo.F[f]]
+    return ((1 - s)[:, None] * T[:, 0] + (s * (1 - r2))[:, None] * T[:, 1] + (s * r2)[:, None] * T[:, 2])
+
+
+def _unsigned(geo: Geometry, Q) -> np.ndarray:
+    from gsdf.distance import TriangleDistance, point_cloud_distance
+
+    if geo.is_mesh:
+        return TriangleDistance(geo.X, geo.F).query(Q)[0]
+    return point_cloud_distance(geo.X, Q)
+
+
+def _heat(geo: Geometry, resolution, lo, hi):
+    from gsdf.heat.volume import signed_heat_volume
+
+    if geo.is_mesh:
+        return signed_heat_volume(mesh=(geo.X, geo.F), resolution=resolution, bbox_min=lo, bbox_max=hi)
+    return signed_heat_volume(points=(geo.X, geo.N), resolution=resolution, bbox_min=lo, bbox_max=hi)
+
+
+def _stored(out: dict, c0, s0, dtype) -> dict:
+    out["center"] = np.asarray(c0, np.float64)
+    out["scale"] = np.float64(s0)
+    return out
+
+
+def _sample_queries(geo, n, uniform_fraction, sigmas, box, c, s, rng):
+    """DeepSDF-style queries: surface points offset by N(0, σ²) at each scale σ·s, plus uniform ones in the
+    cube c ± box·s. Counts: ``round(n·uniform_fraction)`` uniform, the rest split evenly over the scales."""
+    n_uniform = int(round(n * uniform_fraction))
+    n_near = n - n_uniform
+    parts = []
+    if n_near and sigmas:
+        counts = [n_near // len(sigmas) + (i < n_near % len(sigmas)) for i in range(len(sigmas))]
+        S = surface_points(geo, n_near, rng)
+        start = 0
+        for k, sigma in zip(counts, sigmas):
+            parts.append(S[start:start + k] + rng.normal(0.0, sigma * s, (k, 3)))
+            start += k
+    elif n_near:
+        n_uniform = n
+    parts.append(c + box * s * rng.uniform(-1.0, 1.0, (n_uniform, 3)))
+    return np.concatenate(parts)
+
+
+def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normalize: str = "none",
+                uniform_fraction: float = 0.1, sigmas=(0.05, 0.0158), pad: float = 0.05,
+                heat_resolution: int = 64, beta=None, seed: int = 0, dtype: str = "float32",
+                estimate_normals: bool = False) -> dict:
+    """DeepSDF-style signed distance samples of one mesh, soup or oriented cloud.
+
+    ``n_samples`` queries: ``(1 - uniform_fraction)`` of them are surface points (area-weighted) moved by
+    Gaussian offsets, split evenly over the scales ``sigmas`` (× the frame scale: 0.05 and 0.0158 are DeepSDF's
+    variances 0.0025 and 0.00025 in the unit sphere), the rest uniform in the frame's cube ``±(1 + pad)``.
+    ``|sdf|`` is the exact distance to the triangles (nearest point of a cloud); the sign is negative where
+    the fast winding number exceeds 1/2 (``sign="winding"``), or where the signed heat method's distance
+    (a grid of ``heat_resolution`` nodes) is negative (``sign="heat"``).
+
+    Parameters
+    ----------
+    source : str, os.PathLike or Geometry
+        The input.
+    n_samples : int
+        Number of samples n.
+    sign : {"winding", "heat"}
+    normalize : {"none", "sphere", "cube"}
+        Output frame (see the module docstring); the transform is stored as ``center``, ``scale``.
+    uniform_fraction : float in [0, 1]
+    sigmas : sequence of float
+        Offset scales, fractions of the frame scale.
+    pad : float
+        Half-side of the uniform cube is ``(1 + pad)`` frame scales.
+    seed : int
+        Random seed (combined with the input's content).
+    dtype : {"float32", "float64"}
+
+    Returns
+    -------
+    dict
+        ``points`` (n, 3), ``sdf`` (n,) in ``dtype``; ``center`` (3,), ``scale``.
+
+    Examples
+    --------
+    >>> out = sdf_samples("bunny.off", n_samples=10000, normalize="sphere")     # doctest: +SKIP
+    >>> out["points"].shape, out["sdf"].dtype                                     # doctest: +SKIP
+    ((10000, 3), dtype('float32'))
+    """
+    o = check_options("sdf-samples", locals_without_source(locals()))
+    geo = _geometry(source, o["estimate_normals"])
+    c, s, c0, s0 = frame(geo.X, o["normalize"])
+    rng = _rng(geo, o["seed"], "sdf-samples")
+    half = 1.0 + o["pad"]
+    Q = _sample_queries(geo, o["n_samples"], o["uniform_fraction"], o["sigmas"], half, c, s, rng)
+    d = _unsigned(geo, Q)
+    if o["sign"] == "winding":
+        inside = geo.winding(o["beta"])(Q) > 0.5
+    else:
+        m = 1.1 * half * s  # the heat grid holds every query, the tails of the Gaussian offsets included
+        m = max(m, float(np.abs(Q - c).max()) * 1.001)
+        inside = _heat(geo, o["heat_resolution"], c - m, c + m)(Q) < 0
+    dt = DTYPES[o["dtype"]]
+    return _stored({"points": ((Q - c0) / s0).astype(dt), "sdf": (np.where(inside, -d, d) / s0).astype(dt)},
+                   c0, s0, dt)
+
+
+def occupancy(source, n_points: int = 100_000, normalize: str = "none", uniform_fraction: float = 1.0,
+              sigmas=(0.01,), pad: float = 0.1, beta=None, seed: int = 0, dtype: str = "float32",
+              estimate_normals: bool = False) -> dict:
+    """Occupancy-Networks-style inside/outside labels of points, from the generalized winding number.
+
+    By default all ``n_points`` are uniform in the frame's cube ``±(1 + pad)`` (Occupancy Networks: the
+    unit cube padded by 0.1); ``uniform_fraction < 1`` moves the rest near the surface (offsets ``sigmas``).
+    A point is inside where the fast winding number exceeds 1/2.
+
+    Returns
+    -------
+    dict
+        ``points`` (n, 3) and ``winding`` (n,) in ``dtype``, ``occupancy`` (n,) bool; ``center``, ``scale``.
+
+    Example
+    -------
+    >>> out = occupancy("soup.obj", n_points=50000)       # doctest: +SKIP
+    >>> out["occupancy"].mean()                            # doctest: +SKIP
+    0.21
+    """
+    o = check_options("occupancy", locals_without_source(locals()))
+    geo = _geometry(source, o["estimate_normals"])
+    c, s, c0, s0 = frame(geo.X, o["normalize"])
+    rng = _rng(geo, o["seed"], "occupancy")
+    Q = _sample_queries(geo, o["n_points"], o["uniform_fraction"], o["sigmas"], 1.0 + o["pad"], c, s, rng)
+    w = geo.winding(o["beta"])(Q)
+    dt = DTYPES[o["dtype"]]
+    return _stored({"points": ((Q - c0) / s0).astype(dt), "occupancy": w > 0.5, "winding": w.astype(dt)},
+                   c0, s0, dt)
+
+
+GRID_BYTES_PER_NODE = 96  # node positions (24), distance + winding + sign (24), outputs and temporaries
+
+
+def check_grid_memory(resolution: int, max_memory=None) -> None:
+    """Refuse a dense grid whose estimated working memory (``GRID_BYTES_PER_NODE`` × R³) exceeds ``max_memory``
+    (default 80 % of the available memory), before allocating anything: a clear per-item error, not an OOM kill."""
+    need = GRID_BYTES_PER_NODE * int(resolution) ** 3
+    if max_memory is None:
+        try:
+            max_memory = 0.8 * os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        except (ValueError, OSError, AttributeError):  # pragma: no cover - platforms without sysconf
+            return
+    if need > max_memory:
+        raise ValueError(f"resolution: a {resolution}^3 grid needs about {need / 2**30:.1f} GiB, more than the "
+                         f"{max_memory / 2**30:.1f} GiB available (out-of-memory estimate)")
+
+
+def _grid_box(X, normalize, pad):
+    c, s, c0, s0 = frame(X, normalize)
+    half = (1.0 + pad) * (s if normalize != "none" else 0.5 * float((X.max(axis=0) - X.min(axis=0)).max()))
+    return c, half, c0, s0
+
+
+def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str = "none", pad: float = 0.05,
+             beta=None, dtype: str = "float32", estimate_normals: bool = False) -> dict:
+    """Signed distance on a dense cubic grid of ``resolution``³ nodes around one input; negative inside.
+
+    The grid is the cube centred on the input's bounding box with half-side ``(1 + pad)`` × the frame scale
+    (× half the longest box side for ``normalize="none"``). Methods: ``"fast"`` — exact distance to the
+    triangles (nearest point of a cloud) signed by the fast winding number at 1/2; ``"heat"`` — the signed heat
+    method on the same grid (Feng & Crane 2024 §8.2; a generalized signed distance, smooth across holes);
+    ``"pat"`` — Points as Tori (oriented clouds only; Feng 2026 ch. 5).
+
+    Returns
+    -------
+    dict
+        ``sdf`` (R, R, R) in ``dtype`` (C order, x slowest); ``bbox_min``, ``bbox_max``, ``spacing`` (3,);
+        ``center``, ``scale``. All in the stored frame.
+
+    Example
+    -------
+    >>> out = sdf_grid("bunny.off", resolution=64)        # doctest: +SKIP
+    >>> out["sdf"].shape                                    # doctest: +SKIP
+    (64, 64, 64)
+    """
+    o = check_options("sdf-grid", locals_without_source(locals()))
+    geo = _geometry(source, o["estimate_normals"])
+    if o["method"] == "pat" and geo.is_mesh:
+        raise ValueError('method "pat" (Points as Tori) needs an oriented point cloud, not a mesh; '
+                         'use "fast" or "heat"')
+    from gsdf.grid import grid_points
+
+    check_grid_memory(o["resolution"])
+    c, half, c0, s0 = _grid_box(geo.X, o["normalize"], o["pad"])
+    R = o["resolution"]
+    lo, hi = c - half, c + half
+    if o["method"] == "heat":
+        values = _heat(geo, (R, R, R), lo, hi).values
+    else:
+        Q = grid_points(lo, hi, (R, R, R))
+        if o["method"] == "pat":
+            from gsdf.tori import PointsAsTori
+
+            values = PointsAsTori(geo.X, geo.N).signed_distance(Q)
+        else:
+            d = _unsigned(geo, Q)
+            values = np.where(geo.winding(o["beta"])(Q) > 0.5, -d, d)
+    dt = DTYPES[o["dtype"]]
+    lo0, hi0 = (lo - c0) / s0, (hi - c0) / s0
+    return _stored({"sdf": (np.asarray(values).reshape(R, R, R) / s0).astype(dt), "bbox_min": lo0,
+                    "bbox_max": hi0, "spacing": (hi0 - lo0) / (R - 1)}, c0, s0, dt)
+
+
+def surface(source, resolution: int = 128, method: str = "winding", normalize: str = "none", pad: float = 0.05,
+            bisection: int = 10, beta=None, dtype: str = "float32", estimate_normals: bool = False) -> dict:
+    """A watertight surface of one input: the winding number's 1/2 level set, or the signed heat zero set.
+
+    ``method="winding"``: marching cubes on a ``resolution`` grid of the fast winding number, vertices moved
+    onto the level set by ``bisection`` steps along their grid edges (Barill et al. 2018 Fig. 9).
+    ``method="heat"``: the zero level set of the signed heat method's grid distance (Feng & Crane 2024 §8.2).
+    The grid box is the one of :func:`sdf_grid`.
+
+    Returns
+    -------
+    dict
+        ``vertices`` (nv, 3) in ``dtype``, ``faces`` (nf, 3) int64 (outward oriented); ``center``, ``scale``.
+
+    Example
+    -------
+    >>> out = surface("soup.obj", resolution=96)           # doctest: +SKIP
+    >>> out["faces"].shape[1]                               # doctest: +SKIP
+    3
+    """
+    o = check_options("surface", locals_without_source(locals()))
+    geo = _geometry(source, o["estimate_normals"])
+    check_grid_memory(o["resolution"])
+    c, half, c0, s0 = _grid_box(geo.X, o["normalize"], o["pad"])
+    lo, hi = c - half, c + half
+    R = o["resolution"]
+    if o["method"] == "heat":
+        V, F = _heat(geo, (R, R, R), lo, hi).isosurface(0.0)
+    else:
+        from gsdf.contour import extract_isosurface
+
+        V, F = extract_isosurface(geo.winding(o["beta"]), lo, hi, resolution=R, level=0.5,
+                                  bisection_steps=o["bisection"])
+    dt = DTYPES[o["dtype"]]
+    return _stored({"vertices": ((V - c0) / s0).astype(dt), "faces": np.asarray(F, np.int64)}, c0, s0, dt)
+
+
+# ------------------------------------------------------------------------------------------------------------
+# option validation: one table for the library calls, the CLI and per-item manifest options
+# ------------------------------------------------------------------------------------------------------------
+
+TASKS = {"sdf-samples": sdf_samples, "occupancy": occupancy, "sdf-grid": sdf_grid, "surface": surface}
+TASK_ALIASES = {"sdf_samples": "sdf-samples", "sdf_grid": "sdf-grid"}
+
+
+def locals_without_source(values: dict) -> dict:
+    return {k: v for k, v in values.items() if k != "source"}
+
+
+def _float(x, name) -> float:
+    if isinstance(x, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected a number, got the bool {x!r}")
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a number, got {x!r}") from None
+
+
+def _unit(x, name):
+    x = _float(x, name)
+    if not 0.0 <= x <= 1.0:
+        raise ValueError(f"{name}: must lie in [0, 1], got {x}")
+    return x
+
+
+def _nonneg(x, name):
+    x = _float(x, name)
+    if not (np.isfinite(x) and x >= 0):
+        raise ValueError(f"{name}: must be a finite number >= 0, got {x}")
+    return x
+
+
+def _sigmas(x, name):
+    if isinstance(x, str):
+        x = [t for t in x.split(",") if t.strip()]
+    if np.ndim(x) != 1:
+        raise ValueError(f"{name}: expected a list of positive numbers, got {x!r}")
+    return tuple(positive(_float(v, name), name) for v in x)
+
+
+def _flag(x, name):
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, str) and x.strip().lower() in ("true", "1", "yes", "false", "0", "no"):
+        return x.strip().lower() in ("true", "1", "yes")
+    raise ValueError(f"{name}: expected true or false, got {x!r}")
+
+
+def _int(lo):
+    def check(x, name):
+        if isinstance(x, str):
+            try:
+                x = int(x)
+            except ValueError:
+                raise ValueError(f"{name}: expected an integer, got {x!r}") from None
+        return integer(x, name, lo=lo)
+    return check
+
+
+def _optional_positive(x, name):
+    return None if x is None or x == "" else positive(_float(x, name), name)
+
+
+_CHECKS = {
+    "n_samples": _int(1), "n_points": _int(1), "resolution": _int(2), "bisection": _int(0),
+    "heat_resolution": _int(8), "seed": _int(0),
+    "sign": lambda x, n: choice(x, n, {"winding", "heat"}),
+    "normalize": lambda x, n: choice(x, n, set(NORMALIZE)),
+    "dtype": lambda x, n: choice(x, n, set(DTYPES)),
+    "uniform_fraction": _unit, "pad": _nonneg, "sigmas": _sigmas, "beta": _optional_positive,
+    "estimate_normals": _flag,
+}
+_METHODS = {"sdf-grid": {"fast", "heat", "pat"}, "surface": {"winding", "heat"}}
+
+
+def task_name(task) -> str:
+    """The canonical name of a task (``"sdf-samples"``, ...), or ValueError listing the tasks."""
+    name = TASK_ALIASES.get(task, task)
+    if name not in TASKS:
+        raise ValueError(f"task: unknown task {task!r}; expected one of {', '.join(TASKS)}")
+    return name
+
+
+def task_defaults(task) -> dict:
+    """The options of a task and their defaults."""
+    sig = inspect.signature(TASKS[task_name(task)])
+    return {k: p.default for k, p in sig.parameters.items() if k != "source"}
+
+
+def check_options(task, options: dict, where: str = "") -> dict:
+    """Validate the options of ``task``: every key must be one of its parameters; returns them with defaults
+    filled in and values converted (strings from CSV manifests are parsed). Raises ValueError naming the option.
+    """
+    task = task_name(task)
+    defaults = task_defaults(task)
+    prefix = f"{where}: " if where else ""
+    unknown = sorted(set(options) - set(defaults))
+    if unknown:
+        raise ValueError(f"{prefix}option {unknown[0]!r} does not apply to task {task!r} "
+                         f"(its options: {', '.join(defaults)})")
+    out = dict(defaults)
+    out.update(options)
+    for k, v in out.items():
+        if k == "method":
+            out[k] = choice(v, f"{prefix}method", _METHODS[task])
+        elif v is not None or k != "beta":
+            out[k] = _CHECKS[k](v, f"{prefix}{k}")
+    if "uniform_fraction" in out and out["uniform_fraction"] < 1 and not out["sigmas"]:
+        raise ValueError(f"{prefix}sigmas: empty, but uniform_fraction < 1 asks for near-surface samples")
+    return out
+
+
+def run_task(task, source, options: dict) -> dict:
+    """Run ``task`` on ``source`` with ``options`` (validated): ``run_task("sdf-grid", path, {"resolution": 64})``."""
+    return TASKS[task_name(task)](source, **options)

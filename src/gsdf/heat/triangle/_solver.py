@@ -1,0 +1,320 @@
+"""Front-end of the signed heat method on triangle meshes (Feng & Crane 2024, §3–7, Alg. 1–4).
+
+Operators and sources: :mod:`gsdf.heat.triangle._domain` (or :mod:`gsdf.heat.intrinsic._domain` with
+``intrinsic_delaunay=True``); steps I–III, constraints and shift: :mod:`gsdf.heat._core`. What stays here is the
+public class, L1 integration (§7.2), sharpening (§7.3) and curve splitting helpers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gsdf import _checks
+from gsdf._normalize import Frame
+from gsdf.heat._core import SignedHeatCore
+from gsdf.heat.intrinsic._domain import IntrinsicDomain
+from gsdf.heat.triangle._domain import TriangleDomain, raw_curves, raw_points
+from gsdf.curves import as_curves, as_point_sources
+from gsdf.heat.triangle._operators import TriangleMeshOperators
+from gsdf.heat.triangle._sources import build_sources
+
+LEVEL_SETS = ("zero", "multiple", "none")
+CONNECTIONS = ("auto", "complex", "real")
+
+
+class SurfaceSignedHeatSolver:
+    """Generalized signed distance to (broken) curves on a triangle mesh by the signed heat method.
+
+    The operators (CR mass and connection Laplacian, Eqs. 6–9; cotan Laplacian, Eq. 10) are assembled once;
+    the vector heat operator ``M + tL∇`` (Eq. 12) and the Poisson operator are factorized on first use and kept,
+    so further calls cost only solves. Constrained Poisson systems (level-set constraints, §7.1) depend on the
+    curves; their factorizations are cached per constraint set (a repeated call with the same curves and the
+    same constraint type costs only solves).
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+    F : (m, 3) int array
+        Triangle mesh of any topology: boundary, several components, nonmanifold edges/vertices (operators are
+        per-face sums, §9.4). Nonorientable meshes (and faces whose orientation disagrees with a neighbour's)
+        are handled exactly: transport across such an edge is a reflection, so the connection Laplacian is then
+        assembled as a real 2|E|×2|E| block matrix (see ``connection``); give the curve normals
+        (``curve_normals=`` of :meth:`compute_distance`) there, since face normals flip across the seam.
+        Faces with repeated vertices or zero area raise ValueError (remove them first).
+    t_coef : float
+        Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6) of the input mesh.
+    intrinsic_delaunay : bool
+        Build the operators on an intrinsic Delaunay triangulation of the input (§9.4, Fig. 22): Lawson edge
+        flips on edge lengths only (:mod:`gsdf.heat.intrinsic._kernels`), operators from per-face planar
+        layouts; output stays per input vertex. This helps on meshes with obtuse slivers. Curve segments along
+        input edges (vertex polylines, surface points on one edge) keep those edges unflippable (the
+        triangulation is re-flipped, and refactorized, for a curve set whose edges were flipped away; cached per
+        edge set). Segments inside input faces and point sources inside faces need no fixed edges: they are
+        carried through the flips (the logged flips are redone with the points in the planar layout of every
+        flipped quad) and the segments are re-split along the intrinsic edges by tracing, so that Eq. 11 is
+        applied per intrinsic face. Unsigned curves must be closed vertex polylines; ``curve_normals`` is not
+        available; ``compute_distance_l1`` raises NotImplementedError. On a mesh that is already Delaunay no
+        edge flips and the results equal those on the input triangulation.
+    connection : {"auto", "complex", "real"}
+        Form of the connection Laplacian of step I. ``"auto"``: complex ``|E|×|E|`` (Eq. 9) when all faces are
+        consistently oriented, else the real 2|E|×2|E| block form that also represents the reflections across
+        orientation flips. ``"real"`` forces the block form (same result on orientable meshes, ~2× slower);
+        ``"complex"`` forces Eq. 9 (wrong transport across orientation flips; for comparisons only).
+
+    Scale: the mesh is mapped once into its frame (:class:`gsdf._normalize.Frame`: centred, power-of-two
+    scale) and solved there, so results are scale-covariant (φ of ``s·V`` is ``s·φ``) from 1e-150 to 1e150;
+    ``ops`` and ``C`` are in frame units (``frame.length`` / ``frame.area`` map lengths and areas back);
+    ``V`` (the input, also ``V_world``) and ``t`` are in input units.
+
+    Components of the mesh without sources get an arbitrary (near-constant) value; unreferenced vertices
+    get 0 before the final shift.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gsdf.heat import SurfaceSignedHeatSolver
+    >>> from gsdf.data._shapes import grid_mesh
+    >>> from gsdf.contour._surface_curves import level_set_curves
+    >>> V, F = grid_mesh(32)                                   # the square [-1, 1]², normals +z
+    >>> circle = level_set_curves(V, F, np.linalg.norm(V, axis=1) - 0.5)   # counter-clockwise
+    >>> phi = SurfaceSignedHeatSolver(V, F).compute_distance(circle)
+    >>> round(float(phi[np.argmin(np.linalg.norm(V, axis=1))]), 1)          # the centre: 0.5 inside
+    -0.5
+    """
+
+    def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False, connection: str = "auto"):
+        V, F = _checks.as_mesh(V, F)
+        # scale invariance: everything runs in the geometry's frame (centre, power-of-two scale, exact);
+        # distances are mapped back on output (gsdf._normalize)
+        self.frame = Frame.of_mesh(V, F) if len(F) else Frame.of(V)
+        self.V_world, V = V, self.frame.geometry(V)
+        self.connection = _checks.choice(connection, "connection", CONNECTIONS)
+        self.t_coef = _checks.positive(t_coef, "t_coef")
+        rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
+        if rep.any():
+            raise ValueError(f"F: face {int(np.flatnonzero(rep)[0])} repeats a vertex ({int(rep.sum())} "
+                             "degenerate faces); remove degenerate triangles first")
+        dbl = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+        L = np.linalg.norm(V[F[:, 1]] - V[F[:, 0]], axis=1).mean()
+        bad = dbl <= 1e-12 * L * L
+        if bad.any():
+            raise ValueError(f"F: face {int(np.flatnonzero(bad)[0])} has zero area ({int(bad.sum())} degenerate "
+                             "faces); remove degenerate triangles first")
+        self.V, self.F = self.V_world, F
+        self.intrinsic_delaunay = bool(intrinsic_delaunay)
+        self.input_ops = TriangleMeshOperators(V, F)
+        # a vertex point source weighs one input unit against the curves (its old meaning at every scale)
+        self.input_ops.point_weight = float(self.frame.inverse_length(1.0))
+        self.t = self.t_coef * self.input_ops.h ** 2
+        if self.intrinsic_delaunay:
+            # the triangulation is built on first use: by the first solve (with its curve edges kept
+            # unflippable), or without fixed edges when an operator is accessed before any solve
+            self.domain = IntrinsicDomain(V, F, t=self.t, connection=self.connection, input_ops=self.input_ops)
+        else:
+            self.domain = TriangleDomain(t=self.t, connection=self.connection, ops=self.input_ops)
+        self.core = SignedHeatCore(self.domain)
+        self.t = float(self.frame.area(self.t))  # reported in input units (the domain keeps the frame's)
+
+    @property
+    def ops(self) -> TriangleMeshOperators:
+        """Operators of the triangulation in use (the input one, or the current intrinsic one)."""
+        return self.domain.ops
+
+    @property
+    def C(self):
+        """The cotan Laplacian (Eq. 10) of the triangulation in use."""
+        return self.domain.laplacian()
+
+    @property
+    def _cache(self) -> dict:
+        return self.core.poisson._cache
+
+    # ------------------------------------------------------------------ steps
+    @property
+    def vector_heat_factorization(self):
+        """The factorization of ``M + t L∇`` (Eq. 12), built on first use (complex, or the real 2×2 block form
+        on inconsistently oriented meshes)."""
+        return self.core.vector_heat_factorization
+
+    def diffuse(self, sources) -> np.ndarray:
+        """Step I: X = (M + tL∇)⁻¹ X0, complex per edge (Alg. 2)."""
+        return self.vector_heat_factorization.solve(sources.X0)
+
+    def unit_field(self, X: np.ndarray) -> np.ndarray:
+        """Step II: face-averaged, normalized vectors Y (m, 3) (§6, Alg. 3); zero where X vanishes."""
+        return self.core.unit_field(X)
+
+    # ------------------------------------------------------------------ public
+    def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
+                         soft_weight=None, curve_normals=None, progress=None) -> np.ndarray:
+        """Generalized signed distance at the vertices, negative inside.
+
+        Parameters
+        ----------
+        curves : list
+            Each curve a :class:`gsdf.Curve`, an int array of vertex indices (a polyline along edges), an (k, 2)
+            edge set inside a :class:`gsdf.Curve`, or a list of surface points ``(face_index, barycentric
+            (3,))`` (``(vertex, ())`` also means a vertex). A curve oriented counter-clockwise (seen from the
+            side the face normals point to) encloses the negative region. Keyword-only from here on.
+        points : sequence
+            Isolated point sources (App. A.1): vertex indices or ``(face, barycentric)`` tuples (split over the
+            face's vertices). Distance to points is unsigned.
+        curve_signs : list of bool, optional
+            Per curve: True = oriented (signed, default), False = unoriented (unsigned distance, App. A.2; must
+            run along edges). Bools only; must agree with ``Curve.signed``.
+        level_set_constraint : {"zero", "multiple", "none"}
+            ``"zero"``: φ = 0 on all sources (saddle system Eq. 14; vertex sources are eliminated directly);
+            ``"multiple"``: φ constant along every connected curve component (curves sharing a vertex are one
+            component); ``"none"``: no constraint. In every case φ is finally shifted to mean zero along the
+            curves (Alg. 13), or to minimum zero when there are only points.
+        soft_weight : float, optional
+            Replace the hard constraint of ``"zero"`` / ``"multiple"`` by the penalty λ Σ (φ(p_i) - φ(p_0))²
+            over the nodes (§7.1): solves ``(C + λAᵀA)φ = b``. Ignored with ``"none"``.
+        curve_normals : list, optional
+            Explicit surface normals for the signed curves (one entry per curve: None = face normals, a (3,)
+            vector, or one (3,) per curve point), used instead of the face normals in N = T × n (Eq. 11) — the
+            way to orient curves on nonorientable domains (§9.4), where face normals flip across the seam.
+            Negating them negates φ. Not available with ``intrinsic_delaunay=True``.
+        progress : callable, optional
+            ``progress(stage, fraction)`` (:mod:`gsdf.heat._core`).
+
+        Notes
+        -----
+        Sign convention: potpourri3d / the paper turn curve tangents counter-clockwise to get normals, which
+        makes the left side positive; gsdf makes it negative (so a counter-clockwise loop has a negative
+        inside, like a winding number of 1). Values for signed curves are therefore the negative of
+        potpourri3d's, for points and unsigned curves equal. Point sources at vertices follow Eq. 19; points
+        inside faces are split over the face's vertices by their barycentric weights (potpourri3d rejects them).
+        Curve nodes that are surface points cost a saddle factorization per distinct curve set (cached).
+
+        Returns
+        -------
+        phi : (n,) float64
+
+        Example
+        -------
+        >>> from gsdf.data._shapes import grid_mesh
+        >>> V, F = grid_mesh(4)
+        >>> solver = SurfaceSignedHeatSolver(V, F)
+        >>> solver.compute_distance([np.array([6, 7, 12, 6])], level_set_constraint="none").shape
+        (25,)
+        """
+        phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
+                                         level_set_constraint=level_set_constraint, soft_weight=soft_weight,
+                                         progress=progress, curve_normals=curve_normals)
+        return self.frame.length(phi)
+
+    def compute_distance_l1(self, curves, *, points=(), curve_signs=None) -> np.ndarray:
+        """Piecewise-continuous generalized signed distance (§7.2): per-corner values, shape (m, 3).
+
+        For curves that do not bound a region (or are inconsistently oriented) the unit field cannot be
+        integrated by a continuous function; this integrates it exactly in every face and puts the
+        discontinuities where the weighted L1 jump (Eq. 16) is least — a linear program on |F| unknowns solved
+        by HiGHS (seconds for ~10⁴ faces; it grows superlinearly). Shifted so that the length-weighted mean
+        along the curves is zero.
+
+        Example
+        -------
+        >>> corners = solver.compute_distance_l1([open_curve])     # doctest: +SKIP
+        >>> phi_face = corners.mean(axis=1)                          # doctest: +SKIP
+        """
+        from gsdf.heat.triangle._l1 import integrate_l1
+
+        if self.intrinsic_delaunay:
+            raise NotImplementedError("compute_distance_l1 is not available with intrinsic_delaunay=True")
+        cs = as_curves(curves, curve_signs)
+        raw, signs, _ = raw_curves(cs)
+        S = build_sources(self.ops, raw, raw_points(as_point_sources(points)), signs)
+        Y = self.unit_field(self.diffuse(S))
+        Phi = integrate_l1(self.ops, Y)
+        # shift: mean over the curve segments of the value in a face containing the segment midpoint
+        if S.node_rows:
+            ids = np.concatenate([mm[0] for mm in S.seg_mid])
+            w = np.concatenate([mm[1] for mm in S.seg_mid])
+            L = np.concatenate(S.seg_len)
+            vf = self.ops.vertex_faces()
+            # value of the face of the first vertex of the midpoint's support: average of its corner values
+            v0 = ids[np.arange(len(ids)), np.argmax(w, axis=1)]
+            f0 = vf.indices[vf.indptr[v0]]
+            vals = Phi[f0].mean(axis=1)
+            if L.sum() > 0:
+                return self.frame.length(Phi - float((vals * L).sum() / L.sum()))
+        return self.frame.length(Phi - float(Phi.min()))
+
+    def sharpen(self, phi0: np.ndarray, curves, *, points=(), iterations: int = 3000) -> np.ndarray:
+        """Distance sharpening (§7.3, Eq. 18): the largest |∇φ| ≤ 1 function with the sign pattern of ``phi0``
+        that vanishes on the sources, by PDHG warm-started from ``phi0`` (a signed heat result).
+
+        Vertex sources are pinned to 0; for surface points the vertices of their faces keep their values from
+        ``phi0`` (exactly zero on the curve after a ``"zero"`` solve). Returns φ (n,).
+
+        Example
+        -------
+        >>> phi = solver.compute_distance(curves)                  # doctest: +SKIP
+        >>> sharp = solver.sharpen(phi, curves)                     # doctest: +SKIP
+        """
+        from gsdf.heat.triangle._sharpen import sharpen
+
+        phi0 = np.asarray(phi0, dtype=np.float64)
+        if phi0.shape != (self.ops.n_vertices,) or not np.isfinite(phi0).all():
+            raise ValueError(f"phi0: expected {self.ops.n_vertices} finite values, got shape {phi0.shape}")
+        phi0 = self.frame.inverse_length(phi0)
+        raw, signs, _ = raw_curves(as_curves(curves))
+        pts = raw_points(as_point_sources(points))
+        if self.intrinsic_delaunay:
+            raw, pts = self.domain.transfer(raw, pts, signs)
+        S = build_sources(self.ops, raw, pts, None)
+        ids, w, isv = self._all_nodes(S)
+        fixed = np.zeros(self.ops.n_vertices, bool)
+        fixed[ids[isv < 0][w[isv < 0] > 0]] = True
+        values = phi0.copy()
+        fixed[isv[isv >= 0]] = True
+        values[isv[isv >= 0]] = 0.0
+        out = sharpen(self.ops, phi0, fixed, values, iterations=_checks.integer(iterations, "iterations"))[0]
+        return self.frame.length(out)
+
+    def split_curve(self, curve) -> list:
+        """The nodes of ``curve`` as (face, barycentric) points, split where segments cross edges, so that
+        consecutive nodes share a face (the form potpourri3d requires)."""
+        from gsdf.heat.triangle._sources import _bary_curve_segments, _parse_curve
+
+        parsed = _parse_curve(curve, self.input_ops, 0)
+        if parsed[0] == "v":
+            vs = parsed[1]
+            return [(int(v), np.zeros(0)) for v in vs]
+        ids, w, _, _, _ = _bary_curve_segments(self.input_ops, parsed[1], parsed[2], "curve", return_faces=True)
+        return list(zip(ids, w))
+
+    def split_segments(self, curve) -> list:
+        """The segments of ``curve`` as pairs ``[(f, bary_a), (f, bary_b)]`` in one face each (vertex polylines
+        and points on edges included): the per-segment form of potpourri3d's curves."""
+        from gsdf.heat.triangle._sources import _bary_in_face, _faces_of_node
+
+        nodes = self.split_curve(curve)
+        if len(nodes[0][1]) == 0:
+            vf = self.input_ops.vertex_faces()
+            nodes2 = []
+            for v, _ in nodes:
+                r = vf.indptr[v]
+                b = np.zeros(3)
+                b[vf.data[r] - 1] = 1
+                nodes2.append((int(vf.indices[r]), b))
+            nodes = nodes2
+        out = []
+        for (fa, ba), (fb, bb) in zip(nodes[:-1], nodes[1:]):
+            common = _faces_of_node(self.input_ops, fa, ba) & _faces_of_node(self.input_ops, fb, bb)
+            f = min(common)
+            Vf = self.input_ops.V
+            pa, pb = ba @ Vf[self.F[fa]], bb @ Vf[self.F[fb]]
+            out.append([(f, _bary_in_face(self.input_ops, pa, f)), (f, _bary_in_face(self.input_ops, pb, f))])
+        return out
+
+    def _all_nodes(self, S):
+        rows = list(S.node_rows)
+        isv = list(S.node_is_vertex)
+        if S.point_rows is not None:
+            rows.append(S.point_rows)
+            isv.append(S.point_is_vertex)
+        ids = np.concatenate([r[0] for r in rows])
+        w = np.concatenate([r[1] for r in rows])
+        return ids, w, np.concatenate(isv)

@@ -1,0 +1,121 @@
+"""Mesh formats read through the field's libraries: trimesh (GLB/GLTF, 3MF) and meshio (VTK, VTU, Gmsh, Medit,
+Abaqus, Nastran, SU2).
+
+These readers return the raw ``(V, flat, sizes)`` polygon soup that :func:`gsdf.io.read_mesh` validates and
+(optionally) fan-triangulates, exactly as for its own OBJ/OFF/PLY/STL parsers. Nothing is merged, reordered or
+dropped: trimesh is called with ``process=False`` and every mesh of a scene is placed by its node transform and
+appended in scene order; meshio's surface cells (triangles, quads, polygons, and the corner vertices of
+higher-order triangles and quads) are taken block by block in file order, its points as stored (2D points get
+z = 0). Volume cells (tetrahedra, hexahedra, ...) are not a surface and are ignored; a file with nothing else
+is refused with a message saying so.
+
+OBJ, OFF, PLY and STL stay with gsdf's own parsers (:mod:`gsdf.io._mesh`): trimesh with ``process=False`` still
+drops unreferenced OBJ vertices and regroups OFF faces by polygon size, and meshio refuses OFF polygons and OBJ
+texture coordinates that do not match the vertex count — while gsdf must give back broken soups exactly as
+stored, with their polygons.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["TRIMESH_FORMATS", "MESHIO_FORMATS", "read_external"]
+
+#: Read with trimesh (``.3mf`` needs trimesh's optional dependencies lxml and networkx).
+TRIMESH_FORMATS = (".glb", ".gltf", ".3mf")
+#: Read with meshio.
+MESHIO_FORMATS = (".vtk", ".vtu", ".msh", ".mesh", ".inp", ".bdf", ".nas", ".su2")
+
+# meshio cell type -> number of corner vertices that form the polygon (higher-order cells: their corners first)
+_SURFACE_CELLS = {"triangle": 3, "triangle6": 3, "triangle7": 3, "quad": 4, "quad8": 4, "quad9": 4}
+
+
+def read_external(p: str, ext: str):
+    """``(V (n, 3) float64, flat int64, sizes int64)`` of the polygons in ``p`` (an extension listed above)."""
+    if ext in TRIMESH_FORMATS:
+        return _read_trimesh(p, ext)
+    return _read_meshio(p, ext)
+
+
+def _read_trimesh(p: str, ext: str):
+    import trimesh
+
+    try:
+        scene = trimesh.load(p, file_type=ext[1:], process=False, force="scene")
+    except ImportError as exc:
+        raise ValueError(f"{p}: reading {ext} files needs an optional package trimesh uses ({exc.name or exc}); "
+                         "install it, e.g. pip install lxml networkx") from exc
+    except Exception as exc:  # trimesh raises many types for malformed files: report them as bad input
+        raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({type(exc).__name__}: {exc})") from exc
+    Vs, Fs, offset = [], [], 0
+    rank = {name: i for i, name in enumerate(scene.geometry)}  # the file's mesh order
+    nodes = sorted(scene.graph.nodes_geometry, key=lambda n: (rank.get(scene.graph[n][1], len(rank)), str(n)))
+    for node in nodes:
+        transform, name = scene.graph[node]
+        geom = scene.geometry.get(name)
+        if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
+            continue  # point clouds, paths
+        V = np.asarray(geom.vertices, dtype=np.float64)
+        V = V @ transform[:3, :3].T + transform[:3, 3]
+        Vs.append(V)
+        Fs.append(np.asarray(geom.faces, dtype=np.int64) + offset)
+        offset += len(V)
+    if not Vs:
+        raise ValueError(f"{p}: no faces; is this a point cloud? use read_points")
+    F = np.concatenate(Fs)
+    return np.concatenate(Vs), F.ravel(), np.full(len(F), 3, dtype=np.int64)
+
+
+def _read_meshio(p: str, ext: str):
+    m = _read_meshio_raw(p, ext)
+    P = np.asarray(m.points, dtype=np.float64)
+    if P.ndim != 2 or P.shape[1] not in (2, 3):
+        raise ValueError(f"{p}: expected 2D or 3D points, got an array of shape {P.shape}")
+    if P.shape[1] == 2:
+        P = np.column_stack([P, np.zeros(len(P))])
+    flats, sizes, volume = [], [], set()
+    for block in m.cells:
+        data = np.asarray(block.data)
+        if block.type in _SURFACE_CELLS:
+            k = _SURFACE_CELLS[block.type]
+        elif block.type.startswith("polygon") and data.ndim == 2:
+            k = data.shape[1]
+        else:
+            if block.type not in ("vertex", "line", "line3"):
+                volume.add(block.type)
+            continue
+        if len(data) == 0:
+            continue
+        flats.append(data[:, :k].astype(np.int64).ravel())
+        sizes.append(np.full(len(data), k, dtype=np.int64))
+    if not flats:
+        if volume:
+            raise ValueError(f"{p}: has only volume cells ({', '.join(sorted(volume))}), no surface faces")
+        raise ValueError(f"{p}: no faces; is this a point cloud? use read_points")
+    return P, np.concatenate(flats), np.concatenate(sizes)
+
+
+def _read_meshio_raw(p: str, ext: str):
+    """meshio.read with its prints and sys.exit turned into a ValueError naming the file."""
+    import contextlib
+    import io
+    import logging
+    import warnings
+
+    import meshio
+
+    said = io.StringIO()
+    log = logging.getLogger("meshio")
+    level = log.level
+    try:
+        # meshio prints its complaints and calls sys.exit(1) when no reader succeeds: capture both
+        log.setLevel(logging.CRITICAL)
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            m = meshio.read(p)
+    except (Exception, SystemExit) as exc:  # ReadError, ValueError, KeyError, struct errors, SystemExit ...
+        why = " ".join(said.getvalue().split()) or f"{type(exc).__name__}: {exc}"
+        raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({why})") from None
+    finally:
+        log.setLevel(level)
+    return m

@@ -1,0 +1,407 @@
+"""Voxelization by thresholding the (fast) generalized winding number at voxel centers.
+
+Barill et al. 2018, *Fast Winding Numbers for Soups and Clouds*, §4 "Voxelization" (Fig. 11): a voxel is
+*inside* when the winding number of the input at the voxel center is at least 1/2. Because the winding
+number degrades gracefully on open boundaries, self-intersections and inconsistent components, this works
+on triangle soups and oriented point clouds, not only on closed meshes (Fig. 4). The fast (tree) evaluation
+with ``beta = 2`` (triangles) / ``beta = 2.3`` (points) gives the same voxelization as the exact sum in
+practice (§4, "Even a small value of beta = 2 produces the identical voxelization").
+
+The grid here is a grid of *cells*: ``resolution`` cubic cells along the longest axis of the box, values
+sampled at cell centers. (Contrast :class:`gsdf.field.GridField`, whose values live on nodes.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gsdf._checks import as_mesh, as_normals, as_points, as_weights, integer, nonnegative, positive
+from gsdf._memory import check_bytes, grid_bytes
+from gsdf.mesh._topology import manifold_report, split_nonmanifold_vertices
+
+__all__ = [
+    "voxel_grid",
+    "voxel_centers",
+    "winding_grid",
+    "voxelize",
+    "save_voxels",
+    "load_voxels",
+    "voxels_to_mesh",
+]
+
+
+# ----------------------------------------------------------------------------------------------------------
+# grid geometry
+# ----------------------------------------------------------------------------------------------------------
+
+
+def _bbox(bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
+    lo = as_points(bbox_min, "bbox_min")
+    hi = as_points(bbox_max, "bbox_max")
+    if lo.shape[0] != 1 or hi.shape[0] != 1:
+        raise ValueError(f"bbox_min/bbox_max: expected 3 numbers each, got shapes {lo.shape} and {hi.shape}")
+    lo, hi = lo[0], hi[0]
+    if np.any(hi <= lo):
+        raise ValueError(f"bbox_max {hi} must exceed bbox_min {lo} on every axis")
+    return lo, hi
+
+
+def voxel_grid(bbox_min, bbox_max, resolution) -> tuple[tuple[int, int, int], np.ndarray, np.ndarray]:
+    """Shape and exact extent of a cubic-cell voxel grid covering a box.
+
+    The longest axis of ``[bbox_min, bbox_max]`` gets ``resolution`` cells of size
+    ``h = longest / resolution``; the other axes get ``ceil(extent / h)`` cells of the same size, and the
+    grid is centred on the requested box (so it may overhang it by less than one cell on the shorter axes).
+
+    Parameters
+    ----------
+    bbox_min, bbox_max : (3,) float
+        Requested box.
+    resolution : int
+        Number of cells along the longest axis (>= 1).
+
+    Returns
+    -------
+    shape : (nx, ny, nz)
+        Number of cells per axis.
+    grid_min, grid_max : (3,) float64
+        Corners of the voxel grid actually used; cell ``(i, j, k)`` spans
+        ``grid_min + [i, i+1] x [j, j+1] x [k, k+1] * h``.
+
+    Examples
+    --------
+    >>> from gsdf.ops import voxel_grid
+    >>> voxel_grid([0, 0, 0], [2, 1, 1], 4)[0]
+    (4, 2, 2)
+    """
+    lo, hi = _bbox(bbox_min, bbox_max)
+    r = integer(resolution, "resolution", 1)
+    ext = hi - lo
+    h = float(ext.max()) / r
+    n = np.maximum(1, np.ceil(ext / h - 1e-9)).astype(np.int64)
+    n[int(np.argmax(ext))] = r
+    c = 0.5 * (lo + hi)
+    gmin = c - 0.5 * n * h
+    gmax = gmin + n * h
+    return (int(n[0]), int(n[1]), int(n[2])), gmin, gmax
+
+
+def voxel_centers(bbox_min, bbox_max, shape, flat_index=None) -> np.ndarray:
+    """Centers of the cells of a voxel grid, (k, 3), in C order of an array of ``shape``.
+
+    ``flat_index`` (optional, int array) selects cells by their C-order flat index (used for chunking).
+
+    Examples
+    --------
+    >>> from gsdf.ops import voxel_centers
+    >>> voxel_centers([0, 0, 0], [2, 2, 2], (2, 2, 2))[-1].tolist()
+    [1.5, 1.5, 1.5]
+    """
+    lo, hi = _bbox(bbox_min, bbox_max)
+    shape = tuple(int(s) for s in shape)
+    if len(shape) != 3 or min(shape) < 1:
+        raise ValueError(f"shape: expected 3 positive cell counts, got {shape}")
+    h = (hi - lo) / np.array(shape, dtype=np.float64)
+    if flat_index is None:
+        flat_index = np.arange(int(np.prod(shape)), dtype=np.int64)
+    ijk = np.column_stack(np.unravel_index(np.asarray(flat_index, dtype=np.int64), shape)).astype(np.float64)
+    return lo + (ijk + 0.5) * h
+
+
+# ----------------------------------------------------------------------------------------------------------
+# winding evaluation on the grid
+# ----------------------------------------------------------------------------------------------------------
+
+
+def _winding_object(mesh, points, beta):
+    """Validate the input and build the reusable fast winding-number evaluator; also return its points."""
+    if (mesh is None) == (points is None):
+        raise ValueError("give exactly one of mesh=(V, F) or points=(P, N) / (P, N, areas)")
+    kw = {} if beta is None else {"beta": positive(beta, "beta")}
+    if mesh is not None:
+        if not isinstance(mesh, (tuple, list)) or len(mesh) != 2:
+            raise ValueError("mesh: expected a pair (V, F)")
+        V, F = as_mesh(*mesh)
+        from gsdf.winding import FastWindingNumber  # lazy: gsdf.winding owns the numba kernels
+
+        return FastWindingNumber(V, F, **kw), V[np.unique(F)]  # box of the referenced vertices only
+    if not isinstance(points, (tuple, list)) or len(points) not in (2, 3):
+        raise ValueError("points: expected a tuple (P, N) or (P, N, areas)")
+    P = as_points(points[0], "P")
+    if points[1] is None:
+        raise ValueError("N: the winding number of a point cloud needs oriented normals (got None)")
+    N = as_normals(points[1], P.shape[0], "N")
+    areas = None
+    if len(points) == 3 and points[2] is not None:
+        areas = as_weights(points[2], P.shape[0], "areas")
+    from gsdf.winding import FastWindingNumberPoints
+
+    return FastWindingNumberPoints(P, N, areas=areas, **kw), P
+
+
+def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max=None, pad=0.05, beta=None,
+                 chunk=2**20, progress=None):
+    """Fast generalized winding number of a mesh/soup or an oriented point cloud at voxel centers.
+
+    This is :func:`voxelize` without the final threshold (Barill et al. 2018, §4 "Voxelization").
+
+    Parameters
+    ----------
+    mesh : tuple (V, F), optional
+        Triangle mesh or soup, ``V`` (n, 3) float, ``F`` (m, 3) int. Evaluated with
+        :class:`gsdf.winding.FastWindingNumber`.
+    points : tuple (P, N) or (P, N, areas), optional
+        Oriented point cloud, evaluated with :class:`gsdf.winding.FastWindingNumberPoints` (``areas=None``:
+        estimated). Give exactly one of ``mesh`` and ``points``.
+    resolution : int
+        Number of cubic cells along the longest axis of the box.
+    bbox_min, bbox_max : (3,) float, optional
+        Box to voxelize; by default the input's bounding box grown by ``pad`` times its diagonal.
+    pad : float
+        Padding as a fraction of the bounding-box diagonal (used only for the default box), >= 0.
+    beta : float, optional
+        Accuracy parameter of the tree approximation (§3.4); ``None`` uses the evaluator's default
+        (2.0 for triangles, 2.3 for points).
+    chunk : int
+        Number of voxel centers evaluated per call (bounds memory; ``progress`` is called per chunk).
+    progress : callable(done, total), optional
+        Called after each chunk with the number of voxels done so far and the total.
+
+    Returns
+    -------
+    W : (nx, ny, nz) float64
+        Winding number at cell centers; cell ``(i, j, k)`` is centred at
+        ``grid_min + (i + 0.5, j + 0.5, k + 0.5) * h``.
+    grid_min, grid_max : (3,) float64
+        Corners of the voxel grid (see :func:`voxel_grid`; may overhang the requested box by < 1 cell).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gsdf.ops import winding_grid
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    >>> W, lo, hi = winding_grid(mesh=(V, F), resolution=8)
+    >>> W.shape
+    (8, 8, 8)
+    """
+    wn, X = _winding_object(mesh, points, beta)
+    r = integer(resolution, "resolution", 1)
+    pad = nonnegative(pad, "pad", most=1e6)
+    chunk = integer(chunk, "chunk", 1)
+    if progress is not None and not callable(progress):
+        raise ValueError("progress: expected a callable(done, total) or None")
+
+    from gsdf.mesh._geometry import bounding_box
+
+    dlo, dhi = bounding_box(X, pad)
+    if np.any(dhi <= dlo):  # flat input (e.g. a single planar facet): grow the flat axes
+        d = float(np.linalg.norm(dhi - dlo)) or 1.0
+        flat = dhi - dlo <= 1e-12 * d
+        dlo = np.where(flat, dlo - 0.5 * max(pad, 0.05) * d, dlo)
+        dhi = np.where(flat, dhi + 0.5 * max(pad, 0.05) * d, dhi)
+    lo = dlo if bbox_min is None else bbox_min
+    hi = dhi if bbox_max is None else bbox_max
+    shape, gmin, gmax = voxel_grid(lo, hi, r)
+
+    # the grid (8 B/cell, +1 B for voxelize's occupancy) plus one chunk of centres, indices and values
+    check_bytes(grid_bytes(shape, 9) + 64 * min(chunk, grid_bytes(shape, 1)),
+                f"winding grid: resolution={r} gives {shape[0]}x{shape[1]}x{shape[2]} cells")
+    total = int(np.prod(shape))
+    W = np.empty(total, dtype=np.float64)
+    for s in range(0, total, chunk):
+        e = min(total, s + chunk)
+        Q = voxel_centers(gmin, gmax, shape, np.arange(s, e, dtype=np.int64))
+        W[s:e] = np.asarray(wn(Q), dtype=np.float64).reshape(-1)
+        if progress is not None:
+            progress(e, total)
+    return W.reshape(shape), gmin, gmax
+
+
+def voxelize(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max=None, pad=0.05, beta=None,
+             chunk=2**20, progress=None):
+    """Voxelize a mesh, triangle soup or oriented point cloud: inside where the winding number >= 1/2.
+
+    Barill et al. 2018, §4 "Voxelization" and Fig. 11: the occupancy of each cubic cell is decided by the fast
+    generalized winding number at its center, which is robust to holes, self-intersections, duplicated and
+    inconsistently connected geometry (Fig. 4), and works on point clouds (§3.2).
+
+    Parameters
+    ----------
+    mesh, points, resolution, bbox_min, bbox_max, pad, beta, chunk, progress
+        As in :func:`winding_grid`.
+
+    Returns
+    -------
+    occupancy : (nx, ny, nz) bool
+        True for cells whose center has winding number >= 1/2.
+    grid_min, grid_max : (3,) float64
+        Corners of the voxel grid (cell size ``(grid_max - grid_min) / occupancy.shape``, equal on all axes).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gsdf.ops import voxelize
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    >>> occ, lo, hi = voxelize(mesh=(V, F), resolution=16, pad=0.0)
+    >>> bool(occ[1, 1, 1]), bool(occ[-1, -1, -1])
+    (True, False)
+    """
+    W, gmin, gmax = winding_grid(mesh=mesh, points=points, resolution=resolution, bbox_min=bbox_min,
+                                 bbox_max=bbox_max, pad=pad, beta=beta, chunk=chunk, progress=progress)
+    return W >= 0.5, gmin, gmax
+
+
+# ----------------------------------------------------------------------------------------------------------
+# output
+# ----------------------------------------------------------------------------------------------------------
+
+
+def _occupancy(occ) -> np.ndarray:
+    A = np.asarray(occ)
+    if A.ndim != 3:
+        raise ValueError(f"occ: expected a 3D array, got shape {A.shape}")
+    if min(A.shape) < 1:
+        raise ValueError(f"occ: has an empty axis, shape {A.shape}")
+    if A.dtype != bool:
+        if not np.issubdtype(A.dtype, np.number):
+            raise ValueError(f"occ: expected a boolean array, got dtype {A.dtype}")
+        if not np.isin(A, (0, 1)).all():
+            raise ValueError("occ: expected a boolean (0/1) array")
+        A = A.astype(bool)
+    return A
+
+
+def save_voxels(path, occ, bbox_min, bbox_max) -> None:
+    """Write a voxelization to a compressed ``.npz`` file (atomically; another extension is a ValueError).
+
+    Keys: ``occupancy`` (nx, ny, nz) bool, ``bbox_min``, ``bbox_max`` (3,) float64 (grid corners),
+    ``voxel_size`` (3,) float64 and ``kind = "voxels"``. Read back with :func:`load_voxels`.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> from gsdf.ops import save_voxels, load_voxels
+    >>> p = os.path.join(tempfile.mkdtemp(), "v.npz")
+    >>> save_voxels(p, np.ones((2, 2, 2), bool), [0, 0, 0], [1, 1, 1])
+    >>> int(load_voxels(p)[0].sum())
+    8
+    """
+    from gsdf.io._safe_write import atomic_output, check_output_path
+
+    check_output_path(path, extensions=(".npz",))
+    A = _occupancy(occ)
+    lo, hi = _bbox(bbox_min, bbox_max)
+    with atomic_output(path, extensions=(".npz",)) as tmp:
+        np.savez_compressed(tmp, occupancy=A, bbox_min=lo, bbox_max=hi, voxel_size=(hi - lo) / np.array(A.shape),
+                            kind="voxels")
+
+
+def load_voxels(path):
+    """Read a file written by :func:`save_voxels`; returns ``(occupancy, bbox_min, bbox_max)``."""
+    try:
+        with np.load(path) as d:
+            return _occupancy(d["occupancy"]), *_bbox(d["bbox_min"], d["bbox_max"])
+    except (OSError, KeyError, ValueError) as exc:
+        raise ValueError(f"{path}: not a gsdf voxel file ({exc})") from exc
+
+
+def voxels_to_mesh(occ, bbox_min, bbox_max, report: bool = False):
+    """Boundary of the occupied voxels as a triangle mesh (two triangles per exposed cell face).
+
+    Every face between an occupied and an empty cell (or the outside of the grid) becomes a quad split in
+    two triangles, oriented with the normal pointing out of the occupied region. Grid nodes are shared, so
+    the result is closed and welded — except where occupied cells touch only along an edge or at a corner,
+    which no welded surface can represent manifoldly. There the rule is: *cells that share only an edge or a
+    corner are separate*; the faces of each cell at such an edge are paired with each other, and a grid node
+    gets one copy per fan of faces around it. Isolated edge and corner contacts then become closed,
+    edge- and vertex-manifold surfaces with coincident (unwelded) vertex copies at those nodes. An edge
+    contact whose two cells are also connected around the edge's end nodes (through other occupied cells)
+    cannot be cut by copying vertices: such edges stay non-manifold (four faces). ``report=True`` returns
+    what the mesh is (:func:`gsdf.mesh._topology.manifold_report`: closed, edge_manifold, vertex_manifold,
+    welded and the counts of non-manifold edges and vertices).
+
+    Parameters
+    ----------
+    occ : (nx, ny, nz) bool
+        Occupancy, e.g. from :func:`voxelize`.
+    bbox_min, bbox_max : (3,) float
+        Grid corners.
+
+    Returns
+    -------
+    V : (n, 3) float64
+        Used grid nodes.
+    F : (m, 3) int64
+        Outward-oriented triangles; ``(0, 3)`` arrays when nothing is occupied.
+    report : dict
+        Only with ``report=True``: closed / edge-manifold / vertex-manifold / welded and counts.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gsdf.ops import voxels_to_mesh
+    >>> V, F = voxels_to_mesh(np.ones((1, 1, 1), bool), [0, 0, 0], [1, 1, 1])
+    >>> V.shape, F.shape
+    ((8, 3), (12, 3))
+    """
+    A = _occupancy(occ)
+    lo, hi = _bbox(bbox_min, bbox_max)
+    # padded copy and masks (~4 B/cell), plus ~300 B per exposed cell face (at most 6 per occupied cell:
+    # indices, quads, triangles, the unique of the node ids)
+    check_bytes(grid_bytes(np.array(A.shape) + 2, 4) + 300 * 6 * int(np.count_nonzero(A)),
+                f"voxels_to_mesh: a {A.shape[0]}x{A.shape[1]}x{A.shape[2]} occupancy grid")
+    shape = np.array(A.shape, dtype=np.int64)
+    h = (hi - lo) / shape
+    nn = shape + 1  # nodes per axis
+    strides = np.array([nn[1] * nn[2], nn[2], 1], dtype=np.int64)
+    P = np.pad(A, 1, constant_values=False)
+    tris = []
+    cells = []  # flat index of the occupied cell each triangle bounds (pairs faces at non-manifold edges)
+    for d in range(3):
+        e1, e2 = (d + 1) % 3, (d + 2) % 3
+        sl_lo = [slice(1, -1)] * 3
+        sl_hi = [slice(1, -1)] * 3
+        sl_lo[d] = slice(0, -1)
+        sl_hi[d] = slice(1, None)
+        a, b = P[tuple(sl_lo)], P[tuple(sl_hi)]  # cells on the low / high side of node plane i (0..n_d)
+        for sign, mask in ((+1, b & ~a), (-1, a & ~b)):
+            # sign=+1: occupied cell is on the high side -> outward normal is -e_d; and vice versa
+            idx = np.argwhere(mask)  # (k, 3) with idx[:, d] = node plane, others = cell index
+            if idx.shape[0] == 0:
+                continue
+            base = idx @ strides
+            u, v = strides[e1], strides[e2]
+            q = np.column_stack((base, base + u, base + u + v, base + v))  # normal +e_d (e1 x e2 = e_d)
+            if sign > 0:
+                q = q[:, ::-1]
+            tris.append(q[:, [0, 1, 2]])
+            tris.append(q[:, [0, 2, 3]])
+            cell = idx.copy()
+            cell[:, d] -= sign < 0  # sign=+1: the occupied cell is on the high side of node plane i
+            cid = np.ravel_multi_index(cell.T, A.shape)
+            cells += [cid, cid]
+    if not tris:
+        empty = (np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64))
+        return (*empty, manifold_report(*empty)) if report else empty
+    F = np.concatenate(tris)
+    C = np.concatenate(cells)
+    used, F = np.unique(F, return_inverse=True)
+    F = F.reshape(-1, 3).astype(np.int64)
+    ijk = np.column_stack(np.unravel_index(used, tuple(nn))).astype(np.float64)
+    V = lo + ijk * h
+    rep = manifold_report(V, F)
+    if not (rep["edge_manifold"] and rep["vertex_manifold"]):
+        tri_cell = C
+
+        def same_cell(hs):
+            """At an edge with 4 faces (two cells touching along it) pair the two faces of each cell."""
+            cs = tri_cell[hs // 3]
+            o = np.argsort(cs, kind="stable")
+            hs, cs = hs[o], cs[o]
+            return [(hs[i], hs[i + 1]) for i in range(0, len(hs) - 1, 2) if cs[i] == cs[i + 1]]
+
+        V, F = split_nonmanifold_vertices(V, F, pair_ok=same_cell)
+        rep = manifold_report(V, F)
+    return (V, F, rep) if report else (V, F)

@@ -1,0 +1,449 @@
+"""gsdf.batch / `gsdf batch`: tasks against analytic answers, resume, atomic writes, failures, Ctrl-C, local
+processes and a real dask.distributed LocalCluster (bit-identical outputs, a killed worker loses no item)."""
+
+import json
+import os
+import signal
+import time
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from gsdf.batch import (
+    BatchInterrupted,
+    DaskExecutor,
+    Geometry,
+    LocalExecutor,
+    collect_inputs,
+    occupancy,
+    read_manifest,
+    run_batch,
+    sdf_grid,
+    sdf_samples,
+    surface,
+    write_npz_atomic,
+)
+from gsdf.cli.main import main
+from gsdf.io import write_mesh
+
+from tests.shapes import cube, uv_sphere
+
+N = 4000  # samples per item: enough to test, small enough to be fast
+
+
+def _open_sphere():
+    V, F = uv_sphere(12, 24)
+    keep = V[F].mean(axis=1)[:, 2] < 0.8  # a hole around the north pole
+    return V, F[keep]
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory):
+    """Four small meshes in a nested layout (one with a hole, one polygon soup) and one corrupt file."""
+    d = tmp_path_factory.mktemp("in")
+    (d / "a" / "b").mkdir(parents=True)
+    write_mesh(str(d / "sphere.obj"), *uv_sphere(10, 20))
+    write_mesh(str(d / "a" / "cube.off"), *cube())
+    write_mesh(str(d / "a" / "b" / "open.ply"), *_open_sphere())
+    V, F = uv_sphere(8, 16, radius=0.5)
+    write_mesh(str(d / "a" / "small.stl"), V + 2.0, F)
+    (d / "corrupt.obj").write_text("v 0 0 0\nv 1 0 0\nf 1 2 7\n")
+    return d
+
+
+GOOD = {"sphere.npz", "a/cube.npz", "a/b/open.npz", "a/small.npz"}
+
+
+@pytest.fixture(scope="module")
+def local1():
+    """One spawned local worker process, shared by the tests (starting one costs seconds)."""
+    ex = LocalExecutor(1)
+    yield ex
+    ex.close()
+
+
+@pytest.fixture(scope="module")
+def local_run(dataset, tmp_path_factory):
+    out = tmp_path_factory.mktemp("local")
+    return run_batch(str(dataset), "sdf-samples", str(out), {"n_samples": N}, workers=1), out
+
+
+def _outputs(out):
+    return {os.path.relpath(os.path.join(b, f), out) for b, _, fs in os.walk(out) for f in fs if f.endswith(".npz")}
+
+
+# ---------------------------------------------------------------------------------------------- tasks
+
+
+def test_sdf_samples_sphere_analytic():
+    V, F = uv_sphere(24, 48, radius=2.0)
+    out = sdf_samples(Geometry(V, F=F), n_samples=N, normalize="sphere", seed=3)
+    P, d = out["points"], out["sdf"]
+    assert P.shape == (N, 3) and d.shape == (N,) and P.dtype == np.float32 and d.dtype == np.float32
+    assert out["scale"] == pytest.approx(2.0) and np.allclose(out["center"], 0, atol=1e-12)
+    r = np.linalg.norm(P.astype(float), axis=1)
+    assert np.abs(d - (r - 1.0)).max() < 0.01  # unit sphere in the stored frame, up to the faceting
+    assert 0.3 < np.mean(np.abs(r - 1) < 0.05) < 0.95  # most samples near the surface, some uniform
+    # "none" keeps input coordinates: the same samples scaled back
+    raw = sdf_samples(Geometry(V, F=F), n_samples=N, seed=3)
+    assert np.allclose(raw["points"], 2.0 * P, atol=1e-5) and np.allclose(raw["sdf"], 2.0 * d, atol=1e-5)
+    assert raw["scale"] == 1.0
+
+
+def test_sdf_samples_heat_sign_and_open_mesh():
+    V, F = _open_sphere()
+    wind = sdf_samples(Geometry(V, F=F), n_samples=N, seed=1)
+    r = np.linalg.norm(wind["points"], axis=1)
+    far = np.abs(r - 1) > 0.1
+    assert np.all((wind["sdf"][far] < 0) == (r[far] < 1))  # winding sign survives the hole
+    heat = sdf_samples(Geometry(V, F=F), n_samples=N, seed=1, sign="heat", heat_resolution=32)
+    assert np.array_equal(heat["points"], wind["points"]) and np.allclose(np.abs(heat["sdf"]), np.abs(wind["sdf"]))
+    assert np.all((heat["sdf"][far] < 0) == (r[far] < 1))
+
+
+def test_occupancy_grid_surface_analytic():
+    V, F = cube(0.5)
+    g = Geometry(V, F=F)
+    occ = occupancy(g, n_points=N, seed=2)
+    inside = np.all(np.abs(occ["points"]) < 0.5, axis=1)
+    margin = np.abs(np.abs(occ["points"]).max(axis=1) - 0.5) > 1e-3
+    assert occ["occupancy"].dtype == bool and np.array_equal(occ["occupancy"][margin], inside[margin])
+    grid = sdf_grid(g, resolution=17, pad=0.5)
+    X = np.stack(np.meshgrid(*[np.linspace(grid["bbox_min"][i], grid["bbox_max"][i], 17) for i in range(3)],
+                             indexing="ij"), -1)
+    q = np.abs(X) - 0.5  # exact box SDF
+    exact = np.linalg.norm(np.maximum(q, 0), axis=-1) + np.minimum(q.max(axis=-1), 0)
+    assert grid["sdf"].shape == (17, 17, 17) and np.abs(grid["sdf"] - exact).max() < 1e-5
+    assert np.allclose(grid["spacing"], (grid["bbox_max"] - grid["bbox_min"]) / 16)
+    Vs, Fs = uv_sphere(16, 32)
+    s = surface(Geometry(Vs, F=Fs), resolution=24)
+    assert s["faces"].dtype == np.int64 and len(s["faces"]) > 100
+    assert np.abs(np.linalg.norm(s["vertices"], axis=1) - 1).max() < 0.02
+
+
+def test_task_bad_options():
+    V, F = cube()
+    g = Geometry(V, F=F)
+    with pytest.raises(ValueError, match="n_samples"):
+        sdf_samples(g, n_samples=0)
+    with pytest.raises(ValueError, match="normalize"):
+        sdf_samples(g, normalize="ball")
+    with pytest.raises(ValueError, match="pat"):
+        sdf_grid(g, method="pat", resolution=8)
+    with pytest.raises(ValueError, match="zero total area"):
+        sdf_samples(Geometry(np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0.]]), F=np.array([[0, 1, 2]])), n_samples=10)
+    with pytest.raises(ValueError, match="source"):
+        sdf_samples(42)
+    from gsdf.batch import check_options
+
+    for bad, match in [({"n_samples": True}, "n_samples"), ({"pad": float("nan")}, "pad"),
+                       ({"sigmas": "a,b"}, "sigmas: expected a number"), ({"beta": -1}, "beta"),
+                       ({"dtype": "int8"}, "dtype"), ({"uniform_fraction": "x"}, "uniform_fraction")]:
+        with pytest.raises(ValueError, match=match):
+            check_options("sdf-samples", bad)
+    with pytest.raises(ValueError, match="method"):
+        check_options("surface", {"method": "pat"})
+    with pytest.raises(ValueError, match="out-of-memory estimate"):
+        sdf_grid(g, resolution=4000)
+
+
+def test_point_cloud_inputs(tmp_path):
+    from gsdf.io import write_points
+
+    from tests.shapes import fibonacci_sphere
+
+    P = fibonacci_sphere(1500)
+    out = sdf_samples(Geometry(P, N=P), n_samples=N, seed=4)
+    r = np.linalg.norm(out["points"], axis=1)
+    far = np.abs(r - 1) > 0.1
+    assert np.all((out["sdf"][far] < 0) == (r[far] < 1))
+    grid = sdf_grid(Geometry(P, N=P), resolution=9, method="pat")
+    assert grid["sdf"][4, 4, 4] == pytest.approx(-1.0, abs=0.1)  # the centre node, 1 from the sphere
+    write_points(str(tmp_path / "bare.xyz"), P)
+    with pytest.raises(ValueError, match="no normals"):
+        occupancy(str(tmp_path / "bare.xyz"))
+    occ = occupancy(str(tmp_path / "bare.xyz"), n_points=2000, estimate_normals=True)
+    rr = np.linalg.norm(occ["points"], axis=1)
+    ok = np.abs(rr - 1) > 0.1
+    assert np.mean(occ["occupancy"][ok] == (rr[ok] < 1)) > 0.99
+
+
+# ---------------------------------------------------------------------------------- inputs and manifests
+
+
+def test_collect_inputs_layout_and_manifests(dataset, tmp_path):
+    items = collect_inputs(str(dataset))
+    assert {it.output for it in items} == GOOD | {"corrupt.npz"}
+    items = collect_inputs(str(dataset / "a" / "**" / "*.ply"))
+    assert [it.output for it in items] == ["b/open.npz"]
+    csv = tmp_path / "items.csv"
+    csv.write_text(f"path,n_samples\n{dataset / 'sphere.obj'},100\n{dataset / 'a' / 'cube.off'},\n")
+    items = collect_inputs(str(csv))
+    assert [it.options for it in items] == [{"n_samples": "100"}, {}]
+    js = tmp_path / "items.json"
+    js.write_text(json.dumps([str(dataset / "sphere.obj"), {"path": "in/x.off", "seed": 1}]))
+    with pytest.raises(ValueError, match="not a file"):
+        collect_inputs(str(js))
+    (tmp_path / "bad.csv").write_text("file\nx.obj\n")
+    with pytest.raises(ValueError, match="'path' column"):
+        collect_inputs(str(tmp_path / "bad.csv"))
+    (tmp_path / "bad.json").write_text("[1, 2")
+    with pytest.raises(ValueError, match="malformed JSON"):
+        collect_inputs(str(tmp_path / "bad.json"))
+
+
+def test_per_item_options_from_csv(dataset, tmp_path, local1):
+    csv = tmp_path / "items.csv"
+    csv.write_text(f"path,n_samples,seed\n{dataset / 'sphere.obj'},100,\n{dataset / 'a' / 'cube.off'},250,7\n")
+    r = run_batch(str(csv), "sdf-samples", str(tmp_path / "out"), {"n_samples": 50}, executor=local1)
+    assert r.counts["done"] == 2
+    assert np.load(tmp_path / "out" / "sphere.npz")["sdf"].shape == (100,)
+    assert np.load(tmp_path / "out" / "a" / "cube.npz")["points"].shape == (250, 3)
+    (tmp_path / "bad.csv").write_text(f"path,n_samples\n{dataset / 'sphere.obj'},many\n")
+    with pytest.raises(ValueError, match="n_samples: expected an integer"):
+        run_batch(str(tmp_path / "bad.csv"), "sdf-samples", str(tmp_path / "o2"))
+
+
+# ------------------------------------------------------------------------------ the local run, resume
+
+
+def test_local_run_manifest_and_failures(local_run, dataset):
+    r, out = local_run
+    assert r.counts["done"] == 4 and r.counts["failed"] == 1
+    assert _outputs(out) == GOOD
+    state = read_manifest(out / "manifest.jsonl")
+    assert set(state) == GOOD | {"corrupt.npz"}
+    bad = state["corrupt.npz"]
+    assert bad["status"] == "failed" and "out of range" in bad["error"] and bad["failure"] == "item"
+    ok = state["sphere.npz"]
+    assert ok["status"] == "done" and ok["counts"]["faces"] > 0 and ok["arrays"]["points"] == [N, 3]
+    assert set(ok["seconds"]) == {"read", "compute", "write", "total"} and len(ok["input_sha256"]) == 64
+    z = np.load(out / "sphere.npz")
+    assert set(z.files) == {"points", "sdf", "center", "scale"}
+
+
+def test_rerun_recomputes_nothing_and_notices_changes(local_run, dataset, tmp_path, local1):
+    r0, out0 = local_run
+    out = tmp_path / "out"
+    run_batch(str(dataset), "sdf-samples", str(out), {"n_samples": N}, executor=local1)
+    mtimes = {p: os.stat(out / p).st_mtime_ns for p in GOOD}
+    lines = (out / "manifest.jsonl").read_text().count("\n")
+    r = run_batch(str(dataset), "sdf-samples", str(out), {"n_samples": N}, executor=local1)
+    assert r.counts["skipped"] == 5 and r.counts["done"] == 0 and r.executor == ""  # nothing submitted
+    assert {p: os.stat(out / p).st_mtime_ns for p in GOOD} == mtimes
+    assert (out / "manifest.jsonl").read_text().count("\n") == lines
+    # other options: everything again; a changed input: only that item
+    r = run_batch(str(dataset), "sdf-samples", str(out), {"n_samples": N, "seed": 1}, executor=local1)
+    assert r.counts["done"] == 4
+    V, F = uv_sphere(6, 12)
+    changed = tmp_path / "in"
+    import shutil
+
+    shutil.copytree(dataset, changed)
+    out2 = tmp_path / "out2"
+    run_batch(str(changed), "sdf-samples", str(out2), {"n_samples": N}, executor=local1)
+    write_mesh(str(changed / "a" / "cube.off"), V, F)
+    r = run_batch(str(changed), "sdf-samples", str(out2), {"n_samples": N}, executor=local1, retry_failed=True)
+    ran = {x["output"] for x in r.records if x["status"] in ("done", "failed")}
+    assert ran == {"a/cube.npz", "corrupt.npz"}
+
+
+# -------------------------------------------------------------------------------------- atomic writes
+
+
+class _Boom:
+    """An array that interrupts the writer when numpy converts it (mid-file: earlier arrays are written)."""
+
+    def __array__(self, *args, **kwargs):
+        raise KeyboardInterrupt
+
+
+def test_atomic_write_interrupted_leaves_no_file(tmp_path):
+    target = tmp_path / "sub" / "x.npz"
+    with pytest.raises(KeyboardInterrupt):
+        write_npz_atomic(target, {"a": np.zeros(1000), "b": _Boom()})
+    assert not target.exists() and os.listdir(tmp_path / "sub") == []
+    write_npz_atomic(target, {"a": np.arange(3)})
+    with pytest.raises(KeyboardInterrupt):
+        write_npz_atomic(target, {"a": np.zeros(1000), "b": _Boom()})
+    assert np.array_equal(np.load(target)["a"], np.arange(3))  # the old output is intact
+    assert os.listdir(tmp_path / "sub") == ["x.npz"]
+
+
+def test_stale_part_files_never_count(dataset, tmp_path, local1):
+    out = tmp_path / "out"
+    (out / "a").mkdir(parents=True)
+    (out / "a" / ".cube.npz.abc123.part").write_bytes(b"half a zip")  # a worker killed mid-write
+    r = run_batch([str(dataset / "a" / "cube.off")], "sdf-samples", str(out), {"n_samples": 100}, executor=local1)
+    assert r.counts["done"] == 1 and os.listdir(out / "a") == []  # cube.npz sits at the root of that list
+    assert (out / "cube.npz").exists()
+
+
+# ------------------------------------------------------------------------------------------ Ctrl-C
+
+
+def test_interrupt_keeps_manifest_consistent(dataset, tmp_path, local1):
+    out = tmp_path / "out"
+
+    def stop(rec, counts):
+        if counts["done"] + counts["failed"] == 1:
+            raise KeyboardInterrupt
+
+    with pytest.raises(BatchInterrupted) as info:
+        run_batch(str(dataset), "sdf-samples", str(out), {"n_samples": N}, workers=1, progress=stop)
+    res = info.value.result
+    assert res.interrupted and len(res.records) == 5
+    state = read_manifest(out / "manifest.jsonl")
+    for key, rec in state.items():
+        assert rec["status"] in ("done", "failed", "cancelled")
+        assert (rec["status"] == "done") == (out / key).exists()
+    assert any(r["status"] in ("cancelled", "pending") for r in res.records)
+    r = run_batch(str(dataset), "sdf-samples", str(out), {"n_samples": N}, executor=local1)
+    assert _outputs(out) == GOOD and r.counts["done"] + r.counts["skipped"] >= 4
+
+
+# --------------------------------------------------------------------------- worker death, local pool
+
+
+def test_local_worker_killed_loses_no_item(dataset, tmp_path):
+    ex = LocalExecutor(2)
+    killed = []
+
+    def kill_one(rec, counts):
+        if not killed and rec["status"] != "skipped":
+            pid = ex.worker_pids()[0]
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+
+    try:
+        r = run_batch(str(dataset), "sdf-samples", str(tmp_path / "out"), {"n_samples": 50_000}, executor=ex,
+                      progress=kill_one)
+    finally:
+        ex.close()
+    assert killed
+    assert all(x["threads"] == max(1, os.cpu_count() // 2) for x in r.records if x["status"] == "done")
+    assert {x["output"] for x in r.records} == GOOD | {"corrupt.npz"}
+    assert all(x["status"] in ("done", "failed") for x in r.records)
+    assert _outputs(tmp_path / "out") == {x["output"] for x in r.records if x["status"] == "done"}
+
+
+# ----------------------------------------------------------------------------- a real Dask LocalCluster
+
+
+@pytest.fixture(scope="module")
+def dask2():
+    pytest.importorskip("distributed")
+    ex = DaskExecutor.local(2)
+    yield ex
+    ex.close()
+
+
+def test_dask_matches_single_process_bit_for_bit(dask2, local_run, dataset, tmp_path):
+    _, out0 = local_run
+    r = run_batch(str(dataset), "sdf-samples", str(tmp_path / "d"), {"n_samples": N}, executor=dask2)
+    assert r.counts["done"] == 4 and r.counts["failed"] == 1
+    assert "out of range" in r.failed[0]["error"]
+    assert len({x["worker"] for x in r.records}) >= 1
+    for p in GOOD:
+        a, b = np.load(out0 / p), np.load(tmp_path / "d" / p)
+        assert a.files == b.files
+        for k in a.files:
+            assert a[k].tobytes() == b[k].tobytes(), (p, k)
+    assert all(x["threads"] == max(1, os.cpu_count() // 2) for x in r.records if x["status"] == "done")
+    again = run_batch(str(dataset), "sdf-samples", str(tmp_path / "d"), {"n_samples": N}, executor=dask2)
+    assert again.counts["skipped"] == 5
+
+
+def test_dask_connect_shares_host_cores(dask2, dataset, tmp_path):
+    ex = DaskExecutor.connect(dask2.client.scheduler.address, timeout=5)
+    try:
+        assert set(ex.threads_by_worker.values()) == {max(1, os.cpu_count() // 2)}  # 2 workers on this host
+        r = run_batch([str(dataset / "sphere.obj")], "occupancy", str(tmp_path / "c"), {"n_points": 500},
+                      executor=ex)
+    finally:
+        ex.close()
+    assert r.counts["done"] == 1 and r.records[0]["threads"] == max(1, os.cpu_count() // 2)
+    assert np.load(tmp_path / "c" / "sphere.npz")["occupancy"].shape == (500,)
+
+
+def test_dask_worker_killed_loses_no_item(dask2, dataset, tmp_path):
+    items = [str(p) for p in sorted(dataset.rglob("*.*"))]
+    killed = []
+
+    def kill_one(rec, counts):
+        if not killed:
+            pid = dask2.worker_pids()[0]
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+
+    t0 = time.perf_counter()
+    r = run_batch(items, "sdf-samples", str(tmp_path / "k"), {"n_samples": 60_000}, executor=dask2,
+                  progress=kill_one)
+    assert killed and time.perf_counter() - t0 < 60
+    assert {x["output"] for x in r.records} == GOOD | {"corrupt.npz"}
+    assert all(x["status"] in ("done", "failed") for x in r.records)
+    assert {x["output"] for x in r.records if x["status"] == "failed"} <= {"corrupt.npz"} | GOOD
+    assert _outputs(tmp_path / "k") == {x["output"] for x in r.records if x["status"] == "done"}
+    assert r.counts["done"] >= 3  # the killed worker's item was rescheduled (or recorded as failed)
+
+
+# ------------------------------------------------------------------------------------------ bad input
+
+
+def test_bad_inputs_are_clear_errors(dataset, tmp_path):
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="holds no mesh"):
+        run_batch(str(tmp_path / "empty"), "sdf-samples", str(tmp_path / "o"))
+    with pytest.raises(ValueError, match="matches no file"):
+        run_batch(str(tmp_path / "*.nothing"), "sdf-samples", str(tmp_path / "o"))
+    with pytest.raises(ValueError, match="does not exist"):
+        run_batch(str(tmp_path / "missing"), "sdf-samples", str(tmp_path / "o"))
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(ValueError, match="not a folder"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "file"))
+    with pytest.raises(ValueError, match="cannot write"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "file" / "sub"))
+    with pytest.raises(ValueError, match="cannot write"):
+        run_batch(str(dataset), "sdf-samples", "/proc/gsdf-batch-out")
+    with pytest.raises(ValueError, match="conflicting options: workers and scheduler"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), workers=2, scheduler="tcp://127.0.0.1:1")
+    with pytest.raises(ValueError, match="'resolution' does not apply to task 'sdf-samples'"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), {"resolution": 64})
+    with pytest.raises(ValueError, match="task: unknown task"):
+        run_batch(str(dataset), "voxels", str(tmp_path / "o"))
+    with pytest.raises(ValueError, match="workers: expected a positive integer"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), workers=True)
+    assert not (tmp_path / "o").exists()  # nothing was created for a refused run
+
+
+def test_unreachable_scheduler_fails_fast(dataset, tmp_path):
+    pytest.importorskip("distributed")
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="cannot reach the Dask scheduler"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), scheduler="tcp://127.0.0.1:9",
+                  scheduler_timeout=2)
+    assert time.perf_counter() - t0 < 10
+
+
+# ------------------------------------------------------------------------------------------------ CLI
+
+
+def test_cli_batch(dataset, tmp_path):
+    runner = CliRunner()
+    out = tmp_path / "cli"
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "--out", str(out),
+                               "--normalize", "cube", "-q"])
+    assert res.exit_code == 0, res.output
+    assert "done" in res.output and "failed" in res.output and "corrupt.obj" in res.output
+    z = np.load(out / "a" / "cube.npz")
+    assert z["sdf"].shape == (12, 12, 12) and z["scale"] == pytest.approx(0.5)
+    assert -1.0 <= z["sdf"].min() <= -0.85  # the centre is 1 frame unit from every face
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--resolution", "12", "--out",
+                               str(out)])
+    assert res.exit_code != 0 and "--resolution does not apply to --task sdf-samples" in res.output
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--out", str(out), "--workers", "2",
+                               "--dask-local", "2"])
+    assert res.exit_code != 0 and "conflicting options: --workers and --dask-local" in res.output
+    res = runner.invoke(main, ["batch", str(tmp_path / "none*.obj"), "--task", "surface", "--out", str(out)])
+    assert res.exit_code == 1 and "matches no file" in res.output

@@ -1,0 +1,115 @@
+"""The documentation cannot drift from the code: the site builds with warnings as errors (offline), every public
+name has a numpy-style docstring with an Examples section and a reference entry, every guide page's code blocks
+and every script in examples/ run (each failure names its page / block or script)."""
+
+from __future__ import annotations
+
+import glob
+import importlib.util
+import inspect
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+import gsdf
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DOCS = os.path.join(ROOT, "docs")
+PAGES = sorted(glob.glob(os.path.join(DOCS, "guide", "*.md"))) + [os.path.join(DOCS, "formats.md")]
+EXAMPLES = sorted(glob.glob(os.path.join(ROOT, "examples", "*.py")))
+TIMEOUT = 600  # per page / script / build: a hang fails instead of stalling CI
+
+
+def _env():
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.path.join(ROOT, "src") + os.pathsep + env.get("PYTHONPATH", "")
+    env["MPLBACKEND"] = "Agg"
+    return env
+
+
+def _section(doc: str, name: str) -> str:
+    """Body of a numpy-style section ``name`` of a docstring ('' when absent)."""
+    m = re.search(rf"^{name}\n-{{{len(name)}}}\n(.*?)(?=^\S[^\n]*\n-{{3,}}\n|\Z)", doc, re.M | re.S)
+    return m.group(1).strip() if m else ""
+
+
+@pytest.mark.parametrize("name", gsdf.__all__)
+def test_public_name_has_docstring_with_examples(name):
+    doc = inspect.getdoc(getattr(gsdf, name)) or ""
+    assert len(doc.split("\n", 1)[0]) > 10, f"gsdf.{name}: missing or empty docstring summary line"
+    examples = _section(doc, "Examples")
+    assert examples, f"gsdf.{name}: the docstring has no numpy-style 'Examples' section"
+    assert ">>>" in examples, f"gsdf.{name}: the Examples section has no '>>>' example"
+
+
+def test_every_public_name_in_the_api_reference():
+    text = open(os.path.join(DOCS, "api", "index.rst"), encoding="utf-8").read()
+    listed = set(re.findall(r"^   (\w+)$", text, re.M))
+    assert not set(gsdf.__all__) - listed, f"names missing from docs/api/index.rst: {set(gsdf.__all__) - listed}"
+    assert not listed - set(gsdf.__all__), f"docs/api/index.rst lists non-public names: {listed - set(gsdf.__all__)}"
+
+
+def test_guide_pages_in_the_toctree():
+    index = open(os.path.join(DOCS, "index.md"), encoding="utf-8").read()
+    for page in PAGES:
+        rel = os.path.relpath(page, DOCS)[:-3]
+        assert rel in index, f"docs/index.md does not list {rel}"
+
+
+def test_conf_is_offline():
+    conf = open(os.path.join(DOCS, "conf.py"), encoding="utf-8").read()
+    assert "sphinx.ext.intersphinx" not in conf
+    for page in glob.glob(os.path.join(DOCS, "**", "*.md"), recursive=True):
+        for target in re.findall(r"!\[[^\]]*\]\(([^)]+)\)", open(page, encoding="utf-8").read()):
+            assert not re.match(r"\w+://", target), f"{page}: remote image {target}"
+
+
+@pytest.mark.skipif(not all(importlib.util.find_spec(m) for m in ("sphinx", "numpydoc", "myst_parser")),
+                    reason='the docs extra is not installed (pip install -e ".[docs]")')
+def test_docs_build_without_warnings(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-E", "-b", "html", "-d",
+                        str(tmp_path / "doctrees"), DOCS, str(tmp_path / "html")],
+                       capture_output=True, text=True, timeout=TIMEOUT, env=_env(), cwd=ROOT)
+    assert r.returncode == 0, f"sphinx -W failed:\n{r.stderr[-6000:]}"
+    html = (tmp_path / "html" / "index.html").read_text(encoding="utf-8")
+    assert "guide/inside_outside.html" in html
+    for name in gsdf.__all__:
+        assert (tmp_path / "html" / "api" / "generated" / f"gsdf.{name}.html").exists(), f"no page for gsdf.{name}"
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[os.path.basename(p) for p in PAGES])
+def test_guide_page_code_runs(page, tmp_path):
+    r = subprocess.run([sys.executable, os.path.join(DOCS, "run_blocks.py"), page, "--cwd", str(tmp_path)],
+                       capture_output=True, text=True, timeout=TIMEOUT, env=_env())
+    assert r.returncode == 0, f"{os.path.relpath(page, ROOT)}:\n{r.stderr[-6000:]}"
+    # every picture the page shows is one its own code makes
+    text = open(page, encoding="utf-8").read()
+    for target in re.findall(r"!\[[^\]]*\]\((img/[^)]+\.png)\)", text):
+        made = tmp_path / os.path.basename(target)
+        assert made.exists(), f"{os.path.relpath(page, ROOT)} shows {target} but its code does not write it"
+        assert made.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert os.path.exists(os.path.join(os.path.dirname(page), target)), f"{target} is not committed"
+
+
+@pytest.mark.parametrize("script", EXAMPLES, ids=[os.path.basename(p) for p in EXAMPLES])
+def test_example_runs_and_writes_a_png(script, tmp_path):
+    r = subprocess.run([sys.executable, script], capture_output=True, text=True, timeout=TIMEOUT, env=_env(),
+                       cwd=tmp_path)
+    assert r.returncode == 0, f"examples/{os.path.basename(script)} failed:\n{r.stderr[-6000:]}"
+    pngs = list(tmp_path.glob("*.png"))
+    assert pngs, f"examples/{os.path.basename(script)} wrote no PNG"
+    for p in pngs:
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", p
+
+
+def test_run_blocks_names_the_failing_block(tmp_path):
+    page = tmp_path / "page.md"
+    page.write_text("# t\n\n```python\nx = 1\n```\n\ntext\n\n```python\nassert x == 2, 'boom'\n```\n")
+    r = subprocess.run([sys.executable, os.path.join(DOCS, "run_blocks.py"), str(page), "--cwd", str(tmp_path)],
+                       capture_output=True, text=True, timeout=60, env=_env())
+    assert r.returncode == 1
+    assert "block 2 (line 9" in r.stderr and "boom" in r.stderr
+
