@@ -2,6 +2,7 @@
 with ast, resolved to modules of the package, and the graph checked for cycles."""
 
 import ast
+import importlib
 import pathlib
 
 import pytest
@@ -131,3 +132,21 @@ def test_no_package_cycles_in_gsdf():
 def test_package_graph_sees_a_package_cycle():
     g = {"gsdf.a._x": {"gsdf.b._y"}, "gsdf.b._y": set(), "gsdf.b._z": {"gsdf.a._x"}}
     assert find_cycle(package_graph(g)) in (["gsdf.a", "gsdf.b", "gsdf.a"], ["gsdf.b", "gsdf.a", "gsdf.b"])
+
+
+def test_stub_lists_every_public_name_where_it_lives():
+    """src/gsdf/__init__.pyi (what editors and type checkers read) names exactly gsdf.__all__, each imported
+    from the module that gsdf's lazy loader takes it from."""
+    import gsdf
+
+    tree = ast.parse((SRC / "gsdf" / "__init__.pyi").read_text(encoding="utf-8"))
+    stub = {}
+    for node in tree.body:
+        if isinstance(node, ast.ImportFrom):
+            for a in node.names:
+                assert a.asname == a.name, f"re-export {a.name} as itself in the stub"
+                stub[a.name] = node.module
+    assert sorted(stub) == sorted(gsdf.__all__)
+    for name, module in stub.items():
+        assert module == f"gsdf.{gsdf._EXPORTS[name]}", name
+        assert getattr(importlib.import_module(module), name) is getattr(gsdf, name)
