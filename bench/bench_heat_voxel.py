@@ -27,7 +27,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import machine, write_section  # noqa: E402
 
-from gsdf.heat import region_boundary_curves  # noqa: E402
+from gsdf.contour import region_boundary_curves  # noqa: E402
 from gsdf.heat.voxel._digital import digital_surface, integral_invariant_normals  # noqa: E402
 from gsdf.heat.voxel._domain import VoxelSurfaceSignedHeatSolver  # noqa: E402
 

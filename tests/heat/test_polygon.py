@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from gsdf.heat import PolygonMeshSignedHeatSolver, SurfaceSignedHeatSolver, region_boundary_curves
+from gsdf.contour import region_boundary_curves
+from gsdf.heat import PolygonMeshSignedHeatSolver, SurfaceSignedHeatSolver
 from gsdf.data._shapes import sphere_mesh
 from gsdf.heat.triangle._operators import TriangleMeshOperators
 from gsdf.heat.polygon._solver import virtual_vertex_refinement, virtual_vertex_weights

@@ -8,7 +8,8 @@ sources, and threadpoolctl's own view of the BLAS threads."""
 import numpy as np
 import scipy.sparse as sp
 
-from gsdf.heat import PolygonMeshSignedHeatSolver, SurfaceSignedHeatSolver, region_boundary_curves
+from gsdf.contour import region_boundary_curves
+from gsdf.heat import PolygonMeshSignedHeatSolver, SurfaceSignedHeatSolver
 from gsdf.heat.polygon._domain import PolygonDomain, connection_laplacian, frame_transport
 from gsdf.data._shapes import sphere_mesh
 from gsdf.heat.triangle._operators import TriangleMeshOperators

@@ -6,7 +6,7 @@ import pytest
 import scipy.sparse as sp
 
 import gsdf
-from gsdf.heat import region_boundary_curves
+from gsdf.contour import region_boundary_curves
 from gsdf.heat.voxel._degoes import face_operators
 from gsdf.heat.voxel._digital import digital_surface, integral_invariant_normals
 from gsdf.heat.voxel._domain import VoxelSurfaceDomain, VoxelSurfaceSignedHeatSolver

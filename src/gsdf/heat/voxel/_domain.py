@@ -42,7 +42,7 @@ Example
 >>> from gsdf.heat.voxel._domain import VoxelSurfaceSignedHeatSolver
 >>> x = np.indices((24, 24, 24)) - 11.5
 >>> solver = VoxelSurfaceSignedHeatSolver((x ** 2).sum(0) < 10 ** 2)          # a digital ball
->>> from gsdf.heat import region_boundary_curves
+>>> from gsdf.contour import region_boundary_curves
 >>> cap = solver.face_centres[:, 2] < 12.0                                    # the lower half
 >>> phi = solver.compute_distance(region_boundary_curves(solver.faces, cap))
 >>> bool(phi[np.argmin(solver.vertices[:, 2])] < -10)                        # the south pole: −πR/2
