@@ -152,12 +152,6 @@ def tet_iso(bunny):
     return f.isosurface(0.0)
 
 
-@pytest.mark.xfail(reason="the 0-isosurface of the tet field has holes and fins: φ = 0 on every input vertex, and "
-                          "3575 of the 11848 tets have all four vertices at 0 (marching tetrahedra counts 0 as above "
-                          "the level, so they give nothing) -> 24 boundary edges at [8,8,8] (76 / 210 at 16 / 32); "
-                          "a face of three zeros with negative tets on both sides is emitted twice, oppositely "
-                          "oriented, so 6 isosurface vertices have a zero area-weighted normal and the peer's "
-                          "error is NaN (NaN terms dropped: 2.75e-2 at [8,8,8], 6.8e-3 / 1.5e-3 at 16 / 32)", strict=True)
 def test_tet_isosurface(bunny, tet_iso):
     """test.py::TestTetSolver::test_isosurface — ZeroSet constraint, isosurface(φ, 0): average squared
     (pseudo-)distance between the input and the isosurface < 1e-2."""
@@ -166,10 +160,11 @@ def test_tet_isosurface(bunny, tet_iso):
     assert average_squared_distance(V, F, Vi, Fi) < 1e-2
 
 
-@pytest.mark.xfail(reason="24 boundary edges at [8,8,8]: tets with all four vertices at φ = 0 produce no triangle in "
-                          "marching tetrahedra (issue 32; signedheat3d's own surface is closed)", strict=True)
 def test_tet_isosurface_closed(tet_iso):
-    """Issue 32's companion check: the 0-isosurface of a closed input's tet field is closed (no boundary edge)."""
+    """The 0-isosurface of a closed input's tet field is closed (no boundary edge), as signedheat3d's is.
+    Regression: φ = 0 on every input point leaves whole tets at the level; counting the level as above gave 24
+    boundary edges at [8, 8, 8] (76 / 210 at 16 / 32) and NaN in the peer's error (2.75e-2 without the NaN
+    terms); counted as below (libigl's marching_tets): 0 / 0 / 0 and 8.0e-4 / 3.0e-4 / 1.5e-3."""
     Vi, Fi = tet_iso
     E = np.sort(np.concatenate([Fi[:, [0, 1]], Fi[:, [1, 2]], Fi[:, [2, 0]]]), axis=1)
     _, c = np.unique(E, axis=0, return_counts=True)

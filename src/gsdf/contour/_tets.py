@@ -50,12 +50,19 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     """Level set of a piecewise-linear function on a tet mesh (vectorized marching tetrahedra).
 
     Each tet with vertices on both sides contributes one triangle (1 vertex apart) or a quad split in two
-    (2 and 2); crossing points are shared per mesh edge. Where the level passes exactly through mesh nodes,
-    crossing points of different edges coincide: they are welded, zero-area triangles dropped, and a vertex
-    where separate sheets touch is split per fan, so the result is edge- and vertex-manifold (closed away from
-    the mesh boundary). Two cases stay open, and the report says so: flat (zero-volume) tets, which a
-    Delaunay of cospherical points such as a regular grid contains, and tet faces lying wholly on the level
-    (three nodes exactly at ``level``). Triangles are oriented along the gradient of ``values``. ``report=True`` returns
+    (2 and 2); crossing points are shared per mesh edge.
+
+    A node exactly at the level counts as below it (libigl's ``marching_tets`` does the same: a node is above
+    when its value exceeds the level). A field constrained to the level on input points (the signed heat
+    method's "zero" constraint, Feng & Crane 2024 §8.1) has many such nodes, and whole tets at the level;
+    the surface is then the boundary of the region above the level: it runs through the nodes at the level
+    and over the faces of the tets at the level that border a tet above it. Crossing points of different
+    edges that coincide at a node are welded and zero-area triangles dropped; a pair of coincident opposite
+    triangles (a tet face of three nodes at the level between two tets above it: a sheet of zero thickness)
+    cancels; where sheets touch along an edge the faces are paired across the wedges above the level (regions
+    above stay apart) and the vertices split per fan. The result is closed away from the mesh boundary,
+    edge- and vertex-manifold, and consistently oriented, along the gradient of ``values`` (the orientation
+    of the majority of each component where flat tets have no gradient). ``report=True`` returns
     ``(V, F, report)`` with :func:`gsdf.mesh._topology.manifold_report`.
 
     Examples
@@ -74,10 +81,10 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     s = np.asarray(values, float) - finite(level, "level")
     if not (s.min() < 0 < s.max()):
         raise ValueError(f"level {level} is outside the field's range [{s.min() + level:.6g}, {s.max() + level:.6g}]: no surface")
-    # values within round-off of the level are put exactly on it, and a node on the level counts as above it
-    # (a symbolic +0 perturbation): crossings at such a node then coincide exactly and are welded below
+    # values within round-off of the level are put exactly on it, and a node on the level counts as below it:
+    # crossings at such a node then coincide exactly and are welded below
     s = np.where(np.abs(s) <= 1e-12 * float(np.abs(s).max()), 0.0, s)
-    pos = s[T] >= 0
+    pos = s[T] > 0
     npos = pos.sum(axis=1)
     tris, tet_of = [], []
     # one vertex apart: lone vertex and the three others
@@ -108,6 +115,7 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     t = sa / (sa - sb)
     V = X[uniq[:, 0]] + t[:, None] * (X[uniq[:, 1]] - X[uniq[:, 0]])
     V[t == 1.0] = X[uniq[t == 1.0, 1]]  # a crossing at a node is that node, bitwise (so it welds)
+    V[t == 0.0] = X[uniq[t == 0.0, 0]]
     F = inv.reshape(-1, 3)
     # orient along the gradient of the linear interpolant of each triangle's tet
     n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
@@ -119,12 +127,124 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     up[ok] = np.linalg.solve(M[ok], ds[ok][:, :, None])[:, :, 0]
     flip = (n * up).sum(axis=1) < 0
     F[flip] = F[flip][:, [0, 2, 1]]
-    keep = np.linalg.norm(n, axis=1) > 0
     from gsdf.mesh._topology import manifold_report, split_nonmanifold_vertices, weld
 
-    V, F = weld(V, F[keep].astype(np.int64))
+    V, F = weld(V, F.astype(np.int64))
+    F = _cancel_opposite_pairs(F)
     rep = manifold_report(V, F)
-    if not rep["vertex_manifold"]:
-        V, F = split_nonmanifold_vertices(V, F)
+    if not (rep["vertex_manifold"] and rep["edge_manifold"]):
+        V, F = _split_sheets(V, F)
         rep = manifold_report(V, F)
     return (V, F, rep) if report else (V, F)
+
+
+def _cancel_opposite_pairs(F):
+    """Drop pairs of triangles on the same three vertices with opposite orientations (they cancel as a chain:
+    a sheet of zero thickness); an unpaired copy stays."""
+    if len(F) == 0:
+        return F
+    key = np.sort(F, axis=1)
+    # orientation parity of each triangle relative to its sorted key
+    r = np.argsort(F, axis=1, kind="stable")
+    parity = ((r[:, 0] > r[:, 1]).astype(int) + (r[:, 0] > r[:, 2]) + (r[:, 1] > r[:, 2])) % 2
+    _, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    net = np.zeros(inv.max() + 1, np.int64)
+    np.add.at(net, inv, 1 - 2 * parity)
+    cnt = np.bincount(inv)
+    if (cnt == 1).all():
+        return F
+    keep = np.zeros(len(F), bool)
+    # keep |net| triangles of the net orientation in every group
+    order = np.argsort(inv, kind="stable")
+    seen = np.zeros_like(net)
+    for f in order[cnt[inv[order]] > 1].tolist():
+        g, sgn = inv[f], 1 - 2 * parity[f]
+        if net[g] != 0 and np.sign(net[g]) == sgn and seen[g] < abs(net[g]):
+            keep[f] = True
+            seen[g] += 1
+    keep[cnt[inv] == 1] = True
+    return F[keep]
+
+
+def _pair_across_wedges(V, F, hs, shifted=False):
+    """At an edge with more than two faces (faces oriented along the gradient), pair each face with its
+    angular neighbour across a wedge above the level: the surfaces of regions above the level that touch along
+    the edge stay apart (as the level itself counts as below); ``shifted``: across the wedges below instead.
+    ``hs`` are half-edge ids 3 f + k."""
+    hs = np.asarray(hs)
+    f, k = hs // 3, hs % 3
+    p, q, c = F[f, k], F[f, (k + 1) % 3], F[f, (k + 2) % 3]
+    a, b = min(p[0], q[0]), max(p[0], q[0])
+    o = np.where(p == a, 1, -1)  # +1: the face runs a -> b
+    d = V[b] - V[a]
+    d = d / max(np.linalg.norm(d), np.finfo(float).tiny)
+    e1 = np.cross(d, [1.0, 0, 0]) if abs(d[0]) < 0.9 else np.cross(d, [0, 1.0, 0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(d, e1)
+    r = V[c] - V[a]
+    order = np.argsort(np.arctan2(r @ e2, r @ e1), kind="stable")
+    n = len(order)
+    out = []
+    for i in range(n):
+        x, y = order[i], order[(i + 1) % n]
+        if o[x] > 0 > o[y]:  # the wedge from x to y (counter-clockwise about a -> b) is above the level
+            out.append((int(hs[x]), int(hs[y])))
+    if 2 * len(out) != n:  # orientations do not alternate around the edge (degenerate tets): angular neighbours
+        out = [(int(hs[order[i]]), int(hs[order[i + 1]])) for i in range(0, n - 1, 2)]
+    if shifted:  # the other way round
+        out = [(int(hs[order[i]]), int(hs[order[(i + 1) % n]])) for i in range(1, n, 2)]
+    return out
+
+
+def _orient_consistently(V, F):
+    """Flip faces so that every component is consistently oriented, each component keeping the orientation of
+    the (area-weighted) majority of its faces."""
+    from gsdf.mesh._connectivity import MeshTopology
+
+    topo = MeshTopology(F, len(V))
+    flip = topo.orientation_classes()
+    if flip is None or not flip.any():
+        return F
+    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    comp = topo.face_components
+    vote = np.zeros(int(comp.max()) + 1)
+    np.add.at(vote, comp, np.where(flip, -1.0, 1.0) * (area + 1e-300))
+    flip = flip ^ (vote[comp] < 0)
+    F = F.copy()
+    F[flip] = F[flip][:, [0, 2, 1]]
+    return F
+
+
+def _split_sheets(V, F):
+    """Split the vertices where sheets touch (:func:`split_nonmanifold_vertices`), pairing the faces of an edge
+    with more than two across the wedges above the level; where a vertex's fan then still runs twice through
+    such an edge (so no vertex copy can separate the sheets), pair that edge's faces the other way round.
+    Then orient every component consistently."""
+    from gsdf.mesh._topology import _edges, split_nonmanifold_vertices
+
+    def key_of(F_, hs):
+        E, _ = _edges(F_)
+        e = E[hs[0]]
+        return min(e), max(e)
+
+    shifted = set()
+    for _ in range(3):
+        def pair(hs):
+            return _pair_across_wedges(V, F, hs, key_of(F, hs) in shifted)
+
+        V2, F2 = split_nonmanifold_vertices(V, F, pair_ok=pair)
+        E, _ = _edges(F2)
+        und = np.sort(E, axis=1)
+        u, inv, cnt = np.unique(und, axis=0, return_inverse=True, return_counts=True)
+        bad = np.flatnonzero(cnt[inv.reshape(-1)] > 2)
+        if len(bad) == 0:
+            break
+        # the original vertices of the edges still shared by more than two faces: pair those the other way
+        src = np.empty(len(V2), np.int64)
+        src[F2.reshape(-1)] = F.reshape(-1)
+        new = {(int(min(src[a], src[b])), int(max(src[a], src[b]))) for a, b in und[bad]}
+        if new <= shifted:
+            break
+        shifted |= new
+    return V2, _orient_consistently(V2, F2)
