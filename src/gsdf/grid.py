@@ -88,7 +88,16 @@ class Grid:
         Nodes per axis.
 
     Build one from a resolution with :meth:`fit` (a given box) or :meth:`around` (the padded bounding box of
-    an input).
+    an input). Every grid-making function of gsdf takes one as its ``resolution``.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> g = gsdf.Grid.around([[0, 0, 0], [3, 4, 0]], resolution=11)     # the box padded by 0.1 of its diagonal
+    >>> g.shape, g.spacing.tolist(), g.bbox_min.tolist()
+    ((9, 11, 3), [0.5, 0.5, 0.5], [-0.5, -0.5, -0.5])
+    >>> gsdf.Grid(([0, 0, 0], [1, 1, 1]), (2, 2, 2)).points().shape
+    (8, 3)
     """
 
     __slots__ = ("bbox_min", "bbox_max", "shape")

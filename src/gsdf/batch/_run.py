@@ -55,6 +55,13 @@ class BatchOptions:
         BLAS/numba threads per item (default: the cores divided by the concurrent workers).
     scheduler_timeout : float, default 10.0
         Seconds to wait for an unreachable Dask scheduler before a ValueError.
+
+    Examples
+    --------
+    >>> from gsdf import BatchOptions
+    >>> BatchOptions(retry_failed=True).resume
+    True
+    >>> r = run_batch("meshes/", "occupancy", "occ/", batch_options=BatchOptions(threads=2))   # doctest: +SKIP
     """
 
     resume: bool = True

@@ -167,6 +167,13 @@ class SdfSamplesOptions:
         Fast winding number accuracy (default 2 for meshes, 2.3 for clouds).
     estimate_normals : bool, default False
         For a cloud without normals: PCA normals oriented away from the centroid.
+
+    Examples
+    --------
+    >>> from gsdf import SdfSamplesOptions
+    >>> SdfSamplesOptions(sigmas=(0.01,)).uniform_fraction
+    0.1
+    >>> out = sdf_samples("bunny.off", options=SdfSamplesOptions(uniform_fraction=0.5))   # doctest: +SKIP
     """
 
     uniform_fraction: float = 0.1
@@ -193,6 +200,10 @@ class OccupancyOptions:
         Fast winding number accuracy (default 2 for meshes, 2.3 for clouds).
     estimate_normals : bool, default False
         For a cloud without normals: PCA normals oriented away from the centroid.
+
+    Examples
+    --------
+    >>> out = occupancy("scan.xyz", options=OccupancyOptions(estimate_normals=True))   # doctest: +SKIP
     """
 
     uniform_fraction: float = 1.0

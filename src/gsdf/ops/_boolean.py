@@ -55,6 +55,15 @@ class BooleanOptions:
         Zip the closed trim loops of A and B together with thin triangle strips, so that closed inputs give
         a closed, consistently oriented result; ``False`` leaves the seams open, as in the paper. Open trim
         curves (where the other operand has holes) are left as they are.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1.0]])  # a tetrahedron
+    >>> F = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
+    >>> opts = gsdf.BooleanOptions(exact=True, stitch=False)
+    >>> gsdf.mesh_boolean(V, F, V + 5.0, F, "union", options=opts)[1].shape
+    (8, 3)
     """
 
     beta: float = 2.0

@@ -148,7 +148,17 @@ class PointsAsToriOptions:
     curvature_cap : float, default 4.0
         Jet fitting: largest curvature in units of 1/h_i (h_i: median distance to the k-th neighbour).
     kd_eps : float, default 0.0
-        Approximate neighbour search for queries (0 = exact; e.g. 0.3 is ~2x faster far from the cloud).
+        Approximate neighbour search for queries far from the cloud: every neighbour distance used is within a
+        factor (1 + kd_eps) of the true one (0 = exact).
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> P = np.random.default_rng(0).normal(size=(500, 3))
+    >>> P /= np.linalg.norm(P, axis=1, keepdims=True)
+    >>> pat = gsdf.PointsAsTori(P, P, k=32, options=gsdf.PointsAsToriOptions(kd_eps=0.3))
+    >>> bool(pat.signed_distance([[0, 0, 0]])[0] < 0)
+    True
     """
 
     k_eval: int = 64
