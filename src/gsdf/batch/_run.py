@@ -329,15 +329,15 @@ def _hint(ex) -> str:
             "(workers are spawned and import the main module)")
 
 
-def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
+def _drive(ex, todo, writer, result, total, max_retries, report, poll):
     inflight = {}  # future -> job
 
-    def finish(rec, report=True):
+    def finish(rec, announce=True):
         rec.setdefault("time", _now())
         writer.write(rec)
         result.records.append(rec)
-        if report and progress is not None:
-            progress(rec, _tally(result.records, total))
+        if report is not None and announce:
+            report(rec, _tally(result.records, total))
 
     try:
         while todo or inflight:
@@ -386,7 +386,7 @@ def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
         for job in inflight.values():
             finish({**{k: job[k] for k in ("task", "input", "output", "options", "params_sha256", "attempts",
                                            "run")}, "status": "cancelled", "error": "interrupted (Ctrl-C)"},
-                   report=False)
+                   announce=False)
         for job in todo:
             result.records.append({**{k: job[k] for k in ("task", "input", "output", "run")},
                                    "status": "pending"})
