@@ -432,18 +432,43 @@ def test_unreachable_scheduler_fails_fast(dataset, tmp_path):
 def test_cli_batch(dataset, tmp_path):
     runner = CliRunner()
     out = tmp_path / "cli"
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "--out", str(out),
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "-o", str(out),
                                "--normalize", "cube", "-q"])
     assert res.exit_code == 0, res.output
     assert "done" in res.output and "failed" in res.output and "corrupt.obj" in res.output
     z = np.load(out / "a" / "cube.npz")
     assert z["sdf"].shape == (12, 12, 12) and z["scale"] == pytest.approx(0.5)
     assert -1.0 <= z["sdf"].min() <= -0.85  # the centre is 1 frame unit from every face
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--resolution", "12", "--out",
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--bisection", "3", "--output-dir",
                                str(out)])
-    assert res.exit_code != 0 and "--resolution does not apply to --task sdf-samples" in res.output
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--out", str(out), "--workers", "2",
+    assert res.exit_code != 0 and "--bisection does not apply to --task sdf-samples" in res.output
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "occupancy", "--resolution", "12", "-o", str(out)])
+    assert res.exit_code != 0 and "--resolution does not apply to --task occupancy" in res.output
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "-o", str(out), "--workers", "2",
                                "--dask-local", "2"])
     assert res.exit_code != 0 and "conflicting options: --workers and --dask-local" in res.output
     res = runner.invoke(main, ["batch", str(tmp_path / "none*.obj"), "--task", "surface", "--out", str(out)])
-    assert res.exit_code == 1 and "matches no file" in res.output
+    assert res.exit_code == 1 and "matches no file" in res.output  # --out: the old name, kept for one release
+
+
+def test_cli_batch_options_reach_the_library_under_their_names(monkeypatch, tmp_path):
+    """--n-points is n_samples (sdf-samples) or n_points (occupancy); --resolution is the heat grid of
+    sdf-samples; --margin is the library's pad; --threads (group or command) is the per-item thread count."""
+    import gsdf.batch
+    import gsdf.threads
+
+    monkeypatch.setattr(gsdf.threads, "set_num_threads", lambda n: None)  # leave this process's setting alone
+    seen = []
+    monkeypatch.setattr(gsdf.batch, "run_batch", lambda inputs, task, out, opts, **kw: seen.append((task, opts, kw))
+                        or (_ for _ in ()).throw(ValueError("stop")))
+    runner = CliRunner()
+    for args in (["--task", "sdf-samples", "--n-points", "7", "--resolution", "9", "--margin", "0.2"],
+                 ["--task", "occupancy", "--n-points", "5", "--threads", "3"]):
+        res = runner.invoke(main, ["batch", str(tmp_path), "-o", str(tmp_path / "o"), *args])
+        assert res.exit_code == 1 and "stop" in res.output, res.output
+    res = runner.invoke(main, ["--threads", "2", "batch", str(tmp_path), "-o", str(tmp_path / "o"), "--task",
+                               "sdf-grid"])
+    assert res.exit_code == 1
+    assert [(t, o, kw["threads"]) for t, o, kw in seen] == [
+        ("sdf-samples", {"n_samples": 7, "heat_resolution": 9, "pad": 0.2}, None),
+        ("occupancy", {"n_points": 5}, 3), ("sdf-grid", {}, 2)]
