@@ -66,7 +66,7 @@ Example:
               help="h of t = t_coef·h²: the grid spacing (robust to flipped/noisy normals) or the input's mean "
                    "edge length / point spacing (more accurate on clean input with holes).")
 @level_set_option
-@soft_weight_option("Default: 10 on grids (the exact grid constraint is slow: minutes at 64³), exact on tets.")
+@soft_weight_option("Default: 10 on grids, exact on tets.")
 @click.option("--surface-format", type=click.Choice(["ply", "obj", "off", "stl"]), default="ply",
               show_default=True, help="Format of the --offsets surfaces.")
 @normals_option
