@@ -11,8 +11,9 @@ Output policy (the same for every subcommand; see :mod:`gsdf.io._safe_write`):
 * every file is written to a temporary name in the target folder and renamed when complete; missing parent
   folders are created.
 
-Subcommands get this by decorating with :data:`gsdf.cli._options.no_clobber_option` and :func:`report_errors` (which sets the
-policy, refuses any ``OUTPUT_PARAMS`` option naming an input and turns library errors into one-line messages),
+Subcommands get this by decorating with :data:`gsdf.cli._options.no_clobber_option` and :func:`report_errors`
+(which sets the policy, refuses any ``OUTPUT_PARAMS`` option naming an input and turns library errors into
+one-line messages),
 by calling :func:`check_output` on every output name before the work starts, and by writing each file inside
 ``with output_file(path) as tmp:``. Inputs are the values of the command's ``click.Path``
 parameters, so outputs must be declared as plain strings.

@@ -134,9 +134,9 @@ def batch(inputs, task, output_dir, workers, dask_local, scheduler, scheduler_ti
         bar.set_postfix(done=counts["done"], failed=counts["failed"], skipped=counts["skipped"], refresh=False)
 
     try:
-        result = run_batch(inputs, task, output_dir, given, workers=workers, dask_local=dask_local, scheduler=scheduler,
-                           resume=resume, retry_failed=retry_failed, max_retries=max_retries, threads=explicit_threads(),
-                           progress=progress, scheduler_timeout=scheduler_timeout)
+        result = run_batch(inputs, task, output_dir, given, workers=workers, dask_local=dask_local,
+                           scheduler=scheduler, resume=resume, retry_failed=retry_failed, max_retries=max_retries,
+                           threads=explicit_threads(), progress=progress, scheduler_timeout=scheduler_timeout)
     except BatchInterrupted as exc:
         if bar is not None:
             bar.close()
