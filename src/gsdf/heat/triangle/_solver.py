@@ -13,10 +13,10 @@ from gsdf import _checks
 from gsdf._normalize import Frame
 from gsdf.heat._core import SignedHeatCore
 from gsdf.heat.intrinsic._domain import IntrinsicDomain
-from gsdf.heat.triangle._domain import TriangleDomain, raw_curves, raw_points
-from gsdf.curves import as_curves, as_point_sources
+from gsdf.heat.triangle._domain import TriangleDomain
+from gsdf.curves import Curve, as_curves, as_point_sources
 from gsdf.heat.triangle._operators import TriangleMeshOperators
-from gsdf.heat.triangle._sources import build_sources
+from gsdf.heat.triangle._sources import assemble, parse_curves, parse_points
 
 LEVEL_SETS = ("zero", "multiple", "none")
 CONNECTIONS = ("auto", "complex", "real")
@@ -222,16 +222,13 @@ class SurfaceSignedHeatSolver:
 
         if self.intrinsic_delaunay:
             raise NotImplementedError("compute_distance_l1 is not available with intrinsic_delaunay=True")
-        cs = as_curves(curves, curve_signs)
-        raw, signs, _ = raw_curves(cs)
-        S = build_sources(self.ops, raw, raw_points(as_point_sources(points)), signs)
+        S = self.core.sources(curves, points, curve_signs)
         Y = self.unit_field(self.diffuse(S))
         Phi = integrate_l1(self.ops, Y)
         # shift: mean over the curve segments of the value in a face containing the segment midpoint
-        if S.node_rows:
-            ids = np.concatenate([mm[0] for mm in S.seg_mid])
-            w = np.concatenate([mm[1] for mm in S.seg_mid])
-            L = np.concatenate(S.seg_len)
+        if S.node_rows.shape[0]:
+            ids, w = S.extra["midpoints"]
+            L = S.shift_weights
             vf = self.ops.vertex_faces()
             # value of the face of the first vertex of the midpoint's support: average of its corner values
             v0 = ids[np.arange(len(ids)), np.argmax(w, axis=1)]
@@ -259,30 +256,34 @@ class SurfaceSignedHeatSolver:
         if phi0.shape != (self.ops.n_vertices,) or not np.isfinite(phi0).all():
             raise ValueError(f"phi0: expected {self.ops.n_vertices} finite values, got shape {phi0.shape}")
         phi0 = self.frame.inverse_length(phi0)
-        raw, signs, _ = raw_curves(as_curves(curves))
-        pts = raw_points(as_point_sources(points))
+        ops0 = self.input_ops
+        parts = parse_curves(ops0, as_curves(curves))
+        pts = parse_points(ops0, as_point_sources(points))
         if self.intrinsic_delaunay:
-            raw, pts = self.domain.transfer(raw, pts, signs)
-        S = build_sources(self.ops, raw, pts, None)
-        ids, w, isv = self._all_nodes(S)
+            parts, pts = self.domain.transfer(parts, pts)
+        S = assemble(self.ops, [p._replace(signed=True) for p in parts], pts)   # only the source nodes count
+        rows, vertex = S.all_rows()
+        inner = rows[np.flatnonzero(vertex < 0)]
         fixed = np.zeros(self.ops.n_vertices, bool)
-        fixed[ids[isv < 0][w[isv < 0] > 0]] = True
+        fixed[inner.indices[inner.data > 0]] = True
         values = phi0.copy()
-        fixed[isv[isv >= 0]] = True
-        values[isv[isv >= 0]] = 0.0
+        fixed[vertex[vertex >= 0]] = True
+        values[vertex[vertex >= 0]] = 0.0
         out = sharpen(self.ops, phi0, fixed, values, iterations=_checks.integer(iterations, "iterations"))[0]
         return self.frame.length(out)
 
     def split_curve(self, curve) -> list:
         """The nodes of ``curve`` as (face, barycentric) points, split where segments cross edges, so that
         consecutive nodes share a face (the form potpourri3d requires)."""
-        from gsdf.heat.triangle._sources import _bary_curve_segments, _parse_curve
+        from gsdf.heat.triangle._sources import _bary_curve_segments
 
-        parsed = _parse_curve(curve, self.input_ops, 0)
-        if parsed[0] == "v":
-            vs = parsed[1]
-            return [(int(v), np.zeros(0)) for v in vs]
-        ids, w, _, _, _ = _bary_curve_segments(self.input_ops, parsed[1], parsed[2], "curve", return_faces=True)
+        parts = parse_curves(self.input_ops, [Curve(curve)])
+        if len(parts) != 1:
+            raise ValueError(f"curve: expected one curve, got an edge set of {len(parts)} paths")
+        (part,) = parts
+        if part.vertices is not None:
+            return [(int(v), np.zeros(0)) for v in part.vertices]
+        ids, w, _, _, _ = _bary_curve_segments(self.input_ops, part.faces, part.bary, "curve", return_faces=True)
         return list(zip(ids, w))
 
     def split_segments(self, curve) -> list:
@@ -308,13 +309,3 @@ class SurfaceSignedHeatSolver:
             pa, pb = ba @ Vf[self.F[fa]], bb @ Vf[self.F[fb]]
             out.append([(f, _bary_in_face(self.input_ops, pa, f)), (f, _bary_in_face(self.input_ops, pb, f))])
         return out
-
-    def _all_nodes(self, S):
-        rows = list(S.node_rows)
-        isv = list(S.node_is_vertex)
-        if S.point_rows is not None:
-            rows.append(S.point_rows)
-            isv.append(S.point_is_vertex)
-        ids = np.concatenate([r[0] for r in rows])
-        w = np.concatenate([r[1] for r in rows])
-        return ids, w, np.concatenate(isv)
