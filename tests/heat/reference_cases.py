@@ -89,20 +89,22 @@ def surface_cases():
 
 def volume_cases():
     """(name, kwargs of signed_heat_volume) on small grids and tets."""
+    from gsdf.heat.volume import VolumeHeatOptions as O
+
     from tests.shapes import fibonacci_sphere, uv_sphere
 
     V, F = uv_sphere(8, 16)
     F = F[:-6]                                                     # a hole
     P = fibonacci_sphere(300)
     return [
-        ("grid_mesh_none", dict(mesh=(V, F), resolution=16, level_set_constraint="none")),
-        ("grid_pts_none", dict(points=(P, P), resolution=16, level_set_constraint="none")),
-        ("grid_mesh_soft", dict(mesh=(V, F), resolution=16, level_set_constraint="zero")),
-        ("grid_mesh_exact", dict(mesh=(V, F), resolution=12, level_set_constraint="zero", constraint="exact")),
+        ("grid_mesh_none", dict(mesh=(V, F), resolution=16, options=O(level_set_constraint="none"))),
+        ("grid_pts_none", dict(points=(P, P), resolution=16, options=O(level_set_constraint="none"))),
+        ("grid_mesh_soft", dict(mesh=(V, F), resolution=16)),       # "zero" by the penalty c = 10 (soft_weight="auto")
+        ("grid_mesh_exact", dict(mesh=(V, F), resolution=12, options=O(soft_weight=None))),
         ("tet_mesh_zero", dict(mesh=(V, F), domain="tet", resolution=10)),
-        ("tet_mesh_multiple", dict(mesh=(V, F), domain="tet", resolution=10, level_set_constraint="multiple")),
-        ("tet_mesh_none", dict(mesh=(V, F), domain="tet", resolution=10, level_set_constraint="none")),
-        ("tet_heat", dict(mesh=(V, F), domain="tet", resolution=10, step1="heat")),
+        ("tet_mesh_multiple", dict(mesh=(V, F), domain="tet", resolution=10,
+                                   options=O(level_set_constraint="multiple"))),
+        ("tet_mesh_none", dict(mesh=(V, F), domain="tet", resolution=10, options=O(level_set_constraint="none"))),
     ]
 
 

@@ -80,7 +80,7 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
          estimate_normals, quiet):
     import numpy as np
 
-    from gsdf.heat.volume import signed_heat_volume
+    from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
 
     from gsdf.field import GridField, TetField
 
@@ -98,8 +98,10 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
         soft_weight = None
     update, close = _stage_progress(not quiet)
     try:
-        field = signed_heat_volume(domain="tet" if tet else "grid", resolution=grid, t_coef=t_coef, t_scale=t_scale,
-                                   level_set_constraint=constraint, soft_weight=soft_weight, progress=update, **kw)
+        options = VolumeHeatOptions(level_set_constraint=constraint, soft_weight=soft_weight, t_scale=t_scale,
+                                    progress=update)
+        field = signed_heat_volume(domain="tet" if tet else "grid", resolution=grid, t_coef=t_coef, options=options,
+                                   **kw)
     finally:
         close()
     with output_file(output) as tmp:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from gsdf._checks import choice
 from gsdf.heat._domain import HeatDomain
 from gsdf.heat._sources import Sources
 from gsdf.heat.triangle._operators import TriangleMeshOperators
@@ -48,7 +49,7 @@ class TriangleDomain(HeatDomain):
         self.ops = ops if ops is not None else TriangleMeshOperators(V, F)
         self.n_nodes = self.ops.n_vertices
         self.t = float(self.ops.h ** 2 if t is None else t)
-        self.connection = connection
+        self.connection = choice(connection, "connection", CONNECTIONS)
         real = connection == "real" or (connection == "auto" and not self.ops.consistent)
         self.heat_form = "real2" if real else "complex"
         self.C = self.ops.cotan_laplacian().tocsc()   # symmetric: the CSR arrays (transposed, exact copy)

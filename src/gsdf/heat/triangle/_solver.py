@@ -18,8 +18,6 @@ from gsdf.curves import Curve, as_curves, as_point_sources
 from gsdf.heat.triangle._operators import TriangleMeshOperators
 from gsdf.heat.triangle._sources import assemble, parse_curves, parse_points
 
-LEVEL_SETS = ("zero", "multiple", "none")
-CONNECTIONS = ("auto", "complex", "real")
 
 
 class SurfaceSignedHeatSolver:
@@ -37,9 +35,10 @@ class SurfaceSignedHeatSolver:
     F : (m, 3) int array
         Triangle mesh of any topology: boundary, several components, nonmanifold edges/vertices (operators are
         per-face sums, §9.4). Nonorientable meshes (and faces whose orientation disagrees with a neighbour's)
-        are handled exactly: transport across such an edge is a reflection, so the connection Laplacian is then
-        assembled as a real 2|E|×2|E| block matrix (see ``connection``); give the curve normals
-        (``curve_normals=`` of :meth:`compute_distance`) there, since face normals flip across the seam.
+        are handled exactly: transport across such an edge is a reflection, so the connection Laplacian of step I
+        is then assembled as a real 2|E|×2|E| block matrix that represents the reflections (the complex |E|×|E|
+        form of Eq. 9 when all faces agree); give the curve normals (``curve_normals=`` of
+        :meth:`compute_distance`) there, since face normals flip across the seam.
         Faces with repeated vertices or zero area raise ValueError (remove them first).
     t_coef : float
         Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6) of the input mesh.
@@ -55,11 +54,6 @@ class SurfaceSignedHeatSolver:
         applied per intrinsic face. Unsigned curves must be closed vertex polylines; ``curve_normals`` is not
         available; ``compute_distance_l1`` raises NotImplementedError. On a mesh that is already Delaunay no
         edge flips and the results equal those on the input triangulation.
-    connection : {"auto", "complex", "real"}
-        Form of the connection Laplacian of step I. ``"auto"``: complex ``|E|×|E|`` (Eq. 9) when all faces are
-        consistently oriented, else the real 2|E|×2|E| block form that also represents the reflections across
-        orientation flips. ``"real"`` forces the block form (same result on orientable meshes, ~2× slower);
-        ``"complex"`` forces Eq. 9 (wrong transport across orientation flips; for comparisons only).
 
     Scale: the mesh is mapped once into its frame (:class:`gsdf._normalize.Frame`: centred, power-of-two
     scale) and solved there, so results are scale-covariant (φ of ``s·V`` is ``s·φ``) from 1e-150 to 1e150;
@@ -82,13 +76,12 @@ class SurfaceSignedHeatSolver:
     -0.5
     """
 
-    def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False, connection: str = "auto"):
+    def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False):
         V, F = _checks.as_mesh(V, F)
         # scale invariance: everything runs in the geometry's frame (centre, power-of-two scale, exact);
         # distances are mapped back on output (gsdf._normalize)
         self.frame = Frame.of_mesh(V, F) if len(F) else Frame.of(V)
         self.V_world, V = V, self.frame.geometry(V)
-        self.connection = _checks.choice(connection, "connection", CONNECTIONS)
         self.t_coef = _checks.positive(t_coef, "t_coef")
         rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
         if rep.any():
@@ -109,9 +102,9 @@ class SurfaceSignedHeatSolver:
         if self.intrinsic_delaunay:
             # the triangulation is built on first use: by the first solve (with its curve edges kept
             # unflippable), or without fixed edges when an operator is accessed before any solve
-            self.domain = IntrinsicDomain(V, F, t=self.t, connection=self.connection, input_ops=self.input_ops)
+            self.domain = IntrinsicDomain(V, F, t=self.t, input_ops=self.input_ops)
         else:
-            self.domain = TriangleDomain(t=self.t, connection=self.connection, ops=self.input_ops)
+            self.domain = TriangleDomain(t=self.t, ops=self.input_ops)
         self.core = SignedHeatCore(self.domain)
         self.t = float(self.frame.area(self.t))  # reported in input units (the domain keeps the frame's)
 

@@ -6,13 +6,15 @@ the curve — the region a counter-clockwise curve encloses — negative ("negat
 and unoriented curves (whose normals point away from the source) still give positive distance. Compared with
 potpourri3d, signed curves give the opposite sign and unsigned sources the same values.
 
-Curves come in two forms (the contract of ``SurfaceSignedHeatSolver.compute_distance``):
+Curves arrive as :class:`gsdf.Curve` (type-checked by :func:`gsdf.curves.as_curves`); :func:`parse_curves` checks
+them against the mesh and :func:`assemble` turns them, with the point sources of :func:`parse_points`, into the
+one :class:`~gsdf.heat._sources.Sources` of the core:
 
-* an integer array of vertex indices: a polyline along mesh edges;
-* a list of surface points ``(face_index, barycentric (3,))`` (``(vertex_index, ())`` is also accepted, the
-  potpourri3d spelling of a vertex). Consecutive points normally share a face (or lie on one edge); a segment
-  whose end points share no face is split where it crosses mesh edges: it is traced face by face, heading in each face
-  for the end point projected into the face's plane (exactly the straight segment on planar regions, an
+* vertex polylines (and edge sets, chained into polylines) run along mesh edges;
+* surface points ``(face_index, barycentric (3,))`` (``(vertex_index, ())`` is also accepted, the potpourri3d
+  spelling of a vertex). Consecutive points normally share a face (or lie on one edge); a segment whose end
+  points share no face is split where it crosses mesh edges: it is traced face by face, heading in each face for
+  the end point projected into the face's plane (exactly the straight segment on planar regions, an
   approximation of it on curved ones).
 
 Every node becomes a row of a sparse interpolation matrix (nodes × |V|), which serves the level-set
