@@ -68,7 +68,7 @@ class VolumeHeatOptions:
     max_memory: int | None = None
     progress: Callable[[str, float], None] | None = None
 
-    def checked(self, domain: str) -> dict:
+    def _checked(self, domain: str) -> dict:
         """The options validated for ``domain`` (ValueError naming the option): a dict with ``mode`` and ``lam``
         (the soft weight, or None for the hard constraint) in place of the two constraint fields."""
         mode = choice(self.level_set_constraint, "level_set_constraint", set(LEVEL_SETS))
@@ -235,7 +235,7 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
         options = VolumeHeatOptions()
     elif not isinstance(options, VolumeHeatOptions):
         raise ValueError(f"options: expected a gsdf.VolumeHeatOptions, got {type(options).__name__}")
-    opt = options.checked(domain)
+    opt = options._checked(domain)
     # BLAS on one thread (or the explicit gsdf.threads setting) for the whole run: the CG loops of Step III
     # call BLAS dot / norm on 10⁴–10⁶-vectors, where threads cost more than they save
     with blas_region():
