@@ -117,6 +117,20 @@ def test_tet_point_cloud():
     assert np.all(np.abs(f(Q) - [-1.0, -0.5, 0.2]) < [0.2, 0.05, 0.03])  # the centre is a cusp of |x|
 
 
+def test_tet_soft_weight_tends_to_the_hard_constraint(sphere):
+    """The penalty λ Σ (φ(z_i) − φ(z_0))² on tets (the Poisson system pins one vertex: its constants are free)."""
+    V, F = sphere
+    hard = signed_heat_volume(mesh=(V, F), domain="tet", resolution=10)
+    spread = []
+    for lam in (1.0, 1e3):
+        f = signed_heat_volume(mesh=(V, F), domain="tet", resolution=10, options=VolumeHeatOptions(soft_weight=lam))
+        assert f.meta["soft_weight"] == lam and np.isfinite(f.values).all()
+        spread.append(np.ptp(f(V)))
+    assert spread[1] < 1e-2 * spread[0] and np.abs(f(V)).max() < 1e-4   # measured 0.0072, 2.5e-5
+    Q = np.random.default_rng(0).uniform(-1.2, 1.2, (500, 3))
+    assert np.abs(f(Q) - hard(Q)).max() < 1e-3
+
+
 def test_tet_bad_options(sphere):
     V, F = sphere
     for opts, match in [(dict(mesher="gmsh"), "mesher"), (dict(max_memory=1000), "allowed"),

@@ -316,14 +316,23 @@ class FactorizedPoisson(PoissonSolver):
         w = np.broadcast_to(np.asarray(w, np.float64), (A.shape[0],))
         key = hash_key(np.array([3]), w, A.indptr, A.indices, A.data)
 
+        # the exact gauge: the penalty (differences) leaves the constants free, so the first active unknown is
+        # pinned and nodes in no element get 0, as for the free solve
+        keep = np.flatnonzero(self._active)[1:] if self.exact_gauge else None
+
         def build():
             if np.all(w == w[0]):
                 K = self.L + w[0] * (A.T @ A) + sp.diags(self._eps * self.Mv)
             else:
                 K = self.L + A.T @ sp.diags(w) @ A + sp.diags(self._eps * self.Mv)
-            return self._spd(K.tocsc())
+            K = K.tocsc()
+            return self._spd(K if keep is None else K[keep][:, keep])
 
-        return self._cached(key, build).solve(b)
+        if keep is None:
+            return self._cached(key, build).solve(b)
+        phi = np.zeros(self.n)
+        phi[keep] = self._cached(key, build).solve(b[keep])
+        return phi
 
 
 class SignedHeatCore:
