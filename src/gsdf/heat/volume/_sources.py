@@ -63,9 +63,9 @@ def _cloud_sources(P: np.ndarray, N: np.ndarray, areas=None, k: int = 20, candid
     if areas is None:
         if len(P) < 4:
             raise ValueError(f"points: need at least 4 points to estimate point areas, got {len(P)}")
-        from gsdf.winding._point_areas import point_areas
+        from gsdf.winding._point_areas import _point_areas
 
-        areas = point_areas(P, U, k=min(k, len(P) - 1), candidates=candidates)
+        areas = _point_areas(P, U, k=min(k, len(P) - 1), candidates=candidates)
     a = as_weights(areas, len(P), "areas")
     keep &= a > 0
     if not keep.any():
