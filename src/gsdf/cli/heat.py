@@ -77,7 +77,7 @@ def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, lev
          estimate_normals, quiet):
     import numpy as np
 
-    from gsdf.heat.volume import signed_heat_volume
+    from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
 
     from gsdf.field import GridField, TetField
 
@@ -95,9 +95,10 @@ def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, lev
         soft_weight = None
     update, close = _stage_progress(not quiet)
     try:
+        options = VolumeHeatOptions(level_set_constraint=level_set, soft_weight=soft_weight, t_scale=t_scale,
+                                    progress=update)
         field = signed_heat_volume(domain="tet" if tet else "grid", resolution=resolution, t_coef=t_coef,
-                                   t_scale=t_scale, level_set_constraint=level_set, soft_weight=soft_weight,
-                                   progress=update, **kw)
+                                   options=options, **kw)
     finally:
         close()
     with output_file(output) as tmp:
