@@ -171,7 +171,7 @@ def test_bad_options_are_refused():
                                                  bisection_steps=10 ** 9), "bisection_steps"),
         (lambda: gsdf.tori.offset(lambda q: q[:, 0], [1, 2]), "r: expected a number"),
         (lambda: gsdf.ops.mesh_boolean(V, F, V + 0.3, F, "union",
-                                       options=gsdf.BooleanOptions(bisection_steps=np.inf)), "bisection_steps"),
+                                       options=gsdf.BooleanOptions(beta=np.inf)), "beta"),
     ]
     for fn, msg in bad:
         with pytest.raises(ValueError, match=msg):

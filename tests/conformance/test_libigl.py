@@ -426,24 +426,19 @@ def _assert_closed_manifold_genus(V, F, genus):
     assert euler_characteristic(V, F) == 2 - 2 * genus
 
 
-@pytest.mark.xfail(reason="mesh_boolean refuses an empty operand ('V: is empty (0 rows)'); union with nothing "
-                          "should return the (self-)union of A (issue 32)", strict=True, raises=ValueError)
 def test_MeshBoolean__TwoCubes():
     """mesh_boolean.cpp::"MeshBoolean: TwoCubes" — two-boxes-bad-self-union.ply (generated: helpers.py) united
-    with an empty mesh:
-    no exterior edges, vertex- and edge-manifold, genus 0."""
+    with an empty mesh: no exterior edges, vertex- and edge-manifold, genus 0. Regression: an empty operand was
+    refused ('V: is empty')."""
     V1, F1 = two_boxes_bad_self_union()
     Vo, Fo = gsdf.mesh_boolean(V1, F1, np.zeros((0, 3)), np.zeros((0, 3), np.int64), "union")
     _assert_closed_manifold_genus(Vo, Fo, 0)
 
 
-@pytest.mark.xfail(reason="trimming keeps or drops triangles by their vertices' winding numbers only: no cube "
-                          "vertex is inside the bar (w = 0), the bar's x = 0 vertices lie on the cube's face (w = 1/2, "
-                          "not > 1/2) and its x = 2 vertices outside, so nothing is cut: the cube comes back "
-                          "unchanged (Euler 2, volume 1.0; libigl: genus 1, volume 0.9375)", strict=True)
 def test_MeshBoolean__MinusTest():
     """mesh_boolean.cpp::"MeshBoolean: MinusTest" — unit cube minus a 2 x 0.25 x 0.25 bar through it
-    (coplanar at x = 0): closed, manifold, genus 1 (and volume 1 - 0.0625)."""
+    (coplanar at x = 0): closed, manifold, genus 1 (and volume 1 - 0.0625). Regression: trimming by vertex
+    winding numbers returned the cube unchanged (Euler 2, volume 1.0)."""
     A = libigl_mesh("boolean_minus_test_cube.obj")
     B = libigl_mesh("boolean_minus_test_green.obj")
     Vo, Fo = gsdf.mesh_boolean(*A, *B, "difference")
@@ -451,19 +446,14 @@ def test_MeshBoolean__MinusTest():
     assert abs(enclosed_volume(Vo, Fo) - 0.9375) < 1e-9
 
 
-@pytest.mark.xfail(reason="trimming classifies vertices only: A's vertices are B's corners, where w_B = 1/8 (a "
-                          "corner's solid angle), below 1/2, so every triangle is dropped and A ∩ A comes back empty "
-                          "(issue 32: coincident surfaces)", strict=True)
 def test_MeshBoolean__IntersectWithSelf():
-    """mesh_boolean.cpp::"MeshBoolean: IntersectWithSelf" — cube ∩ cube: closed, manifold, genus 0."""
+    """mesh_boolean.cpp::"MeshBoolean: IntersectWithSelf" — cube ∩ cube: closed, manifold, genus 0.
+    Regression: coincident faces were dropped (an empty result)."""
     V, F = libigl_mesh("cube.obj")
     Vo, Fo = gsdf.mesh_boolean(V, F, V, F, "intersection")
     _assert_closed_manifold_genus(Vo, Fo, 0)
 
 
-@pytest.mark.xfail(reason="no vertex of either tet is inside the other (w = 0, and 1/4 at each apex, which lies on "
-                          "an edge of the other's base), so no triangle is cut or dropped: the 'union' is both tets, "
-                          "overlapping (volume 8/3; libigl's closed union: 7/3)", strict=True)
 def test_python_cgal__mesh_boolean_union():
     """test_all.py::test_cgal — igl.copyleft.cgal.mesh_boolean(VA, FA, VB, FB, "union") of a tet and its z-flip
     (libigl asserts nothing; compared with libigl's own answer: same volume, closed)."""
@@ -673,9 +663,6 @@ def test_point_areas__sphere_no_outliers():
     assert (err > 0.1).sum() == 0
 
 
-@pytest.mark.xfail(reason="the trimmed self-union of two-boxes-bad-self-union.ply is not closed (480 boundary "
-                          "edges): the input is an unwelded soup whose own faces are trimmed against the same "
-                          "field, and kept triangles are not stitched where the two copies meet", strict=True)
 def test_MeshBoolean__TwoCubes_as_self_union():
     """mesh_boolean.cpp::"MeshBoolean: TwoCubes" through the call gsdf accepts (A ∪ A instead of A ∪ ∅): closed,
     manifold, genus 0."""

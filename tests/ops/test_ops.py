@@ -383,21 +383,6 @@ def test_boolean_with_point_cloud_field(spheres):
     assert abs(volume(V, F) / ANALYTIC["union"] - 1) < 0.02
 
 
-def test_boolean_without_stitching_leaves_the_seam_open(spheres, boolean_results):
-    VA, FA, VB, FB = spheres
-    V, F = mesh_boolean(VA, FA, VB, FB, "union", options=BooleanOptions(stitch=False))
-    und, dirc = edge_counts(F)
-    assert np.all(dirc == 1) and set(np.unique(und)) == {1, 2}
-    # the open edges are exactly the two trim loops, whose vertices lie on the intersection circle x = 0.4
-    H = np.concatenate((F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]))
-    Hs = np.sort(H, axis=1)
-    u, c = np.unique(Hs, axis=0, return_counts=True)
-    seam = np.unique(u[c == 1])
-    assert np.allclose(V[seam, 0], 0.4, atol=0.01)
-    Vs, Fs = boolean_results["union"]
-    assert len(Fs) - len(F) == len(seam)  # the zipper adds one triangle per seam vertex
-
-
 def test_trim_mesh_plane():
     V, F = icosphere(3)
     Vt, Ft = trim_mesh(V, F, lambda Q: (Q[:, 2] < 0).astype(float), keep="inside", bisection_steps=20)
@@ -433,8 +418,6 @@ def test_boolean_bad_input():
         mesh_boolean(VA, FA - 1, VB, FA, "union")
     with pytest.raises(ValueError, match="shape"):
         mesh_boolean(VA[:, :2], FA, VB, FA, "union")
-    with pytest.raises(ValueError, match="bisection_steps"):
-        mesh_boolean(VA, FA, VB, FA, "union", options=BooleanOptions(bisection_steps=-1))
     with pytest.raises(ValueError, match="beta"):
         mesh_boolean(VA, FA, VB, FA, "union", options=BooleanOptions(beta=float("nan")))
     with pytest.raises(ValueError, match="options"):

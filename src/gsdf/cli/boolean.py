@@ -1,4 +1,4 @@
-"""``gsdf boolean``: union / intersection / difference of soups by trimming against winding fields."""
+"""``gsdf boolean``: union / intersection / difference of meshes or soups (their winding-number regions)."""
 
 from __future__ import annotations
 
@@ -19,8 +19,9 @@ from gsdf.cli._options import (
 @click.command("boolean", short_help="Union, intersection, difference of meshes or soups.",
                help="""Boolean of meshes A and B, robust to holes and soups (Barill et al. 2018, Figs. 12-15).
 
-Each mesh is trimmed against the 1/2 level set of the other's winding number; triangles straddling the
-level set are cut. `difference` is A minus B.
+The boundary of the union, intersection or difference of the regions where the winding numbers of A and B
+exceed 1/2, cut exactly along the intersection curves (closed inputs give a closed output). `difference` is
+A minus B.
 
 \b
 Example:
