@@ -7,6 +7,9 @@ the argument and the problem, instead of crashing inside a numba kernel.
 
 from __future__ import annotations
 
+import functools
+import inspect
+
 import numpy as np
 
 
@@ -161,3 +164,53 @@ def choice(x, name: str, options) -> str:
     if not isinstance(x, (str, int)) or isinstance(x, bool) or x not in options:
         raise ValueError(f"{name}: must be one of {sorted(options)}, got {x!r}")
     return x
+
+
+def query_shaped(dim: int = 3):
+    """Decorator for a function or method whose argument ``Q`` is a set of query points.
+
+    Besides the (q, dim) array the function takes, ``Q`` may have any shape (..., dim): the function sees the
+    points as (q, dim) rows, and every result whose first axis runs over the queries comes back shaped
+    (...) + its trailing shape (numpy's convention; Open3D's raycasting scene does the same). An empty set of
+    queries ((0, dim), or any shape with a zero) gives empty results of the right dtypes and trailing shapes,
+    as numpy functions do: the function is run on one dummy point and its results are cut to no row.
+    """
+
+    def deco(fn):
+        names = list(inspect.signature(fn).parameters)
+        pos = names.index("Q")
+
+        @functools.wraps(fn)
+        def wrapper(*args, **kwargs):
+            given = len(args) > pos
+            if not given and "Q" not in kwargs:
+                return fn(*args, **kwargs)
+            Q = args[pos] if given else kwargs["Q"]
+            try:
+                A = np.asarray(Q)
+            except Exception:  # ragged input: let the function refuse it with its own message
+                return fn(*args, **kwargs)
+            if A.ndim < 2 or A.shape[-1] != dim or A.dtype == object or (A.ndim == 2 and A.shape[0] > 0):
+                return fn(*args, **kwargs)  # (q, dim) with q > 0, or a single point: unchanged
+            lead = A.shape[:-1]
+            flat = A.reshape(-1, dim)
+            n = flat.shape[0]
+            if n == 0:
+                flat = np.zeros((1, dim))
+            if given:
+                args = args[:pos] + (flat,) + args[pos + 1:]
+            else:
+                kwargs = dict(kwargs, Q=flat)
+            return _shape_results(fn(*args, **kwargs), lead, n)
+
+        return wrapper
+
+    return deco
+
+
+def _shape_results(out, lead, n):
+    if isinstance(out, tuple):
+        return tuple(_shape_results(o, lead, n) for o in out)
+    if isinstance(out, np.ndarray) and out.ndim >= 1 and out.shape[0] == max(n, 1):
+        return out[:n].reshape(lead + out.shape[1:])
+    return out

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_points
+from gsdf._checks import as_points, query_shaped
 from gsdf.contour._tets import locate_in_tets, marching_tetrahedra
 from gsdf.grid import Grid
 
@@ -107,6 +107,7 @@ class GridField(Field):
         """Node positions, shape (nx*ny*nz, 3), in C order of ``values``."""
         return self.grid.points()
 
+    @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         """Trilinear interpolation at query points ``Q`` (q, 3); points outside are clamped to the box."""
         Q = as_points(Q, "Q", allow_empty=True)
@@ -340,6 +341,7 @@ class TetField(Field):
     def bbox_max(self):
         return self.vertices.max(axis=0)
 
+    @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         """Barycentric (piecewise linear) interpolation at ``Q`` (q, 3); outside the mesh: nearest vertex."""
         Q = as_points(Q, "Q", allow_empty=True)
@@ -448,6 +450,7 @@ class SurfaceField(Field):
             raise ValueError(f"bary: expected finite shape ({len(face)}, 3), got {bary.shape}")
         return (bary * self.values[self.faces[face]]).sum(axis=1)
 
+    @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         """Values at the points of the surface closest to ``Q`` (q, 3) (on the surface: at ``Q`` itself)."""
         Q = as_points(Q, "Q", allow_empty=True)

@@ -207,7 +207,7 @@ def _marching_cubes_case(unpacked, stride):
     V, F = gsdf.read_mesh(unpacked(P, "bunny_oded.obj"))
     V = normalize_points(V, center=[0.5, 0.5, 0.5])
     gs = 150
-    field = gsdf.signed_distance_grid(V, F, resolution=gs, bbox_min=[0, 0, 0], bbox_max=[1, 1, 1])
+    field = gsdf.signed_distance_grid(V, F, resolution=gsdf.Grid.fit(([0, 0, 0], [1, 1, 1]), gs))
     s1 = field.values.ravel()
     U, G = field.isosurface(0.0)
     GV = field.grid_points().reshape(-1, 3)
@@ -236,7 +236,7 @@ def test_offset_surface__bunny(unpacked):
     (gpytoolbox checks with do_meshes_intersect; gsdf has no triangle–triangle test, so: every vertex of the
     0.1 offset lies outside the 0.05 offset and every vertex of the 0.05 offset inside the 0.1 offset.)"""
     V, F = gsdf.read_mesh(unpacked(P, "bunny_oded.obj"))
-    field = gsdf.signed_distance_grid(V, F, resolution=50, pad=0.3)
+    field = gsdf.signed_distance_grid(V, F, resolution=gsdf.Grid.around(V, 50, pad=0.3))
     u1, g1 = gsdf.offset_surface(field, 0.05)
     u2, g2 = gsdf.offset_surface(field, 0.1)
     assert (gsdf.signed_distance(u1, g1, u2) > 0).all()
@@ -362,14 +362,15 @@ def test_read_mesh__ply_read_then_write(unpacked, tmp_path, which, binary):
                 assert np.isclose(got[k], v).all()
 
 
-@pytest.mark.xfail(reason="write_mesh(vertex_data=) takes (n,) arrays only ('expected a numeric array of shape "
-                          "(n,)'): gpytoolbox's N= (n, 3) and C= (n, 4) have to be split by hand (issue 32)",
-                   strict=True, raises=ValueError)
 def test_read_mesh__ply_write_normals_as_one_array(unpacked, tmp_path):
     """test_read_mesh.py::test_ply_read_then_write — write_mesh(..., N=N) with N (n, 3): one per-vertex
-    attribute of 3 components."""
+    attribute of 3 components, read back as its columns normal_0 .. normal_2. Regression: refused."""
     V, F = gsdf.read_mesh(unpacked(P, "example_cube-ascii.ply"))
-    gsdf.write_mesh(str(tmp_path / "temp.ply"), V, F, vertex_data={"normal": np.random.rand(len(V), 3)})
+    N = np.random.default_rng(1).random((len(V), 3))
+    p = str(tmp_path / "temp.ply")
+    gsdf.write_mesh(p, V, F, vertex_data={"normal": N})
+    got = gsdf.read_vertex_data(p)
+    assert np.all(np.column_stack([got[f"normal_{j}"] for j in range(3)]) == N)
 
 
 @pytest.mark.xfail(reason="gsdf writes and reads no per-face attributes (gpytoolbox C with one row per face)",

@@ -60,18 +60,11 @@ def test_compute_occupancy(o3d):
     np.testing.assert_allclose((w >= 0.5).astype(float), [1.0, 0.0])
 
 
-@pytest.mark.parametrize("shape", [
-    [11],
-    pytest.param([1, 2, 3], marks=pytest.mark.xfail(
-        reason="queries shaped (..., 3) are refused ('Q: expected shape (n, 3), got (1, 2, 3, 3)'); Open3D returns "
-               "(...)-shaped results (issue 32)", strict=True, raises=ValueError)),
-    pytest.param([32, 14], marks=pytest.mark.xfail(
-        reason="queries shaped (..., 3) are refused ('Q: expected shape (n, 3), got (32, 14, 3)') (issue 32)",
-        strict=True, raises=ValueError)),
-])
+@pytest.mark.parametrize("shape", [[11], [1, 2, 3], [32, 14], [0]])
 def test_output_shapes(shape):
     """test_raycasting_scene.py::test_output_shapes — distance, signed distance and occupancy of queries shaped
-    shape + [3] have shape ``shape``; closest points shape + [3]. (Ray outputs: no gsdf counterpart.)"""
+    shape + [3] have shape ``shape``; closest points shape + [3]. (Ray outputs: no gsdf counterpart.) [0]: an
+    empty query array gives empty results. Regression: (..., 3) and (0, 3) queries were refused."""
     rs = np.random.RandomState(123)
     rs.uniform(size=shape + [6])                      # the rays drawn first, as the peer does
     q = rs.uniform(size=shape + [3]).astype(np.float32)
@@ -98,7 +91,7 @@ def test_sphere_wrong_occupancy(o3d):
     V, F = o3d["tsphere_V"], o3d["tsphere_F"]
     xyz_range = np.linspace(V.min(0) * 1.1, V.max(0) * 1.1, num=6)
     q = np.stack(np.meshgrid(*xyz_range.T), axis=-1).astype(np.float32)
-    occ = (gsdf.winding_number(V, F, q.reshape(-1, 3)) >= 0.5).astype(np.float32).reshape(q.shape[:-1])
+    occ = (gsdf.winding_number(V, F, q) >= 0.5).astype(np.float32)  # (6, 6, 6, 3) queries -> (6, 6, 6)
     np.testing.assert_equal(occ, EXPECTED)
 
 

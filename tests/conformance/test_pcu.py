@@ -50,13 +50,20 @@ def test_closest_points_on_mesh(unpacked):
     assert round(float(np.max(np.abs(d - np.linalg.norm(p - C, axis=1)))), 7) == 0.0
 
 
-@pytest.mark.xfail(reason="read_mesh refuses a PLY without faces ('no faces; is this a point cloud? use "
-                          "read_points'); point-cloud-utils' load_mesh_vf returns v and an empty f (issue 32)",
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): read_mesh refuses a PLY without "
+                          "faces with a message naming read_points ('no faces; is this a point cloud? use "
+                          "read_points'); point-cloud-utils' load_mesh_vf returns v and an empty f",
                    strict=True, raises=ValueError)
 def test_ply_load_save__as_mesh(unpacked, tmp_path):
     """test_examples.py::test_ply_load_save — load_mesh_vf(duplicated_pcloud.ply) then save_mesh_vf."""
     v, f = gsdf.read_mesh(unpacked(P, "duplicated_pcloud.ply"))
     gsdf.write_mesh(str(tmp_path / "test.ply"), v, f)
+
+
+def test_ply_load_save__refusal_names_read_points(unpacked):
+    """What read_mesh says instead: the faceless PLY is refused, and the message names the function to call."""
+    with pytest.raises(ValueError, match="no faces; is this a point cloud\\? use read_points"):
+        gsdf.read_mesh(unpacked(P, "duplicated_pcloud.ply"))
 
 
 def test_ply_load_save__as_points(unpacked, tmp_path):
@@ -81,15 +88,16 @@ def test_ply_with_custom_attributes__scalar(unpacked, tmp_path):
     assert np.all(gsdf.read_vertex_data(p)["scalar"] == scalar)
 
 
-@pytest.mark.xfail(reason="write_mesh(vertex_data=) takes (n,) arrays only: a (n, 3) 'vector' attribute is refused "
-                          "('expected a numeric array of shape (n,)') (issue 32)", strict=True, raises=ValueError)
 def test_ply_with_custom_attributes__vector(unpacked, tmp_path):
-    """test_examples.py::test_ply_with_custom_attributes — a (n, 3) per-vertex attribute survives exactly."""
+    """test_examples.py::test_ply_with_custom_attributes — a (n, 3) per-vertex attribute survives exactly (PLY
+    properties are scalars: it is stored and read back as vector_0, vector_1, vector_2). Regression: an (n, 3)
+    entry was refused ('expected a numeric array of shape (n,)')."""
     v, f = gsdf.read_mesh(unpacked(P, "bunny.ply"))
     vector = np.random.default_rng(0).random(v.shape)
     p = str(tmp_path / "test.ply")
     gsdf.write_mesh(p, v, f, vertex_data={"vector": vector})
-    assert np.all(gsdf.read_vertex_data(p)["vector"] == vector)
+    got = gsdf.read_vertex_data(p)
+    assert np.all(np.column_stack([got[f"vector_{j}"] for j in range(3)]) == vector)
 
 
 def test_triangle_soup_fast_winding_number(unpacked):

@@ -79,14 +79,13 @@ def test_write_read_point_cloud(tmp_path, ext):
     assert np.amax(np.abs(V - Vnew)) < 1e-6
 
 
-@pytest.mark.xfail(reason="SurfaceSignedHeatSolver refuses the soup: 'F: face 986 repeats a vertex (5 degenerate "
-                          "faces); remove degenerate triangles first' (issue 32: drop them with a warning). Without "
-                          "those 5 faces the same call works", strict=True, raises=ValueError)
 def test_mesh_heat_distance():
     """potpourri3d_test.py::test_mesh_heat_distance — distance from vertex 7 and from [1, 2, 3] on the random
-    soup: one value per vertex (stateful solver and one-off calls)."""
+    soup: one value per vertex (stateful solver and one-off calls). The soup has faces that repeat a vertex:
+    dropped with a warning. Regression: the mesh was refused ('F: face 986 repeats a vertex')."""
     V, F = generate_verts(), generate_faces()
-    s = gsdf.SurfaceSignedHeatSolver(V, F)
+    with pytest.warns(UserWarning, match="repeat a vertex"):
+        s = gsdf.SurfaceSignedHeatSolver(V, F)
     assert s.compute_distance([], points=[7]).shape[0] == V.shape[0]
     assert s.compute_distance([], points=[1, 2, 3]).shape[0] == V.shape[0]
 

@@ -148,7 +148,8 @@ def test_tet_compute_distance_to_point_cloud(cloud):
 
 @pytest.fixture(scope="module")
 def tet_iso(bunny):
-    f = gsdf.signed_heat_volume(mesh=bunny, domain="tet", resolution=TET_RESOLUTION, level_set_constraint="zero")
+    f = gsdf.signed_heat_volume(mesh=bunny, domain="tet", resolution=TET_RESOLUTION,
+                                options=gsdf.VolumeHeatOptions(level_set_constraint="zero"))
     return f.isosurface(0.0)
 
 
@@ -187,8 +188,9 @@ def test_grid_get_grid_resolution(grid_default):
     assert len(res) == 3 and all(r > 0 for r in res)
 
 
-@pytest.mark.xfail(reason="signed_heat_volume refuses a box that does not contain the input (bunny_small reaches "
-                          "x = ±1.0014, the peer's box is [-1, 1]^3); signedheat3d accepts it", strict=True,
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): signed_heat_volume refuses a box "
+                          "that does not contain the input (bunny_small reaches x = ±1.0014, the peer's box is "
+                          "[-1, 1]^3); signedheat3d accepts it and leaves the input's tips outside", strict=True,
                    raises=ValueError)
 def test_grid_get_bbox(bunny):
     """test.py::TestGridSolver::test_get_bbox — bbox_min = (-1,-1,-1), bbox_max = (1,1,1) are returned as set
@@ -197,14 +199,13 @@ def test_grid_get_bbox(bunny):
     assert np.linalg.norm(f.bbox_min - [-1, -1, -1]) < 1e-8 and np.linalg.norm(f.bbox_max - [1, 1, 1]) < 1e-8
 
 
-@pytest.mark.xfail(reason="the refusal prints gsdf's internal frame (box [-0.4997..., 0.5002...], input box "
-                          "[-0.5004..., 0.5004...]) instead of the user's units (issue 32)", strict=True)
 def test_grid_get_bbox_error_in_user_units(bunny):
-    """The refusal of test_get_bbox's box names the boxes in the caller's units (the given ±1)."""
+    """The refusal of test_get_bbox's box names the boxes in the caller's units (the given ±1). Regression: it
+    printed gsdf's internal frame (±0.5)."""
     with pytest.raises(ValueError) as e:
         gsdf.signed_heat_volume(mesh=bunny, bbox_min=[-1, -1, -1], bbox_max=[1, 1, 1], resolution=8)
     msg = str(e.value)
-    assert "-1." in msg and "1.0014" in msg
+    assert "[[-1. -1. -1.], [1. 1. 1.]]" in msg and "-1.00139" in msg  # the given box, the bunny's x reach
 
 
 def test_grid_to_grid_array(grid_default):

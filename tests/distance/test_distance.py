@@ -381,14 +381,11 @@ def test_bad_input_raises_value_error():
         lambda: unsigned_distance(V, F[:, :2], Q),
         lambda: unsigned_distance(V, F + 1, Q),
         lambda: unsigned_distance(V, F - 1, Q),
-        lambda: unsigned_distance(V, F, np.zeros((0, 3))),
         lambda: unsigned_distance(V, np.zeros((0, 3), int), Q),
         lambda: TriangleDistance(V, F, leaf_size=0),
         lambda: TriangleDistance(V, F, leaf_size=2.5),
-        lambda: TriangleDistance(V, F).query(np.zeros((0, 3))),
         lambda: signed_distance(V, F, Qn),
         lambda: signed_distance(V, F, Q, beta=-1),
-        lambda: point_cloud_distance(V, np.zeros((0, 3))),
         lambda: point_cloud_distance(Vn, Q),
         lambda: signed_distance_points(V, V[:3], Q),
         lambda: signed_distance_points(V, np.zeros_like(V), Q),
@@ -399,6 +396,10 @@ def test_bad_input_raises_value_error():
         with pytest.raises(ValueError):
             case()
             pytest.fail(f"case {k} did not raise")
+    # no queries is not an error: empty results (tests/test_query_shapes.py covers every call)
+    assert unsigned_distance(V, F, np.zeros((0, 3))).shape == (0,)
+    assert TriangleDistance(V, F).query(np.zeros((0, 3)))[2].shape == (0, 3)
+    assert point_cloud_distance(V, np.zeros((0, 3))).shape == (0,)
 
 
 def test_bad_sign_mode_names_the_options():
@@ -426,3 +427,67 @@ def test_refit_answers_as_a_fresh_tree():
         np.testing.assert_allclose(np.einsum("qk,qkx->qx", bary, W[F[face]]), cl, atol=1e-12)
     with pytest.raises(ValueError, match="V"):
         td.refit(V[:-1])
+
+
+def _airplane():
+    """A closed fuselage (a capped octagonal tube along x) and single-layer wings and tail crossing it: the
+    ShapeNet airplane's (mesh2sdf's plane.obj) mix of solid parts and double-sided sheets."""
+    import gsdf
+
+    k = 8
+    ang = np.arange(k) * 2 * np.pi / k
+    xs = np.array([-1.0, 1.0])
+    ring = np.column_stack([np.cos(ang), np.sin(ang)]) * 0.15
+    V = [np.column_stack([np.full(k, x), ring]) for x in xs] + [np.array([[-1.0, 0, 0], [1.0, 0, 0]])]
+    V = np.vstack(V)
+    F = []
+    for i in range(k):
+        j = (i + 1) % k
+        F += [[i, j, k + j], [i, k + j, k + i]]  # the side, outward
+        F += [[2 * k, j, i], [2 * k + 1, k + i, k + j]]  # the caps
+    F = np.array(F)
+    assert gsdf.mesh_topology(V, F)["closed"]
+    wing = np.array([[-0.3, -1.2, 0], [0.3, -1.2, 0], [0.3, 1.2, 0], [-0.3, 1.2, 0]])
+    W = np.array([[0, 1, 2], [0, 2, 3]]) + len(V)
+    return np.vstack([V, wing]), np.vstack([F, W])
+
+
+def test_shell_gives_double_sided_sheets_an_inside():
+    """Open single-layer sheets have no inside (winding number 1/2 on one side, -1/2 on the other): a point just
+    above a wing is outside. With shell=t the wing is a plate of thickness t; the solid fuselage stays inside
+    either way; nothing changes beyond t/2 of the surface."""
+    import gsdf
+
+    V, F = _airplane()
+    Q = np.array([[0.0, 0.8, 0.01], [0.0, 0.8, -0.01], [0.0, 0.0, 0.05], [0.0, 0.8, 0.3], [0.9, 0.0, 0.0]])
+    s = gsdf.signed_distance(V, F, Q)
+    assert s[0] > 0 and s[1] > 0 and s[2] < 0 and s[3] > 0 and s[4] < 0
+    t = 0.04
+    sh = gsdf.signed_distance(V, F, Q, shell=t)
+    np.testing.assert_allclose(sh[:2], 0.01 - t / 2, atol=1e-12)  # inside the plate
+    assert sh[2] < 0 and sh[4] < 0 and sh[2] <= s[2]
+    assert sh[3] == pytest.approx(s[3] - t / 2)
+    G = gsdf.signed_distance_grid(V, F, resolution=24, shell=t)
+    G0 = gsdf.signed_distance_grid(V, F, resolution=24)
+    np.testing.assert_allclose(G.values, np.minimum(G0.values, np.abs(G0.values) - t / 2))
+    with pytest.raises(ValueError, match="shell"):
+        gsdf.signed_distance(V, F, Q, shell=-1.0)
+
+
+def test_signed_distance_return_closest_is_libigls_output():
+    """libigl's signed_distance(P, V, F) returns (S, I, C, N): the closest triangle, closest point, normal."""
+    import gsdf
+
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 1, 3], [0, 2, 1], [0, 3, 2], [1, 2, 3]])
+    Q = np.array([[0.5, 0.5, 0.5], [0.1, 0.1, -1.0], [-1.0, -1.0, -1.0]])
+    for sign in ("winding", "pseudonormal"):
+        S, I, C, N = gsdf.signed_distance(V, F, Q, sign=sign, return_closest=True)
+        np.testing.assert_allclose(S, gsdf.signed_distance(V, F, Q, sign=sign))
+        d, face, C2 = gsdf.unsigned_distance(V, F, Q, return_closest=True)
+        np.testing.assert_array_equal(I, face)
+        np.testing.assert_allclose(C, C2)
+        np.testing.assert_allclose(np.linalg.norm(N, axis=1), 1)
+    assert I[0] == 3 and I[1] == 1
+    np.testing.assert_allclose(C[0], [1 / 3] * 3, atol=1e-15)
+    np.testing.assert_allclose(N[2], -np.ones(3) / np.sqrt(3), atol=1e-12)  # pseudonormal at the corner vertex

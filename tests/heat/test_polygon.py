@@ -190,8 +190,10 @@ def test_polygon_bad_input():
         PolygonMeshSignedHeatSolver(V, [[0, 1]])
     with pytest.raises(ValueError, match="out of range"):
         PolygonMeshSignedHeatSolver(V, [[0, 1, 99]])
-    with pytest.raises(ValueError, match="repeats a vertex"):
-        PolygonMeshSignedHeatSolver(V, [[0, 1, 6, 1]])
+    with pytest.warns(UserWarning, match="1 polygons repeat a vertex"):  # dropped, not refused
+        s = PolygonMeshSignedHeatSolver(V, list(Q) + [[0, 1, 6, 1]])
+    np.testing.assert_allclose(s.compute_distance([], points=[3]),
+                               PolygonMeshSignedHeatSolver(V, Q).compute_distance([], points=[3]))
     with pytest.raises(ValueError, match="empty"):
         PolygonMeshSignedHeatSolver(V, [])
     with pytest.raises(ValueError, match="t_coef"):

@@ -203,8 +203,8 @@ def test_bad_options(small):
 
 def test_bad_mesh():
     V, F = grid_mesh(4)
-    with pytest.raises(ValueError, match="repeats a vertex"):
-        SurfaceSignedHeatSolver(V, np.concatenate([F, [[0, 0, 1]]]))
+    with pytest.raises(ValueError, match="every face repeats a vertex"), pytest.warns(UserWarning):
+        SurfaceSignedHeatSolver(V, [[0, 0, 1]])
     V2 = np.concatenate([V, [[2.0, 2.0, 0.0]]])
     with pytest.raises(ValueError, match="zero area"):
         SurfaceSignedHeatSolver(V2, np.concatenate([F, [[0, 4, 2]]]))   # collinear (along y = -1)
@@ -254,3 +254,25 @@ def test_sharpening_keeps_sign_and_lipschitz(disk):
     assert _eps(solver, phi, exact) < 1.2 * _eps(solver, phi0, exact) + 1e-3
     with pytest.raises(ValueError, match="phi0"):
         solver.sharpen(phi0[:-1], curves)
+
+
+def test_faces_repeating_a_vertex_are_dropped_with_a_warning():
+    """potpourri3d's random soup has faces like (i, i, j): they have no area; the solver drops them with a
+    warning (it refused the mesh), the distance equals that on the mesh without them, and face indices in
+    sources still refer to the input faces."""
+    from gsdf.data._shapes import grid_mesh
+
+    V, F = grid_mesh(8)
+    bad = np.array([[3, 3, 4], [10, 11, 10]])
+    Fb = np.vstack([F[:5], bad[:1], F[5:], bad[1:]])  # input face 5 and the last are degenerate
+    with pytest.warns(UserWarning, match="2 faces repeat a vertex"):
+        sb = SurfaceSignedHeatSolver(V, Fb)
+    s = SurfaceSignedHeatSolver(V, F)
+    np.testing.assert_allclose(sb.compute_distance([], points=[7]), s.compute_distance([], points=[7]))
+    b = np.array([0.2, 0.3, 0.5])
+    # input face 6 is face 5 of the mesh without the degenerate ones
+    np.testing.assert_allclose(sb.compute_distance([], points=[(6, b)]), s.compute_distance([], points=[(5, b)]))
+    curve = [(6, b), (20, b), (41, b)]
+    np.testing.assert_allclose(sb.compute_distance([curve]), s.compute_distance([[(5, b), (19, b), (40, b)]]))
+    with pytest.raises(ValueError, match="face 5 repeats a vertex"):
+        sb.compute_distance([], points=[(5, b)])

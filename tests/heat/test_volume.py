@@ -180,3 +180,17 @@ def test_input_spacing_and_t_scale_input():
 def test_bad_input(kwargs, msg):
     with pytest.raises(ValueError, match=msg):
         signed_heat_volume(**kwargs)
+
+
+def test_box_refusal_names_the_boxes_in_the_callers_units():
+    """A box that does not contain the input is refused, and the message gives both boxes in the caller's
+    coordinates (not the internal frame's: ±0.5 for the caller's ±1)."""
+    import gsdf
+    from gsdf.data._shapes import sphere_mesh
+
+    V, F = sphere_mesh(2)
+    V = V * [1.5, 1.0, 1.0] + [10.0, 0, 0]  # x from 8.5 to 11.5
+    with pytest.raises(ValueError) as e:
+        gsdf.signed_heat_volume(mesh=(V, F), bbox_min=[9, -2, -2], bbox_max=[11, 2, 2], resolution=8)
+    msg = str(e.value)
+    assert "9." in msg and "11." in msg and "8.5" in msg and "11.5" in msg

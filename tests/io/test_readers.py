@@ -557,9 +557,39 @@ def test_gmsh_and_medit_through_meshio(tmp_path):
         V, polys = read_mesh(tmp_path / name, triangulate=False)
         np.testing.assert_allclose(V, SOUP_V)
         assert [q.tolist() for q in polys] == [[0, 1, 5], [0, 1, 5], [0, 1, 2, 3]]  # tetra and line ignored
-    meshio.write(tmp_path / "vol.vtu", meshio.Mesh(SOUP_V, [("tetra", np.array([[0, 1, 2, 5]]))]))
-    with pytest.raises(ValueError, match=errmsg(tmp_path / "vol.vtu") + ".*only volume cells \\(tetra\\)"):
+    meshio.write(tmp_path / "vol.vtu", meshio.Mesh(SOUP_V, [("hexahedron", np.array([[0, 1, 2, 3, 4, 5, 0, 1]]))]))
+    with pytest.raises(ValueError, match=errmsg(tmp_path / "vol.vtu") + ".*only volume cells \\(hexahedron\\)"):
         read_mesh(tmp_path / "vol.vtu")
+
+
+def test_tets_only_give_their_boundary(tmp_path):
+    """A volume mesh of tetrahedra only (.msh, .mesh, .vtu): its surface is the boundary of the tets, outward
+    (libigl's readMESH test case: one tet, no triangle section)."""
+    import meshio
+
+    X = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [1, 0, 0], [1, 1, 1.0]])
+    T = np.array([[0, 1, 2, 3], [1, 2, 3, 4]])  # negative, then positive volume: both come out outward
+    for name, fmt in (("t.msh", "gmsh22"), ("t.mesh", "medit"), ("t.vtu", None)):
+        meshio.write(tmp_path / name, meshio.Mesh(X, [("tetra", T)]), file_format=fmt)
+        V, F = read_mesh(tmp_path / name)
+        np.testing.assert_allclose(V, X)
+        assert F.shape == (6, 3)  # 8 tet faces, the shared one dropped
+        vol = np.einsum("ij,ij->i", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])).sum() / 6
+        assert vol == pytest.approx(1 / 6 + 1 / 3)
+
+
+def test_gmsh_element_data_meshio_cannot_attach_is_skipped(tmp_path):
+    """Element data over the tets of a Gmsh file that also has triangles: meshio refuses the file ("Incompatible
+    cell data"); read_mesh reads it without the data sections (libigl's readMSH test file is of this kind)."""
+    X = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    txt = ("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n"
+           + "".join(f"{i + 1} {x} {y} {z}\n" for i, (x, y, z) in enumerate(X))
+           + "$EndNodes\n$Elements\n2\n1 2 2 1 1 1 3 2\n2 4 2 2 2 1 2 3 4\n$EndElements\n"
+           + '$ElementData\n1\n"c"\n1\n0.0\n3\n0\n1\n1\n2 0.5\n$EndElementData\n')
+    p = write(tmp_path / "m.msh", txt)
+    V, F = read_mesh(p)
+    np.testing.assert_allclose(V, X)
+    np.testing.assert_array_equal(F, [[0, 2, 1]])
 
 
 GARBAGE = bytes(range(256)) * 4 + b"\xff\xfe\x00"
@@ -758,4 +788,15 @@ def test_binary_ply_mixed_polygons_fast_path(tmp_path, byte_order, layout):
     data = p.read_bytes()
     p.write_bytes(data[:-5])
     with pytest.raises(ValueError, match=errmsg(p) + ".*ends early"):
+        read_mesh(p)
+
+
+def test_off_faces_continuing_on_the_next_lines(tmp_path):
+    """OFF face records whose indices continue on the following lines (libigl reads
+    inspired_mesh_quads_Conjugate.off, written one index per line); a colour after the last index is skipped."""
+    p = write(tmp_path / "w.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n4 0 \n1 \n3 \n2 \n3 0\n1 2 255 0 0\n")
+    V, polys = read_mesh(p, triangulate=False)
+    assert [q.tolist() for q in polys] == [[0, 1, 3, 2], [0, 1, 2]]
+    p = write(tmp_path / "short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n")
+    with pytest.raises(ValueError, match="line 6: face announces 4 vertices"):
         read_mesh(p)

@@ -38,3 +38,26 @@ def test_library_writers_refuse_wrong_extensions_and_keep_names(tmp_path):
     pat.save(tmp_path / "t.npz")
     back = gsdf.PointsAsTori.load(tmp_path / "t.npz")
     np.testing.assert_array_equal(back.signed_distance(P[:5]), pat.signed_distance(P[:5]))
+
+
+def test_vertex_data_with_several_components(tmp_path):
+    """An (n, 3) per-vertex array (point-cloud-utils' custom attributes, gpytoolbox's N=): PLY stores its columns
+    as name_0, name_1, name_2; VTK/VTU as one 3-component array."""
+    from gsdf.io import read_vertex_data, write_mesh
+
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    vec = np.random.default_rng(0).random((4, 3))
+    for binary in (True, False):
+        p = tmp_path / f"v{binary}.ply"
+        write_mesh(p, V, F, vertex_data={"vector": vec, "d": V[:, 0]}, binary=binary)
+        got = read_vertex_data(p)
+        assert list(got) == ["vector_0", "vector_1", "vector_2", "d"]
+        np.testing.assert_array_equal(np.column_stack([got[f"vector_{j}"] for j in range(3)]), vec)
+    p = tmp_path / "v.vtu"
+    write_mesh(p, V, F, vertex_data={"vector": vec})
+    np.testing.assert_array_equal(read_vertex_data(p)["vector"], vec)
+    with pytest.raises(ValueError, match="given twice"):
+        write_mesh(tmp_path / "x.ply", V, F, vertex_data={"n": vec, "n_0": V[:, 0]})
+    with pytest.raises(ValueError, match=r"shape \(4,\) or \(4, k\)"):
+        write_mesh(tmp_path / "x.ply", V, F, vertex_data={"n": vec[:3]})

@@ -124,3 +124,21 @@ def test_estimate_normals_sphere():
     assert np.max(1.0 - np.einsum("ij,ij->i", No, U)) < 1e-2
     # estimated normals give the same areas as exact ones
     assert point_areas(P, No).sum() == pytest.approx(point_areas(P, U).sum(), rel=1e-3)
+
+
+def test_no_cell_far_off_on_random_sphere_points():
+    """10,000 random unit-sphere points at the default k = 20: against the exact spherical Voronoi areas no
+    cell is more than 10 % off (110 were, max 94 %, when the hull of 20 neighbours leaving a wide angular gap
+    cut the cell); only the cells that hull cut changed (394), recomputed with 40 neighbours."""
+    import gsdf
+    from scipy.spatial import SphericalVoronoi
+
+    P = np.random.default_rng(0).normal(size=(10000, 3))
+    P /= np.linalg.norm(P, axis=1, keepdims=True)
+    exact = SphericalVoronoi(P).calculate_areas()
+    a = gsdf.point_areas(P, P)
+    err = np.abs(a / exact - 1)
+    assert (err > 0.1).sum() == 0 and np.median(err) < 1e-3
+    # cells the hull did not cut are the plain k = 20 cells: the square clip gives the same
+    sq = gsdf.point_areas(P, P, boundary="square")
+    assert (a == sq).sum() >= 9500

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from gsdf._checks import as_points
+from gsdf._checks import as_points, query_shaped
 from gsdf._normalize import Frame
 
 __all__ = ["PointCloudDistance", "point_cloud_distance"]
@@ -31,6 +31,7 @@ class PointCloudDistance:
         self._frame = Frame.of(self.P)  # the tree lives in the normalised frame (gsdf._normalize)
         self.tree = cKDTree(self._frame.geometry(self.P, "P"))
 
+    @query_shaped()
     def query(self, Q):
         """Returns ``(d (q,), index (q,) int64, closest (q, 3))`` for the query points ``Q`` (q, 3)."""
         Q = as_points(Q, "Q")
@@ -40,6 +41,7 @@ class PointCloudDistance:
         return self._frame.length(np.asarray(d, dtype=np.float64) + excess), idx, self.P[idx]
 
 
+@query_shaped()
 def point_cloud_distance(P, Q, return_closest: bool = False):
     """Distance from every query ``Q`` (q, 3) to the nearest of the points ``P`` (p, 3).
 

@@ -9,13 +9,18 @@ Convention: negative inside, positive outside, ``|signed| == unsigned`` everywhe
   closest point and ``n`` the angle-weighted pseudonormal of the feature (face interior, edge or vertex)
   containing it. Much cheaper (no winding number), exact on **closed, consistently oriented 2-manifold**
   meshes, but meaningless on open or broken geometry (a hole flips the sign of whole regions).
+
+A single-layer sheet (an open surface, e.g. the wings of a ShapeNet airplane) bounds nothing: its winding number
+is ±1/2 on its two sides, so no query is inside it. ``shell=t`` asks for it explicitly: the result is the signed
+distance to the union of the winding-number solid and the shell of thickness ``t`` around the surface,
+``min(s, |s| − t/2)`` (mesh2sdf's ``fix=True, level=t/2`` gives that shell too). It is never a default.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_normals, as_points, as_weights, choice, positive
+from gsdf._checks import as_mesh, as_normals, as_points, as_weights, choice, positive, query_shaped
 from gsdf.mesh._pseudonormals import pseudonormals
 from gsdf.distance._points import point_cloud_distance
 from gsdf.distance._triangles import TriangleDistance
@@ -51,7 +56,9 @@ def _pseudonormal_sign(V, F, Q, closest, face, bary) -> np.ndarray:
     return np.where(s < 0, -1.0, 1.0)
 
 
-def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0):
+@query_shaped()
+def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0, return_closest: bool = False,
+                    shell: float | None = None):
     """Signed distance from points ``Q`` (q, 3) to the triangle mesh/soup ``(V, F)``; negative inside.
 
     Parameters
@@ -66,10 +73,26 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0):
     beta : float
         Accuracy parameter of the fast winding number (``sign="winding"`` only): clusters farther than
         ``beta`` times their radius are approximated by their expansion.
+    return_closest : bool, default False
+        Also return the closest triangle, closest point and normal, as libigl's ``signed_distance``
+        (``S, I, C, N``; as :func:`gsdf.signed_distance_grid` does on a grid).
+    shell : float, optional
+        Thickness of a shell around the surface added to the inside (see the module documentation): the signed
+        distance to the union of the winding-number solid and the points within ``shell / 2`` of the surface.
+        For open single-layer sheets, which otherwise have no inside. Off by default.
 
     Returns
     -------
-    (q,) float64
+    S : (q,) float64
+        Signed distances (``Q`` of shape (..., 3) gives shape (...)).
+    I : (q,) int64
+        With ``return_closest``: index of the closest triangle.
+    C : (q, 3) float64
+        The closest point on the surface.
+    N : (q, 3) float64
+        The normal there: the angle-weighted pseudonormal of the closest feature (face, edge or vertex) with
+        ``sign="pseudonormal"``, the unit normal of the closest triangle with ``sign="winding"`` (zero for a
+        degenerate triangle).
 
     Examples
     --------
@@ -79,22 +102,66 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0):
     >>> d = gsdf.signed_distance(V, F, [[0.1, 0.1, 0.1], [-1.0, 0.0, 0.0]])
     >>> np.round(d, 3).tolist()                 # negative inside
     [-0.1, 1.0]
+    >>> S, I, C, N = gsdf.signed_distance(V, F, [[0.5, 0.5, 0.5]], return_closest=True)   # libigl's outputs
+    >>> I.tolist(), np.round(C, 3).tolist()
+    ([3], [[0.333, 0.333, 0.333]])
     """
     V, F = as_mesh(V, F)
     Q = as_points(Q, "Q")
     choice(sign, "sign", SIGN_MODES)
     beta = positive(beta, "beta")
+    if not isinstance(return_closest, (bool, np.bool_)):
+        raise ValueError(f"return_closest: expected True or False, got {return_closest!r}")
+    if shell is not None:
+        shell = positive(shell, "shell")
     td = TriangleDistance(V, F)
     if sign == "winding":
         from gsdf.winding import fast_winding_number  # lazy: the winding module is independent of this one
 
-        d, _, _ = td.query(Q)
+        d, face, closest = td.query(Q)
         w = np.asarray(fast_winding_number(V, F, Q, beta=beta, order=2), dtype=np.float64)
-        return np.where(w > 0.5, -d, d)
-    d, face, closest, bary = td.query_barycentric(Q)
-    return _pseudonormal_sign(V, F, Q, closest, face, bary) * d
+        S = np.where(w > 0.5, -d, d)
+    else:
+        d, face, closest, bary = td.query_barycentric(Q)
+        S = _pseudonormal_sign(V, F, Q, closest, face, bary) * d
+    if shell is not None:
+        S = with_shell(S, shell)
+    if not return_closest:
+        return S
+    if sign == "pseudonormal":
+        N = closest_pseudonormal(V, F, face, bary)
+    else:
+        n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+        ln = np.linalg.norm(n, axis=1, keepdims=True)
+        N = np.divide(n, ln, out=np.zeros_like(n), where=ln > 0)[face]
+    return S, face, closest, N
 
 
+def with_shell(S, thickness: float):
+    """Signed distance to the union of the region ``S < 0`` and the shell of the given thickness around the
+    surface ``S = 0``: ``min(S, |S| - thickness / 2)``."""
+    return np.minimum(S, np.abs(S) - 0.5 * thickness)
+
+
+def closest_pseudonormal(V, F, face, bary):
+    """Angle-weighted pseudonormal of the feature (face, edge, vertex) that holds each closest point, unit."""
+    pn = pseudonormals(V, F)
+    zero = bary <= BARY_TOL
+    nz = zero.sum(axis=1)
+    n = pn.face[face].copy()
+    on_edge = nz == 1
+    if on_edge.any():
+        k = np.argmax(zero[on_edge], axis=1)
+        n[on_edge] = pn.edge[face[on_edge], k]
+    on_vertex = nz >= 2
+    if on_vertex.any():
+        k = np.argmax(bary[on_vertex], axis=1)
+        n[on_vertex] = pn.vertex[F[face[on_vertex], k]]
+    ln = np.linalg.norm(n, axis=1, keepdims=True)
+    return np.divide(n, ln, out=np.zeros_like(n), where=ln > 0)
+
+
+@query_shaped()
 def signed_distance_points(P, N, Q, areas=None, beta: float = 2.3):
     """Signed distance to an oriented point cloud; negative inside.
 

@@ -29,7 +29,7 @@ import dataclasses
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_mesh, as_points, integer
+from gsdf._checks import as_mesh, as_points, integer, query_shaped
 from gsdf._normalize import Frame
 from gsdf.spatial._morton import morton_order
 from gsdf.spatial._bvh import build_triangle_bvh
@@ -545,6 +545,7 @@ class TriangleDistance:
         self.bvh = dataclasses.replace(b, lo=lo, hi=hi)
         return self
 
+    @query_shaped()
     def query(self, Q):
         """Unsigned distance from each query point to the nearest triangle.
 
@@ -561,6 +562,7 @@ class TriangleDistance:
         d, face, closest, _ = self._query(Q, want_bary=False)
         return d, face, closest
 
+    @query_shaped()
     def query_barycentric(self, Q):
         """Like :meth:`query` but also returns the barycentric coordinates (q, 3) of the closest point in
         its triangle ``F[face]`` (exact zeros on edges, exact one at vertices)."""
@@ -568,6 +570,7 @@ class TriangleDistance:
         return self._query(Q)
 
 
+@query_shaped()
 def unsigned_distance(V, F, Q, return_closest: bool = False):
     """Unsigned distance from points ``Q`` (q, 3) to the triangle mesh/soup ``(V, F)``.
 

@@ -6,8 +6,10 @@ These readers return the raw ``(V, flat, sizes)`` polygon soup that :func:`gsdf.
 dropped: trimesh is called with ``process=False`` and every mesh of a scene is placed by its node transform and
 appended in scene order; meshio's surface cells (triangles, quads, polygons, and the corner vertices of
 higher-order triangles and quads) are taken block by block in file order, its points as stored (2D points get
-z = 0). Volume cells (tetrahedra, hexahedra, ...) are not a surface and are ignored; a file with nothing else
-is refused with a message saying so.
+z = 0). Volume cells (tetrahedra, hexahedra, ...) are not a surface and are ignored, except in a file whose only
+cells are tetrahedra: its surface is then the boundary of the tets (the triangles used by one tet, outward). A
+file with other volume cells only is refused with a message saying so. Gmsh element or node data that meshio
+cannot attach to the cells (data over the tets of a file that also has triangles) is skipped.
 
 OBJ, OFF, PLY and STL stay with gsdf's own parsers (:mod:`gsdf.io._mesh`): trimesh with ``process=False`` still
 drops unreferenced OBJ vertices and regroups OFF faces by polygon size, and meshio refuses OFF polygons and OBJ
@@ -89,10 +91,27 @@ def _read_meshio(p: str, ext: str):
         flats.append(data[:, :k].astype(np.int64).ravel())
         sizes.append(np.full(len(data), k, dtype=np.int64))
     if not flats:
+        if volume == {"tetra"}:
+            T = np.concatenate([np.asarray(b.data, dtype=np.int64) for b in m.cells if b.type == "tetra"])
+            F = tet_boundary(P, T)
+            return P, F.ravel(), np.full(len(F), 3, dtype=np.int64)
         if volume:
             raise ValueError(f"{p}: has only volume cells ({', '.join(sorted(volume))}), no surface faces")
         raise ValueError(f"{p}: no faces; is this a point cloud? use read_points")
     return P, np.concatenate(flats), np.concatenate(sizes)
+
+
+def tet_boundary(P, T):
+    """The triangles of tets ``T`` used by exactly one tet, oriented outward (a tet of negative volume has its
+    faces reversed), in tet order."""
+    T = np.asarray(T, dtype=np.int64).reshape(-1, 4)
+    a, b, c, d = (P[T[:, i]] for i in range(4))
+    neg = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) < 0
+    Fc = np.stack([T[:, [1, 2, 3]], T[:, [0, 3, 2]], T[:, [0, 1, 3]], T[:, [0, 2, 1]]], axis=1)
+    Fc[neg] = Fc[neg][:, :, ::-1]
+    Fc = Fc.reshape(-1, 3)
+    _, inv, cnt = np.unique(np.sort(Fc, axis=1), axis=0, return_inverse=True, return_counts=True)
+    return Fc[cnt[inv.reshape(-1)] == 1]
 
 
 def _read_meshio_raw(p: str, ext: str):
@@ -112,10 +131,40 @@ def _read_meshio_raw(p: str, ext: str):
         log.setLevel(logging.CRITICAL)
         with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            m = meshio.read(p)
+            try:
+                m = meshio.read(p)
+            except Exception:
+                m = _read_gmsh_without_data(meshio, p) if ext == ".msh" else None
+                if m is None:
+                    raise
     except (Exception, SystemExit) as exc:  # ReadError, ValueError, KeyError, struct errors, SystemExit ...
         why = " ".join(said.getvalue().split()) or f"{type(exc).__name__}: {exc}"
         raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({why})") from None
     finally:
         log.setLevel(level)
     return m
+
+
+_GMSH_DATA = (b"ElementData", b"NodeData", b"ElementNodeData")
+
+
+def _read_gmsh_without_data(meshio, p: str):
+    """A Gmsh file meshio refuses because of its data sections (e.g. element data over the tets of a file that
+    also has triangles: "Incompatible cell data"), read again without them; None when it has none."""
+    import os
+    import re
+    import tempfile
+
+    with open(p, "rb") as fh:
+        data = fh.read()
+    pat = rb"(^|\n)\$(" + b"|".join(_GMSH_DATA) + rb")\r?\n.*?\$End\2\r?\n"
+    stripped, n = re.subn(pat, rb"\1", data, flags=re.S)
+    if n == 0:
+        return None
+    fd, tmp = tempfile.mkstemp(suffix=".msh")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(stripped)
+        return meshio.read(tmp, file_format="gmsh")
+    finally:
+        os.unlink(tmp)

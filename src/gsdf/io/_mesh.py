@@ -482,11 +482,37 @@ def _parse_off(p: str, data: bytes, with_faces: bool = True):
     sizes = tab.integers(tab.numbers(tab.start[rows]), rows, "face size")
     short = np.flatnonzero((sizes < 0) | (c < sizes + 1))
     if short.size:
-        r = rows[short[0]]
-        raise tab.error(r, f"face announces {sizes[short[0]]} vertices but lists {tab.counts[r] - 1} values")
+        return V, N, *_off_faces_across_lines(tab, f0, nf, nv)
     row_of = np.repeat(rows, sizes)
     flat = tab.integers(tab.ragged(rows, 1, sizes), row_of, "face vertex index")
     return V, N, _off_range(tab, flat, row_of, nv), sizes
+
+
+def _off_faces_across_lines(tab: _Table, f0: int, nf: int, nv: int):
+    """Face records read as a stream of numbers, as libigl's reader does: a record is its size and that many
+    indices, which may continue on the following lines; the rest of the line holding its last index (colour
+    values) is skipped. Returns (flat, sizes)."""
+    tok = tab.tokens
+    end = int(tab.start[-1])
+    k = int(tab.start[f0])
+    firsts, sizes = [], []
+    for _ in range(nf):
+        if k >= end:
+            raise ValueError(f"{tab.path}: the file ends after {len(sizes)} of the {nf} faces its header announces")
+        r = int(np.searchsorted(tab.start, k, side="right")) - 1
+        n = int(tab.integers(tab.numbers([k]), np.array([r]), "face size")[0])
+        if n < 0 or k + n >= end:
+            raise tab.error(r, f"face announces {n} vertices but the file ends after {end - k - 1} more values")
+        firsts.append(k + 1)
+        sizes.append(n)
+        last = int(np.searchsorted(tab.start, k + n, side="right")) - 1  # the line of its last index
+        k = int(tab.start[last + 1])
+    sizes = np.array(sizes, dtype=np.int64)
+    idx = np.repeat(np.array(firsts, dtype=np.int64), sizes) + (np.arange(int(sizes.sum()))
+                                                                  - np.repeat(np.cumsum(sizes) - sizes, sizes))
+    row_of = np.searchsorted(tab.start, idx, side="right") - 1
+    flat = tab.integers(tab.numbers(idx), row_of, "face vertex index")
+    return _off_range(tab, flat, row_of, nv), sizes
 
 
 def _off_range(tab: _Table, flat, row_of, nv: int):
@@ -640,8 +666,9 @@ def read_mesh(path, triangulate: bool = True):
 
 
 def read_vertex_data(path) -> dict:
-    """Per-vertex scalar properties stored with a mesh: PLY vertex properties other than x, y, z (e.g. the
-    ``distance`` that ``gsdf heat-surface`` writes), or VTK/VTU point data (one component each).
+    """Per-vertex properties stored with a mesh: PLY vertex properties other than x, y, z (e.g. the
+    ``distance`` that ``gsdf heat-surface`` writes; scalars, so an (n, k) array written by :func:`write_mesh`
+    comes back as ``name_0`` ... ``name_{k-1}``), or VTK/VTU point data (an (n, k) array for k components).
 
     Parameters
     ----------
@@ -650,7 +677,7 @@ def read_vertex_data(path) -> dict:
 
     Returns
     -------
-    dict of str -> (n,) float64 ndarray
+    dict of str -> (n,) or (n, k) float64 ndarray
         In file order; aligned with the ``V`` of :func:`read_mesh` on the same file.
 
     Examples
@@ -688,6 +715,8 @@ def read_vertex_data(path) -> dict:
         a = np.asarray(a)
         if a.ndim == 1 or (a.ndim == 2 and a.shape[1] == 1):
             out[name] = a.reshape(-1).astype(np.float64)
+        elif a.ndim == 2:
+            out[name] = a.astype(np.float64)
     return out
 
 
@@ -716,15 +745,30 @@ def _faces_arg(F, nv: int):
 
 
 def _vertex_data(vertex_data, n: int) -> dict:
+    """name -> (n,) or (n, k) float64 arrays, validated."""
     out = {}
     for name, values in (vertex_data or {}).items():
         if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) or name in ("x", "y", "z"):
             raise ValueError(f"vertex_data: invalid property name {name!r} (an identifier other than x, y, z)")
         a = np.asarray(values)
-        if a.shape != (n,) or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool):
-            raise ValueError(f"vertex_data[{name!r}]: expected a numeric array of shape ({n},), "
+        if (a.ndim not in (1, 2) or a.shape[0] != n or (a.ndim == 2 and a.shape[1] == 0)
+                or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool)):
+            raise ValueError(f"vertex_data[{name!r}]: expected a numeric array of shape ({n},) or ({n}, k), "
                              f"got {a.dtype} {a.shape}")
         out[name] = a.astype(np.float64)
+    return out
+
+
+def _ply_columns(extra: dict) -> dict:
+    """PLY properties are scalars: an (n, k) entry ``name`` becomes ``name_0`` ... ``name_{k-1}``."""
+    out = {}
+    for name, a in extra.items():
+        cols = {name: a} if a.ndim == 1 else {f"{name}_{j}": a[:, j] for j in range(a.shape[1])}
+        for c, col in cols.items():
+            if c in out or c in extra and c != name:
+                raise ValueError(f"vertex_data: property {c!r} given twice (an (n, k) entry {name!r} writes "
+                                 f"{name}_0 ... {name}_{a.shape[1] - 1 if a.ndim == 2 else 0})")
+            out[c] = col
     return out
 
 
@@ -781,9 +825,10 @@ def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
     F : (m, k) array_like of int, or list of 1-d int sequences
         Faces (0-based).  A list of polygons of varying size is accepted for OBJ, OFF and PLY;
         STL stores triangles only, so polygons are fan-triangulated for it.
-    vertex_data : dict of str -> (n,) float array, optional
-        Extra per-vertex scalars (e.g. a distance field) written as PLY vertex properties
-        (doubles), or VTK/VTU point data.  Other formats raise ValueError.
+    vertex_data : dict of str -> (n,) or (n, k) float array, optional
+        Extra per-vertex values (e.g. a distance field, or normals as one (n, 3) array) written as PLY vertex
+        properties (doubles; an (n, k) entry ``name`` as the k properties ``name_0`` ... ``name_{k-1}``), or as
+        VTK/VTU point data (an (n, k) entry as one k-component array).  Other formats raise ValueError.
     binary : bool, default True
         PLY only: binary little-endian (default) or ASCII.
 
@@ -813,6 +858,7 @@ def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
         elif ext == ".obj":
             _write_text(tmp, _format_rows(V, "v ") + _polygon_lines(flat, sizes, "f ", 1, False))
         elif ext == ".ply":
-            _write_ply(tmp, {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2], **extra}, (flat, sizes), binary=binary)
+            _write_ply(tmp, {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2], **_ply_columns(extra)}, (flat, sizes),
+                       binary=binary)
         else:
             _write_stl(tmp, V, _fan(flat, sizes))

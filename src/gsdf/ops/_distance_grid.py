@@ -17,7 +17,7 @@ __all__ = ["signed_distance_grid"]
 
 
 def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "winding", beta: float | None = None,
-                         return_closest: bool = False, progress=None):
+                         return_closest: bool = False, shell: float | None = None, progress=None):
     """Signed distance (negative inside) on the nodes of a regular grid around a mesh/soup or oriented cloud.
 
     ``|S|`` is the exact distance to the triangles (:class:`gsdf.TriangleDistance`) or to the nearest point of a
@@ -42,6 +42,11 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
         Accuracy of the fast winding number (default 2 for meshes, 2.3 for points).
     return_closest : bool, default False
         Also return libigl's ``I, C, N``.
+    shell : float, optional
+        Thickness of a shell around the surface added to the inside: the signed distance to the union of the
+        winding-number solid and the points within ``shell / 2`` of the surface, ``min(S, |S| - shell / 2)``
+        (:func:`gsdf.signed_distance`). For open single-layer sheets (ShapeNet-style), which otherwise have no
+        inside; mesh2sdf's ``fix=True, level=L`` corresponds to ``shell=2 L``. Off by default.
     progress : callable ``progress(stage, fraction)``, optional
         Called while the winding numbers are evaluated (``stage="winding numbers"``, fraction in [0, 1]).
 
@@ -70,12 +75,15 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
     >>> S, I, C, N = gsdf.signed_distance_grid((V, F), resolution=gsdf.Grid(([0, 0, 0], [1, 1, 1]), (8, 8, 8)),
     ...                                        return_closest=True)
     """
+    from gsdf.distance._signed import with_shell
     from gsdf.field import GridField
     from gsdf.grid import as_grid
 
     choice(sign, "sign", ("winding", "pseudonormal"))
     if not isinstance(return_closest, (bool, np.bool_)):
         raise ValueError(f"return_closest: expected True or False, got {return_closest!r}")
+    if shell is not None:
+        shell = positive(shell, "shell")
     report = _progress(progress)
     if points is not None:
         if V is not None or F is not None:
@@ -107,10 +115,10 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
         w = _chunked(FastWindingNumberPoints(P, Nrm, beta=positive(2.3 if beta is None else beta, "beta")), Q,
                      report)
         s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
-        S = GridField(s.reshape(grid.shape), *grid.box)
+        S = GridField((s if shell is None else with_shell(s, shell)).reshape(grid.shape), *grid.box)
         return (S, idx, P[idx], Nrm[idx]) if return_closest else S
 
-    from gsdf.distance._signed import _pseudonormal_sign
+    from gsdf.distance._signed import _pseudonormal_sign, closest_pseudonormal
     from gsdf.distance._triangles import TriangleDistance
 
     if sign == "pseudonormal":
@@ -125,11 +133,11 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
         w = _chunked(FastWindingNumber(V, F, beta=positive(2.0 if beta is None else beta, "beta")), Q, report)
         d, face, closest = TriangleDistance(V, F).query(Q)
         s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
-    S = GridField(s.reshape(grid.shape), *grid.box)
+    S = GridField((s if shell is None else with_shell(s, shell)).reshape(grid.shape), *grid.box)
     if not return_closest:
         return S
     if sign == "pseudonormal":
-        N = _closest_pseudonormal(V, F, face, bary)
+        N = closest_pseudonormal(V, F, face, bary)
     else:
         n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
         ln = np.linalg.norm(n, axis=1, keepdims=True)
@@ -163,24 +171,3 @@ def _chunked(winding, Q, progress, stage: str = "winding numbers") -> np.ndarray
         w[s:e] = winding(Q[s:e])
         progress(stage, e / n)
     return w
-
-
-def _closest_pseudonormal(V, F, face, bary):
-    """Angle-weighted pseudonormal of the feature (face, edge, vertex) that holds each closest point."""
-    from gsdf.mesh._pseudonormals import pseudonormals
-    from gsdf.distance._signed import BARY_TOL
-
-    pn = pseudonormals(V, F)
-    zero = bary <= BARY_TOL
-    nz = zero.sum(axis=1)
-    n = pn.face[face].copy()
-    on_edge = nz == 1
-    if on_edge.any():
-        k = np.argmax(zero[on_edge], axis=1)
-        n[on_edge] = pn.edge[face[on_edge], k]
-    on_vertex = nz >= 2
-    if on_vertex.any():
-        k = np.argmax(bary[on_vertex], axis=1)
-        n[on_vertex] = pn.vertex[F[face[on_vertex], k]]
-    ln = np.linalg.norm(n, axis=1, keepdims=True)
-    return np.divide(n, ln, out=np.zeros_like(n), where=ln > 0)

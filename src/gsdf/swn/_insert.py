@@ -115,16 +115,21 @@ def insert_surface_points(V, F, curves):
 
 def _area(poly, X) -> float:
     P = X[poly]
+    P = P - P[0]  # local coordinates: the round-off is that of the polygon's size, not of its position
     return 0.5 * float(np.linalg.norm(np.cross(P, np.roll(P, -1, axis=0)).sum(axis=0)))
 
 
 def _ear_clip(poly, X):
     """Triangulate a convex planar polygon (vertex ids in boundary order, possibly with collinear runs of
     inserted points): repeatedly cut off the largest non-degenerate ear whose removal leaves a polygon of
-    nonzero area, so no zero-area triangle is made."""
+    nonzero area, so no zero-area triangle is made. "Zero" is below 1e-12 of the polygon's area or below the
+    area the rounding of its vertices' coordinates can make (an inserted midpoint is off the line of its edge
+    by up to an ulp of the coordinates: far from the origin that exceeds 1e-12 of a thin face's area)."""
     poly = list(poly)
     tris = []
-    tol = 1e-12 * max(_area(poly, X), 1e-300)
+    P = X[poly]
+    diam = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
+    tol = max(1e-12 * _area(poly, X), 64 * np.finfo(float).eps * float(np.abs(P).max()) * diam, 1e-300)
     while len(poly) > 3:
         k = len(poly)
         best, best_a = None, tol

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_points, integer, positive
+from gsdf._checks import as_points, integer, positive, query_shaped
 from gsdf.tori._blend import NeighbourBlend
 from gsdf.tori._pat import _clean_cloud, _sigma
 
@@ -95,6 +95,7 @@ class _Convolution:
         self._blend = NeighbourBlend(self.P, self.C, None if r_eval is None else positive(r_eval, "r_eval"),
                                      integer(k_eval, "k_eval"), integer(k_fallback, "k_fallback"))
 
+    @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         b = self._blend
 
@@ -133,6 +134,7 @@ class SignedHopfCole(_Convolution):
 
     _mode = 0
 
+    @query_shaped()
     def signed_distance(self, Q) -> np.ndarray:
         """φ_SHC at the query points (q,)."""
         return self(Q)
@@ -153,6 +155,7 @@ class SmoothedSignedPlanarDistance(_Convolution):
 
     _mode = 1
 
+    @query_shaped()
     def signed_distance(self, Q) -> np.ndarray:
         """φ_SSPD at the query points (q,)."""
         return self(Q)
@@ -177,6 +180,7 @@ class LogSumExpDistance(_Convolution):
         P = as_points(P, "P")
         super().__init__(P, np.tile([0.0, 0.0, 1.0], (len(P), 1)) if N is None else N, **kw)
 
+    @query_shaped()
     def unsigned_distance(self, Q) -> np.ndarray:
         """LogSumExp distance at the query points (q,)."""
         return self(Q)
@@ -224,6 +228,7 @@ class WindingNumberPipeline:
         self._dist = TriangleDistance(self.V, self.F)
         self._fwn = FastWindingNumber(self.V, self.F)
 
+    @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         d = self._dist.query(Q)[0]
         w = self._fwn(Q)

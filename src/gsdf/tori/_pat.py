@@ -22,7 +22,7 @@ import dataclasses
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_points, choice, finite, integer, nonnegative, positive
+from gsdf._checks import as_points, choice, finite, integer, nonnegative, positive, query_shaped
 from gsdf._normalize import Frame
 from gsdf.grid import PAD, Grid, padded_box
 from gsdf.threads import apply_env
@@ -301,12 +301,14 @@ class PointsAsTori:
         # a clamped far query (gsdf._normalize.FAR) is farther by ``excess``; there φ grows like the distance
         return fr.length(out + excess)
 
+    @query_shaped()
     def signed_distance(self, Q) -> np.ndarray:
         """Generalized signed distance φ(Q) of Eq. 5.6, (q,) float64; negative inside."""
         return self._eval(Q, False)
 
     __call__ = signed_distance
 
+    @query_shaped()
     def gradient(self, Q) -> np.ndarray:
         """Analytic gradient ∇φ(Q) of Eq. 5.6, (q, 3) float64."""
         return self._eval(Q, True)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_faces, as_mesh, as_normals, as_points, as_weights
+from gsdf._checks import as_faces, as_mesh, as_normals, as_points, as_weights, query_shaped
 from gsdf._normalize import Frame
 from gsdf.winding._query import map_queries
 from gsdf.winding._solid_angle import solid_angle_w
@@ -75,6 +75,7 @@ def triangle_corners(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(V[F].reshape(-1, 9))
 
 
+@query_shaped()
 def winding_number(V, F, Q, method: str = "auto") -> np.ndarray:
     """Exact generalized winding number of a triangle soup at query points.
 
@@ -118,6 +119,7 @@ def winding_number(V, F, Q, method: str = "auto") -> np.ndarray:
     return map_queries(lambda q, out: _wn_triangles(T, q, out), Q, frame=frame)
 
 
+@query_shaped()
 def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
     """Exact (direct-sum) winding number of an oriented point cloud, Eq. 5 of Barill et al. 2018.
 
@@ -143,6 +145,7 @@ def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
     return map_queries(lambda q, out: _wn_points(P, NA, q, out), Q, frame=frame)
 
 
+@query_shaped(2)
 def winding_number_2d(V, E, Q) -> np.ndarray:
     """Exact winding number of 2D polylines (edge list ``E`` into ``V``) at 2D query points.
 

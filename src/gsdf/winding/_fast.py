@@ -50,7 +50,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_mesh, integer
+from gsdf._checks import as_mesh, integer, query_shaped
 from gsdf._normalize import Frame
 from gsdf.spatial._bvh import BVH, build_bvh, build_volume_bvh
 from gsdf.spatial._wide import widen
@@ -782,6 +782,7 @@ def _single_thread(serial: bool):
 class _FastWindingBase:
     tree: BVH
 
+    @query_shaped()
     def __call__(self, Q, progress=None) -> np.ndarray:
         """Winding numbers at query points ``Q`` (q, 3); evaluated in parallel chunks."""
         return map_queries(self._kernel, Q, progress=progress, coherent=True, frame=self._frame)
@@ -895,6 +896,7 @@ class FastWindingNumberPoints(_FastWindingBase):
             _eval_points(q, self._P, self._NA, self._N, self._C, self.beta ** 2, self.order, out)
 
 
+@query_shaped()
 def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarray:
     """Fast generalized winding number of a triangle soup at ``Q`` (one call: build the tree, query).
 
@@ -912,6 +914,7 @@ def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarra
     return FastWindingNumber(V, F, beta=beta, order=order)(Q)
 
 
+@query_shaped()
 def fast_winding_number_points(P, N, Q, areas=None, beta: float = 2.3, order: int = 2) -> np.ndarray:
     """Fast winding number of an oriented point cloud at ``Q``; ``areas=None`` estimates point areas.
 

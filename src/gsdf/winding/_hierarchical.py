@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_mesh, integer
+from gsdf._checks import as_mesh, integer, query_shaped
 from gsdf._normalize import Frame
 from gsdf.spatial._bvh import build_bvh
 from gsdf.winding._query import map_queries
@@ -143,6 +143,7 @@ class ExactWindingNumber:
         # the cap pays off when it has fewer triangles than the node itself
         self._use_cap = np.diff(self._ptr) < (t.end - t.start)
 
+    @query_shaped()
     def __call__(self, Q, progress=None) -> np.ndarray:
         return map_queries(self._kernel, Q, progress=progress, coherent=True, frame=self._frame)
 

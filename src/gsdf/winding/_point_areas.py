@@ -197,10 +197,11 @@ def _convex_hull(pts, m, hull):
 
 
 @njit(cache=True, nogil=True)
-def _voronoi_areas(P, N, plane, idx, offset, clip_hull, out, r0, r1):
+def _voronoi_areas(P, N, plane, idx, offset, clip_hull, out, cut, r0, r1):
     """Cell areas of points offset + r for the rows r0 <= r < r1 of ``idx`` (neighbours), ``plane``
-    (projection normals). Serial and GIL-free: :func:`point_areas` runs row ranges on threads
-    (:func:`gsdf.threads.run_ranges`; a numba parallel loop here cost ~1 s more to compile on a cold start)."""
+    (projection normals); ``cut[r]`` is set where the hull of the neighbours cut the cell. Serial and GIL-free:
+    :func:`point_areas` runs row ranges on threads (:func:`gsdf.threads.run_ranges`; a numba parallel loop here
+    cost ~1 s more to compile on a cold start)."""
     m = idx.shape[1]
     cap = 2 * m + 16  # scratch buffers, allocated once per range
     Q = np.empty((m + 1, 2))
@@ -209,12 +210,13 @@ def _voronoi_areas(P, N, plane, idx, offset, clip_hull, out, r0, r1):
     H = np.empty((2 * m + 4, 2))
     F, G = np.empty((8, 3)), np.empty((8, 3))
     for r in range(r0, r1):
-        out[r] = _cell_area(P, N, plane, idx, offset + r, r, clip_hull, Q, A0, B0, H, F, G)
+        out[r], cut[r] = _cell_area(P, N, plane, idx, offset + r, r, clip_hull, Q, A0, B0, H, F, G)
 
 
 @njit(cache=True)
 def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
-    """Voronoi cell area of point ``i`` (see point_areas) in the plane with normal ``plane[row]``."""
+    """Voronoi cell area of point ``i`` (see point_areas) in the plane with normal ``plane[row]``, and whether
+    the convex hull of the neighbours cut it."""
     n = P.shape[0]
     m = idx.shape[1]
     nx = plane[row, 0]
@@ -222,7 +224,7 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
     nz = plane[row, 2]
     nn = np.sqrt(nx * nx + ny * ny + nz * nz)
     if nn == 0.0:
-        return 0.0
+        return 0.0, False
     nx /= nn
     ny /= nn
     nz /= nn
@@ -264,7 +266,7 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
         if r2 > r2max:
             r2max = r2
     if cnt == 0 or r2max == 0.0:
-        return 0.0
+        return 0.0, False
     R = np.sqrt(r2max)
     tol2 = (_DUP_REL * R) ** 2
 
@@ -296,9 +298,12 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
         if k == 0:
             break
         r2cell = _max_radius2(A, k)
+    cut = False
     if clip_hull and k > 0 and not _cell_inside_hull(Q, np.int64(cnt), A, k, F, G):
         # restrict the cell to the convex hull of p_i and its kept neighbours, so that a point on
         # the border of an open surface only gets the part of its cell that lies on the surface
+        before = _polygon_area(A, k) if k >= 3 else 0.0
+        cut = True
         Q[cnt, 0] = 0.0
         Q[cnt, 1] = 0.0
         nh = _convex_hull(Q, cnt + 1, H)  # (sorts Q: not used after this)
@@ -321,7 +326,9 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
                     break
                 r2cell = _max_radius2(A, k)
     area = _polygon_area(A, k) if k >= 3 else 0.0
-    return area / (1.0 + ndup)
+    if cut:
+        cut = area < before
+    return area / (1.0 + ndup), cut
 
 
 # ----------------------------------------------------------------------------------------------
@@ -364,15 +371,19 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     N : (n, 3) array_like
         Normals (any length; only their direction is used).  Rows that are zero get area 0.
     k : int, default 20
-        Neighbourhood size (the paper's value; its results are insensitive to it).  With fewer
-        than ``k + 1`` points, all other points are used (``min(k, n - 1)``).
+        Neighbourhood size (the paper's value).  With fewer than ``k + 1`` points, all other points
+        are used (``min(k, n - 1)``).  Where the neighbours do not surround the cell (the hull clip
+        below cuts it: a point on a border, or an interior point whose ``k`` nearest leave a wide
+        angular gap), the cell is computed again with ``2 k``, then ``4 k`` neighbours.
     boundary : {"hull", "square"}, default "hull"
         How cells of points on the border of an open surface (or at the rim of the sampled
         region) are bounded.  ``"hull"`` additionally clips the cell to the convex hull of
         ``p_i`` and its kept neighbours — the same restriction libigl's implementation gets
         from summing over the Delaunay triangles around ``p_i`` — so a border point of a
         uniform grid gets half a cell and a corner a quarter, and the areas of a planar grid
-        sum to the area of the sampled square.  ``"square"`` only clips to the starting
+        sum to the area of the sampled square.  An interior point whose ``k`` nearest
+        neighbours lie to one side gets its cell cut too; such cells are recomputed with more
+        neighbours (``k`` above).  ``"square"`` only clips to the starting
         square, so border cells extend up to ``R`` beyond the point (an overestimate).  For
         interior points both give the plain Voronoi cell.
     candidates : int, default 8
@@ -449,20 +460,55 @@ def _point_areas(P: np.ndarray, N: np.ndarray, k: int = 20, boundary: str = "hul
     N = N / np.maximum(np.abs(N).max(axis=1, keepdims=True), np.finfo(float).tiny)
     knn = _candidate_search(P, kc + 1)  # the kc + 1 nearest, itself included
     out = np.zeros(n)
+    cut = np.zeros(n, np.bool_)
     chunk = max(1, (1 << 22) // (kc + 1))  # bounded memory: ~32 MB of neighbour indices at a time
     for s in range(0, n, chunk):
         e = min(n, s + chunk)
         cand = knn.rows(s, e)
         sel = np.full((e - s, kk + 1), -1, np.int64)
         plane = np.zeros((e - s, 3))
-        part = out[s:e]
+        part, pcut = out[s:e], cut[s:e]
         grain = SERIAL_POINTS if n < SERIAL_POINTS else 256  # small clouds: one call on this thread
         run_ranges(lambda r0, r1: _tangent_neighbours(P, N, cand, s, kk, sel, plane, r0, r1), e - s, grain)
-        run_ranges(lambda r0, r1: _voronoi_areas(P, N, plane, sel, s, boundary == "hull", part, r0, r1), e - s, grain)
+        run_ranges(lambda r0, r1: _voronoi_areas(P, N, plane, sel, s, boundary == "hull", part, pcut, r0, r1),
+                   e - s, grain)
+    _recompute_cut_cells(P, N, out, cut, kk, candidates)
     a = frame.area(out)
     if not np.isfinite(a).all():
         raise ValueError(f"P: point areas overflow float64 at this scale (cloud half-size 2^{frame.exponent})")
     return a
+
+
+#: Cells the neighbours' hull cut are recomputed with this many times ``k`` neighbours, in turn, until none cuts.
+GROW = (2, 4)
+
+
+def _recompute_cut_cells(P, N, out, cut, k, candidates):
+    """Recompute, with 2 k and then 4 k neighbours, the cells that the hull of their k neighbours cut (written
+    into ``out``). On 10,000 random unit-sphere points 394 cells were cut at k = 20, 110 of them by more than
+    10 % (the k nearest leave an angular gap of 85 degrees or more); with 40 neighbours none is cut. Points on
+    the border of an open surface stay cut and keep the last value."""
+    idx = np.flatnonzero(cut)
+    n = P.shape[0]
+    for g in GROW:
+        kg = min(g * k, n - 1)
+        if not len(idx) or kg <= k:
+            break
+        kc = min(n - 1, kg * min(int(candidates), n))
+        _, cand = cKDTree(P).query(P[idx], k=kc + 1, workers=-1)
+        cand = np.ascontiguousarray(cand.reshape(len(idx), kc + 1), dtype=np.int64)
+        sel = np.full((1, kg + 1), -1, np.int64)
+        plane = np.zeros((1, 3))
+        a, c = np.zeros(1), np.zeros(1, np.bool_)
+        still = np.zeros(len(idx), bool)
+        for t, i in enumerate(idx.tolist()):
+            sel[:] = -1
+            _tangent_neighbours(P, N, cand[t:t + 1], i, kg, sel, plane, 0, 1)
+            _voronoi_areas(P, N, plane, sel, i, True, a, c, 0, 1)
+            out[i] = a[0]
+            still[t] = c[0]
+        idx = idx[still]
+        k = kg
 
 
 @njit(cache=True)

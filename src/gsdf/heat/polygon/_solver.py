@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from gsdf import _checks
 from gsdf._normalize import Frame
 from gsdf.heat._core import SignedHeatCore
@@ -23,8 +25,9 @@ class PolygonMeshSignedHeatSolver:
 
     Parameters
     ----------
-    V : (n, 3) float; polygons : list of int sequences (or an (m, k) array), any mix of degrees, planar or not;
-    t_coef : float, diffusion time ``t = t_coef · (mean polygon edge length)²``.
+    V : (n, 3) float; polygons : list of int sequences (or an (m, k) array), any mix of degrees, planar or not
+    (a polygon that repeats a vertex is dropped with a warning); t_coef : float, diffusion time
+    ``t = t_coef · (mean polygon edge length)²``.
 
     Attributes
     ----------
@@ -52,6 +55,7 @@ class PolygonMeshSignedHeatSolver:
         V = _checks.as_points(V, "V")
         self.frame = Frame.of(V)
         self.V_world = V
+        polygons = _without_repeats(polygons)
         self.domain = d = PolygonDomain(self.frame.geometry(V), polygons, t_coef=t_coef)
         self.core = SignedHeatCore(d)
         fr = self.frame  # attributes in input units (L, Lconn, P, frames are scale-free); fine_ops: frame units
@@ -84,3 +88,21 @@ class PolygonMeshSignedHeatSolver:
                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
                                          progress=progress)
         return self.frame.length(phi)
+
+
+def _without_repeats(polygons):
+    """The polygons without those that repeat a vertex (a warning says how many); anything not a list of index
+    sequences is passed on unchanged for the domain to validate."""
+    import warnings
+
+    try:
+        polys = [np.asarray(q).ravel() for q in polygons]
+        rep = [len(np.unique(q)) < len(q) for q in polys]
+    except (TypeError, ValueError):
+        return polygons
+    if not any(rep):
+        return polygons
+    keep = [q for q, r in zip(polys, rep) if not r]
+    warnings.warn(f"polygons: {sum(rep)} polygons repeat a vertex (first: polygon {rep.index(True)}); they are "
+                  "dropped", stacklevel=3)
+    return keep

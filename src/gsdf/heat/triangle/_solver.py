@@ -7,6 +7,8 @@ public class, L1 integration (§7.2), sharpening (§7.3) and curve splitting hel
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from gsdf import _checks
@@ -39,7 +41,9 @@ class SurfaceSignedHeatSolver:
         is then assembled as a real 2|E|×2|E| block matrix that represents the reflections (the complex |E|×|E|
         form of Eq. 9 when all faces agree); give the curve normals (``curve_normals=`` of
         :meth:`compute_distance`) there, since face normals flip across the seam.
-        Faces with repeated vertices or zero area raise ValueError (remove them first).
+        Faces that repeat a vertex have no area and are dropped with a warning (``F`` of the solver lists the
+        faces kept; face indices given in curves and point sources still refer to the input ``F``); other faces
+        of zero area raise ValueError (remove them first).
     t_coef : float
         Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6) of the input mesh.
     intrinsic_delaunay : bool
@@ -84,9 +88,16 @@ class SurfaceSignedHeatSolver:
         self.V_world, V = V, self.frame.geometry(V)
         self.t_coef = _checks.positive(t_coef, "t_coef")
         rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
+        self._kept = None  # input face -> kept face (-1: dropped), when faces were dropped
         if rep.any():
-            raise ValueError(f"F: face {int(np.flatnonzero(rep)[0])} repeats a vertex ({int(rep.sum())} "
-                             "degenerate faces); remove degenerate triangles first")
+            warnings.warn(f"F: {int(rep.sum())} faces repeat a vertex (first: face {int(np.flatnonzero(rep)[0])}); "
+                          "they have no area and are dropped", stacklevel=2)
+            self._kept = np.full(len(F), -1, np.int64)
+            self._kept[~rep] = np.arange(int((~rep).sum()))
+            self._input_face = np.flatnonzero(~rep)
+            F = F[~rep]
+            if not len(F):
+                raise ValueError("F: every face repeats a vertex")
         dbl = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
         L = np.linalg.norm(V[F[:, 1]] - V[F[:, 0]], axis=1).mean()
         bad = dbl <= 1e-12 * L * L
@@ -136,6 +147,30 @@ class SurfaceSignedHeatSolver:
     def unit_field(self, X: np.ndarray) -> np.ndarray:
         """Step II: face-averaged, normalized vectors Y (m, 3) (§6, Alg. 3); zero where X vanishes."""
         return self.core.unit_field(X)
+
+    def _kept_faces(self, curves, points, curve_signs):
+        """Curves and point sources with their face indices mapped to the faces kept (when faces that repeat a
+        vertex were dropped); ``curve_signs`` folded into the curves then."""
+        if self._kept is None:
+            return curves, points, curve_signs
+
+        def face(f, name):
+            if not 0 <= f < len(self._kept):
+                return f  # out of range: the domain's own message
+            g = int(self._kept[f])
+            if g < 0:
+                raise ValueError(f"{name}: face {f} repeats a vertex and was dropped")
+            return g
+
+        out = []
+        for k, c in enumerate(as_curves(curves, curve_signs)):
+            if c.kind == "points":
+                nodes = [(face(f, f"curves[{k}]") if len(b) else f, b) for f, b in c.nodes]
+                c = Curve(nodes, signed=c.signed)
+            out.append(c)
+        pts = [p if not isinstance(p, tuple) or not len(p[1]) else (face(p[0], "points"), p[1])
+               for p in as_point_sources(points)]
+        return out, pts, None
 
     # ------------------------------------------------------------------ public
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
@@ -192,6 +227,7 @@ class SurfaceSignedHeatSolver:
         >>> solver.compute_distance([np.array([6, 7, 12, 6])], level_set_constraint="none").shape
         (25,)
         """
+        curves, points, curve_signs = self._kept_faces(curves, points, curve_signs)
         phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
                                          progress=progress, curve_normals=curve_normals)
@@ -215,6 +251,7 @@ class SurfaceSignedHeatSolver:
 
         if self.intrinsic_delaunay:
             raise NotImplementedError("compute_distance_l1 is not available with intrinsic_delaunay=True")
+        curves, points, curve_signs = self._kept_faces(curves, points, curve_signs)
         S = self.core.sources(curves, points, curve_signs)
         Y = self.unit_field(self.diffuse(S))
         Phi = integrate_l1(self.ops, Y)
@@ -249,6 +286,7 @@ class SurfaceSignedHeatSolver:
         if phi0.shape != (self.ops.n_vertices,) or not np.isfinite(phi0).all():
             raise ValueError(f"phi0: expected {self.ops.n_vertices} finite values, got shape {phi0.shape}")
         phi0 = self.frame.inverse_length(phi0)
+        curves, points, _ = self._kept_faces(curves, points, None)
         ops0 = self.input_ops
         parts = parse_curves(ops0, as_curves(curves))
         pts = parse_points(ops0, as_point_sources(points))
@@ -270,14 +308,19 @@ class SurfaceSignedHeatSolver:
         consecutive nodes share a face (the form potpourri3d requires)."""
         from gsdf.heat.triangle._sources import _bary_curve_segments
 
-        parts = parse_curves(self.input_ops, [Curve(curve)])
+        (curve,), _, _ = self._kept_faces([Curve(curve)], (), None)
+        parts = parse_curves(self.input_ops, [curve])
         if len(parts) != 1:
             raise ValueError(f"curve: expected one curve, got an edge set of {len(parts)} paths")
         (part,) = parts
         if part.vertices is not None:
             return [(int(v), np.zeros(0)) for v in part.vertices]
         ids, w, _, _, _ = _bary_curve_segments(self.input_ops, part.faces, part.bary, "curve", return_faces=True)
-        return list(zip(ids, w))
+        return list(zip(self._input_faces(ids), w))
+
+    def _input_faces(self, faces):
+        """Kept-face indices back to the input's (identity unless faces were dropped)."""
+        return list(faces) if self._kept is None else [int(self._input_face[f]) for f in faces]
 
     def split_segments(self, curve) -> list:
         """The segments of ``curve`` as pairs ``[(f, bary_a), (f, bary_b)]`` in one face each (vertex polylines
@@ -285,6 +328,8 @@ class SurfaceSignedHeatSolver:
         from gsdf.heat.triangle._sources import _bary_in_face, _faces_of_node
 
         nodes = self.split_curve(curve)
+        if self._kept is not None and len(nodes[0][1]):
+            nodes = [(int(self._kept[f]), b) for f, b in nodes]
         if len(nodes[0][1]) == 0:
             vf = self.input_ops.vertex_faces()
             nodes2 = []
@@ -300,5 +345,6 @@ class SurfaceSignedHeatSolver:
             f = min(common)
             Vf = self.input_ops.V
             pa, pb = ba @ Vf[self.F[fa]], bb @ Vf[self.F[fb]]
-            out.append([(f, _bary_in_face(self.input_ops, pa, f)), (f, _bary_in_face(self.input_ops, pb, f))])
+            g = self._input_faces([f])[0]
+            out.append([(g, _bary_in_face(self.input_ops, pa, f)), (g, _bary_in_face(self.input_ops, pb, f))])
         return out

@@ -146,8 +146,12 @@ def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = PA
     return _grid_box(X, resolution, lo, hi, pad)
 
 
-def _grid_box(X, resolution, lo=None, hi=None, pad: float = PAD):
-    """:func:`volume_grid_box` of validated positions ``X`` and corners ``lo``, ``hi`` ((3,) or None)."""
+def _grid_box(X, resolution, lo=None, hi=None, pad: float = PAD, frame=None):
+    """:func:`volume_grid_box` of validated positions ``X`` and corners ``lo``, ``hi`` ((3,) or None); with the
+    ``frame`` they are in, its errors name the boxes in the caller's units."""
+    def user(a):
+        return a if frame is None else frame.point(np.asarray(a, dtype=np.float64)[None])[0]
+
     xlo, xhi = X.min(axis=0), X.max(axis=0)
     diag = float(np.linalg.norm(xhi - xlo))
     if diag == 0:
@@ -155,10 +159,11 @@ def _grid_box(X, resolution, lo=None, hi=None, pad: float = PAD):
     lo = xlo - pad * diag if lo is None else lo
     hi = xhi + pad * diag if hi is None else hi
     if np.any(hi <= lo):
-        raise ValueError(f"bbox_max {hi} must exceed bbox_min {lo} on every axis")
+        raise ValueError(f"bbox_max {user(hi)} must exceed bbox_min {user(lo)} on every axis")
     tol = 1e-9 * max(diag, float(np.abs(hi - lo).max()))
     if np.any(xlo < lo - tol) or np.any(xhi > hi + tol):
-        raise ValueError(f"the bounding box [{lo}, {hi}] does not contain the input (input box [{xlo}, {xhi}])")
+        raise ValueError(f"the bounding box [{user(lo)}, {user(hi)}] does not contain the input (input box "
+                         f"[{user(xlo)}, {user(xhi)}])")
     if np.ndim(resolution) == 0:
         r = integer(resolution, "resolution", lo=2)
         if r > MAX_RESOLUTION:
@@ -249,7 +254,7 @@ def _signed_heat_volume(mesh, points, domain, resolution, bbox_min, bbox_max, t_
         bbox_min = frame.queries(as_points(bbox_min, "bbox_min"), "bbox_min")[0]
     if bbox_max is not None:
         bbox_max = frame.queries(as_points(bbox_max, "bbox_max"), "bbox_max")[0]
-    lo, hi, shape = _grid_box(X, resolution, bbox_min, bbox_max)
+    lo, hi, shape = _grid_box(X, resolution, bbox_min, bbox_max, frame=frame)
     t = positive(t_coef * input_spacing(X, F) ** 2, "t") if opt["t_scale"] == "input" else None
     common = dict(t_coef=t_coef, t=t, mode=opt["mode"], lam=opt["lam"], theta=opt["theta"],
                   max_memory=opt["max_memory"], progress=opt["progress"], frame=frame)
