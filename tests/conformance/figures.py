@@ -1,17 +1,17 @@
-"""Print the "before" figures of issue 32's failures (public gsdf API only; peers' answers from data/refs/).
+"""Print the figures of the failures the conformance suite found (issue 32): the tet isosurface, booleans, the
+SWN demo's twirl and torus, the sign rule, the point-cloud comparison, point areas, the inputs the peers take.
 
-    cd /work/notes/conformance && nice python3 figures.py            # all sections, ~1 min
-    nice python3 figures.py tet bool                                  # some of them
+    PYTHONPATH=src python3 tests/conformance/figures.py             # all sections, a few minutes
+    PYTHONPATH=src python3 tests/conformance/figures.py tet bool    # some of them
 
-Sections: tet, bool, twirl, sign, cloud, areas, inputs, torus.
+Sections: tet, bool, twirl, sign, cloud, areas, inputs, torus. Public gsdf API only; the peers' answers come
+from data/refs/ (record_refs.py); the libigl-tests-data files are the generated stand-ins of helpers.py.
 """
 
 from __future__ import annotations
 
 import gzip
 import os
-import shutil
-import subprocess
 import sys
 import tempfile
 import warnings
@@ -19,12 +19,14 @@ from pathlib import Path
 
 import numpy as np
 
-import gsdf
-
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE / "tests"))
-from cases import (PP3D_BROKEN, PP3D_CLOUD_CURVE, PP3D_POINTS, PP3D_POLY_CURVE,  # noqa: E402
-                   fibonacci_sphere_case, uv_sphere_polygons)
+sys.path.insert(0, str(HERE.parents[1]))          # the repository root: tests.conformance.* importable
+
+import gsdf  # noqa: E402
+from tests.conformance.cases import (PP3D_BROKEN, PP3D_CLOUD_CURVE, PP3D_POINTS, PP3D_POLY_CURVE,  # noqa: E402
+                                     fibonacci_sphere_case, uv_sphere_polygons)
+from tests.conformance.helpers import (box_mesh, grid_quads, msh22_text, tet_boundary, tet_cube,  # noqa: E402
+                                       two_boxes_bad_self_union, wrapped_off_text)
 
 DATA = HERE / "data"
 TMP = Path(tempfile.mkdtemp())
@@ -38,10 +40,6 @@ def asset(peer, name):
     if not out.exists():
         out.write_bytes(gzip.decompress((DATA / peer / (name + ".gz")).read_bytes()))
     return str(out)
-
-
-def ext(name):
-    return str(DATA / "_external" / "libigl" / name)
 
 
 def refs(name):
@@ -97,7 +95,8 @@ def tet():
         return np.sign(np.sum(N[i] * (Q - Pp[i]), axis=1)) * d
 
     for res in (8, 16, 32):
-        f = gsdf.signed_heat_volume(mesh=(V, F), domain="tet", resolution=np.array([res] * 3))
+        f = gsdf.signed_heat_volume(mesh=(V, F), domain="tet", resolution=np.array([res] * 3),
+                                    options=gsdf.VolumeHeatOptions(level_set_constraint="zero"))
         Vi, Fi = f.isosurface(0.0)
         N1, N2 = normals(V, F), normals(Vi, Fi)
         a, b = approx(V, Vi, N2) ** 2, approx(Vi, V, N1) ** 2
@@ -117,16 +116,17 @@ def tet():
 
 def bool_():
     print("booleans (libigl MeshBoolean tests; volumes are signed volumes of the result)")
-    A = gsdf.read_mesh(ext("boolean_minus_test_cube.obj"))
-    B = gsdf.read_mesh(ext("boolean_minus_test_green.obj"))
+    A = box_mesh([0, 0, 0], [1, 1, 1])
+    B = box_mesh([0, 0.375, 0.375], [2, 0.625, 0.625])
     Vo, Fo = gsdf.mesh_boolean(*A, *B, "difference")
     print(f"  MinusTest cube - bar: Euler {euler(Fo)} (want 0), volume {volume(Vo, Fo):.6f} (want 0.9375), "
           f"boundary edges {boundary_edges(Fo)[0]}")
-    C = gsdf.read_mesh(ext("cube.obj"))
+    C = box_mesh([-0.5] * 3, [0.5] * 3)
     Vo, Fo = gsdf.mesh_boolean(*C, *C, "intersection")
     print(f"  IntersectWithSelf cube ∩ cube: {len(Fo)} faces (want a closed genus-0 cube)")
-    T = gsdf.read_mesh(ext("two-boxes-bad-self-union.ply"))
-    try_("TwoCubes A ∪ ∅", lambda: gsdf.mesh_boolean(*T, np.zeros((0, 3)), np.zeros((0, 3), np.int64), "union"))
+    T = two_boxes_bad_self_union()
+    try_("TwoCubes A ∪ ∅ (Euler, boundary edges)", lambda: (lambda R: (euler(R[1]), boundary_edges(R[1])[0]))(
+        gsdf.mesh_boolean(*T, np.zeros((0, 3)), np.zeros((0, 3), np.int64), "union")))
     Vo, Fo = gsdf.mesh_boolean(*T, *T, "union")
     print(f"  TwoCubes A ∪ A: boundary edges {boundary_edges(Fo)[0]}, Euler {euler(Fo)} (want 0 boundary, 2)")
     r = refs("libigl")
@@ -145,13 +145,15 @@ def bool_():
 def twirl():
     print("surface winding numbers, SWN demo 'twirl'")
     mesh, curves = asset("swn", "twirl.obj"), asset("swn", "twirl.txt")
-    exe = shutil.which("gsdf")
-    r = subprocess.run([exe, "swn", mesh, curves, "-o", str(TMP / "tw.ply"), "--quiet"], capture_output=True, text=True)
-    print(f"  gsdf swn twirl.obj twirl.txt: rc {r.returncode}: {r.stderr.strip()[-200:]}")
+    from click.testing import CliRunner
+
+    from gsdf.cli.swn import swn
+
+    r = CliRunner().invoke(swn, [mesh, curves, "-o", str(TMP / "tw.ply"), "--quiet"])
+    print(f"  gsdf swn twirl.obj twirl.txt: exit code {r.exit_code} {r.output.strip()[-200:]}")
     V, F = gsdf.read_mesh(mesh)
-    try_("read_curves(twirl.txt)", lambda: gsdf.read_curves(curves, F))
-    sys.path.insert(0, str(HERE / "tests"))
-    from test_swn import parse_swn_curves
+    try_("read_curves(twirl.txt): segments", lambda: sum(len(c) - 1 for c in gsdf.read_curves(curves, F).curves))
+    from tests.conformance.test_swn import parse_swn_curves
 
     res = gsdf.surface_winding_number(V, F, parse_swn_curves(curves))
     labels, counts = np.unique(res.face_labels, return_counts=True)
@@ -218,11 +220,16 @@ def areas():
 
 def inputs():
     print("inputs the peers take")
-    try_("OFF with wrapped faces", lambda: gsdf.read_mesh(ext("inspired_mesh_quads_Conjugate.off"))[1].shape)
-    try_(".msh (tri + tet + data)", lambda: gsdf.read_mesh(ext("sphere_lowres_TMS_1-0001_Magstim_70mm_Fig8_nii_scalar.msh"))[1].shape)
+    p = TMP / "w.off"
+    p.write_text(wrapped_off_text(*grid_quads(12, 9)))
+    try_("OFF with wrapped faces", lambda: len(gsdf.read_mesh(str(p), triangulate=False)[1]))
+    Vt, Tt = tet_cube(3)
+    p = TMP / "m.msh"
+    p.write_text(msh22_text(Vt, Tt, tet_boundary(Tt)))
+    try_(".msh (tri + tet + element data)", lambda: gsdf.read_mesh(str(p))[1].shape)
     p = TMP / "t.mesh"
     p.write_text("MeshVersionFormatted 1\nDimension 3\nVertices\n4\n0 0 0 0\n0 0 1 0\n0 1 0 0\n1 0 0 0\nTetrahedra\n1\n1 2 3 4 0\n")
-    try_(".mesh with only a tet", lambda: gsdf.read_mesh(str(p)))
+    try_(".mesh with only a tet", lambda: gsdf.read_mesh(str(p))[1].shape)
     try_("faceless PLY to read_mesh", lambda: gsdf.read_mesh(asset("pcu", "duplicated_pcloud.ply")))
     V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
     F = np.array([[0, 1, 3], [0, 2, 1], [0, 3, 2], [1, 2, 3]])
@@ -230,10 +237,11 @@ def inputs():
     try_("signed_distance, Q (0, 3)", lambda: gsdf.signed_distance(V, F, np.zeros((0, 3))).shape)
     try_("winding_number, Q (0, 3)", lambda: gsdf.winding_number(V, F, np.zeros((0, 3))).shape)
     try_("signed_distance(return_closest=True)", lambda: len(gsdf.signed_distance(V, F, V, return_closest=True)))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
         try_("SurfaceSignedHeatSolver, a face repeating a vertex",
-             lambda: gsdf.SurfaceSignedHeatSolver(V, np.vstack([F, [[0, 0, 1]]])))
+             lambda: gsdf.SurfaceSignedHeatSolver(V, np.vstack([F, [[0, 0, 1]]])).F.shape)
+    print(f"    warning: {[str(x.message) for x in w]}")
     try_("write_mesh(vertex_data={'n': (n, 3)})",
          lambda: gsdf.write_mesh(str(TMP / "a.ply"), V, F, vertex_data={"n": np.zeros((4, 3))}))
     Vb, Fb = gsdf.read_mesh(asset("signed_heat_python", "bunny_small.obj"))
@@ -243,8 +251,7 @@ def inputs():
 
 def torus():
     print("surface winding numbers vs the SWN authors' torus_w.obj (torus.obj + torus-phi.txt)")
-    sys.path.insert(0, str(HERE / "tests"))
-    from test_swn import parse_swn_curves
+    from tests.conformance.test_swn import parse_swn_curves
 
     V, F = gsdf.read_mesh(asset("swn", "torus.obj"))
     res = gsdf.surface_winding_number(V, F, parse_swn_curves(asset("swn", "torus-phi.txt")))

@@ -369,3 +369,23 @@ def hemisphere_mesh():
     F = F[V[F][:, :, 2].min(axis=1) >= -1e-12]
     used, F = np.unique(F, return_inverse=True)
     return V[used], F.reshape(-1, 3)
+
+
+def airplane():
+    """A closed fuselage (a capped octagonal tube along x) and a single-layer wing crossing it: the
+    ShapeNet airplane's (mesh2sdf's plane.obj) mix of solid parts and double-sided sheets."""
+    k = 8
+    ang = np.arange(k) * 2 * np.pi / k
+    xs = np.array([-1.0, 1.0])
+    ring = np.column_stack([np.cos(ang), np.sin(ang)]) * 0.15
+    V = [np.column_stack([np.full(k, x), ring]) for x in xs] + [np.array([[-1.0, 0, 0], [1.0, 0, 0]])]
+    V = np.vstack(V)
+    F = []
+    for i in range(k):
+        j = (i + 1) % k
+        F += [[i, j, k + j], [i, k + j, k + i]]  # the side, outward
+        F += [[2 * k, j, i], [2 * k + 1, k + i, k + j]]  # the caps
+    F = np.array(F)
+    wing = np.array([[-0.3, -1.2, 0], [0.3, -1.2, 0], [0.3, 1.2, 0], [-0.3, 1.2, 0]])
+    W = np.array([[0, 1, 2], [0, 2, 3]]) + len(V)
+    return np.vstack([V, wing]), np.vstack([F, W])

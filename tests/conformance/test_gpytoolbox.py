@@ -56,7 +56,7 @@ def test_fast_winding_number__precomputed_bvh(unpacked):
     assert np.array_equal(fwn(pin), fwn(pin))
 
 
-@pytest.mark.xfail(reason="documented difference: gpytoolbox.winding_number in 3-D routes to the fast tree "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): gpytoolbox.winding_number in 3-D routes to the fast tree "
                           "(identical values); gsdf.winding_number is the exact sum, which the tree approximates "
                           "to ~1e-4 this close (1e-3) to the surface", strict=True)
 def test_fast_winding_number__winding_number_routes_to_tree(unpacked):
@@ -308,7 +308,7 @@ def test_read_mesh__meshes(unpacked):
 STL = [("sphere_binary.stl", 4080, 1360), ("fox_ascii.stl", 1866, 622), ("sphere_binary_solid_header.stl", 4080, 1360)]
 
 
-@pytest.mark.xfail(reason="gsdf.read_mesh always welds STL corners (682 / 311 / 682 vertices); there is no option to "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): gsdf.read_mesh always welds STL corners (682 / 311 / 682 vertices); there is no option to "
                           "keep the 3 corners per triangle (gpytoolbox merge_stl=False)", strict=True)
 @pytest.mark.parametrize("name,nv,nf", STL)
 def test_read_mesh__stl_reader_unmerged(unpacked, name, nv, nf):
@@ -373,7 +373,7 @@ def test_read_mesh__ply_write_normals_as_one_array(unpacked, tmp_path):
     assert np.all(np.column_stack([got[f"normal_{j}"] for j in range(3)]) == N)
 
 
-@pytest.mark.xfail(reason="gsdf writes and reads no per-face attributes (gpytoolbox C with one row per face)",
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): gsdf writes and reads no per-face attributes (gpytoolbox C with one row per face)",
                    strict=True)
 def test_write_mesh__ply_face_colors(unpacked, tmp_path):
     """test_write_mesh.py::test_ply_read_then_write — per_face colours C (m, 4) written and read back."""

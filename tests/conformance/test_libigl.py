@@ -333,7 +333,7 @@ def test_readPLY__quad_cube(tmp_path):
     assert {"nx", "ny", "nz", "s", "t"} <= set(vd) and all(v.shape == (24,) for v in vd.values())
 
 
-@pytest.mark.xfail(reason="gsdf has no reader of PLY face properties (libigl: FD 6 x 4, headers red green blue "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): gsdf has no reader of PLY face properties (libigl: FD 6 x 4, headers red green blue "
                           "alpha)", strict=True)
 def test_readPLY__quad_cube_face_data(tmp_path):
     """readPLY.cpp::"readPLY: quad_cube.ply" — FD 6 x 4 with headers red, green, blue, alpha."""
@@ -555,7 +555,7 @@ def test_python_normals_and_distances__signed_distance():
                                atol=1e-12)
 
 
-@pytest.mark.xfail(reason="documented difference: on an open surface libigl's winding-number sign types return "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): on an open surface libigl's winding-number sign types return "
                           "d * (1 - 2w) (0.667 and 0.333 at distance 0.5 above the square, w = -1/6 / +1/6); "
                           "gsdf returns sign(1/2 - w) * d = 0.5", strict=True)
 @pytest.mark.parametrize("kind", ["winding", "fwn"])

@@ -118,7 +118,7 @@ def test_sample_mesh_signed_zero(solver):
     assert rel_l2(phi, -r["signed_zero"]) < AGREE
 
 
-@pytest.mark.xfail(reason="preserve_source_normals=True has no gsdf counterpart: with it potpourri3d's "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): preserve_source_normals=True has no gsdf counterpart: with it potpourri3d's "
                           "level_set_constraint='none' values differ from gsdf's by 1.1 % (relative L2)", strict=True)
 def test_sample_mesh_signed_none_preserve_normals(solver):
     """sample.py — compute_distance(curves, [], [], preserve_source_normals=True, level_set_constraint='none')."""
@@ -145,21 +145,15 @@ def test_sample_mesh_surface_point_curve(bunny, solver):
     assert rel_l2(phi, -r["sp_zero"]) < AGREE
 
 
-@pytest.mark.xfail(reason="docs/formats.md's rule 'gsdf = −potpourri3d for signed curves' does not hold with point "
-                          "sources (relative L2 0.88); what holds in every case is gsdf(C) = potpourri3d(C reversed) "
-                          "(next test)", strict=True)
-def test_sample_mesh_mixed_documented_rule(solver):
-    """sample.py — mixed_dist = compute_distance(curves, [True]*3, points, ZeroSet): signed curves and points."""
-    r = ref(P)
-    phi = solver.compute_distance([gsdf.Curve(c) for c in PP3D_BROKEN], points=PP3D_POINTS)
-    assert rel_l2(phi, -r["mixed_zero"]) < AGREE
-
-
 def test_sample_mesh_mixed_reversed_curves(solver):
-    """sample.py's mixed case against potpourri3d with every curve reversed: equal (measured 2.7e-8)."""
+    """The sign rule (docs/formats.md): gsdf(C) = potpourri3d(C reversed). sample.py's mixed case (signed curves
+    and point sources, ZeroSet) against potpourri3d with every curve reversed: equal (measured 2.7e-8). Against
+    the negative of potpourri3d's own mixed result — the rule documented before, which holds for signed curves
+    alone (test_sample_mesh_signed_zero) — it is 0.88 off: the point distances do not flip."""
     r = ref(P)
     phi = solver.compute_distance([gsdf.Curve(c) for c in PP3D_BROKEN], points=PP3D_POINTS)
     assert rel_l2(phi, r["mixed_zero_reversed"]) < AGREE
+    assert rel_l2(phi, -r["mixed_zero"]) > 0.5
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -173,7 +167,7 @@ def poly(unpacked):
     return V, polys
 
 
-@pytest.mark.xfail(reason="gsdf and potpourri3d differ by 6.7 % (relative L2) on bunny_poly; on the analytic UV "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): gsdf and potpourri3d differ by 6.7 % (relative L2) on bunny_poly; on the analytic UV "
                           "sphere (next tests) gsdf is 0.8 % from the exact distance, potpourri3d 7.0 %", strict=True)
 def test_sample_polygon_unsigned(poly):
     """sample.py — PolygonMeshHeatSolver(V, F).compute_distance([100, 1000])."""
@@ -182,7 +176,7 @@ def test_sample_polygon_unsigned(poly):
     assert rel_l2(phi, r["poly_unsigned"]) < CLOSE
 
 
-@pytest.mark.xfail(reason="gsdf and potpourri3d differ by 5.4 % (relative L2) on bunny_poly (same sign "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): gsdf and potpourri3d differ by 5.4 % (relative L2) on bunny_poly (same sign "
                           "convention); on the analytic UV sphere both are within 0.12 % of the exact signed "
                           "distance", strict=True)
 def test_sample_polygon_signed(poly):
@@ -219,7 +213,7 @@ def test_analytic_polygon_sphere_signed():
 # ---------------------------------------------------------------------------------------------------------------
 
 
-@pytest.mark.xfail(reason="gsdf and potpourri3d differ by 9.8 % / 14 % (relative L2) on the bunny cloud; on the "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): gsdf and potpourri3d differ by 9.8 % / 14 % (relative L2) on the bunny cloud; on the "
                           "analytic Fibonacci sphere gsdf is 3.5 % from the exact distance, potpourri3d 1.6 %",
                    strict=True)
 @pytest.mark.parametrize("sources,key", [([4], "cloud_dist4"), ([4, 13, 784], "cloud_dist_multi")])
@@ -230,7 +224,7 @@ def test_sample_cloud_unsigned(poly, sources, key):
     assert rel_l2(phi, r[key]) < CLOSE
 
 
-@pytest.mark.xfail(reason="gsdf and potpourri3d differ by 0.65 (potpourri3d's PCA normals, inconsistent) / 0.47 "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): gsdf and potpourri3d differ by 0.65 (potpourri3d's PCA normals, inconsistent) / 0.47 "
                           "(normals made consistent) relative L2 on the bunny cloud; not a sign convention (same "
                           "sign). Against the polygon-mesh solution with the polygon curve gsdf's cloud is 9.6 % "
                           "off, potpourri3d's 30 %; on the analytic sphere gsdf 1.3 %, potpourri3d 2.1 %",
@@ -255,9 +249,10 @@ def test_analytic_cloud_sphere_signed():
     phi = gsdf.PointCloudSignedHeatSolver(Pc, Pc).compute_distance([gsdf.Curve(curve)])
     assert rel_l2(phi, exact) < 2e-2
     assert rel_l2(phi, exact) <= rel_l2(r["sphere_signed"], exact)
+    assert rel_l2(r["sphere_signed"], exact) < 5e-2      # potpourri3d's cloud solver: the same sign as gsdf
 
 
-@pytest.mark.xfail(reason="on the analytic cloud gsdf's unsigned point distance is 3.5 % from the exact geodesic "
+@pytest.mark.xfail(reason="documented difference (docs/formats.md, conventions): on the analytic cloud gsdf's unsigned point distance is 3.5 % from the exact geodesic "
                           "distance, potpourri3d's 1.6 %", strict=True)
 def test_analytic_cloud_sphere_unsigned():
     """The same cloud, distance from point 0: exact arccos(p . p0); gsdf no worse than potpourri3d."""

@@ -429,36 +429,14 @@ def test_refit_answers_as_a_fresh_tree():
         td.refit(V[:-1])
 
 
-def _airplane():
-    """A closed fuselage (a capped octagonal tube along x) and single-layer wings and tail crossing it: the
-    ShapeNet airplane's (mesh2sdf's plane.obj) mix of solid parts and double-sided sheets."""
-    import gsdf
-
-    k = 8
-    ang = np.arange(k) * 2 * np.pi / k
-    xs = np.array([-1.0, 1.0])
-    ring = np.column_stack([np.cos(ang), np.sin(ang)]) * 0.15
-    V = [np.column_stack([np.full(k, x), ring]) for x in xs] + [np.array([[-1.0, 0, 0], [1.0, 0, 0]])]
-    V = np.vstack(V)
-    F = []
-    for i in range(k):
-        j = (i + 1) % k
-        F += [[i, j, k + j], [i, k + j, k + i]]  # the side, outward
-        F += [[2 * k, j, i], [2 * k + 1, k + i, k + j]]  # the caps
-    F = np.array(F)
-    assert gsdf.mesh_topology(V, F)["closed"]
-    wing = np.array([[-0.3, -1.2, 0], [0.3, -1.2, 0], [0.3, 1.2, 0], [-0.3, 1.2, 0]])
-    W = np.array([[0, 1, 2], [0, 2, 3]]) + len(V)
-    return np.vstack([V, wing]), np.vstack([F, W])
-
-
 def test_shell_gives_double_sided_sheets_an_inside():
     """Open single-layer sheets have no inside (winding number 1/2 on one side, -1/2 on the other): a point just
     above a wing is outside. With shell=t the wing is a plate of thickness t; the solid fuselage stays inside
     either way; nothing changes beyond t/2 of the surface."""
     import gsdf
+    from tests.conformance.helpers import airplane
 
-    V, F = _airplane()
+    V, F = airplane()
     Q = np.array([[0.0, 0.8, 0.01], [0.0, 0.8, -0.01], [0.0, 0.0, 0.05], [0.0, 0.8, 0.3], [0.9, 0.0, 0.0]])
     s = gsdf.signed_distance(V, F, Q)
     assert s[0] > 0 and s[1] > 0 and s[2] < 0 and s[3] > 0 and s[4] < 0

@@ -20,8 +20,9 @@ per cover *edge*: ``b_i = Σ_j w_ij (x_i − x_j) · Y_ij`` with w_ij = −L_ij 
 and X_j — the face formula of §5.5 with the vector averaged over the edge instead of the face (identical for a
 constant field). Then ``L φ = b`` with the level-set constraints of §7.1.
 
-Sign convention: gsdf's left-negative; potpourri3d's ``PointCloudHeatSolver.compute_signed_distance`` is
-left-positive (its values are the negative of these).
+Sign convention: gsdf's left-negative. potpourri3d's ``PointCloudHeatSolver.compute_signed_distance`` has the
+same sign (unlike its triangle-mesh solver): on a Fibonacci unit sphere with the equator loop both approximate
+−asin z, gsdf within 1.3 %, potpourri3d 2.1 % (tests/conformance/test_potpourri3d.py).
 """
 
 from __future__ import annotations

@@ -1,8 +1,9 @@
 """Front-end of the signed heat method with a point cloud as the domain (Feng & Crane 2024, §8.4): operators
 in :mod:`gsdf.heat.pointcloud._domain`, steps I–III in :mod:`gsdf.heat._core`.
 
-Sign convention: gsdf's left-negative; potpourri3d's ``PointCloudHeatSolver.compute_signed_distance`` is
-left-positive (its values are the negative of these).
+Sign convention: gsdf's left-negative. potpourri3d's ``PointCloudHeatSolver.compute_signed_distance`` has the
+same sign (unlike its triangle-mesh solver): on a Fibonacci unit sphere with the equator loop both approximate
+−asin z, gsdf within 1.3 %, potpourri3d 2.1 % (tests/conformance/test_potpourri3d.py).
 """
 
 from __future__ import annotations

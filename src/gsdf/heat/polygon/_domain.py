@@ -28,8 +28,9 @@ solves ``L φ = b`` with the level-set constraints of §7.1. The diffusion time 
 the mean polygon edge length (geometry-central's choice for polygon meshes).
 
 Curves run along polygon edges (vertex-index polylines). Sign convention as everywhere in gsdf: the left of a
-curve (the inside of a counter-clockwise loop seen from the normal side) is negative, the opposite of
-potpourri3d.
+curve (the inside of a counter-clockwise loop seen from the normal side) is negative. potpourri3d's
+``PolygonMeshHeatSolver.compute_signed_distance`` has the same sign (unlike its triangle-mesh solver): on a UV
+sphere of quads both are within 0.12 % of the exact signed distance to a ring (tests/conformance).
 
 :class:`PolygonDomain` supplies these operators to :class:`gsdf.heat._core.SignedHeatCore` (sources: the
 vertex-based ones of :class:`~gsdf.heat._domain.VertexSurfaceDomain`);

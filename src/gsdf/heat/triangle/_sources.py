@@ -4,7 +4,8 @@ Sign convention: the normal of an oriented curve is its tangent turned 90° *clo
 paper and potpourri3d turn it counter-clockwise), so that C φ = b (∇φ ≈ Y) makes the region to the *left* of
 the curve — the region a counter-clockwise curve encloses — negative ("negative inside"), while point sources
 and unoriented curves (whose normals point away from the source) still give positive distance. Compared with
-potpourri3d, signed curves give the opposite sign and unsigned sources the same values.
+potpourri3d: gsdf's result for curves C is potpourri3d's for C reversed (with signed curves alone, the negative
+of potpourri3d's; not with signed curves and points together).
 
 Curves arrive as :class:`gsdf.Curve` (type-checked by :func:`gsdf.curves.as_curves`); :func:`parse_curves` checks
 them against the mesh and :func:`assemble` turns them, with the point sources of :func:`parse_points`, into the
