@@ -22,7 +22,7 @@ _EXPORTS = {
     "fast_winding_number": "winding", "fast_winding_number_points": "winding",
     "point_areas": "winding", "estimate_normals": "winding",
     # surface winding numbers (thesis ch. 6)
-    "SurfaceWindingNumbers": "swn", "surface_winding_number": "swn",
+    "SurfaceWindingNumbers": "swn", "surface_winding_number": "swn", "SWNOptions": "swn",
     # distance
     "TriangleDistance": "distance", "PointCloudDistance": "distance", "unsigned_distance": "distance",
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",

@@ -55,7 +55,11 @@ from gsdf.ops import (
     winding_grid as winding_grid,
 )
 from gsdf.recon import reconstruct_simply_connected as reconstruct_simply_connected
-from gsdf.swn import SurfaceWindingNumbers as SurfaceWindingNumbers, surface_winding_number as surface_winding_number
+from gsdf.swn import (
+    SurfaceWindingNumbers as SurfaceWindingNumbers,
+    SWNOptions as SWNOptions,
+    surface_winding_number as surface_winding_number,
+)
 from gsdf.threads import get_num_threads as get_num_threads, set_num_threads as set_num_threads
 from gsdf.tori import (
     LogSumExpDistance as LogSumExpDistance,

@@ -71,7 +71,7 @@ Example:
 def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     from gsdf.io import read_mesh
     from gsdf.io._swn_curves import read_swn_curves
-    from gsdf.swn._solver import SurfaceWindingNumbers
+    from gsdf.swn._solver import SurfaceWindingNumbers, SWNOptions
     from gsdf.swn._insert import insert_curves
 
     check_output(output, (".ply", ".obj"))
@@ -90,7 +90,8 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
 
     bar, update = progress_bar(5, "swn steps", enabled=not quiet)
     try:
-        res = solver.solve(list(segs), method=method, epsilon=epsilon, time_limit=time_limit, progress=update)
+        res = solver.solve(list(segs), method=method, options=SWNOptions(epsilon=epsilon, time_limit=time_limit),
+                           progress=update)
     finally:
         bar.close()
     with output_file(output, (".ply", ".obj")) as tmp:
