@@ -46,7 +46,7 @@ _EXPORTS = {
     "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
     "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "view",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
-    "reconstruct_simply_connected": "recon", "mesh_topology": "mesh",
+    "reconstruct_simply_connected": "recon", "ReconstructionOptions": "recon", "mesh_topology": "mesh",
     # dataset batches (issue 16)
     "run_batch": "batch", "sdf_samples": "batch",
     # one thread setting for numba kernels and BLAS (gsdf.threads)

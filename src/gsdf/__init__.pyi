@@ -54,7 +54,10 @@ from gsdf.ops import (
     voxels_to_mesh as voxels_to_mesh,
     winding_grid as winding_grid,
 )
-from gsdf.recon import reconstruct_simply_connected as reconstruct_simply_connected
+from gsdf.recon import (
+    ReconstructionOptions as ReconstructionOptions,
+    reconstruct_simply_connected as reconstruct_simply_connected,
+)
 from gsdf.swn import (
     SurfaceWindingNumbers as SurfaceWindingNumbers,
     SWNOptions as SWNOptions,

@@ -56,9 +56,10 @@ def reconstruct(cloud, out, method, outliers, clusters, max_iterations, resoluti
 
     click.echo(f"{cloud}: {len(P)} points{' with normals' if N is not None else ''}; method {method}")
     if method == "simply-connected":
-        from gsdf.recon import reconstruct_simply_connected
+        from gsdf.recon import ReconstructionOptions, reconstruct_simply_connected
         V, F, rep = reconstruct_simply_connected(P, N, outliers=outliers, clusters=clusters,
-                                                 max_iterations=max_iterations, progress=say, return_report=True)
+                                                 options=ReconstructionOptions(max_iterations=max_iterations),
+                                                 progress=say, return_report=True)
         click.echo(f"  {rep['iterations']} round(s); {int(rep['outliers'].sum())} points judged outliers; "
                    f"{rep['n_tets']} tets; {rep['timings']['total']:.2f} s")
     else:

@@ -372,10 +372,38 @@ class SurfaceWindingNumbers:
             return res
 
         say("Darboux derivative")
+        om, gamma, Jv, removed, obj, passes = self._passes(u, g, ends, method, options, endpoint_rule, T, say)
+
+        say("final jump solve")
+        t0 = time.perf_counter()
+        Jv = np.where(np.abs(Jv) < 1e-9, 0.0, Jv)
+        # thesis §6.1.2 step ⑤: w jumps across "Γ ∖ Jv", the bounding part as a subset of the input, on the
+        # input's edges only; the completion of the nonbounding part off the input (Jv across the gaps) is not a
+        # jump of w. Vertices where the bounding part does not close become endpoints.
+        bnd = np.where(g != 0, g - removed, 0.0)
+        ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
+        if np.any(bnd != g):
+            w = self._jump_solve(bnd, ends2, endpoint_rule)
+        else:                                     # nothing nonbounding: w = u
+            w = u
+        T["final_solve"] = time.perf_counter() - t0
+        res = self._finish(w, u, g, Jv, ends, om, gamma, method, T, bnd, labels=labels)
+        res.lp_objective = obj
+        res.passes = passes
+        if progress is not None:
+            progress(5, 5)
+        return res
+
+    def _passes(self, u, g, ends, method, options, endpoint_rule, T, say):
+        """Steps ①–④ on the input and then on its remainders (step ⑤'s subset reading): after each pass the
+        input edges whose jump the residual explains by at least a half leave the input, and the remainder is
+        decomposed again while it loses edges (at most ``MAX_PASSES``). Returns (ω, γ of the first pass, Jv
+        summed over the passes, the input removed as nonbounding, LP objective, passes)."""
+        dec = self.dec
         for key in ("darboux", "hodge", "lp", "residual"):
             T[key] = 0.0
-        Jv = zero.copy()                    # the residual, summed over the passes
-        removed = zero.copy()               # input edges read as nonbounding
+        Jv = np.zeros(dec.n_edges)          # the residual, summed over the passes
+        removed = np.zeros(dec.n_edges)     # input edges read as nonbounding
         obj = 0.0
         cur, ends_cur, u_cur = g, ends, u
         for k_pass in range(MAX_PASSES):
@@ -399,26 +427,7 @@ class SurfaceWindingNumbers:
             cur = np.where(cur != 0, cur - cut, 0.0)
             if not np.any(cur):
                 break
-
-        say("final jump solve")
-        t0 = time.perf_counter()
-        Jv = np.where(np.abs(Jv) < 1e-9, 0.0, Jv)
-        # thesis §6.1.2 step ⑤: w jumps across "Γ ∖ Jv", the bounding part as a subset of the input, on the
-        # input's edges only; the completion of the nonbounding part off the input (Jv across the gaps) is not a
-        # jump of w. Vertices where the bounding part does not close become endpoints.
-        bnd = np.where(g != 0, g - removed, 0.0)
-        ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
-        if np.any(bnd != g):
-            w = self._jump_solve(bnd, ends2, endpoint_rule)
-        else:                                     # nothing nonbounding: w = u
-            w = u
-        T["final_solve"] = time.perf_counter() - t0
-        res = self._finish(w, u, g, Jv, ends, om, gamma, method, T, bnd, labels=labels)
-        res.lp_objective = obj
-        res.passes = k_pass + 1
-        if progress is not None:
-            progress(5, 5)
-        return res
+        return om, gamma, Jv, removed, obj, k_pass + 1
 
     def _decompose(self, u, g, ends, method, epsilon, time_limit, T, say=None):
         """Steps ②–④ for the chain g with jump-harmonic u: (ω, γ, Jv, LP objective); adds to T's steps."""
