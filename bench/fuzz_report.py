@@ -163,7 +163,7 @@ def _mesh_calls():
             Q, *[np.asarray(V)[k: k + len(np.atleast_2d(Q))] for k in range(3)]),
         "face_normals": lambda V, F, Q: face_normals(np.asarray(V, float), np.asarray(F)),
         "pseudonormals": lambda V, F, Q: pseudonormals(V, F),
-        "voxelize[mesh]": lambda V, F, Q: gsdf.ops._voxelize(mesh=(V, F), resolution=12)[0],
+        "voxelize[mesh]": lambda V, F, Q: gsdf.ops.voxelize(mesh=(V, F), resolution=12)[0],
         "mesh_boolean": lambda V, F, Q: gsdf.ops.mesh_boolean(V, F, np.asarray(V) + 0.3 * np.ptp(np.asarray(V, float), 0),
                                                               F, "union"),
     }
@@ -179,7 +179,7 @@ def _cloud_calls():
         "estimate_normals": lambda P, N, Q: estimate_normals(P, orient_towards=[0, 0, 0]),
         "PointsAsTori": lambda P, N, Q: gsdf.PointsAsTori(P, N, k=16).signed_distance(Q),
         "PointsAsTori.gradient": lambda P, N, Q: gsdf.PointsAsTori(P, N, k=16).gradient(Q),
-        "voxelize[points]": lambda P, N, Q: gsdf.ops._voxelize(points=(P, N), resolution=10)[0],
+        "voxelize[points]": lambda P, N, Q: gsdf.ops.voxelize(points=(P, N), resolution=10)[0],
     }
 
 
@@ -218,11 +218,11 @@ def _option_cases():
         "PAT curvature_cap": lambda x: gsdf.PointsAsTori(P, P, k=16, curvature_cap=x)(Q0),
         "PAT kd_eps": lambda x: gsdf.PointsAsTori(P, P, k=16, kd_eps=x)(np.random.default_rng(0).uniform(-3, 3, (5000, 3))),
         "PAT estimator": lambda x: gsdf.PointsAsTori(P, P, k=16, estimator=x)(Q0),
-        "voxelize resolution": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=x)[0],
-        "voxelize pad": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=8, pad=x)[0],
-        "voxelize beta": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=8, beta=x)[0],
-        "voxelize chunk": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=8, chunk=x)[0],
-        "voxelize bbox_min": lambda x: gsdf.ops._voxelize(mesh=(V, F), resolution=8, bbox_min=x)[0],
+        "voxelize resolution": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=x)[0],
+        "voxelize pad": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=8, pad=x)[0],
+        "voxelize beta": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=8, beta=x)[0],
+        "voxelize chunk": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=8, chunk=x)[0],
+        "voxelize bbox_min": lambda x: gsdf.ops.voxelize(mesh=(V, F), resolution=8, bbox_min=x)[0],
         "extract_isosurface resolution": lambda x: gsdf.contour.extract_isosurface(
             lambda q: np.linalg.norm(q, axis=1), [-1] * 3, [1] * 3, resolution=x, level=0.5)[0],
         "extract_isosurface level": lambda x: gsdf.contour.extract_isosurface(

@@ -16,7 +16,7 @@ from hypothesis.extra import numpy as hnp  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf.contour import extract_isosurface  # noqa: E402
-from gsdf.ops import _voxelize as voxelize  # noqa: E402
+from gsdf.ops import voxelize  # noqa: E402
 from gsdf.winding._point_areas import estimate_normals, point_areas  # noqa: E402
 
 # ---- strategies ----------------------------------------------------------------------------------------
@@ -254,14 +254,15 @@ def test_options_are_validated(mesh, name, value):
 @given(clouds(), queries(16), POW2, st.sampled_from([0.0, 0.3, 2.0]))
 def test_points_as_tori(cloud, Q, s, kd_eps):
     P, N = cloud
-    pat = _ok_or_valueerror(lambda: gsdf.PointsAsTori(P, N, k=12, kd_eps=kd_eps))
+    opts = gsdf.PointsAsToriOptions(kd_eps=kd_eps)
+    pat = _ok_or_valueerror(lambda: gsdf.PointsAsTori(P, N, k=12, options=opts))
     assume(pat is not None)
     v = pat.signed_distance(Q)
     assert v.shape == (len(Q),) and np.isfinite(v).all()
     g = pat.gradient(Q)
     assert g.shape == (len(Q), 3) and np.isfinite(g).all()
     assert np.array_equal(_threads(1, lambda: pat(Q)), _threads(2, lambda: pat(Q)))
-    ps = gsdf.PointsAsTori(P * s, N, k=12, kd_eps=kd_eps)
+    ps = gsdf.PointsAsTori(P * s, N, k=12, options=opts)
     # power-of-two scales map to the same normalised cloud: same neighbours, same ties, same tori
     np.testing.assert_allclose(ps.signed_distance(Q * s) / s, v, rtol=1e-9, atol=1e-12)
 
