@@ -89,3 +89,57 @@ def test_defaults_bit_identical_to_the_previous_code(tmp_path):
     for k in old:
         assert old[k].shape == new[k].shape, k
         assert np.array_equal(old[k], new[k]), k
+
+
+_INSERT_SCRIPT = r'''
+import sys
+import numpy as np
+import gsdf
+try:                                            # the module's place before and after the layout change
+    from gsdf.swn._insert import insert_curves, insert_surface_points
+    from gsdf.io._swn_curves import read_swn_curves
+except ImportError:
+    from gsdf.winding.surface_curves import insert_curves, insert_surface_points
+    from gsdf.io.swn_curves import read_swn_curves
+
+out = {}
+data = sys.argv[2]
+for name, mesh, cur in (("double-torus", "double-torus.obj", "double-torus.txt"), ("annulus", "annulus.obj",
+                        "annulus.txt"), ("S", "S.obj", "S.txt"), ("torus", "torus.obj", "torus-phi.txt"),
+                        ("bunny", "bunny.obj", "bunny-heart.txt")):
+    V, F = gsdf.read_mesh(f"{data}/{mesh}")
+    r = insert_curves(V, F, read_swn_curves(f"{data}/{cur}", F))
+    for k, a in zip("VFSP", r):
+        out[f"{name}:{k}"] = a
+n = 16
+i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+V = np.column_stack([i.ravel() / n, j.ravel() / n, np.zeros(i.size)])
+a = (i[:-1, :-1] * (n + 1) + j[:-1, :-1]).ravel()
+F = np.vstack([np.column_stack([a, a + n + 1, a + n + 2]), np.column_stack([a, a + n + 2, a + 1])])
+circle = gsdf.level_set_curves(V, F, np.linalg.norm(V[:, :2] - 0.5, axis=1) - 0.3)
+inner = [(100, b) for b in ([0.6, 0.2, 0.2], [0.2, 0.6, 0.2], [0.2, 0.2, 0.6], [0.6, 0.2, 0.2])]   # inside a face
+for name, curves in (("circle", circle), ("interior", [inner])):
+    r = insert_surface_points(V, F, curves)
+    for k, a in zip("VFSP", r):
+        out[f"{name}:{k}"] = a
+np.savez(sys.argv[1], **out)
+'''
+
+DATA = pathlib.Path("/work/shared/data/swn")
+
+
+@pytest.mark.skipif(not DATA.is_dir(), reason="no author data")
+def test_curve_insertion_bit_identical_to_the_previous_code(tmp_path):
+    res = []
+    for side, src in (("old", OLD_SRC), ("new", NEW_SRC)):
+        env = dict(os.environ, PYTHONPATH=str(src), PYTHONDONTWRITEBYTECODE="1")
+        if side == "old":
+            env["NUMBA_CACHE_DIR"] = os.path.join(tempfile.gettempdir(), "gsdf-old-vs-new-numba")
+        path = tmp_path / f"{side}.npz"
+        subprocess.run([sys.executable, "-c", _INSERT_SCRIPT, str(path), str(DATA)], check=True, env=env,
+                       cwd=tmp_path)
+        res.append(dict(np.load(path)))
+    old, new = res
+    assert sorted(old) == sorted(new)
+    for k in old:
+        assert old[k].shape == new[k].shape and np.array_equal(old[k], new[k]), k
