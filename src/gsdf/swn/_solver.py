@@ -328,8 +328,8 @@ class SurfaceWindingNumbers:
 
         Interior endpoints: a discrete branch point on simply connected surfaces (an angular ramp of the corner
         values round the endpoint, :meth:`gsdf.dec.TriangleDEC.branch_coordinates`), excluded with projective
-        interpolation of their corners on the others (:meth:`_jump_solve`). Face labels: with an LP the faces
-        at each gap of the bounding curves are rounded at the level of w across that gap
+        interpolation of their corners on the others (:meth:`_jump_solve`). Face labels: with ``method="lp"`` or
+        ``"reduced"`` the faces at each gap of the bounding curves are rounded at the level of w across that gap
         (:meth:`gap_shift`); ``method="none"`` rounds at one global level (:meth:`rounding_offset`).
         """
         if method not in METHODS:
@@ -531,8 +531,8 @@ class SurfaceWindingNumbers:
 
     def gap_shift(self, wf, bounding, ends, s: float, eps: float = GAP_EPS,
                   max_edges: int = GAP_MAX_EDGES) -> np.ndarray:
-        """Per-face shift of the rounding level at the gaps of the curves (the labels of :meth:`solve` with an
-        LP): the faces are labelled ``round(wf - s - shift)``.
+        """Per-face shift of the rounding level at the gaps of the curves (the labels of :meth:`solve` with
+        ``method="lp"`` or ``"reduced"``): the faces are labelled ``round(wf - s - shift)``.
 
         Next to an interior endpoint w is a branch point — it takes every value of one unit interval on a small
         circle round it — so every level set of w in that interval runs from one end of a gap to the other, a
