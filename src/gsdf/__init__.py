@@ -39,7 +39,7 @@ _EXPORTS = {
     "VoxelSurfaceSignedHeatSolver": "heat",
     "Curve": "curves", "read_curves": "io", "write_curves": "io",
     # the signed heat method in volumes (grids, tets) and morphology
-    "signed_heat_volume": "heat.volume", "YukawaTree": "heat.volume",
+    "signed_heat_volume": "heat.volume", "VolumeHeatOptions": "heat.volume", "YukawaTree": "heat.volume",
     "TetField": "field", "marching_tetrahedra": "contour",
     "offset_surface": "ops", "dilate_erode": "ops", "erode_dilate": "ops",
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)

@@ -38,7 +38,11 @@ from gsdf.heat import (
     SurfaceSignedHeatSolver as SurfaceSignedHeatSolver,
     VoxelSurfaceSignedHeatSolver as VoxelSurfaceSignedHeatSolver,
 )
-from gsdf.heat.volume import YukawaTree as YukawaTree, signed_heat_volume as signed_heat_volume
+from gsdf.heat.volume import (
+    VolumeHeatOptions as VolumeHeatOptions,
+    YukawaTree as YukawaTree,
+    signed_heat_volume as signed_heat_volume,
+)
 from gsdf.io import (
     read_curves as read_curves,
     read_mesh as read_mesh,

@@ -113,7 +113,7 @@ def test_occupancy_grid_surface_analytic():
     inside = np.all(np.abs(occ["points"]) < 0.5, axis=1)
     margin = np.abs(np.abs(occ["points"]).max(axis=1) - 0.5) > 1e-3
     assert occ["occupancy"].dtype == bool and np.array_equal(occ["occupancy"][margin], inside[margin])
-    grid = sdf_grid(g, resolution=17, pad=0.5)
+    grid = sdf_grid(g, resolution=17, margin=0.5)
     X = np.stack(np.meshgrid(*[np.linspace(grid["bbox_min"][i], grid["bbox_max"][i], 17) for i in range(3)],
                              indexing="ij"), -1)
     q = np.abs(X) - 0.5  # exact box SDF
@@ -127,12 +127,13 @@ def test_occupancy_grid_surface_analytic():
 
 
 def test_sdf_grid_is_signed_distance_grid_on_the_task_grid():
-    """sdf-grid "fast" is gsdf.signed_distance_grid on the task's cube: the same numbers; and on the grid of the
-    former rule (half-side (1 + pad) x half the longest side) the former computation's numbers, bit for bit."""
+    """sdf-grid "fast" is gsdf.signed_distance_grid on the task's cube (half-side (1 + margin) x half the longest
+    side for normalize="none"): the same numbers, and the former distance + winding-sign computation's numbers
+    on the same nodes, bit for bit."""
     import gsdf
     from gsdf.batch._tasks import cube as task_cube, task_grid
     from gsdf.distance import TriangleDistance
-    from gsdf.grid import PAD, Grid
+    from gsdf.grid import Grid
     from gsdf.winding import FastWindingNumber
 
     V, F = _open_sphere()
@@ -140,9 +141,9 @@ def test_sdf_grid_is_signed_distance_grid_on_the_task_grid():
     g = Geometry(V, F=F)
     out = sdf_grid(g, resolution=11, dtype="float64")
     grid = task_grid(V, 11)
-    c, half = task_cube(V)
+    c, half = task_cube(V, "none", 0.05, grid=True)
     lo, hi = V.min(0), V.max(0)
-    assert np.allclose(c, 0.5 * (lo + hi)) and half == pytest.approx(0.5 * (hi - lo).max() + PAD * np.linalg.norm(hi - lo))
+    assert np.allclose(c, 0.5 * (lo + hi)) and half == 1.05 * 0.5 * float((hi - lo).max())
     assert grid.shape == (11, 11, 11) and np.array_equal(out["bbox_min"], grid.bbox_min)
     S = gsdf.signed_distance_grid(V, F, resolution=grid)
     assert np.array_equal(out["sdf"], S.values)
@@ -177,7 +178,7 @@ def test_task_bad_options():
         sdf_samples(42)
     from gsdf.batch import check_options
 
-    for bad, match in [({"n_samples": True}, "n_samples"), ({"pad": float("nan")}, "pad"),
+    for bad, match in [({"n_samples": True}, "n_samples"), ({"margin": float("nan")}, "margin"),
                        ({"sigmas": "a,b"}, "sigmas: expected a number"), ({"beta": -1}, "beta"),
                        ({"dtype": "int8"}, "dtype"), ({"uniform_fraction": "x"}, "uniform_fraction")]:
         with pytest.raises(ValueError, match=match):
@@ -185,7 +186,7 @@ def test_task_bad_options():
     with pytest.raises(ValueError, match="method"):
         check_options("surface", {"method": "pat"})
     with pytest.raises(ValueError, match="options"):
-        sdf_samples(g, options={"pad": 0.1})
+        sdf_samples(g, options={"margin": 0.1})
     from gsdf.batch import run_task
 
     with pytest.raises(ValueError, match="'bisection' does not apply"):
@@ -485,18 +486,43 @@ def test_unreachable_scheduler_fails_fast(dataset, tmp_path):
 def test_cli_batch(dataset, tmp_path):
     runner = CliRunner()
     out = tmp_path / "cli"
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "--out", str(out),
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "-o", str(out),
                                "--normalize", "cube", "-q"])
     assert res.exit_code == 0, res.output
     assert "done" in res.output and "failed" in res.output and "corrupt.obj" in res.output
     z = np.load(out / "a" / "cube.npz")
     assert z["sdf"].shape == (12, 12, 12) and z["scale"] == pytest.approx(0.5)
     assert -1.0 <= z["sdf"].min() <= -0.85  # the centre is 1 frame unit from every face
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--resolution", "12", "--out",
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--bisection", "3", "--output-dir",
                                str(out)])
-    assert res.exit_code != 0 and "--resolution does not apply to --task sdf-samples" in res.output
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--out", str(out), "--workers", "2",
+    assert res.exit_code != 0 and "--bisection does not apply to --task sdf-samples" in res.output
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "occupancy", "--resolution", "12", "-o", str(out)])
+    assert res.exit_code != 0 and "--resolution does not apply to --task occupancy" in res.output
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "-o", str(out), "--workers", "2",
                                "--dask-local", "2"])
     assert res.exit_code != 0 and "conflicting options: --workers and --dask-local" in res.output
     res = runner.invoke(main, ["batch", str(tmp_path / "none*.obj"), "--task", "surface", "--out", str(out)])
-    assert res.exit_code == 1 and "matches no file" in res.output
+    assert res.exit_code == 1 and "matches no file" in res.output  # --out: the old name, kept for one release
+
+
+def test_cli_batch_options_reach_the_library_under_their_names(monkeypatch, tmp_path):
+    """--n-points is n_samples (sdf-samples) or n_points (occupancy); --resolution is the heat grid of
+    sdf-samples; --threads (group or command) is the per-item thread count."""
+    import gsdf.batch
+    import gsdf.threads
+
+    monkeypatch.setattr(gsdf.threads, "set_num_threads", lambda n: None)  # leave this process's setting alone
+    seen = []
+    monkeypatch.setattr(gsdf.batch, "run_batch", lambda inputs, task, out, opts, **kw: seen.append((task, opts, kw))
+                        or (_ for _ in ()).throw(ValueError("stop")))
+    runner = CliRunner()
+    for args in (["--task", "sdf-samples", "--n-points", "7", "--resolution", "9", "--margin", "0.2"],
+                 ["--task", "occupancy", "--n-points", "5", "--threads", "3"]):
+        res = runner.invoke(main, ["batch", str(tmp_path), "-o", str(tmp_path / "o"), *args])
+        assert res.exit_code == 1 and "stop" in res.output, res.output
+    res = runner.invoke(main, ["--threads", "2", "batch", str(tmp_path), "-o", str(tmp_path / "o"), "--task",
+                               "sdf-grid"])
+    assert res.exit_code == 1
+    assert [(t, o, kw["batch_options"].threads) for t, o, kw in seen] == [
+        ("sdf-samples", {"n_samples": 7, "heat_resolution": 9, "margin": 0.2}, None),
+        ("occupancy", {"n_points": 5}, 3), ("sdf-grid", {}, 2)]

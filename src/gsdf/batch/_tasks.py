@@ -17,12 +17,13 @@ every task         ``center`` (3,) float64 and ``scale`` () float64: stored coor
 
 Normalisation frames (``normalize``): ``"sphere"`` maps the input into the unit ball (centre of the bounding
 box, scale = the largest vertex distance from it), ``"cube"`` into [-1, 1]³ (scale = half the longest box side),
-``"none"`` keeps the input's coordinates. Every task works in one cube around the input: its bounding box grown
-by ``pad`` × its diagonal on every side (the padding rule of :mod:`gsdf.grid`), widened to a cube about its
-centre. Uniform samples are drawn in it, and the grids of ``sdf-grid`` and ``surface`` are its
-:class:`gsdf.Grid` of ``resolution`` nodes per side. Near-surface offsets are fractions of the frame scale (the
-sphere frame for ``"none"``). So the same input gives the same samples for every ``normalize``, up to the stored
-transform.
+``"none"`` keeps the input's coordinates. Every task works in one cube, fixed in the frame: centred on the
+bounding box, half-side ``1 + margin`` frame scales — so every item of a dataset normalized the same way shares
+the same box, as learning pipelines expect (DeepSDF, Occupancy Networks). Uniform samples are drawn in it, and the
+grids of ``sdf-grid`` and ``surface`` are its :class:`gsdf.Grid` of ``resolution`` nodes per side. Near-surface
+offsets are fractions of the frame scale. With ``normalize="none"`` the samples use the sphere frame's scale and
+the grids the cube frame's (half the longest side, the tightest cube). So the same input gives the same samples
+for every ``normalize``, up to the stored transform.
 
 Signs come from the generalized winding number at 1/2 (Barill et al. 2018 §4; robust to holes, flips and
 soups) or from the signed heat method's zero level set (Feng & Crane 2024 §8.2). Random sampling is seeded
@@ -40,7 +41,7 @@ import os
 import numpy as np
 
 from gsdf._checks import choice, integer, positive
-from gsdf.grid import PAD, Grid, padded_box
+from gsdf.grid import Grid
 from gsdf.io._geometry import Geometry, load_geometry
 
 NORMALIZE = ("none", "sphere", "cube")
@@ -116,11 +117,11 @@ def _heat(geo: Geometry, resolution, lo, hi):
     return signed_heat_volume(points=(geo.X, geo.N), resolution=resolution, bbox_min=lo, bbox_max=hi)
 
 
-def cube(X, pad: float = PAD):
-    """The cube every task works in: centre and half-side of the bounding box of ``X`` grown by ``pad`` × its
-    diagonal on every side (:func:`gsdf.grid.padded_box`), widened to a cube about its centre."""
-    lo, hi = padded_box(X, pad)
-    return 0.5 * (lo + hi), 0.5 * float((hi - lo).max())
+def cube(X, normalize: str, margin: float, grid: bool = False):
+    """The cube a task works in: centre (the bounding box's) and half-side ``(1 + margin)`` frame scales
+    (:func:`frame`; for ``normalize="none"`` a grid uses the cube frame, half the longest side)."""
+    c, s, _, _ = frame(X, "cube" if grid and normalize == "none" else normalize)
+    return c, (1.0 + float(margin)) * s
 
 
 def _stored(out: dict, c0, s0, dtype) -> dict:
@@ -159,8 +160,8 @@ class SdfSamplesOptions:
     sigmas : sequence of float, default (0.05, 0.0158)
         Near-surface offset scales, fractions of the frame scale: DeepSDF's variances 0.0025 and 0.00025 in the
         unit sphere.
-    pad : float, default :data:`gsdf.grid.PAD`
-        The cube: the input's bounding box grown by ``pad`` × its diagonal, widened to a cube.
+    margin : float, default 0.05
+        The task's cube has half-side ``1 + margin`` frame scales (the module docstring).
     heat_resolution : int, default 64
         With ``sign="heat"``: nodes along the longest side of the signed heat method's grid.
     beta : float, optional
@@ -178,7 +179,7 @@ class SdfSamplesOptions:
 
     uniform_fraction: float = 0.1
     sigmas: tuple = (0.05, 0.0158)
-    pad: float = PAD
+    margin: float = 0.05
     heat_resolution: int = 64
     beta: float | None = None
     estimate_normals: bool = False
@@ -194,8 +195,8 @@ class OccupancyOptions:
         Share of the points drawn uniformly in the task's cube (the rest: near the surface).
     sigmas : sequence of float, default (0.01,)
         Near-surface offset scales, fractions of the frame scale.
-    pad : float, default :data:`gsdf.grid.PAD`
-        The cube: the input's bounding box grown by ``pad`` × its diagonal, widened to a cube.
+    margin : float, default 0.1
+        The task's cube has half-side ``1 + margin`` frame scales (the module docstring).
     beta : float, optional
         Fast winding number accuracy (default 2 for meshes, 2.3 for clouds).
     estimate_normals : bool, default False
@@ -208,7 +209,7 @@ class OccupancyOptions:
 
     uniform_fraction: float = 1.0
     sigmas: tuple = (0.01,)
-    pad: float = PAD
+    margin: float = 0.1
     beta: float | None = None
     estimate_normals: bool = False
 
@@ -268,7 +269,7 @@ def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normali
     o = _task_options("sdf-samples", locals())
     geo = _geometry(source, o["estimate_normals"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
-    centre, half = cube(geo.X, o["pad"])
+    centre, half = cube(geo.X, o["normalize"], o["margin"])
     rng = _rng(geo, o["seed"], "sdf-samples")
     Q = _sample_queries(geo, o["n_samples"], o["uniform_fraction"], o["sigmas"], s, centre, half, rng)
     d = _unsigned(geo, Q)
@@ -305,7 +306,7 @@ def occupancy(source, n_points: int = 100_000, normalize: str = "none", seed: in
     o = _task_options("occupancy", locals())
     geo = _geometry(source, o["estimate_normals"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
-    centre, half = cube(geo.X, o["pad"])
+    centre, half = cube(geo.X, o["normalize"], o["margin"])
     rng = _rng(geo, o["seed"], "occupancy")
     Q = _sample_queries(geo, o["n_points"], o["uniform_fraction"], o["sigmas"], s, centre, half, rng)
     w = geo.winding(o["beta"])(Q)
@@ -331,19 +332,19 @@ def check_grid_memory(resolution: int, max_memory=None) -> None:
                          f"{max_memory / 2**30:.1f} GiB available (out-of-memory estimate)")
 
 
-def task_grid(X, resolution: int, pad: float = PAD) -> Grid:
+def task_grid(X, resolution: int, normalize: str = "none", margin: float = 0.05) -> Grid:
     """The grid of ``sdf-grid`` and ``surface``: :meth:`gsdf.Grid.fit` of the task's cube (:func:`cube`),
     ``resolution`` nodes per side."""
-    centre, half = cube(X, pad)
+    centre, half = cube(X, normalize, margin, grid=True)
     return Grid.fit((centre - half, centre + half), resolution)
 
 
-def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str = "none", pad: float = PAD,
+def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str = "none", margin: float = 0.05,
              beta=None, dtype: str = "float32", estimate_normals: bool = False) -> dict:
     """Signed distance on a dense cubic grid of ``resolution``³ nodes around one input; negative inside.
 
-    The grid is :func:`task_grid`: the task's cube (the input's bounding box grown by ``pad`` × its diagonal,
-    widened to a cube), ``resolution`` nodes per side. Methods: ``"fast"`` — :func:`gsdf.signed_distance_grid`
+    The grid is :func:`task_grid`: the task's cube (half-side ``1 + margin`` frame scales, the module
+    docstring), ``resolution`` nodes per side. Methods: ``"fast"`` — :func:`gsdf.signed_distance_grid`
     (exact distance to the triangles or nearest point of a cloud, signed by the fast winding number at 1/2);
     ``"heat"`` — the signed heat method on the same grid (Feng & Crane 2024 §8.2; a generalized signed
     distance, smooth across holes); ``"pat"`` — Points as Tori (oriented clouds only; Feng 2026 ch. 5).
@@ -367,7 +368,7 @@ def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str
                          'use "fast" or "heat"')
     check_grid_memory(o["resolution"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
-    grid = task_grid(geo.X, o["resolution"], o["pad"])
+    grid = task_grid(geo.X, o["resolution"], o["normalize"], o["margin"])
     if o["method"] == "heat":
         values = _heat(geo, grid.shape, *grid.box).values
     elif o["method"] == "pat":
@@ -385,7 +386,7 @@ def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str
                     "bbox_max": hi0, "spacing": (hi0 - lo0) / (np.array(grid.shape) - 1)}, c0, s0, dt)
 
 
-def surface(source, resolution: int = 128, method: str = "winding", normalize: str = "none", pad: float = PAD,
+def surface(source, resolution: int = 128, method: str = "winding", normalize: str = "none", margin: float = 0.05,
             bisection: int = 10, beta=None, dtype: str = "float32", estimate_normals: bool = False) -> dict:
     """A watertight surface of one input: the winding number's 1/2 level set, or the signed heat zero set.
 
@@ -409,7 +410,7 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
     geo = _geometry(source, o["estimate_normals"])
     check_grid_memory(o["resolution"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
-    grid = task_grid(geo.X, o["resolution"], o["pad"])
+    grid = task_grid(geo.X, o["resolution"], o["normalize"], o["margin"])
     if o["method"] == "heat":
         V, F = _heat(geo, grid.shape, *grid.box).isosurface(0.0)
     else:
@@ -493,7 +494,7 @@ _CHECKS = {
     "sign": lambda x, n: choice(x, n, {"winding", "heat"}),
     "normalize": lambda x, n: choice(x, n, set(NORMALIZE)),
     "dtype": lambda x, n: choice(x, n, set(DTYPES)),
-    "uniform_fraction": _unit, "pad": _nonneg, "sigmas": _sigmas, "beta": _optional_positive,
+    "uniform_fraction": _unit, "margin": _nonneg, "sigmas": _sigmas, "beta": _optional_positive,
     "estimate_normals": _flag,
 }
 _METHODS = {"sdf-grid": {"fast", "heat", "pat"}, "surface": {"winding", "heat"}}
