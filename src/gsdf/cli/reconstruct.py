@@ -60,8 +60,8 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
     check_output(png, (".png",), "--png")
     P, N = read_points(cloud)
 
-    def say(stage):
-        if not quiet:
+    def say(stage, fraction):
+        if not quiet and fraction < 1:
             click.echo(f"  {stage} ...", err=True)
 
     click.echo(f"{cloud}: {len(P)} points{' with normals' if N is not None else ''}; method {method}")
