@@ -98,11 +98,15 @@ def view(files, output, size, up, azimuth, elevation, level, slice_, field_name,
     t = time.perf_counter()
     items = items_from_files(files, field_name, title)
     opts = ViewOptions(level=level, slice_axis=axis, slice_at=at)
-    if output is None:
-        show(*items, up=up, azimuth=azimuth, elevation=elevation, options=opts)
-        return
-    with output_file(output, (".png",), what="--screenshot") as tmp:
-        img = show(*items, screenshot=tmp, size=size, up=up, azimuth=azimuth, elevation=elevation, options=opts)
+    try:
+        if output is None:
+            show(*items, up=up, azimuth=azimuth, elevation=elevation, options=opts)
+            return
+        with output_file(output, (".png",), what="--screenshot") as tmp:
+            img = show(*items, screenshot=tmp, size=size, up=up, azimuth=azimuth, elevation=elevation,
+                       options=opts)
+    except (RuntimeError, ImportError) as exc:          # no display, no polyscope, no EGL: say what to do
+        raise click.ClickException(str(exc)) from exc
     if not quiet:
         click.echo(f"{len(files)} file(s), {img.shape[1]}x{img.shape[0]} in {time.perf_counter() - t:.1f} s -> "
                    f"{os.path.abspath(output)}")

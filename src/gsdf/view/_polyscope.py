@@ -130,8 +130,6 @@ def render(scene, *, size, view_dir, upv, fill, screenshot=None):
     if translucent:
         ps.set_transparency_render_passes(3)     # one translucent layer over opaque parts: 3 passes suffice
     pts = np.concatenate(scene.frame)
-    if len(pts) > 50_000:                        # framing: a subsample holds the extremes closely enough
-        pts = pts[np.random.default_rng(0).choice(len(pts), 50_000, replace=False)]
     clear = _overlay_boxes(ps, bars, scene.legends(), width, height) if headless else ()
     cam, target = frame_camera(pts, width, height, ps.get_vertical_fov_degrees(), view_dir, upv, fill, clear)
     ps.look_at_dir(tuple(cam), tuple(target), tuple(upv))

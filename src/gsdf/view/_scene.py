@@ -508,6 +508,13 @@ def frame_camera(pts, width: int, height: int, fov_deg: float, view_dir, upv, fi
     Returns (camera, target).
     """
     pts = np.asarray(pts, float)
+    if len(pts) > 64:              # the extremes of every projection are vertices of the convex hull
+        from scipy.spatial import ConvexHull, QhullError
+
+        try:
+            pts = pts[ConvexHull(pts).vertices]
+        except (QhullError, ValueError):       # flat or degenerate: all points
+            pass
     back = np.asarray(view_dir, float) / np.linalg.norm(view_dir)
     right = np.cross(upv, back)
     right /= np.linalg.norm(right)
@@ -526,8 +533,9 @@ def frame_camera(pts, width: int, height: int, fov_deg: float, view_dir, upv, fi
         target = 0.5 * (pts.min(0) + pts.max(0))
         radius = 0.5 * float(np.linalg.norm(pts.max(0) - pts.min(0))) or 1.0
         d = radius / math.sin(math.atan(min(hx, ty) * fill))
-        for _ in range(6):
-            # the distance at which the projected spread fits (bisection; the spread shrinks with distance)
+
+        def fit(target, d):
+            """The distance at which the projected spread fits (bisection; the spread shrinks with distance)."""
             near = float(np.max(pts @ back - target @ back)) + 1e-6 * radius
             a, b = near, max(d, near) * 2.0
             while True:
@@ -542,12 +550,33 @@ def frame_camera(pts, width: int, height: int, fov_deg: float, view_dir, upv, fi
                     b = m
                 else:
                     a = m
-            d = b
-            xp, yp = project(target, d)
-            sx, sy = 0.5 * (xp.min() + xp.max()) - cx, 0.5 * (yp.min() + yp.max())
-            if abs(sx) < 1e-3 * tx and abs(sy) < 1e-3 * ty:
+            return b
+
+        def centre(C, Z, c):
+            """The sideways shift s that centres the projections (C - s) / Z on c (bisection: monotone in s)."""
+            def g(s):
+                q = (C - s) / Z
+                return q.max() + q.min() - 2 * c
+            L = float(np.abs(C).max() + np.abs(c) * Z.max()) + 1.0
+            a, b = -L, L
+            while g(a) < 0:
+                a *= 2
+            while g(b) > 0:
+                b *= 2
+            for _ in range(60):
+                m = 0.5 * (a + b)
+                a, b = (m, b) if g(m) > 0 else (a, m)
+            return 0.5 * (a + b)
+
+        for _ in range(30):
+            d = fit(target, d)
+            rel = pts - target
+            Z = d - rel @ back
+            sx, sy = centre(rel @ right, Z, cx), centre(rel @ up, Z, 0.0)
+            target = target + sx * right + sy * up
+            if abs(sx) < 1e-6 * radius and abs(sy) < 1e-6 * radius:
                 break
-            target = target + (sx * right + sy * up) * d     # sideways: the projection moves by about (sx, sy)
+        d = fit(target, d)
         xp, yp = project(target, d)
         return target + back * d, target, (0.5 + 0.5 * xp / tx) * width, (0.5 - 0.5 * yp / ty) * height
 
