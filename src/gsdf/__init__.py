@@ -30,11 +30,11 @@ _EXPORTS = {
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",
     # fields, contouring, operations
     "Field": "field", "GridField": "field", "SurfaceField": "field", "load_field": "field",
-    "signed_distance_grid": "ops",
+    "Grid": "grid", "signed_distance_grid": "ops",
     "extract_isosurface": "contour", "refine_on_edges": "contour", "slice_contours": "contour",
     "write_svg": "contour",
     "voxelize": "ops", "winding_grid": "ops", "save_voxels": "ops", "voxels_to_mesh": "ops",
-    "mesh_boolean": "ops",
+    "mesh_boolean": "ops", "BooleanOptions": "ops",
     # the signed heat method on surfaces (Feng & Crane 2024)
     "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
     "level_set_curves": "contour", "region_boundary_curves": "contour",
@@ -45,14 +45,14 @@ _EXPORTS = {
     "TetField": "field", "marching_tetrahedra": "contour",
     "offset_surface": "ops", "dilate_erode": "ops", "erode_dilate": "ops",
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
-    "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
-    "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori",
+    "PointsAsTori": "tori", "PointsAsToriOptions": "tori", "SignedHopfCole": "tori",
+    "SmoothedSignedPlanarDistance": "tori", "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori",
     # pictures and the viewer (polyscope: the extra gsdf[view])
     "view": "view", "ViewOptions": "view", "render_png": "view",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
     "reconstruct_simply_connected": "recon", "mesh_topology": "mesh",
-    # dataset batches (issue 16)
-    "run_batch": "batch", "sdf_samples": "batch",
+    # dataset batches
+    "run_batch": "batch", "BatchOptions": "batch", "sdf_samples": "batch", "SdfSamplesOptions": "batch",
     # one thread setting for numba kernels and BLAS (gsdf.threads)
     "set_num_threads": "threads", "get_num_threads": "threads",
 }

@@ -1,6 +1,11 @@
 """Type stub of the lazy public API (gsdf/__init__.py): editors and type checkers see every public name."""
 
-from gsdf.batch import run_batch as run_batch, sdf_samples as sdf_samples
+from gsdf.batch import (
+    BatchOptions as BatchOptions,
+    SdfSamplesOptions as SdfSamplesOptions,
+    run_batch as run_batch,
+    sdf_samples as sdf_samples,
+)
 from gsdf.contour import (
     extract_isosurface as extract_isosurface,
     level_set_curves as level_set_curves,
@@ -26,6 +31,7 @@ from gsdf.field import (
     TetField as TetField,
     load_field as load_field,
 )
+from gsdf.grid import Grid as Grid
 from gsdf.heat import (
     PointCloudSignedHeatSolver as PointCloudSignedHeatSolver,
     PolygonMeshSignedHeatSolver as PolygonMeshSignedHeatSolver,
@@ -44,6 +50,7 @@ from gsdf.io import (
 )
 from gsdf.mesh import mesh_topology as mesh_topology
 from gsdf.ops import (
+    BooleanOptions as BooleanOptions,
     dilate_erode as dilate_erode,
     erode_dilate as erode_dilate,
     mesh_boolean as mesh_boolean,
@@ -60,6 +67,7 @@ from gsdf.threads import get_num_threads as get_num_threads, set_num_threads as 
 from gsdf.tori import (
     LogSumExpDistance as LogSumExpDistance,
     PointsAsTori as PointsAsTori,
+    PointsAsToriOptions as PointsAsToriOptions,
     SignedHopfCole as SignedHopfCole,
     SmoothedSignedPlanarDistance as SmoothedSignedPlanarDistance,
     WindingNumberPipeline as WindingNumberPipeline,

@@ -12,9 +12,11 @@ from click.testing import CliRunner
 
 from gsdf.batch import (
     BatchInterrupted,
+    BatchOptions,
     DaskExecutor,
     Geometry,
     LocalExecutor,
+    SdfSamplesOptions,
     collect_inputs,
     occupancy,
     read_manifest,
@@ -95,9 +97,11 @@ def test_sdf_samples_heat_sign_and_open_mesh():
     V, F = _open_sphere()
     wind = sdf_samples(Geometry(V, F=F), n_samples=N, seed=1)
     r = np.linalg.norm(wind["points"], axis=1)
-    far = np.abs(r - 1) > 0.1
+    # away from the surface, and not inside right under the hole (z > 0.76), where w is near 1/2
+    far = (np.abs(r - 1) > 0.1) & ~((r < 1) & (wind["points"][:, 2] > 0.6))
     assert np.all((wind["sdf"][far] < 0) == (r[far] < 1))  # winding sign survives the hole
-    heat = sdf_samples(Geometry(V, F=F), n_samples=N, seed=1, sign="heat", heat_resolution=32)
+    heat = sdf_samples(Geometry(V, F=F), n_samples=N, seed=1, sign="heat",
+                       options=SdfSamplesOptions(heat_resolution=32))
     assert np.array_equal(heat["points"], wind["points"]) and np.allclose(np.abs(heat["sdf"]), np.abs(wind["sdf"]))
     assert np.all((heat["sdf"][far] < 0) == (r[far] < 1))
 
@@ -122,6 +126,42 @@ def test_occupancy_grid_surface_analytic():
     assert np.abs(np.linalg.norm(s["vertices"], axis=1) - 1).max() < 0.02
 
 
+def test_sdf_grid_is_signed_distance_grid_on_the_task_grid():
+    """sdf-grid "fast" is gsdf.signed_distance_grid on the task's cube: the same numbers; and on the grid of the
+    former rule (half-side (1 + pad) x half the longest side) the former computation's numbers, bit for bit."""
+    import gsdf
+    from gsdf.batch._tasks import cube as task_cube, task_grid
+    from gsdf.distance import TriangleDistance
+    from gsdf.grid import PAD, Grid
+    from gsdf.winding import FastWindingNumber
+
+    V, F = _open_sphere()
+    V = V * [1.0, 0.8, 0.6]
+    g = Geometry(V, F=F)
+    out = sdf_grid(g, resolution=11, dtype="float64")
+    grid = task_grid(V, 11)
+    c, half = task_cube(V)
+    lo, hi = V.min(0), V.max(0)
+    assert np.allclose(c, 0.5 * (lo + hi)) and half == pytest.approx(0.5 * (hi - lo).max() + PAD * np.linalg.norm(hi - lo))
+    assert grid.shape == (11, 11, 11) and np.array_equal(out["bbox_min"], grid.bbox_min)
+    S = gsdf.signed_distance_grid(V, F, resolution=grid)
+    assert np.array_equal(out["sdf"], S.values)
+    # the former sdf_grid: the cube c +- (1 + pad) * L / 2, nodes np.linspace, |d| and the winding sign
+    old_half = 1.05 * 0.5 * float((hi - lo).max())
+    Q = np.stack(np.meshgrid(*[np.linspace(c[k] - old_half, c[k] + old_half, 11) for k in range(3)],
+                             indexing="ij"), -1).reshape(-1, 3)
+    d = TriangleDistance(V, F).query(Q)[0]
+    old = np.where(FastWindingNumber(V, F, beta=2.0)(Q) > 0.5, -d, d)
+    same = Grid((Q[0], Q[-1]), (11, 11, 11))
+    assert np.array_equal(same.points(), Q)
+    assert np.array_equal(gsdf.signed_distance_grid(V, F, resolution=same).values.ravel(), old)
+    P = V[::3]
+    N = P / np.linalg.norm(P, axis=1, keepdims=True)
+    cloud = sdf_grid(Geometry(P, N=N), resolution=9, dtype="float64")
+    Sc = gsdf.signed_distance_grid(None, points=(P, N), resolution=task_grid(P, 9))
+    assert np.array_equal(cloud["sdf"], Sc.values)
+
+
 def test_task_bad_options():
     V, F = cube()
     g = Geometry(V, F=F)
@@ -144,6 +184,12 @@ def test_task_bad_options():
             check_options("sdf-samples", bad)
     with pytest.raises(ValueError, match="method"):
         check_options("surface", {"method": "pat"})
+    with pytest.raises(ValueError, match="options"):
+        sdf_samples(g, options={"pad": 0.1})
+    from gsdf.batch import run_task
+
+    with pytest.raises(ValueError, match="'bisection' does not apply"):
+        run_task("sdf-samples", g, {"bisection": 3})
     with pytest.raises(ValueError, match="out-of-memory estimate"):
         sdf_grid(g, resolution=4000)
 
@@ -163,7 +209,9 @@ def test_point_cloud_inputs(tmp_path):
     write_points(str(tmp_path / "bare.xyz"), P)
     with pytest.raises(ValueError, match="no normals"):
         occupancy(str(tmp_path / "bare.xyz"))
-    occ = occupancy(str(tmp_path / "bare.xyz"), n_points=2000, estimate_normals=True)
+    from gsdf.batch import OccupancyOptions
+
+    occ = occupancy(str(tmp_path / "bare.xyz"), n_points=2000, options=OccupancyOptions(estimate_normals=True))
     rr = np.linalg.norm(occ["points"], axis=1)
     ok = np.abs(rr - 1) > 0.1
     assert np.mean(occ["occupancy"][ok] == (rr[ok] < 1)) > 0.99
@@ -244,7 +292,8 @@ def test_rerun_recomputes_nothing_and_notices_changes(local_run, dataset, tmp_pa
     out2 = tmp_path / "out2"
     run_batch(str(changed), "sdf-samples", str(out2), {"n_samples": N}, executor=local1)
     write_mesh(str(changed / "a" / "cube.off"), V, F)
-    r = run_batch(str(changed), "sdf-samples", str(out2), {"n_samples": N}, executor=local1, retry_failed=True)
+    r = run_batch(str(changed), "sdf-samples", str(out2), {"n_samples": N}, executor=local1,
+                  batch_options=BatchOptions(retry_failed=True))
     ran = {x["output"] for x in r.records if x["status"] in ("done", "failed")}
     assert ran == {"a/cube.npz", "corrupt.npz"}
 
@@ -286,8 +335,8 @@ def test_stale_part_files_never_count(dataset, tmp_path, local1):
 def test_interrupt_keeps_manifest_consistent(dataset, tmp_path, local1):
     out = tmp_path / "out"
 
-    def stop(rec, counts):
-        if counts["done"] + counts["failed"] == 1:
+    def stop(stage, fraction):
+        if stage in ("done", "failed"):
             raise KeyboardInterrupt
 
     with pytest.raises(BatchInterrupted) as info:
@@ -310,8 +359,8 @@ def test_local_worker_killed_loses_no_item(dataset, tmp_path):
     ex = LocalExecutor(2)
     killed = []
 
-    def kill_one(rec, counts):
-        if not killed and rec["status"] != "skipped":
+    def kill_one(stage, fraction):
+        if not killed and stage != "skipped":
             pid = ex.worker_pids()[0]
             os.kill(pid, signal.SIGKILL)
             killed.append(pid)
@@ -371,7 +420,7 @@ def test_dask_worker_killed_loses_no_item(dask2, dataset, tmp_path):
     items = [str(p) for p in sorted(dataset.rglob("*.*"))]
     killed = []
 
-    def kill_one(rec, counts):
+    def kill_one(stage, fraction):
         if not killed:
             pid = dask2.worker_pids()[0]
             os.kill(pid, signal.SIGKILL)
@@ -406,8 +455,12 @@ def test_bad_inputs_are_clear_errors(dataset, tmp_path):
         run_batch(str(dataset), "sdf-samples", str(tmp_path / "file" / "sub"))
     with pytest.raises(ValueError, match="cannot write"):
         run_batch(str(dataset), "sdf-samples", "/proc/gsdf-batch-out")
-    with pytest.raises(ValueError, match="conflicting options: workers and scheduler"):
-        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), workers=2, scheduler="tcp://127.0.0.1:1")
+    with pytest.raises(ValueError, match="conflicting options: workers and the scheduler"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), workers=2, executor="tcp://127.0.0.1:1")
+    with pytest.raises(ValueError, match="executor: expected"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), executor=3)
+    with pytest.raises(ValueError, match="batch_options"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), batch_options={"resume": False})
     with pytest.raises(ValueError, match="'resolution' does not apply to task 'sdf-samples'"):
         run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), {"resolution": 64})
     with pytest.raises(ValueError, match="task: unknown task"):
@@ -421,8 +474,8 @@ def test_unreachable_scheduler_fails_fast(dataset, tmp_path):
     pytest.importorskip("distributed")
     t0 = time.perf_counter()
     with pytest.raises(ValueError, match="cannot reach the Dask scheduler"):
-        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), scheduler="tcp://127.0.0.1:9",
-                  scheduler_timeout=2)
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), executor="tcp://127.0.0.1:9",
+                  batch_options=BatchOptions(scheduler_timeout=2))
     assert time.perf_counter() - t0 < 10
 
 

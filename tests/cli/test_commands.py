@@ -78,7 +78,7 @@ def test_voxelize_and_surface_of_cloud(files):
     with np.load(out) as d:
         occ = d["occupancy"]
     frac = occ.mean()
-    assert 0.2 < frac < 0.6
+    assert 0.15 < frac < 0.6  # a unit ball in its bounding box padded by 0.1 of the diagonal: ~0.2
     surf = files["dir"] / "s.ply"
     r = run("surface", files["cloud"], "-o", surf, "--resolution", 32)
     assert r.exit_code == 0, r.output

@@ -56,7 +56,8 @@ Examples:
 @click.option("--heat-resolution", type=click.IntRange(8), default=None,
               help="sdf-samples --sign heat: heat grid nodes per side [64].")
 @click.option("--bisection", type=click.IntRange(0, 60), default=None, help="surface: bisection steps [10].")
-@click.option("--pad", type=click.FloatRange(0), default=None, help="Box padding, fraction of the frame scale.")
+@click.option("--pad", type=click.FloatRange(0), default=None,
+              help="Box padding, fraction of the bounding-box diagonal [0.1].")
 @click.option("--uniform-fraction", type=click.FloatRange(0, 1), default=None,
               help="sdf-samples / occupancy: fraction of uniform (not near-surface) points [0.1 / 1.0].")
 @click.option("--sigmas", default=None, help="Near-surface offset scales, comma-separated [0.05,0.0158].")
@@ -74,7 +75,7 @@ Examples:
 @report_errors
 def batch(inputs, task, out, workers, dask_local, scheduler, scheduler_timeout, threads, resume, retry_failed,
           max_retries, quiet, **task_options):
-    from gsdf.batch import BatchInterrupted, run_batch
+    from gsdf.batch import BatchInterrupted, BatchOptions, run_batch
     from gsdf.batch._tasks import task_defaults
 
     chosen = [f"--{n}" for n, v in (("workers", workers), ("dask-local", dask_local), ("scheduler", scheduler))
@@ -89,22 +90,31 @@ def batch(inputs, task, out, workers, dask_local, scheduler, scheduler_timeout, 
     if given.get("estimate_normals") is False:
         given.pop("estimate_normals")
     bar = None
+    counts = {"done": 0, "failed": 0, "skipped": 0}
 
-    def progress(rec, counts):
+    def progress(stage, fraction):
         nonlocal bar
         if quiet:
             return
+        counts[stage] = counts.get(stage, 0) + 1
         if bar is None:
             from tqdm import tqdm
 
-            bar = tqdm(total=counts["total"], desc=task, unit="item", dynamic_ncols=True)
+            bar = tqdm(total=round(sum(counts.values()) / fraction), desc=task, unit="item", dynamic_ncols=True)
         bar.update(1)
         bar.set_postfix(done=counts["done"], failed=counts["failed"], skipped=counts["skipped"], refresh=False)
 
+    if scheduler is not None:
+        executor = scheduler
+    elif dask_local is not None:
+        executor, workers = "dask", dask_local
+    else:
+        executor = "local"
     try:
-        result = run_batch(inputs, task, out, given, workers=workers, dask_local=dask_local, scheduler=scheduler,
-                           resume=resume, retry_failed=retry_failed, max_retries=max_retries, threads=threads,
-                           progress=progress, scheduler_timeout=scheduler_timeout)
+        result = run_batch(inputs, task, out, given, workers=workers, executor=executor, progress=progress,
+                           batch_options=BatchOptions(resume=resume, retry_failed=retry_failed,
+                                                      max_retries=max_retries, threads=threads,
+                                                      scheduler_timeout=scheduler_timeout))
     except BatchInterrupted as exc:
         if bar is not None:
             bar.close()

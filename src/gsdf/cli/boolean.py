@@ -28,12 +28,12 @@ Example:
 @report_errors
 def boolean(a, b, op, output, exact, beta):
     from gsdf.io import MESH_WRITE_FORMATS, read_mesh, write_mesh
-    from gsdf.ops import mesh_boolean
+    from gsdf.ops import BooleanOptions, mesh_boolean
 
     check_output(output, MESH_WRITE_FORMATS)
     VA, FA = read_mesh(a)
     VB, FB = read_mesh(b)
-    V, F = mesh_boolean(VA, FA, VB, FB, op, beta=beta, exact=exact)
+    V, F = mesh_boolean(VA, FA, VB, FB, op, options=BooleanOptions(beta=beta, exact=exact))
     with output_file(output) as tmp:
         write_mesh(tmp, V, F)
     click.echo(f"{op}: {len(FA)} + {len(FB)} triangles -> {len(F)} triangles -> {os.path.abspath(output)}")

@@ -17,24 +17,26 @@ from gsdf.cli._common import (
     quiet_option,
     report_errors,
 )
+from gsdf.grid import PAD
 
 
 def signed_distance_grid(geo, resolution: int, pad: float, sign: str = "winding", beta=None, quiet=True):
     """Signed distance on the nodes of a grid around the loaded input ``geo`` (:func:`gsdf.signed_distance_grid`
     with a progress bar); returns a :class:`gsdf.GridField`."""
+    from gsdf.grid import Grid
     from gsdf.ops._distance_grid import signed_distance_grid as grid_sdf
 
     if sign == "pseudonormal" and not geo.is_mesh:
         raise ValueError("--sign pseudonormal needs a mesh, not a point cloud")
     kw = dict(V=geo.X, F=geo.F) if geo.is_mesh else dict(V=None, points=(geo.X, geo.N))
-    bar, update = progress_bar(1, "winding numbers", not quiet and sign == "winding")
+    grid = Grid.around(geo.X, resolution, pad)
+    bar, update = progress_bar(grid.size, "winding numbers", not quiet and sign == "winding")
 
-    def progress(done, total):
-        bar.total = total
-        update(done, total)
+    def progress(stage, fraction):
+        update(round(fraction * grid.size), grid.size)
 
     with bar:
-        return grid_sdf(resolution=resolution, pad=pad, sign=sign, beta=beta, progress=progress, **kw)
+        return grid_sdf(resolution=grid, sign=sign, beta=beta, progress=progress, **kw)
 
 
 @click.command("sdf", help="""Signed distance grid of INPUT (mesh, soup or oriented cloud); negative inside.
@@ -52,7 +54,7 @@ Example:
               ".vtk, .vti or .vtu.")
 @click.option("--resolution", type=click.IntRange(2, 2048), default=64, show_default=True,
               help="Grid nodes along the longest side.")
-@click.option("--pad", type=click.FloatRange(0), default=0.05, show_default=True,
+@click.option("--pad", type=click.FloatRange(0), default=PAD, show_default=True,
               help="Box padding, fraction of the diagonal.")
 @click.option("--sign", type=click.Choice(["winding", "pseudonormal"]), default="winding", show_default=True)
 @click.option("--png", default=None, help="Also write a PNG of the middle slice (z) with isolines.")

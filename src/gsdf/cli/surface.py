@@ -18,6 +18,7 @@ from gsdf.cli._common import (
     quiet_option,
     report_errors,
 )
+from gsdf.grid import PAD
 
 
 @click.command("surface", help="""Extract the surface of INPUT as the winding number's 1/2 level set.
@@ -37,7 +38,8 @@ Example:
 @click.option("--level", type=float, default=0.5, show_default=True, help="Winding number iso-value.")
 @click.option("--bisection", type=click.IntRange(0, 60), default=10, show_default=True,
               help="Bisection steps per vertex (0: plain marching cubes).")
-@click.option("--pad", type=click.FloatRange(0), default=0.05, show_default=True)
+@click.option("--pad", type=click.FloatRange(0), default=PAD, show_default=True,
+              help="Box padding, fraction of the diagonal.")
 @beta_option
 @normals_option
 @quiet_option

@@ -5,7 +5,6 @@ from __future__ import annotations
 import os
 
 import click
-import numpy as np
 
 from gsdf.cli._common import (
     check_output,
@@ -16,6 +15,7 @@ from gsdf.cli._common import (
     quiet_option,
     report_errors,
 )
+from gsdf.grid import PAD
 
 GRID_EXTENSIONS = (".npz", ".npy", ".vtk", ".vti", ".vtu")
 
@@ -54,7 +54,7 @@ Examples:
 @click.option("--grid", type=click.IntRange(4, 1024), default=None,
               help="Grid nodes along the longest side (default 64 for meshes; required for an .npz grid).")
 @click.option("--offsets", default=None, help="Comma-separated level values to contour (default 0).")
-@click.option("--pad", type=click.FloatRange(0), default=0.1, show_default=True, help="Box padding, fraction of the diagonal.")
+@click.option("--pad", type=click.FloatRange(0), default=PAD, show_default=True, help="Box padding, fraction of the diagonal.")
 @click.option("-k", "k", type=click.IntRange(6, 1024), default=64, show_default=True, help="Neighbours per torus fit.")
 @normals_option
 @quiet_option
@@ -80,17 +80,13 @@ def tori(points, out, estimator, grid, offsets, pad, k, estimate_normals, quiet)
             pat.save(tmp)
         click.echo(f"fitted tori -> {os.path.abspath(out)}")
         return
-    res = grid or 64
-    lo, hi = pat.P.min(0), pat.P.max(0)
-    m = pad * np.linalg.norm(hi - lo) + max(abs(v) for v in levels)
-    lo, hi = lo - m, hi + m
+    from gsdf.tori._pat import level_grid
+
+    g = level_grid(pat.P, grid or 64, max(abs(v) for v in levels), pad)
     if ext in GRID_EXTENSIONS:
         from gsdf.field import GridField
-        from gsdf.grid import grid_points, grid_shape
 
-        shape = grid_shape(lo, hi, res)
-        hi = lo + (np.array(shape) - 1) * (hi - lo).max() / (res - 1)
-        field = GridField(pat.signed_distance(grid_points(lo, hi, shape)).reshape(shape), lo, hi)
+        field = GridField(pat.signed_distance(g.points()).reshape(g.shape), *g.box)
         with output_file(out) as tmp:
             field.save(tmp)
         click.echo(f"signed distance grid {field.shape} -> {os.path.abspath(out)}")
@@ -99,7 +95,7 @@ def tori(points, out, estimator, grid, offsets, pad, k, estimate_normals, quiet)
     from gsdf.io import write_mesh
 
     for v, path in zip(levels, mesh_paths):
-        V, F = extract_isosurface(pat.signed_distance, lo, hi, res, level=v, inside="below")
+        V, F = extract_isosurface(pat.signed_distance, resolution=g, level=v, inside="below")
         with output_file(path) as tmp:
             write_mesh(tmp, V, F)
         click.echo(f"level {v:g}: {len(F)} triangles -> {os.path.abspath(path)}")

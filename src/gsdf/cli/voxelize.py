@@ -17,6 +17,7 @@ from gsdf.cli._common import (
     quiet_option,
     report_errors,
 )
+from gsdf.grid import PAD
 
 
 @click.command("voxelize", help="""Voxelize INPUT: a voxel is inside where the winding number at its centre is >= 1/2.
@@ -30,9 +31,10 @@ Example:
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
 @click.option("-o", "--output", required=True, help="Output .npz.")
-@click.option("--resolution", type=click.IntRange(1, 4096), default=100, show_default=True,
+@click.option("--resolution", type=click.IntRange(2, 4096), default=100, show_default=True,
               help="Voxels along the longest side.")
-@click.option("--pad", type=click.FloatRange(0), default=0.05, show_default=True)
+@click.option("--pad", type=click.FloatRange(0), default=PAD, show_default=True,
+              help="Box padding, fraction of the diagonal.")
 @click.option("--mesh-out", default=None, help="Also write the boundary faces of the occupied voxels.")
 @beta_option
 @normals_option
@@ -40,6 +42,9 @@ Example:
 @no_clobber_option
 @report_errors
 def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, quiet):
+    import numpy as np
+
+    from gsdf.grid import Grid
     from gsdf.io import MESH_WRITE_FORMATS
     from gsdf.ops import save_voxels, voxelize as run, voxels_to_mesh
 
@@ -47,12 +52,12 @@ def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, q
     check_output(mesh_out, MESH_WRITE_FORMATS, "--mesh-out")
     geo = load_geometry(input, estimate_normals)
     kw = {"mesh": (geo.X, geo.F)} if geo.is_mesh else {"points": (geo.X, geo.N)}
-    bar, update = progress_bar(1, "voxelizing", not quiet)
+    grid = Grid.around(geo.X[np.unique(geo.F)] if geo.is_mesh else geo.X, resolution, pad)  # as gsdf.voxelize
+    bar, update = progress_bar(grid.size, "voxelizing", not quiet)
     with bar:
-        def progress(done, total):
-            bar.total = total
-            update(done, total)
-        occ, lo, hi = run(resolution=resolution, pad=pad, beta=beta, progress=progress, **kw)
+        def progress(stage, fraction):
+            update(round(fraction * grid.size), grid.size)
+        occ, lo, hi = run(resolution=grid, beta=beta, progress=progress, **kw)
     with output_file(output, (".npz",)) as tmp:
         save_voxels(tmp, occ, lo, hi)
     click.echo(f"{geo.describe()}\n{int(occ.sum())} of {occ.size} voxels inside, grid {occ.shape} -> "

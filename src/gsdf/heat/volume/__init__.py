@@ -6,7 +6,7 @@ import numpy as np
 
 from gsdf._checks import as_mesh, as_points, choice, integer, positive
 from gsdf._normalize import Frame
-from gsdf.grid import grid_shape
+from gsdf.grid import PAD, Grid
 from gsdf.heat.volume._memory import check_memory
 from gsdf.heat.volume._sources import Sources, mesh_sources, point_sources
 from gsdf.heat._yukawa import YukawaTree
@@ -63,13 +63,12 @@ def input_spacing(X, F=None) -> float:
     return float(d.mean())
 
 
-def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = 0.1):
+def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = PAD):
     """The grid box and node counts used by :func:`signed_heat_volume`.
 
-    With an int ``resolution`` the longest side gets that many nodes and cells are cubes (the box is extended
-    on its shorter sides to a whole number of cells); with three ints the box is used exactly. Missing box
-    corners default to the input's box padded by ``pad`` × its diagonal. Raises ValueError when the box does
-    not contain the input ``X``.
+    With an int ``resolution``, :meth:`gsdf.Grid.fit` of the box (``resolution`` nodes along the longest side,
+    cubic cells); with three ints the box is used exactly. Missing box corners default to the input's box
+    padded by ``pad`` × its diagonal. Raises ValueError when the box does not contain the input ``X``.
 
     Returns ``(bbox_min, bbox_max, shape)``.
     """
@@ -89,16 +88,14 @@ def volume_grid_box(X, resolution, bbox_min=None, bbox_max=None, pad: float = 0.
         r = integer(resolution, "resolution", lo=2)
         if r > MAX_RESOLUTION:
             raise ValueError(f"resolution: {r} is absurdly large (at most {MAX_RESOLUTION})")
-        shape = grid_shape(lo, hi, r)
-        hcell = float((hi - lo).max()) / (r - 1)
-        hi = lo + (np.array(shape) - 1) * hcell  # cubic cells
-    else:
-        res = np.asarray(resolution).ravel()
-        if res.shape != (3,):
-            raise ValueError(f"resolution: expected an int or three ints, got {resolution!r}")
-        shape = tuple(integer(v, "resolution", lo=2) for v in res.tolist())
-        if max(shape) > MAX_RESOLUTION:
-            raise ValueError(f"resolution: {shape} is absurdly large (at most {MAX_RESOLUTION} per axis)")
+        grid = Grid.fit((lo, hi), r)
+        return grid.bbox_min, grid.bbox_max, grid.shape
+    res = np.asarray(resolution).ravel()
+    if res.shape != (3,):
+        raise ValueError(f"resolution: expected an int or three ints, got {resolution!r}")
+    shape = tuple(integer(v, "resolution", lo=2) for v in res.tolist())
+    if max(shape) > MAX_RESOLUTION:
+        raise ValueError(f"resolution: {shape} is absurdly large (at most {MAX_RESOLUTION} per axis)")
     return lo, hi, tuple(int(s) for s in shape)
 
 
