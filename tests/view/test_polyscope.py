@@ -114,3 +114,22 @@ def test_save_png_uses_polyscope_or_gsdf_renderers(headless, tmp_path):
     V, F = _sphere()
     assert save_png(tmp_path / "m.png", (V, F, V[:, 0]), view=(0, 0, 1), renderer="gsdf") == "gsdf"
     assert picture.problems(picture.load(tmp_path / "m.png"), colour_bar=False) == []
+
+
+def test_window_extras_register(headless):
+    """The interactive window adds the whole volume field (polyscope's volume grid / tet mesh, disabled); the
+    registration is checked headless (a window cannot open here)."""
+    from scipy.spatial import Delaunay
+
+    from gsdf.view import _polyscope, _scene
+
+    ps = _polyscope.session(headless=True)
+    P = np.random.default_rng(0).uniform(-1, 1, (200, 3))
+    for f in (_ball_grid(9), gsdf.TetField(P, Delaunay(P).simplices, P[:, 0])):
+        (it,) = _scene.coerce([f])
+        sc = _scene.build([it], gsdf.ViewOptions(), np.array([0, 0, 1.0]), np.array([0, 1.0, 0]))
+        try:
+            _polyscope._register_volume(ps, sc.volumes[0])
+            assert ps.has_volume_grid("field (volume)") or ps.has_volume_mesh("field (volume)")
+        finally:
+            ps.remove_all_structures()
