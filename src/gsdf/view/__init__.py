@@ -8,7 +8,9 @@ line writes: polyscope's when it can render here, else gsdf's own renderers: PNG
 pointwise signed distance functions (``_trace``, :func:`render_png`).
 
 The package and the function share the name ``gsdf.view``: ``gsdf.view`` is always the function (see
-``gsdf/__init__.py``); import the package's other names with ``from gsdf.view import ...``.
+``gsdf/__init__.py``). Import the package's other names with ``from gsdf.view import save_png`` or
+``from gsdf.view._png import write_png``; ``import gsdf.view._png as m`` does not work (it reads the attribute
+``gsdf.view``, the function).
 """
 
 from gsdf.view._picture import save_png
