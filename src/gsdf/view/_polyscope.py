@@ -118,7 +118,7 @@ def render(scene, *, size, view_dir, upv, fill, screenshot=None):
         planes.append(sp)
     bars, translucent = {}, False
     for part in scene.parts:
-        st = _register(ps, part, length, bars)
+        st = _register(ps, part, length, bars, headless)
         for k, sp in enumerate(planes):
             if getattr(part, "cut", None) != k:
                 st.set_ignore_slice_plane(sp, True)
@@ -153,13 +153,16 @@ def _bar_width(title: str, ui: float) -> float:
     return max(6.6 * len(title), 75.0) * ui
 
 
-def _bar_kw(ps, scalar, bars):
-    """Colour-map keywords; the first quantity of each title shows its colour bar (top left, side by side)."""
+def _bar_kw(ps, scalar, bars, headless):
+    """Colour-map keywords; the first quantity of each title shows its colour bar (in screenshots top left, side
+    by side; in a window where polyscope puts it, clear of its panels)."""
     kw = dict(enabled=True, cmap=scalar.cmap, vminmax=tuple(float(v) for v in scalar.vrange))
     if scalar.title not in bars:
-        ui = ps.get_ui_scale()
-        x = 18 * ui + sum(_bar_width(t, ui) + 24 * ui for t in bars)
-        kw.update(onscreen_colorbar_enabled=True, onscreen_colorbar_location=(x, 18 * ui))
+        kw.update(onscreen_colorbar_enabled=True)
+        if headless:
+            ui = ps.get_ui_scale()
+            x = 18 * ui + sum(_bar_width(t, ui) + 24 * ui for t in bars)
+            kw.update(onscreen_colorbar_location=(x, 18 * ui))
         bars[scalar.title] = scalar
     return kw
 
@@ -180,7 +183,7 @@ def _overlay_boxes(ps, bars, legends, width, height):
     return out
 
 
-def _register(ps, part, length, bars):
+def _register(ps, part, length, bars, headless):
     if isinstance(part, SurfacePart):
         st = ps.register_surface_mesh(part.name, part.V, part.F, color=part.color, smooth_shade=not part.flat,
                                       edge_width=1.0 if part.edges else 0.0, back_face_policy="identical",
@@ -190,7 +193,7 @@ def _register(ps, part, length, bars):
         if part.scalar is not None:
             s = part.scalar
             vals = s.values.reshape(-1)
-            st.add_scalar_quantity(s.title, vals, defined_on=s.on, **_bar_kw(ps, s, bars))
+            st.add_scalar_quantity(s.title, vals, defined_on=s.on, **_bar_kw(ps, s, bars, headless))
         if part.labels is not None:
             st.add_color_quantity(part.labels.title, part.labels.colors, defined_on=part.labels.on, enabled=True)
         return st
@@ -203,7 +206,8 @@ def _register(ps, part, length, bars):
         st = ps.register_point_cloud(part.name, part.P, color=part.color)
         st.set_radius(part.radius * length, relative=False)
         if part.scalar is not None:
-            st.add_scalar_quantity(part.scalar.title, part.scalar.values, **_bar_kw(ps, part.scalar, bars))
+            st.add_scalar_quantity(part.scalar.title, part.scalar.values,
+                                   **_bar_kw(ps, part.scalar, bars, headless))
         elif part.colors is not None:
             st.add_color_quantity("normal shading", part.colors, enabled=True)
             st.set_material("flat")
