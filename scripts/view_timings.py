@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 import gsdf
-from gsdf.view import _polyscope, _scene
+from gsdf.render import _polyscope, _scene
 
 
 def _timed(fn, repeat=3):

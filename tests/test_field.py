@@ -81,7 +81,7 @@ def test_library_writers_refuse_unknown_extensions_without_writing(tmp_path):
     with pytest.raises(ValueError, match="not a folder"):
         gsdf.write_mesh(tmp_path / "f" / "x.ply", V, F)
     with pytest.raises(ValueError, match=r"\.png"):
-        from gsdf.view._png import write_png
+        from gsdf.render._png import write_png
 
         write_png(tmp_path / "i.jpg", np.zeros((2, 2, 3), np.uint8))
     assert sorted(os.listdir(tmp_path)) == ["f"]

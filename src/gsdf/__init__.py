@@ -4,8 +4,6 @@ Re-exports only; see ``docs/architecture.md`` for the layout. Names are resolved
 ``import gsdf`` stays fast: numba and scipy load on first use of a function that needs them.
 """
 
-import sys as _sys
-import types as _types
 from importlib import import_module
 
 from gsdf._jit import configure_cache as _configure_cache
@@ -48,7 +46,7 @@ _EXPORTS = {
     "PointsAsTori": "tori", "PointsAsToriOptions": "tori", "SignedHopfCole": "tori",
     "SmoothedSignedPlanarDistance": "tori", "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori",
     # pictures and the viewer (polyscope: the extra gsdf[view])
-    "view": "view", "ViewOptions": "view", "render_png": "view",
+    "view": "render", "ViewOptions": "render", "render_png": "render",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
     "reconstruct_simply_connected": "recon", "ReconstructionOptions": "recon", "mesh_topology": "mesh",
     # dataset batches
@@ -70,21 +68,6 @@ def __getattr__(name):
     value = getattr(import_module(f".{module}", __name__), name)
     globals()[name] = value
     return value
-
-
-class _Package(_types.ModuleType):
-    """The module type of ``gsdf``: the subpackage ``gsdf.view`` holds the function ``gsdf.view``, and Python binds
-    a subpackage as an attribute of its parent when it is first imported (e.g. by ``from gsdf.view._png import
-    write_png``); that binding gets the function instead, so ``gsdf.view`` is the function whatever was imported
-    first."""
-
-    def __setattr__(self, name, value):
-        if name == "view" and isinstance(value, _types.ModuleType):
-            value = value.view
-        super().__setattr__(name, value)
-
-
-_sys.modules[__name__].__class__ = _Package
 
 
 def __dir__():

@@ -112,6 +112,8 @@ def test_outputs_are_spelled_one_way(name):
         return
     assert len(short_o) == 1, f"gsdf {name}: one -o"
     want = ["-o", "--output-dir"] if name in FOLDER_OUTPUT else ["-o", "--output"]
+    if name == "view":              # the contract (design notes) names it --screenshot: one option, two names
+        want = want + ["--screenshot"]
     assert short_o[0].opts == want, f"gsdf {name}: -o is {short_o[0].opts}, want {want}"
     assert short_o[0].name == want[1][2:].replace("-", "_")
     # no other visible option names an output with another spelling

@@ -2,7 +2,6 @@
 
 The screenshot tests are skipped, with the reason, where polyscope or EGL is missing."""
 
-import os
 import sys
 
 import numpy as np
@@ -18,7 +17,7 @@ from tests.view import picture
 @pytest.fixture(scope="module")
 def headless():
     pytest.importorskip("polyscope", reason="polyscope is not installed (pip install -e '.[view]')")
-    from gsdf.view import _polyscope
+    from gsdf.render import _polyscope
 
     why = _polyscope.available()
     if why is not None:

@@ -31,6 +31,7 @@ SECTIONS = (
     ("Signed heat method", ("heat", "heat-surface")),
     ("Curves on surfaces", ("swn",)),
     ("Point clouds", ("tori", "render", "reconstruct")),
+    ("Viewing", ("view",)),
     ("Printing", ("slice",)),
     ("Datasets", ("batch",)),
     ("Setup", ("demo", "warmup")),

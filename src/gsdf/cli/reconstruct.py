@@ -87,7 +87,7 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
         write_mesh(tmp, V, F)
     click.echo(f"mesh -> {os.path.abspath(output)}")
     if png is not None:
-        from gsdf.view._raster import render_function_png
+        from gsdf.render._raster import render_function_png
         with output_file(png, (".png",), what="--png") as tmp:
             render_function_png(tmp, V, F, np.asarray(V)[:, 1], view=view)
         click.echo(f"preview -> {os.path.abspath(png)}")

@@ -41,9 +41,9 @@ Example:
 def render(points, output, level, size, view, up, estimate_normals, quiet):
     import numpy as np
 
-    from gsdf.view._png import write_png
+    from gsdf.render._png import write_png
     from gsdf.tori import PointsAsTori
-    from gsdf.view._trace import sphere_trace
+    from gsdf.render._trace import sphere_trace
     from gsdf.cli.tori import _load_cloud
 
     check_output(output, (".png",))

@@ -79,7 +79,7 @@ def sdf(input, output, resolution, pad, sign, png, mesh_output, beta, estimate_n
         field.save(tmp)
     click.echo(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")
     if png:
-        from gsdf.view._png import write_field_slice_png
+        from gsdf.render._png import write_field_slice_png
 
         with output_file(png, what="--png") as tmp:
             write_field_slice_png(tmp, field)

@@ -7,22 +7,11 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import check_output, no_clobber_option, output_file, quiet_option, report_errors
+from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._options import common_options, no_clobber_option
 
 _CLOUD_EXTENSIONS = (".xyz", ".pwn", ".pc", ".npy")
 _CURVE_EXTENSIONS = (".txt",)
-
-
-def _threads(ctx, param, value):
-    """``--threads N``: the same setting as ``gsdf --threads N`` (this one wins)."""
-    if value is not None:
-        from gsdf import threads
-
-        try:
-            threads.set_num_threads(threads.parse_num_threads(value, name="--threads"))
-        except ValueError as exc:
-            raise click.BadParameter(str(exc), ctx=ctx, param=param) from None
-    return value
 
 
 def _size(ctx, param, value):
@@ -72,16 +61,14 @@ Examples:
 @click.option("--field", "field_name", default=None, metavar="NAME",
               help="Vertex property of a PLY/VTK mesh to colour by (default: the first one).")
 @click.option("--title", default=None, help="Colour-bar title of the (first) field, units included.")
-@quiet_option
-@click.option("--threads", default=None, metavar="N", expose_value=False, callback=_threads,
-              help="Threads for numba kernels and BLAS (the same as gsdf --threads).")
+@common_options
 @no_clobber_option
 @report_errors
 def view(files, output, size, up, azimuth, elevation, level, slice_, field_name, title, quiet):
     import time
 
-    from gsdf.view._view import ViewOptions
-    from gsdf.view._view import view as show
+    from gsdf.render._view import ViewOptions
+    from gsdf.render._view import view as show
 
     check_output(output, (".png",), "--screenshot")
     axis, at = None, None
@@ -199,7 +186,7 @@ def _field_file(p, name, ext):
             pat = PointsAsTori.load(p)
             return (f"Points as Tori {name}", pat), None
         raise exc
-    from gsdf.view._scene import field_kind
+    from gsdf.render._scene import field_kind
 
     kind = field_kind(f.values)
     what = {"signed": "signed distance", "winding": "winding number"}.get(kind, "value")
@@ -233,7 +220,7 @@ def _curves(p, V, F):
     """Polylines (k, 3) of a curve file on the mesh (V, F): the signed heat method's format and OBJ lines
     (:func:`gsdf.read_curves`), else the surface winding numbers' demo format (nodes and segments)."""
     from gsdf.io import read_curves
-    from gsdf.view._scene import MeshItem, _curves_on_mesh
+    from gsdf.render._scene import MeshItem, _curves_on_mesh
 
     try:
         src = read_curves(p, F)

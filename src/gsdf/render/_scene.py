@@ -2,7 +2,7 @@
 isosurfaces, isolines, colour ranges) and where the camera goes.
 
 Everything here is numpy (plus gsdf's own contouring), so the scene can be built and checked where polyscope or
-an OpenGL context is missing; :mod:`gsdf.view._polyscope` only registers the parts built here.
+an OpenGL context is missing; :mod:`gsdf.render._polyscope` only registers the parts built here.
 
 Items and what they become (:func:`coerce`):
 

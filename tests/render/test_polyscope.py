@@ -18,7 +18,7 @@ from tests.view import picture
 @pytest.fixture(scope="module")
 def headless():
     pytest.importorskip("polyscope", reason="polyscope is not installed (pip install -e '.[view]')")
-    from gsdf.view import _polyscope
+    from gsdf.render import _polyscope
 
     why = _polyscope.available()
     if why is not None:
@@ -105,7 +105,7 @@ def test_camera_options_turn_the_view(headless, tmp_path):
 
 
 def test_save_png_uses_polyscope_or_gsdf_renderers(headless, tmp_path):
-    from gsdf.view import save_png
+    from gsdf.render import save_png
 
     g = _ball_grid(17)
     assert save_png(tmp_path / "p.png", g, size=(640, 480)) == "polyscope"
@@ -121,7 +121,7 @@ def test_window_extras_register(headless):
     registration is checked headless (a window cannot open here)."""
     from scipy.spatial import Delaunay
 
-    from gsdf.view import _polyscope, _scene
+    from gsdf.render import _polyscope, _scene
 
     ps = _polyscope.session(headless=True)
     P = np.random.default_rng(0).uniform(-1, 1, (200, 3))

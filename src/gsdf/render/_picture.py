@@ -12,7 +12,7 @@ _DECISION: dict = {}
 def polyscope_reason() -> str | None:
     """None when polyscope renders headless here, else why not; decided once per process."""
     if "reason" not in _DECISION:
-        from gsdf.view import _polyscope
+        from gsdf.render import _polyscope
 
         _DECISION["reason"] = _polyscope.available()
     return _DECISION["reason"]
@@ -46,7 +46,7 @@ def save_png(path, *items, view=None, size=(1200, 900), options=None, renderer: 
     renderer = choice(renderer, "renderer", ("auto", "polyscope", "gsdf"))
     check_output_path(path, extensions=(".png",), what="png")
     if renderer == "polyscope" or (renderer == "auto" and polyscope_reason() is None):
-        from gsdf.view._view import render
+        from gsdf.render._view import render
 
         render(items, path, size, "auto", (35.0, 25.0), options, view_dir=view)
         return "polyscope"
@@ -56,14 +56,14 @@ def save_png(path, *items, view=None, size=(1200, 900), options=None, renderer: 
 
 def _fallback(path, items, view, options):
     """gsdf's own renderers: the first item that one of them can draw."""
-    from gsdf.view import _scene
-    from gsdf.view._raster import render_function_png
+    from gsdf.render import _scene
+    from gsdf.render._raster import render_function_png
 
     d = (0.3, 0.2, 1.0) if view is None else tuple(float(x) for x in view)
     for it in _scene.coerce(items):
         if isinstance(it, _scene.VolumeItem):
             from gsdf.field import GridField
-            from gsdf.view._png import write_field_slice_png
+            from gsdf.render._png import write_field_slice_png
 
             f = it.field
             if not isinstance(f, GridField):         # a tet field, resampled on a grid over its box
@@ -95,7 +95,7 @@ def _fallback(path, items, view, options):
             return
         if isinstance(it, _scene.CloudItem) and it.N is not None:
             from gsdf.tori import PointsAsTori
-            from gsdf.view._trace import render_png
+            from gsdf.render._trace import render_png
 
             render_png(PointsAsTori(it.P, it.N), path, 512, 512, view=d)
             return

@@ -6,15 +6,10 @@ polyscope; ``_polyscope``: every polyscope call). :func:`save_png` is the pictur
 line writes: polyscope's when it can render here, else gsdf's own renderers: PNG writing and colour maps
 (``_png``), a z-buffer rasterizer of vertex functions on triangle meshes (``_raster``) and sphere tracing of
 pointwise signed distance functions (``_trace``, :func:`render_png`).
-
-The package and the function share the name ``gsdf.view``: ``gsdf.view`` is always the function (see
-``gsdf/__init__.py``). Import the package's other names with ``from gsdf.view import save_png`` or
-``from gsdf.view._png import write_png``; ``import gsdf.view._png as m`` does not work (it reads the attribute
-``gsdf.view``, the function).
 """
 
-from gsdf.view._picture import save_png
-from gsdf.view._trace import render_png, sphere_trace
-from gsdf.view._view import ViewOptions, view
+from gsdf.render._picture import save_png
+from gsdf.render._trace import render_png, sphere_trace
+from gsdf.render._view import ViewOptions, view
 
 __all__ = ["view", "ViewOptions", "save_png", "render_png", "sphere_trace"]

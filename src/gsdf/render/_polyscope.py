@@ -1,5 +1,5 @@
 """Every call gsdf makes to polyscope (Sharp et al., polyscope.run): one session per process, the parts of a
-:class:`gsdf.view._scene.Scene` registered as polyscope structures, a window or a headless screenshot.
+:class:`gsdf.render._scene.Scene` registered as polyscope structures, a window or a headless screenshot.
 
 Headless rendering uses polyscope's EGL backend; on a machine without a GPU, Mesa's software EGL (Debian:
 ``libegl1 libegl-mesa0 libgl1-mesa-dri``) renders the same pictures. The call sequence:
@@ -23,7 +23,7 @@ import sys
 
 import numpy as np
 
-from gsdf.view._scene import CloudPart, CurvePart, SurfacePart, frame_camera
+from gsdf.render._scene import CloudPart, CurvePart, SurfacePart, frame_camera
 
 INSTALL_HINT = ("gsdf.view needs polyscope: pip install 'gsdf[view]' (from a checkout of gsdf: "
                 "pip install -e '.[view]')")
@@ -251,7 +251,7 @@ def _font(size: int):
 
 
 def draw_legends(img, legends, right: bool = False):
-    """Each :class:`~gsdf.view._scene.Labels` as a title and one swatch per label with its share of the area, in
+    """Each :class:`~gsdf.render._scene.Labels` as a title and one swatch per label with its share of the area, in
     the top left corner (top right when colour bars take the left)."""
     from PIL import Image, ImageDraw
 

@@ -73,13 +73,13 @@ class ViewOptions:
         if self.slice_axis is not None and str(self.slice_axis).lower().lstrip("+-") not in ("x", "y", "z"):
             raise ValueError(f"slice_axis: expected 'x', 'y' or 'z', got {self.slice_axis!r}")
         if self.front != "auto":
-            from gsdf.view._scene import axis_vector
+            from gsdf.render._scene import axis_vector
 
             axis_vector(self.front)
         if not (isinstance(self.fill, (int, float)) and 0 < self.fill <= 1):
             raise ValueError(f"fill: expected a number in (0, 1], got {self.fill!r}")
         if self.vrange is not None:
-            from gsdf.view._scene import colour_range
+            from gsdf.render._scene import colour_range
 
             colour_range(np.zeros(1), "plain", self.vrange)
 
@@ -160,7 +160,7 @@ def render(items, screenshot, size, up, angles, options, view_dir=None):
     """:func:`view` with the camera given by ``angles`` (azimuth, elevation) or by ``view_dir`` (the direction from
     the scene towards the camera, as the ``--view x,y,z`` options of the commands)."""
     from gsdf._checks import integer
-    from gsdf.view import _scene
+    from gsdf.render import _scene
 
     options = ViewOptions() if options is None else options
     if not isinstance(options, ViewOptions):
@@ -183,7 +183,7 @@ def render(items, screenshot, size, up, angles, options, view_dir=None):
     else:
         view_dir, upv = _scene.direction_camera(view_dir, up)
     scene = _scene.build(things, options, view_dir, upv)
-    from gsdf.view import _polyscope
+    from gsdf.render import _polyscope
 
     if screenshot is None and not _polyscope.has_display():
         raise RuntimeError("gsdf.view: no display to open a window on; pass screenshot='out.png' to render to a "
@@ -191,7 +191,7 @@ def render(items, screenshot, size, up, angles, options, view_dir=None):
     img = _polyscope.render(scene, size=size, view_dir=view_dir, upv=upv, fill=options.fill,
                             screenshot=screenshot)
     if screenshot is not None:
-        from gsdf.view._png import write_png
+        from gsdf.render._png import write_png
 
         write_png(screenshot, img, min_size=1)
     return img
