@@ -11,7 +11,7 @@ from click.testing import CliRunner
 import gsdf
 from gsdf.cli.main import main
 from tests.shapes import uv_sphere
-from tests.view import picture
+from tests.render import picture
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,7 @@ import pytest
 
 import gsdf
 from tests.shapes import uv_sphere
-from tests.view import picture
+from tests.render import picture
 
 
 @pytest.fixture(scope="module")
