@@ -8,7 +8,7 @@ import click
 import numpy as np
 
 from gsdf.cli._common import check_output, output_file, report_errors
-from gsdf.cli._options import common_options, no_clobber_option
+from gsdf.cli._options import NUMBER, common_options, no_clobber_option
 
 _CLOUD_EXTENSIONS = (".xyz", ".pwn", ".pc", ".npy")
 _CURVE_EXTENSIONS = (".txt",)
@@ -54,7 +54,7 @@ Examples:
               help="Camera turn about the up axis, degrees.")
 @click.option("--elevation", type=click.FloatRange(-89, 89), default=25.0, show_default=True,
               help="Camera height above the horizon, degrees.")
-@click.option("--level", type=float, default=None,
+@click.option("--level", type=NUMBER, default=None,
               help="Isosurface / bold isoline level (default: 0 for signed fields, 1/2 for winding numbers).")
 @click.option("--slice", "slice_", default=None, metavar="AXIS[=AT]",
               help="Slice of volume fields: axis x, y or z, optionally at a coordinate (e.g. z=0.25).")
