@@ -8,20 +8,10 @@ import click
 import numpy as np
 
 from gsdf.cli._common import check_output, output_file, report_errors
-from gsdf.cli._options import NUMBER, common_options, no_clobber_option
+from gsdf.cli._options import NUMBER, SIZE, UP, common_options, no_clobber_option
 
 _CLOUD_EXTENSIONS = (".xyz", ".pwn", ".pc", ".npy")
 _CURVE_EXTENSIONS = (".txt",)
-
-
-def _size(ctx, param, value):
-    try:
-        w, h = (int(t) for t in value.lower().split("x"))
-        if not (64 <= w <= 8192 and 64 <= h <= 8192):
-            raise ValueError
-    except ValueError:
-        raise click.BadParameter(f"expected WIDTHxHEIGHT (64..8192 each), got {value!r}") from None
-    return w, h
 
 
 @click.command("view", short_help="Show meshes, clouds, curves and results (polyscope); --screenshot PNG.",
@@ -46,10 +36,9 @@ Examples:
 @click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, exists=True))
 @click.option("-o", "--output", "--screenshot", "output", default=None, metavar="FILE",
               help="Render to this PNG instead of opening a window (no display needed).")
-@click.option("--size", default="1200x900", show_default=True, callback=_size, metavar="WxH",
-              help="Screenshot size in pixels.")
-@click.option("--up", type=click.Choice(["auto", "x", "y", "z", "-x", "-y", "-z"]), default="auto",
-              show_default=True, help="The model's up axis (auto: y, or the normal of a flat scene).")
+@click.option("--size", type=SIZE, default="1200x900", show_default=True, help="Screenshot size in pixels: N or WxH.")
+@click.option("--up", type=UP, default="auto", show_default=True,
+              help="The model's up direction: auto (y, or the normal of a flat scene), an axis (x, -y, ...) or x,y,z.")
 @click.option("--azimuth", type=click.FloatRange(-360, 360), default=35.0, show_default=True,
               help="Camera turn about the up axis, degrees.")
 @click.option("--elevation", type=click.FloatRange(-89, 89), default=25.0, show_default=True,

@@ -426,7 +426,13 @@ def polyline_graph(polys) -> tuple:
 # ---------------------------------------------------------------------------------------------------------------
 
 def axis_vector(spec) -> np.ndarray:
-    """"x", "-y", "+z" (or 0/1/2) as a unit vector."""
+    """"x", "-y", "+z" (or 0/1/2, or a 3-vector) as a unit vector."""
+    if not isinstance(spec, (str, int, np.integer)):
+        v = np.asarray(spec, dtype=float).ravel()
+        n = float(np.linalg.norm(v)) if v.shape == (3,) and np.all(np.isfinite(v)) else 0.0
+        if not n > 0:
+            raise ValueError(f"expected an axis x, y, z, -x, -y, -z or a nonzero 3-vector, got {spec!r}")
+        return v / n
     if isinstance(spec, (int, np.integer)) and 0 <= int(spec) <= 2:
         v = np.zeros(3)
         v[int(spec)] = 1.0
@@ -451,7 +457,7 @@ def camera_direction(up, front, azimuth: float, elevation: float, extent) -> tup
     azimuth, elevation : degrees; turn about ``up`` (towards the right) and height above the horizon.
     """
     extent = np.asarray(extent, float)
-    if up == "auto":
+    if isinstance(up, str) and up == "auto":
         thin = int(np.argmin(extent))
         if extent[thin] < 0.1 * extent.max():
             upv = np.zeros(3)
@@ -489,7 +495,7 @@ def direction_camera(view_dir, up="auto") -> tuple:
     if d.shape != (3,) or not np.isfinite(d).all() or not np.linalg.norm(d) > 0:
         raise ValueError(f"view: expected a nonzero direction (x, y, z), got {view_dir!r}")
     d = d / np.linalg.norm(d)
-    if up != "auto":
+    if not (isinstance(up, str) and up == "auto"):
         upv = axis_vector(up)
     else:
         upv = np.array([0.0, 1.0, 0.0]) if abs(d[1]) < math.cos(math.radians(15)) else np.array([0.0, 0.0, 1.0])

@@ -116,7 +116,7 @@ def view(*items, screenshot=None, size=(1200, 900), up="auto", azimuth: float = 
         Render to this ``.png`` file (``size`` pixels) instead of opening a window.
     size : (int, int), default (1200, 900)
         Width and height of the screenshot in pixels.
-    up : {"auto", "x", "y", "z", "-x", "-y", "-z"}, default "auto"
+    up : {"auto", "x", "y", "z", "-x", "-y", "-z"} or (3,) float, default "auto"
         The model's up axis. "auto": y, except that a flat scene (thinnest side below 10 % of the longest) is
         seen from above its normal axis.
     azimuth, elevation : float, default 35 and 25
@@ -170,7 +170,7 @@ def render(items, screenshot, size, up, angles, options, view_dir=None):
     except (TypeError, ValueError):
         raise ValueError(f"size: expected (width, height), got {size!r}") from None
     size = (integer(w, "size[0]", lo=64, hi=8192), integer(h, "size[1]", lo=64, hi=8192))
-    if up != "auto":
+    if not (isinstance(up, str) and up == "auto"):
         _scene.axis_vector(up)
     if screenshot is not None:
         from gsdf.io._safe_write import check_output_path
