@@ -214,3 +214,19 @@ def _shape_results(out, lead, n):
     if isinstance(out, np.ndarray) and out.ndim >= 1 and out.shape[0] == max(n, 1):
         return out[:n].reshape(lead + out.shape[1:])
     return out
+
+
+def progress_callback(progress, name: str = "progress"):
+    """The one progress signature of gsdf: ``progress(stage: str, fraction: float)``, fraction in [0, 1].
+
+    Returns ``progress`` itself, or a no-op for None; a ValueError naming the argument when it is not callable.
+    """
+    if progress is None:
+        return _no_progress
+    if not callable(progress):
+        raise ValueError(f"{name}: expected a callable progress(stage, fraction) or None, got {type(progress).__name__}")
+    return progress
+
+
+def _no_progress(stage: str, fraction: float) -> None:
+    return None
