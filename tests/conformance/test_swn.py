@@ -75,6 +75,7 @@ def test_twirl_segments_direct(twirl):
     assert len(np.unique(res.face_labels)) >= 2
 
 
+@pytest.mark.parametrize("name,nseg", [("twirl.txt", 1456), ("torus-phi.txt", 88)])
 def test_read_curves_reads_swn_files(unpacked, name, nseg):
     """gsdf.read_curves on the SWN demo's curve files gives their segments. Regression: read_curves knew only
     the signed heat demo's format ('l 0 1' read as 1-based OBJ indices)."""
