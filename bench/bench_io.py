@@ -21,7 +21,7 @@ import warnings
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
-from common import machine, median_time, table, write_section  # noqa: E402
+from common import command, heading, median_time, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
 
@@ -85,9 +85,8 @@ def main():
             del cells
         except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio calls sys.exit on failures
             rows.append([ext, "meshio.read", "-", f"fails: {type(exc).__name__}", ""])
-    load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
-    text = (f"## Mesh readers (bench/bench_io.py {n_lat})\n\n{machine()}\n\nload: `{load}` (other helpers share the "
-            f"2 cores: times are indicative, compare within a row group)\n\n"
+    text = (heading("Mesh readers against trimesh and meshio", command("bench_io.py", [str(n_lat)]))
+            + "Times are indicative on a shared machine: compare within a row group.\n\n"
             f"Soup: {len(V0)} vertices (100 unreferenced), {len(polys)} polygons (quads, duplicated and degenerate "
             f"triangles) -> {len(F0)} triangles after fan triangulation. 'exact' = vertices and triangles identical "
             "to what was written, in order.\n\n"
