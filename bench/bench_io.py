@@ -10,6 +10,7 @@ Run: ``PYTHONPATH=src python3 bench/bench_io.py [n_lat]`` (default 400 -> ~0.32 
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import os
@@ -55,7 +56,9 @@ def exact(V, F, V0, F0) -> str:
 
 
 def main():
-    n_lat = int(sys.argv[1]) if len(sys.argv) > 1 else 400
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("n_lat", nargs="?", type=int, default=400, help="latitude rings of the soup (400: ~0.32 M triangles)")
+    n_lat = ap.parse_args().n_lat
     import meshio
     import trimesh
 
