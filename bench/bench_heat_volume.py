@@ -613,7 +613,7 @@ def run_speed(quick, load, scaling_only, write):
 
     if scaling_only:  # just the growth table, in its own section
         names = []
-        text = list(head)
+        text = []
     else:
         rows, srows, _ = speed_table(names, rep_g, rep_a, "idle", partial)
         text = head + tables(rows, srows)
