@@ -123,7 +123,7 @@ def test_pat_kd_eps_never_gives_nan():
 def test_grid_allocations_are_refused_with_size_and_limit(monkeypatch):
     from gsdf._memory import available_bytes, check_bytes
     from gsdf.contour import extract_isosurface
-    from gsdf.ops import _voxelize as voxelize, voxels_to_mesh
+    from gsdf.ops import voxelize, voxels_to_mesh
 
     with pytest.raises(ValueError, match=r"100000x100000x100000 cells: needs about 8\.0 PB, more than the"):
         voxelize(mesh=(V, F), resolution=100000)
@@ -164,7 +164,7 @@ def test_bad_options_are_refused():
         (lambda: gsdf.PointsAsTori(P2, P2, k=16, normal_weight=-1), "normal_weight"),
         (lambda: gsdf.PointsAsTori(P2, P2, k=16, kd_eps=np.nan), "kd_eps"),
         (lambda: gsdf.PointsAsTori(P2, P2, k=16, estimator=["jet"]), "estimator"),
-        (lambda: gsdf.ops._voxelize(mesh=(V, F), resolution=8, chunk=np.inf), "chunk"),
+        (lambda: gsdf.ops.voxelize(mesh=(V, F), resolution=8, chunk=np.inf), "chunk"),
         (lambda: gsdf.contour.extract_isosurface(lambda q: q[:, 0], [-1] * 3, [1] * 3, 8, level=0.0,
                                                  bisection_steps=10 ** 9), "bisection_steps"),
         (lambda: gsdf.tori.offset(lambda q: q[:, 0], [1, 2]), "r: expected a number"),

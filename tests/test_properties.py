@@ -16,7 +16,7 @@ from hypothesis.extra import numpy as hnp  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf.contour import extract_isosurface  # noqa: E402
-from gsdf.ops import _voxelize as voxelize  # noqa: E402
+from gsdf.ops import voxelize  # noqa: E402
 from gsdf.winding._point_areas import estimate_normals, point_areas  # noqa: E402
 
 # ---- strategies ----------------------------------------------------------------------------------------

@@ -14,7 +14,7 @@ from gsdf.ops import (
     trim_mesh,
     voxel_centers,
     voxel_grid,
-    _voxelize as voxelize,
+    voxelize,
     voxels_to_mesh,
     winding_grid,
 )

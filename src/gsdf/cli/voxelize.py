@@ -41,7 +41,7 @@ Example:
 @report_errors
 def voxelize(input, output, resolution, pad, mesh_out, beta, estimate_normals, quiet):
     from gsdf.io import MESH_WRITE_FORMATS
-    from gsdf.ops import save_voxels, _voxelize as run, voxels_to_mesh
+    from gsdf.ops import save_voxels, voxelize as run, voxels_to_mesh
 
     check_output(output, (".npz",))
     check_output(mesh_out, MESH_WRITE_FORMATS, "--mesh-out")
