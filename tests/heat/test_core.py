@@ -150,7 +150,7 @@ def test_volume_core_matches_pre_core_solvers(name, kw, monkeypatch):
         # error on the benchmark clouds): the default stays within 1e-4, the old areas reproduce the run exactly
         phi = np.asarray(signed_heat_volume(**kw).values).ravel()
         assert np.abs(phi - REF[name]).max() <= 1e-4 * max(1.0, float(np.abs(REF[name]).max()))
-        monkeypatch.setattr(hv, "point_sources", lambda P, N: hv.sources.point_sources(P, N, candidates=8))
+        monkeypatch.setattr(hv, "point_sources", lambda P, N: hv._sources.point_sources(P, N, candidates=8))
     if name in _NEW_SPELLING:
         kw.pop("constraint", None)
         kw.update(_NEW_SPELLING[name])
