@@ -233,8 +233,9 @@ def test_signed_distance_grid_matches_the_exact_cube_distance(sign):
 @pytest.mark.parametrize("sign", ["winding", "pseudonormal"])
 def test_signed_distance_grid_return_closest(sign):
     V, F = cube()
-    S, I, C, N = gsdf.signed_distance_grid((V, F), resolution=9, bbox_min=[-1, -1, -1], bbox_max=[1, 1, 1],
+    S, I, C, N = gsdf.signed_distance_grid((V, F), resolution=gsdf.Grid.fit(([-1, -1, -1], [1, 1, 1]), 9),
                                            sign=sign, return_closest=True)
+    assert S.shape == (9, 9, 9) and np.array_equal(S.bbox_min, [-1, -1, -1])
     Q = S.grid_points()
     assert I.shape == (len(Q),) and C.shape == N.shape == (len(Q), 3) and I.dtype == np.int64
     np.testing.assert_allclose(np.linalg.norm(Q - C, axis=1), np.abs(S.values.ravel()), atol=1e-12)
@@ -263,14 +264,56 @@ def test_signed_distance_grid_points_and_bad_input():
     V, F = cube()
     for kw, msg in [(dict(resolution=1), "resolution"), (dict(resolution=True), "resolution"),
                     (dict(sign="bogus"), "sign"), (dict(return_closest="yes"), "return_closest"),
-                    (dict(bbox_min=[0, 0, 0]), "bbox"), (dict(bbox_min=[1, 1, 1], bbox_max=[0, 0, 0]), "bbox"),
-                    (dict(pad=-1), "pad"), (dict(points=(P, P)), "points")]:
+                    (dict(resolution=(8, 8, 8)), "resolution"), (dict(progress=1), "progress"),
+                    (dict(points=(P, P)), "points")]:
         with pytest.raises(ValueError, match=msg):
             gsdf.signed_distance_grid(V, F, **kw)
     with pytest.raises(ValueError, match="pseudonormal"):
         gsdf.signed_distance_grid(None, points=(P, P), sign="pseudonormal")
     with pytest.raises(ValueError):
         gsdf.signed_distance_grid(V)
+
+
+def _old_grid(X, resolution, pad):
+    """The former node layout of signed_distance_grid (before gsdf.Grid), written out."""
+    lo, hi = X.min(axis=0), X.max(axis=0)
+    d = float(np.linalg.norm(hi - lo)) or 1.0
+    lo, hi = lo - pad * d, hi + pad * d
+    ext = hi - lo
+    h = ext.max() / (resolution - 1)
+    shape = tuple(int(max(2, np.ceil(e / h - 1e-9) + 1)) for e in ext)
+    hi = lo + (np.array(shape) - 1) * h
+    axes = [np.linspace(lo[k], hi[k], shape[k]) for k in range(3)]
+    X3 = np.meshgrid(*axes, indexing="ij")
+    return lo, hi, shape, np.column_stack([a.ravel() for a in X3])
+
+
+@pytest.mark.parametrize("pad", [0.05, 0.1])
+def test_signed_distance_grid_same_nodes_same_values_as_before(pad):
+    """Grid.around reproduces the former box and nodes bit for bit, and the values there are the former
+    computation's (exact distance signed by the fast winding number at 1/2), bit for bit."""
+    from gsdf.distance import TriangleDistance
+    from gsdf.winding import FastWindingNumber
+
+    V, F = cube()
+    V = V * [1.0, 0.7, 0.45] + [0.1, 0.2, 0.3]
+    lo, hi, shape, Q = _old_grid(V, 13, pad)
+    g = gsdf.Grid.around(V, 13, pad)
+    assert g.shape == shape and np.array_equal(g.bbox_min, lo) and np.array_equal(g.bbox_max, hi)
+    assert np.array_equal(g.points(), Q)
+    d = TriangleDistance(V, F).query(Q)[0]
+    old = np.where(FastWindingNumber(V, F, beta=2.0)(Q) > 0.5, -d, d)
+    S = gsdf.signed_distance_grid(V, F, resolution=g)
+    assert np.array_equal(S.values.ravel(), old)
+    if pad == 0.1:  # the default box
+        assert np.array_equal(gsdf.signed_distance_grid(V, F, resolution=13).values, S.values)
+
+
+def test_signed_distance_grid_progress():
+    V, F = cube()
+    calls = []
+    gsdf.signed_distance_grid(V, F, resolution=6, progress=lambda stage, f: calls.append((stage, f)))
+    assert calls == [("winding numbers", 1.0)]
 
 
 def test_load_field_dispatches_on_the_arrays(tmp_path):

@@ -112,7 +112,7 @@ def test_pat_kd_eps_never_gives_nan():
     rng = np.random.default_rng(0)
     Qr = rng.uniform(-4, 4, (20000, 3))
     for eps in (0.3, 1.0):
-        v = gsdf.PointsAsTori(P, P, k=20, kd_eps=eps).signed_distance(Qr)
+        v = gsdf.PointsAsTori(P, P, k=20, options=gsdf.PointsAsToriOptions(kd_eps=eps)).signed_distance(Qr)
         assert np.isfinite(v).all()
         assert np.abs(v - (np.linalg.norm(Qr, axis=1) - 1)).max() < 0.1
 
@@ -125,7 +125,7 @@ def test_grid_allocations_are_refused_with_size_and_limit(monkeypatch):
     from gsdf.contour import extract_isosurface
     from gsdf.ops import voxelize, voxels_to_mesh
 
-    with pytest.raises(ValueError, match=r"100000x100000x100000 cells: needs about 8\.0 PB, more than the"):
+    with pytest.raises(ValueError, match=r"100000x100000x100000 voxels: needs about 8\.0 PB, more than the"):
         voxelize(mesh=(V, F), resolution=100000)
     with pytest.raises(ValueError, match="extract_isosurface: resolution=100000.*needs about"):
         extract_isosurface(lambda q: q[:, 0], [0, 0, 0], [1, 1, 1], resolution=100000)
@@ -160,15 +160,18 @@ def test_bad_options_are_refused():
         (lambda: gsdf.ExactWindingNumber(V, F, leaf_size=1e300), "leaf_size"),
         (lambda: gsdf.distance.TriangleDistance(V, F, leaf_size=2 ** 64), "leaf_size"),
         (lambda: gsdf.fast_winding_number(V, F, Q1, order=np.array([1, 2])), "order: must be 0, 1 or 2"),
-        (lambda: gsdf.PointsAsTori(P2, P2, k=16, ridge=-1), "ridge: must be a finite number >= 0"),
-        (lambda: gsdf.PointsAsTori(P2, P2, k=16, normal_weight=-1), "normal_weight"),
-        (lambda: gsdf.PointsAsTori(P2, P2, k=16, kd_eps=np.nan), "kd_eps"),
+        (lambda: gsdf.PointsAsTori(P2, P2, k=16, options=gsdf.PointsAsToriOptions(ridge=-1)),
+         "ridge: must be a finite number >= 0"),
+        (lambda: gsdf.PointsAsTori(P2, P2, k=16, options=gsdf.PointsAsToriOptions(normal_weight=-1)),
+         "normal_weight"),
+        (lambda: gsdf.PointsAsTori(P2, P2, k=16, options=gsdf.PointsAsToriOptions(kd_eps=np.nan)), "kd_eps"),
         (lambda: gsdf.PointsAsTori(P2, P2, k=16, estimator=["jet"]), "estimator"),
-        (lambda: gsdf.ops.voxelize(mesh=(V, F), resolution=8, chunk=np.inf), "chunk"),
+        (lambda: gsdf.ops.voxelize(mesh=(V, F), resolution=np.inf), "resolution"),
         (lambda: gsdf.contour.extract_isosurface(lambda q: q[:, 0], [-1] * 3, [1] * 3, 8, level=0.0,
                                                  bisection_steps=10 ** 9), "bisection_steps"),
         (lambda: gsdf.tori.offset(lambda q: q[:, 0], [1, 2]), "r: expected a number"),
-        (lambda: gsdf.ops.mesh_boolean(V, F, V + 0.3, F, "union", bisection_steps=np.inf), "bisection_steps"),
+        (lambda: gsdf.ops.mesh_boolean(V, F, V + 0.3, F, "union",
+                                       options=gsdf.BooleanOptions(bisection_steps=np.inf)), "bisection_steps"),
     ]
     for fn, msg in bad:
         with pytest.raises(ValueError, match=msg):
@@ -210,21 +213,21 @@ def test_render_png_refuses_degenerate_views_and_blank_images(tmp_path):
     out = str(tmp_path / "r.png")
     box = dict(bbox_min=[-1] * 3, bbox_max=[1] * 3)
     with pytest.raises(ValueError, match="empty, flat"):
-        gsdf.tori.render_png(ball, out, 16, 16, bbox_min=[0] * 3, bbox_max=[0] * 3)
+        gsdf.render_png(ball, out, 16, 16, bbox_min=[0] * 3, bbox_max=[0] * 3)
     with pytest.raises(ValueError, match="view: the zero vector"):
-        gsdf.tori.render_png(ball, out, 16, 16, view=(0, 0, 0), **box)
+        gsdf.render_png(ball, out, 16, 16, view=(0, 0, 0), **box)
     with pytest.raises(ValueError, match="parallel to the view"):
-        gsdf.tori.render_png(ball, out, 16, 16, view=(0, 2, 0), **box)
+        gsdf.render_png(ball, out, 16, 16, view=(0, 2, 0), **box)
     with pytest.raises(ValueError, match="no ray hit"):
-        gsdf.tori.render_png(ball, out, 16, 16, level=-3.0, **box)
+        gsdf.render_png(ball, out, 16, 16, level=-3.0, **box)
     with pytest.raises(ValueError, match="width"):
-        gsdf.tori.render_png(ball, out, 0, 16, **box)
+        gsdf.render_png(ball, out, 0, 16, **box)
     with pytest.raises(ValueError, match="sdf: returned NaN"):
-        gsdf.tori.render_png(lambda q: np.full(len(q), np.nan), out, 8, 8, **box)
+        gsdf.render_png(lambda q: np.full(len(q), np.nan), out, 8, 8, **box)
     import os
 
     assert not os.path.exists(out)
-    gsdf.tori.render_png(ball, out, 16, 16, **box)
+    gsdf.render_png(ball, out, 16, 16, **box)
     assert os.path.getsize(out) > 0
 
 

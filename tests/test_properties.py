@@ -254,14 +254,15 @@ def test_options_are_validated(mesh, name, value):
 @given(clouds(), queries(16), POW2, st.sampled_from([0.0, 0.3, 2.0]))
 def test_points_as_tori(cloud, Q, s, kd_eps):
     P, N = cloud
-    pat = _ok_or_valueerror(lambda: gsdf.PointsAsTori(P, N, k=12, kd_eps=kd_eps))
+    opts = gsdf.PointsAsToriOptions(kd_eps=kd_eps)
+    pat = _ok_or_valueerror(lambda: gsdf.PointsAsTori(P, N, k=12, options=opts))
     assume(pat is not None)
     v = pat.signed_distance(Q)
     assert v.shape == (len(Q),) and np.isfinite(v).all()
     g = pat.gradient(Q)
     assert g.shape == (len(Q), 3) and np.isfinite(g).all()
     assert np.array_equal(_threads(1, lambda: pat(Q)), _threads(2, lambda: pat(Q)))
-    ps = gsdf.PointsAsTori(P * s, N, k=12, kd_eps=kd_eps)
+    ps = gsdf.PointsAsTori(P * s, N, k=12, options=opts)
     # power-of-two scales map to the same normalised cloud: same neighbours, same ties, same tori
     np.testing.assert_allclose(ps.signed_distance(Q * s) / s, v, rtol=1e-9, atol=1e-12)
 

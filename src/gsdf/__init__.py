@@ -22,33 +22,33 @@ _EXPORTS = {
     "fast_winding_number": "winding", "fast_winding_number_points": "winding",
     "point_areas": "winding", "estimate_normals": "winding",
     # surface winding numbers (thesis ch. 6)
-    "SurfaceWindingNumbers": "swn", "surface_winding_number": "swn",
+    "SurfaceWindingNumbers": "swn", "surface_winding_number": "swn", "SWNOptions": "swn",
     # distance
     "TriangleDistance": "distance", "PointCloudDistance": "distance", "unsigned_distance": "distance",
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",
     # fields, contouring, operations
     "Field": "field", "GridField": "field", "SurfaceField": "field", "load_field": "field",
-    "signed_distance_grid": "ops",
+    "Grid": "grid", "signed_distance_grid": "ops",
     "extract_isosurface": "contour", "refine_on_edges": "contour", "slice_contours": "contour",
     "write_svg": "contour",
     "voxelize": "ops", "winding_grid": "ops", "save_voxels": "ops", "voxels_to_mesh": "ops",
-    "mesh_boolean": "ops",
+    "mesh_boolean": "ops", "BooleanOptions": "ops",
     # the signed heat method on surfaces (Feng & Crane 2024)
     "SurfaceSignedHeatSolver": "heat", "PolygonMeshSignedHeatSolver": "heat", "PointCloudSignedHeatSolver": "heat",
     "level_set_curves": "contour", "region_boundary_curves": "contour",
     "VoxelSurfaceSignedHeatSolver": "heat",
     "Curve": "curves", "read_curves": "io", "write_curves": "io",
     # the signed heat method in volumes (grids, tets) and morphology
-    "signed_heat_volume": "heat.volume", "YukawaTree": "heat.volume",
+    "signed_heat_volume": "heat.volume", "VolumeHeatOptions": "heat.volume", "YukawaTree": "heat.volume",
     "TetField": "field", "marching_tetrahedra": "contour",
     "offset_surface": "ops", "dilate_erode": "ops", "erode_dilate": "ops",
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
-    "PointsAsTori": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
+    "PointsAsTori": "tori", "PointsAsToriOptions": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
     "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "view",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
-    "reconstruct_simply_connected": "recon", "mesh_topology": "mesh",
-    # dataset batches (issue 16)
-    "run_batch": "batch", "sdf_samples": "batch",
+    "reconstruct_simply_connected": "recon", "ReconstructionOptions": "recon", "mesh_topology": "mesh",
+    # dataset batches
+    "run_batch": "batch", "BatchOptions": "batch", "sdf_samples": "batch", "SdfSamplesOptions": "batch",
     # one thread setting for numba kernels and BLAS (gsdf.threads)
     "set_num_threads": "threads", "get_num_threads": "threads",
 }

@@ -1,6 +1,11 @@
 """Type stub of the lazy public API (gsdf/__init__.py): editors and type checkers see every public name."""
 
-from gsdf.batch import run_batch as run_batch, sdf_samples as sdf_samples
+from gsdf.batch import (
+    BatchOptions as BatchOptions,
+    SdfSamplesOptions as SdfSamplesOptions,
+    run_batch as run_batch,
+    sdf_samples as sdf_samples,
+)
 from gsdf.contour import (
     extract_isosurface as extract_isosurface,
     level_set_curves as level_set_curves,
@@ -26,13 +31,18 @@ from gsdf.field import (
     TetField as TetField,
     load_field as load_field,
 )
+from gsdf.grid import Grid as Grid
 from gsdf.heat import (
     PointCloudSignedHeatSolver as PointCloudSignedHeatSolver,
     PolygonMeshSignedHeatSolver as PolygonMeshSignedHeatSolver,
     SurfaceSignedHeatSolver as SurfaceSignedHeatSolver,
     VoxelSurfaceSignedHeatSolver as VoxelSurfaceSignedHeatSolver,
 )
-from gsdf.heat.volume import YukawaTree as YukawaTree, signed_heat_volume as signed_heat_volume
+from gsdf.heat.volume import (
+    VolumeHeatOptions as VolumeHeatOptions,
+    YukawaTree as YukawaTree,
+    signed_heat_volume as signed_heat_volume,
+)
 from gsdf.io import (
     read_curves as read_curves,
     read_mesh as read_mesh,
@@ -44,6 +54,7 @@ from gsdf.io import (
 )
 from gsdf.mesh import mesh_topology as mesh_topology
 from gsdf.ops import (
+    BooleanOptions as BooleanOptions,
     dilate_erode as dilate_erode,
     erode_dilate as erode_dilate,
     mesh_boolean as mesh_boolean,
@@ -54,12 +65,20 @@ from gsdf.ops import (
     voxels_to_mesh as voxels_to_mesh,
     winding_grid as winding_grid,
 )
-from gsdf.recon import reconstruct_simply_connected as reconstruct_simply_connected
-from gsdf.swn import SurfaceWindingNumbers as SurfaceWindingNumbers, surface_winding_number as surface_winding_number
+from gsdf.recon import (
+    ReconstructionOptions as ReconstructionOptions,
+    reconstruct_simply_connected as reconstruct_simply_connected,
+)
+from gsdf.swn import (
+    SurfaceWindingNumbers as SurfaceWindingNumbers,
+    SWNOptions as SWNOptions,
+    surface_winding_number as surface_winding_number,
+)
 from gsdf.threads import get_num_threads as get_num_threads, set_num_threads as set_num_threads
 from gsdf.tori import (
     LogSumExpDistance as LogSumExpDistance,
     PointsAsTori as PointsAsTori,
+    PointsAsToriOptions as PointsAsToriOptions,
     SignedHopfCole as SignedHopfCole,
     SmoothedSignedPlanarDistance as SmoothedSignedPlanarDistance,
     WindingNumberPipeline as WindingNumberPipeline,

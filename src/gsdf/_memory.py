@@ -81,13 +81,13 @@ def grid_bytes(shape, bytes_per_node: float) -> int:
     return int(n * bytes_per_node)
 
 
-def check_bytes(nbytes: float, what: str) -> None:
-    """Raise ``ValueError`` when ``nbytes`` exceeds :func:`available_bytes`.
+def check_bytes(nbytes: float, what: str, limit: int | None = None) -> None:
+    """Raise ``ValueError`` when ``nbytes`` exceeds ``limit`` (default :func:`available_bytes`).
 
     ``what`` names the request (e.g. ``"voxelize: resolution=4000 grid (4000×4000×4000 cells)"``) and should
-    say what to lower. The heat/volume path and any other module can call this with its own estimate.
+    say what to lower.
     """
-    limit = available_bytes()
+    limit = available_bytes() if limit is None else int(limit)
     if nbytes > limit:
         raise ValueError(f"{what}: needs about {human(nbytes)}, more than the {human(limit)} allowed; "
                          f"lower the resolution/size, or set {ENV} (bytes) to change the limit")

@@ -6,7 +6,7 @@ import numpy as np
 
 from gsdf._checks import as_points
 from gsdf.contour._tets import locate_in_tets, marching_tetrahedra
-from gsdf.grid import grid_points
+from gsdf.grid import Grid
 
 
 class Field:
@@ -95,12 +95,17 @@ class GridField(Field):
         return tuple(self.values.shape)
 
     @property
+    def grid(self) -> Grid:
+        """The :class:`gsdf.Grid` of the nodes."""
+        return Grid((self.bbox_min, self.bbox_max), self.values.shape)
+
+    @property
     def spacing(self) -> np.ndarray:
         return (self.bbox_max - self.bbox_min) / (np.array(self.values.shape) - 1)
 
     def grid_points(self) -> np.ndarray:
         """Node positions, shape (nx*ny*nz, 3), in C order of ``values``."""
-        return grid_points(self.bbox_min, self.bbox_max, self.values.shape)
+        return self.grid.points()
 
     def __call__(self, Q) -> np.ndarray:
         """Trilinear interpolation at query points ``Q`` (q, 3); points outside are clamped to the box."""

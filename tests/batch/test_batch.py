@@ -12,9 +12,11 @@ from click.testing import CliRunner
 
 from gsdf.batch import (
     BatchInterrupted,
+    BatchOptions,
     DaskExecutor,
     Geometry,
     LocalExecutor,
+    SdfSamplesOptions,
     collect_inputs,
     occupancy,
     read_manifest,
@@ -95,9 +97,11 @@ def test_sdf_samples_heat_sign_and_open_mesh():
     V, F = _open_sphere()
     wind = sdf_samples(Geometry(V, F=F), n_samples=N, seed=1)
     r = np.linalg.norm(wind["points"], axis=1)
-    far = np.abs(r - 1) > 0.1
+    # away from the surface, and not inside right under the hole (z > 0.76), where w is near 1/2
+    far = (np.abs(r - 1) > 0.1) & ~((r < 1) & (wind["points"][:, 2] > 0.6))
     assert np.all((wind["sdf"][far] < 0) == (r[far] < 1))  # winding sign survives the hole
-    heat = sdf_samples(Geometry(V, F=F), n_samples=N, seed=1, sign="heat", heat_resolution=32)
+    heat = sdf_samples(Geometry(V, F=F), n_samples=N, seed=1, sign="heat",
+                       options=SdfSamplesOptions(heat_resolution=32))
     assert np.array_equal(heat["points"], wind["points"]) and np.allclose(np.abs(heat["sdf"]), np.abs(wind["sdf"]))
     assert np.all((heat["sdf"][far] < 0) == (r[far] < 1))
 
@@ -109,7 +113,7 @@ def test_occupancy_grid_surface_analytic():
     inside = np.all(np.abs(occ["points"]) < 0.5, axis=1)
     margin = np.abs(np.abs(occ["points"]).max(axis=1) - 0.5) > 1e-3
     assert occ["occupancy"].dtype == bool and np.array_equal(occ["occupancy"][margin], inside[margin])
-    grid = sdf_grid(g, resolution=17, pad=0.5)
+    grid = sdf_grid(g, resolution=17, margin=0.5)
     X = np.stack(np.meshgrid(*[np.linspace(grid["bbox_min"][i], grid["bbox_max"][i], 17) for i in range(3)],
                              indexing="ij"), -1)
     q = np.abs(X) - 0.5  # exact box SDF
@@ -120,6 +124,43 @@ def test_occupancy_grid_surface_analytic():
     s = surface(Geometry(Vs, F=Fs), resolution=24)
     assert s["faces"].dtype == np.int64 and len(s["faces"]) > 100
     assert np.abs(np.linalg.norm(s["vertices"], axis=1) - 1).max() < 0.02
+
+
+def test_sdf_grid_is_signed_distance_grid_on_the_task_grid():
+    """sdf-grid "fast" is gsdf.signed_distance_grid on the task's cube (half-side (1 + margin) x half the longest
+    side for normalize="none"): the same numbers, and the former distance + winding-sign computation's numbers
+    on the same nodes, bit for bit."""
+    import gsdf
+    from gsdf.batch._tasks import cube as task_cube, task_grid
+    from gsdf.distance import TriangleDistance
+    from gsdf.grid import Grid
+    from gsdf.winding import FastWindingNumber
+
+    V, F = _open_sphere()
+    V = V * [1.0, 0.8, 0.6]
+    g = Geometry(V, F=F)
+    out = sdf_grid(g, resolution=11, dtype="float64")
+    grid = task_grid(V, 11)
+    c, half = task_cube(V, "none", 0.05, grid=True)
+    lo, hi = V.min(0), V.max(0)
+    assert np.allclose(c, 0.5 * (lo + hi)) and half == 1.05 * 0.5 * float((hi - lo).max())
+    assert grid.shape == (11, 11, 11) and np.array_equal(out["bbox_min"], grid.bbox_min)
+    S = gsdf.signed_distance_grid(V, F, resolution=grid)
+    assert np.array_equal(out["sdf"], S.values)
+    # the former sdf_grid: the cube c +- (1 + pad) * L / 2, nodes np.linspace, |d| and the winding sign
+    old_half = 1.05 * 0.5 * float((hi - lo).max())
+    Q = np.stack(np.meshgrid(*[np.linspace(c[k] - old_half, c[k] + old_half, 11) for k in range(3)],
+                             indexing="ij"), -1).reshape(-1, 3)
+    d = TriangleDistance(V, F).query(Q)[0]
+    old = np.where(FastWindingNumber(V, F, beta=2.0)(Q) > 0.5, -d, d)
+    same = Grid((Q[0], Q[-1]), (11, 11, 11))
+    assert np.array_equal(same.points(), Q)
+    assert np.array_equal(gsdf.signed_distance_grid(V, F, resolution=same).values.ravel(), old)
+    P = V[::3]
+    N = P / np.linalg.norm(P, axis=1, keepdims=True)
+    cloud = sdf_grid(Geometry(P, N=N), resolution=9, dtype="float64")
+    Sc = gsdf.signed_distance_grid(None, points=(P, N), resolution=task_grid(P, 9))
+    assert np.array_equal(cloud["sdf"], Sc.values)
 
 
 def test_task_bad_options():
@@ -137,13 +178,19 @@ def test_task_bad_options():
         sdf_samples(42)
     from gsdf.batch import check_options
 
-    for bad, match in [({"n_samples": True}, "n_samples"), ({"pad": float("nan")}, "pad"),
+    for bad, match in [({"n_samples": True}, "n_samples"), ({"margin": float("nan")}, "margin"),
                        ({"sigmas": "a,b"}, "sigmas: expected a number"), ({"beta": -1}, "beta"),
                        ({"dtype": "int8"}, "dtype"), ({"uniform_fraction": "x"}, "uniform_fraction")]:
         with pytest.raises(ValueError, match=match):
             check_options("sdf-samples", bad)
     with pytest.raises(ValueError, match="method"):
         check_options("surface", {"method": "pat"})
+    with pytest.raises(ValueError, match="options"):
+        sdf_samples(g, options={"margin": 0.1})
+    from gsdf.batch import run_task
+
+    with pytest.raises(ValueError, match="'bisection' does not apply"):
+        run_task("sdf-samples", g, {"bisection": 3})
     with pytest.raises(ValueError, match="out-of-memory estimate"):
         sdf_grid(g, resolution=4000)
 
@@ -163,7 +210,9 @@ def test_point_cloud_inputs(tmp_path):
     write_points(str(tmp_path / "bare.xyz"), P)
     with pytest.raises(ValueError, match="no normals"):
         occupancy(str(tmp_path / "bare.xyz"))
-    occ = occupancy(str(tmp_path / "bare.xyz"), n_points=2000, estimate_normals=True)
+    from gsdf.batch import OccupancyOptions
+
+    occ = occupancy(str(tmp_path / "bare.xyz"), n_points=2000, options=OccupancyOptions(estimate_normals=True))
     rr = np.linalg.norm(occ["points"], axis=1)
     ok = np.abs(rr - 1) > 0.1
     assert np.mean(occ["occupancy"][ok] == (rr[ok] < 1)) > 0.99
@@ -244,7 +293,8 @@ def test_rerun_recomputes_nothing_and_notices_changes(local_run, dataset, tmp_pa
     out2 = tmp_path / "out2"
     run_batch(str(changed), "sdf-samples", str(out2), {"n_samples": N}, executor=local1)
     write_mesh(str(changed / "a" / "cube.off"), V, F)
-    r = run_batch(str(changed), "sdf-samples", str(out2), {"n_samples": N}, executor=local1, retry_failed=True)
+    r = run_batch(str(changed), "sdf-samples", str(out2), {"n_samples": N}, executor=local1,
+                  batch_options=BatchOptions(retry_failed=True))
     ran = {x["output"] for x in r.records if x["status"] in ("done", "failed")}
     assert ran == {"a/cube.npz", "corrupt.npz"}
 
@@ -286,8 +336,8 @@ def test_stale_part_files_never_count(dataset, tmp_path, local1):
 def test_interrupt_keeps_manifest_consistent(dataset, tmp_path, local1):
     out = tmp_path / "out"
 
-    def stop(rec, counts):
-        if counts["done"] + counts["failed"] == 1:
+    def stop(stage, fraction):
+        if stage in ("done", "failed"):
             raise KeyboardInterrupt
 
     with pytest.raises(BatchInterrupted) as info:
@@ -310,8 +360,8 @@ def test_local_worker_killed_loses_no_item(dataset, tmp_path):
     ex = LocalExecutor(2)
     killed = []
 
-    def kill_one(rec, counts):
-        if not killed and rec["status"] != "skipped":
+    def kill_one(stage, fraction):
+        if not killed and stage != "skipped":
             pid = ex.worker_pids()[0]
             os.kill(pid, signal.SIGKILL)
             killed.append(pid)
@@ -371,7 +421,7 @@ def test_dask_worker_killed_loses_no_item(dask2, dataset, tmp_path):
     items = [str(p) for p in sorted(dataset.rglob("*.*"))]
     killed = []
 
-    def kill_one(rec, counts):
+    def kill_one(stage, fraction):
         if not killed:
             pid = dask2.worker_pids()[0]
             os.kill(pid, signal.SIGKILL)
@@ -406,8 +456,12 @@ def test_bad_inputs_are_clear_errors(dataset, tmp_path):
         run_batch(str(dataset), "sdf-samples", str(tmp_path / "file" / "sub"))
     with pytest.raises(ValueError, match="cannot write"):
         run_batch(str(dataset), "sdf-samples", "/proc/gsdf-batch-out")
-    with pytest.raises(ValueError, match="conflicting options: workers and scheduler"):
-        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), workers=2, scheduler="tcp://127.0.0.1:1")
+    with pytest.raises(ValueError, match="conflicting options: workers and the scheduler"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), workers=2, executor="tcp://127.0.0.1:1")
+    with pytest.raises(ValueError, match="executor: expected"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), executor=3)
+    with pytest.raises(ValueError, match="batch_options"):
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), batch_options={"resume": False})
     with pytest.raises(ValueError, match="'resolution' does not apply to task 'sdf-samples'"):
         run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), {"resolution": 64})
     with pytest.raises(ValueError, match="task: unknown task"):
@@ -421,8 +475,8 @@ def test_unreachable_scheduler_fails_fast(dataset, tmp_path):
     pytest.importorskip("distributed")
     t0 = time.perf_counter()
     with pytest.raises(ValueError, match="cannot reach the Dask scheduler"):
-        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), scheduler="tcp://127.0.0.1:9",
-                  scheduler_timeout=2)
+        run_batch(str(dataset), "sdf-samples", str(tmp_path / "o"), executor="tcp://127.0.0.1:9",
+                  batch_options=BatchOptions(scheduler_timeout=2))
     assert time.perf_counter() - t0 < 10
 
 
@@ -432,18 +486,43 @@ def test_unreachable_scheduler_fails_fast(dataset, tmp_path):
 def test_cli_batch(dataset, tmp_path):
     runner = CliRunner()
     out = tmp_path / "cli"
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "--out", str(out),
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "-o", str(out),
                                "--normalize", "cube", "-q"])
     assert res.exit_code == 0, res.output
     assert "done" in res.output and "failed" in res.output and "corrupt.obj" in res.output
     z = np.load(out / "a" / "cube.npz")
     assert z["sdf"].shape == (12, 12, 12) and z["scale"] == pytest.approx(0.5)
     assert -1.0 <= z["sdf"].min() <= -0.85  # the centre is 1 frame unit from every face
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--resolution", "12", "--out",
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--bisection", "3", "--output-dir",
                                str(out)])
-    assert res.exit_code != 0 and "--resolution does not apply to --task sdf-samples" in res.output
-    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "--out", str(out), "--workers", "2",
+    assert res.exit_code != 0 and "--bisection does not apply to --task sdf-samples" in res.output
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "occupancy", "--resolution", "12", "-o", str(out)])
+    assert res.exit_code != 0 and "--resolution does not apply to --task occupancy" in res.output
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "-o", str(out), "--workers", "2",
                                "--dask-local", "2"])
     assert res.exit_code != 0 and "conflicting options: --workers and --dask-local" in res.output
     res = runner.invoke(main, ["batch", str(tmp_path / "none*.obj"), "--task", "surface", "--out", str(out)])
-    assert res.exit_code == 1 and "matches no file" in res.output
+    assert res.exit_code == 1 and "matches no file" in res.output  # --out: the old name, kept for one release
+
+
+def test_cli_batch_options_reach_the_library_under_their_names(monkeypatch, tmp_path):
+    """--n-points is n_samples (sdf-samples) or n_points (occupancy); --resolution is the heat grid of
+    sdf-samples; --threads (group or command) is the per-item thread count."""
+    import gsdf.batch
+    import gsdf.threads
+
+    monkeypatch.setattr(gsdf.threads, "set_num_threads", lambda n: None)  # leave this process's setting alone
+    seen = []
+    monkeypatch.setattr(gsdf.batch, "run_batch", lambda inputs, task, out, opts, **kw: seen.append((task, opts, kw))
+                        or (_ for _ in ()).throw(ValueError("stop")))
+    runner = CliRunner()
+    for args in (["--task", "sdf-samples", "--n-points", "7", "--resolution", "9", "--margin", "0.2"],
+                 ["--task", "occupancy", "--n-points", "5", "--threads", "3"]):
+        res = runner.invoke(main, ["batch", str(tmp_path), "-o", str(tmp_path / "o"), *args])
+        assert res.exit_code == 1 and "stop" in res.output, res.output
+    res = runner.invoke(main, ["--threads", "2", "batch", str(tmp_path), "-o", str(tmp_path / "o"), "--task",
+                               "sdf-grid"])
+    assert res.exit_code == 1
+    assert [(t, o, kw["batch_options"].threads) for t, o, kw in seen] == [
+        ("sdf-samples", {"n_samples": 7, "heat_resolution": 9, "margin": 0.2}, None),
+        ("occupancy", {"n_points": 5}, 3), ("sdf-grid", {}, 2)]

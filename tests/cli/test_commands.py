@@ -54,7 +54,7 @@ def test_sdf_grid_png_and_surface(files):
     out = files["dir"] / "sdf.npz"
     png = files["dir"] / "slice.png"
     surf = files["dir"] / "zero.ply"
-    r = run("sdf", files["mesh"], "-o", out, "--resolution", 24, "--png", png, "--surface", surf, "-q")
+    r = run("sdf", files["mesh"], "-o", out, "--resolution", 24, "--png", png, "--mesh-output", surf, "-q")
     assert r.exit_code == 0, r.output
     field = gsdf.GridField.load(out)
     # the CLI's grid equals the library's signed distance at the nodes (and interpolates them exactly)
@@ -73,12 +73,12 @@ def test_sdf_grid_png_and_surface(files):
 
 def test_voxelize_and_surface_of_cloud(files):
     out = files["dir"] / "vox.npz"
-    r = run("voxelize", files["cloud"], "-o", out, "--resolution", 20, "--mesh-out", files["dir"] / "vox.obj", "-q")
+    r = run("voxelize", files["cloud"], "-o", out, "--resolution", 20, "--mesh-output", files["dir"] / "vox.obj", "-q")
     assert r.exit_code == 0, r.output
     with np.load(out) as d:
         occ = d["occupancy"]
     frac = occ.mean()
-    assert 0.2 < frac < 0.6
+    assert 0.15 < frac < 0.6  # a unit ball in its bounding box padded by 0.1 of the diagonal: ~0.2
     surf = files["dir"] / "s.ply"
     r = run("surface", files["cloud"], "-o", surf, "--resolution", 32)
     assert r.exit_code == 0, r.output

@@ -1,5 +1,5 @@
 """Every `gsdf` subcommand on bad inputs and bad outputs: a non-zero exit, one error line, no traceback, inputs
-untouched (issue 14, items 1, 2 and 6).
+untouched.
 
 The table COMMANDS holds one valid invocation per subcommand (checked to succeed, so the failing cases fail for
 the reason they test); a new subcommand must get a row (test_every_subcommand_has_a_row).
@@ -25,7 +25,7 @@ COMMANDS = {
     "surface": (["{mesh}", "--resolution", "6", "--bisection", "0", "-q"], "s.ply"),
     "boolean": (["{mesh}", "{mesh2}", "--op", "union", "--exact"], "b.ply"),
     "slice": (["{mesh}", "--layers", "1", "--resolution", "8", "-q"], "s.svg"),
-    "heat": (["{mesh}", "--grid", "6", "-q"], "h.npz"),
+    "heat": (["{mesh}", "--resolution", "6", "-q"], "h.npz"),
     "heat-surface": (["{sphere}", "--curves", "{curves}", "-q"], "h.ply"),
     "tori": (["{cloud}", "-k", "8"], "t.npz"),
     "render": (["{cloud}", "--size", "8"], "r.png"),
@@ -195,13 +195,13 @@ def test_input_as_output_is_refused(name, slot, inputs, tmp_path):
     assert digest([inputs[k] for k in INPUT_KEYS]) == before
 
 
-@pytest.mark.parametrize("option", ["--png", "--surface"])
+@pytest.mark.parametrize("option", ["--png", "--mesh-output"])
 def test_secondary_outputs_are_checked_too(option, inputs, tmp_path):
     before = digest([inputs[k] for k in INPUT_KEYS])
     r = invoke(args_for("sdf", inputs, tmp_path / "s.npz") + [option, inputs["mesh"]])
     assert_clean_failure(r)
     assert not (tmp_path / "s.npz").exists()  # refused before any work
-    r = invoke(args_for("voxelize", inputs, tmp_path / "v.npz") + ["--mesh-out", inputs["mesh"]])
+    r = invoke(args_for("voxelize", inputs, tmp_path / "v.npz") + ["--mesh-output", inputs["mesh"]])
     assert_clean_failure(r, contains="input")
     assert digest([inputs[k] for k in INPUT_KEYS]) == before
 
@@ -212,7 +212,7 @@ def test_heat_offsets_never_overwrite_an_input(inputs, tmp_path):
     V, F = cube()
     gsdf.write_mesh(str(src), V, F)
     before = digest([str(src)])
-    r = invoke(["heat", str(src), "--grid", "6", "-q", "--offsets", "0", "-o", str(tmp_path / "m.npz")])
+    r = invoke(["heat", str(src), "--resolution", "6", "-q", "--offsets", "0", "-o", str(tmp_path / "m.npz")])
     assert_clean_failure(r, contains="input")
     assert digest([str(src)]) == before and not (tmp_path / "m.npz").exists()
 
@@ -246,7 +246,7 @@ def test_sdf_writes_every_field_format_under_the_name_given(ext, inputs, tmp_pat
 
 
 def test_heat_tet_reports_its_nodes_and_refuses_vti(inputs, tmp_path):
-    r = invoke(["heat", inputs["mesh"], "--tet", "--grid", "6", "-q", "-o", str(tmp_path / "t.vtu")])
+    r = invoke(["heat", inputs["mesh"], "--tet", "--resolution", "6", "-q", "-o", str(tmp_path / "t.vtu")])
     assert r.exit_code == 0, r.output
     assert "-node tet mesh" in r.output and "?" not in r.output
     line = assert_clean_failure(invoke(["heat", inputs["mesh"], "--tet", "-q", "-o", str(tmp_path / "t.vti")]))

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from gsdf.contour import extract_isosurface, refine_on_edges, slice_contours, write_slices_svg, write_svg
+from gsdf.grid import Grid
 
 R0 = 0.61  # deliberately not on a grid node
 BOX = ([-1.0, -1.0, -1.0], [1.0, 1.0, 1.0])
@@ -64,12 +65,40 @@ def test_isosurface_closed_sphere_outward():
     assert vol == pytest.approx(4.0 / 3.0 * np.pi * R0**3, rel=2e-2)  # positive: outward normals
 
 
-def test_isosurface_signed_distance_inside_below():
+def test_isosurface_signed_distance_inside_below(monkeypatch):
+    import gsdf.contour._isosurface as iso
+
     sdf = lambda Q: np.linalg.norm(Q, axis=1) - 0.5  # noqa: E731
-    V, F = extract_isosurface(sdf, [-1, -1, -1], [1, 1, 1.2], resolution=24, level=0.0, inside="below", chunk=1000)
+    V, F = extract_isosurface(sdf, [-1, -1, -1], [1, 1, 1.2], resolution=24, level=0.0, inside="below")
     chi, counts, vol = mesh_stats(V, F)
     assert chi == 2 and np.all(counts == 2) and vol > 0
     assert np.abs(np.linalg.norm(V, axis=1) - 0.5).max() < 1e-6
+    calls = []
+    monkeypatch.setattr(iso, "CHUNK", 1000)
+    V2, F2 = extract_isosurface(lambda Q: calls.append(len(Q)) or sdf(Q), [-1, -1, -1], [1, 1, 1.2],
+                                resolution=24, level=0.0, inside="below")
+    assert max(calls) == 1000 and np.array_equal(V, V2) and np.array_equal(F, F2)  # chunking changes nothing
+
+
+def test_isosurface_grid_rule_and_same_nodes_same_mesh():
+    """The grid is Grid.fit of the box (cubic cells, upper corner up to the last node); given as a Grid, the
+    nodes the former rule used (np.linspace of the exact box) give the former mesh bit for bit."""
+    f = sigmoid_ball(center=(0.1, -0.05, 0.02))
+    lo, hi = np.array([-1.0, -1.0, -0.9]), np.array([1.0, 1.0, 1.0])
+    g = Grid.fit((lo, hi), 24)
+    assert g.shape == (24, 24, 23) and np.allclose(g.spacing, 2 / 23)
+    assert np.array_equal(extract_isosurface(f, lo, hi, 24)[0], extract_isosurface(f, resolution=g)[0])
+    # the former rule kept the box exactly: nodes np.linspace(lo, hi, n) with the same node counts
+    old = Grid((lo, hi), g.shape)
+    V, F = extract_isosurface(f, resolution=old)
+    axes = [np.linspace(lo[d], hi[d], g.shape[d]) for d in range(3)]
+    assert all(np.array_equal(a, b) for a, b in zip(old.axes(), axes))
+    chi, counts, vol = mesh_stats(V, F)
+    assert chi == 2 and np.all(counts == 2)
+    with pytest.raises(ValueError, match="omit"):
+        extract_isosurface(f, lo, hi, resolution=g)
+    with pytest.raises(ValueError, match="box"):
+        extract_isosurface(f, resolution=24)
 
 
 def test_refine_on_edges():
@@ -123,9 +152,27 @@ def test_slice_sphere_equator():
     err = np.abs(np.linalg.norm(P, axis=1) - R0).max()
     assert err < 1e-4
     assert signed_area(P) == pytest.approx(np.pi * R0**2, rel=2e-2) and signed_area(P) > 0  # CCW
-    (C0,) = slice_contours(f, 0.0, *BOX, resolution=32, bisection_steps=0)
+
+
+
+def test_slice_bisection_beats_linear_interpolation(monkeypatch):
+    import gsdf.contour._slicing as sl
+
+    f = sigmoid_ball()
+    (C,) = slice_contours(f, [0.0], *BOX, resolution=32)
+    err = np.abs(np.linalg.norm(C[0], axis=1) - R0).max()
+    monkeypatch.setattr(sl, "BISECTION_STEPS", 0)
+    (C0,) = slice_contours(f, 0.0, *BOX, resolution=32)
     err0 = np.abs(np.linalg.norm(C0[0], axis=1) - R0).max()
     assert err0 > 1e-3 and err0 > 100 * err
+
+
+def test_slice_on_a_grid():
+    f = sigmoid_ball()
+    g = Grid.fit(BOX, 32)
+    (C,) = slice_contours(f, [0.0], *BOX, resolution=32)
+    (Cg,) = slice_contours(f, [0.0], resolution=g)
+    assert len(C) == len(Cg) == 1 and np.array_equal(C[0], Cg[0])
 
 
 def test_slice_heights_and_empty_slices():
@@ -223,6 +270,11 @@ def test_write_svg(tmp_path):
     W, H = map(float, r2.get("viewBox").split()[2:])
     assert float(r2.get("width")[:-2]) == pytest.approx(1000 * W)
     assert H == pytest.approx(2 * W, rel=0.05)  # two slices of a square frame
+    out3 = write_svg(tmp_path / "o.svg", S1, style={"fill": "none", "stroke": "red"})
+    p3 = ET.parse(out3).getroot().find(f"{SVG}g/{SVG}path")
+    assert (p3.get("fill"), p3.get("stroke"), p3.get("fill-rule")) == ("none", "red", "evenodd")
+    with pytest.raises(ValueError, match="style"):
+        write_svg(tmp_path / "u.svg", S1, style="red")
     with pytest.raises(ValueError, match="slice"):
         write_svg(tmp_path / "u.svg", [np.zeros((4, 2))])
     with pytest.raises(ValueError, match="bbox"):

@@ -130,36 +130,38 @@ def test_core_progress_signature():
 
 
 # ------------------------------------------------------------------------------------------ volumes
-# the old grid default, "zero" by the soft penalty (weight 10), is soft_weight="auto" (the default) and 10.0;
-# the old constraint="exact" is soft_weight=None (the hard constraint)
-_NEW_SPELLING = {"grid_mesh_soft": dict(soft_weight=10.0),
-                 "grid_mesh_exact": dict(level_set_constraint="zero", soft_weight=None)}
 VOLUME = volume_cases()
 
 
+@pytest.fixture
+def tree_step1(monkeypatch):
+    """Step I on grids by the Yukawa tree sum, as in the frozen runs (grids choose the screened grid solve where
+    it is trusted since, :class:`gsdf.heat.grid._domain.GridDomain`)."""
+    import functools
+
+    import gsdf.heat.volume._solve as solve
+    from gsdf.heat.grid._domain import GridDomain
+
+    monkeypatch.setattr(solve, "GridDomain", functools.partial(GridDomain, step1="yukawa"))
+
+
 @pytest.mark.parametrize("name,kw", VOLUME, ids=[c[0] for c in VOLUME])
-def test_volume_core_matches_pre_core_solvers(name, kw, monkeypatch):
+def test_volume_core_matches_pre_core_solvers(name, kw, monkeypatch, tree_step1):
     import gsdf.heat.volume as hv
     from gsdf.heat.volume import signed_heat_volume
 
-    kw = dict(kw)
-    if kw.get("domain", "grid") == "grid":
-        kw["step1"] = "yukawa"  # the frozen run's Step I (grids default to the screened grid solve since)
     if "points" in kw:
-        # the frozen run estimated cloud areas from 8·k candidates; the default is 2·k since issue 17 (lower
-        # error on the benchmark clouds): the default stays within 1e-4, the old areas reproduce the run exactly
+        # the frozen run estimated cloud areas from 8·k candidates; the default is now 2·k (lower error on the
+        # benchmark clouds): the default stays within 1e-4, the old areas reproduce the run exactly
         phi = np.asarray(signed_heat_volume(**kw).values).ravel()
         assert np.abs(phi - REF[name]).max() <= 1e-4 * max(1.0, float(np.abs(REF[name]).max()))
-        monkeypatch.setattr(hv, "point_sources", lambda P, N: hv._sources.point_sources(P, N, candidates=8))
-    if name in _NEW_SPELLING:
-        kw.pop("constraint", None)
-        kw.update(_NEW_SPELLING[name])
+        monkeypatch.setattr(hv, "_cloud_sources", lambda P, N: hv._sources._cloud_sources(P, N, candidates=8))
     phi = np.asarray(signed_heat_volume(**kw).values).ravel()
     ref = REF[name]
     scale = max(1.0, float(np.abs(ref).max()))
     # the soft penalty is solved by preconditioned CG to a relative residual of 1e-3 (GridPoisson.penalty_tol):
-    # agreement with the frozen run holds to that tolerance (φ within 4.2e-4 of its range), not to rounding
-    # (issue 17). The hard constraints
+    # agreement with the frozen run holds to that tolerance (φ within 4.2e-4 of its range), not to rounding.
+    # The hard constraints
     # through points inside faces are a saddle system with a -1e-12 I block (FactorizedPoisson.constrained): rounding
     # in the BLAS kernels under SuperLU is amplified there, so the same code gives phi differing by up to
     # 1.7e-7 with OpenBLAS's SkylakeX kernels against the Haswell/Zen ones the fixture was made with
@@ -171,7 +173,7 @@ def test_volume_core_matches_pre_core_solvers(name, kw, monkeypatch):
 def test_grid_multiple_and_hard_zero():
     """Two disjoint spheres: "multiple" makes φ one constant per sphere (cell rows), "zero" makes it 0 on both,
     the soft penalty only nearly; inside is negative in every case."""
-    from gsdf.heat.volume import signed_heat_volume
+    from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
     from gsdf.heat.grid._poisson import cell_constraint_matrix
 
     from tests.shapes import uv_sphere
@@ -180,8 +182,9 @@ def test_grid_multiple_and_hard_zero():
     V2 = np.concatenate([V - [0.8, 0, 0], V + [0.8, 0, 0]])
     F2 = np.concatenate([F, F + len(V)])
     kw = dict(mesh=(V2, F2), resolution=(20, 12, 12), bbox_min=[-1.5, -0.7, -0.7], bbox_max=[1.5, 0.7, 0.7])
-    fields = {m: signed_heat_volume(level_set_constraint=m, soft_weight=None, **kw) for m in ("zero", "multiple")}
-    fields["soft"] = signed_heat_volume(soft_weight=10.0, **kw)
+    fields = {m: signed_heat_volume(**kw, options=VolumeHeatOptions(level_set_constraint=m, soft_weight=None))
+              for m in ("zero", "multiple")}
+    fields["soft"] = signed_heat_volume(**kw, options=VolumeHeatOptions(soft_weight=10.0))
     T = V2[F2]
     B = T.mean(axis=1)
     a = 0.5 * np.linalg.norm(np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]), axis=1)
@@ -243,7 +246,7 @@ def test_a_new_vertex_domain_plugs_into_the_core():
 
 
 def test_grid_multiple_on_a_cloud_uses_its_components():
-    from gsdf.heat.volume import signed_heat_volume
+    from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
     from gsdf.heat.volume._sources import cloud_components, point_sources
 
     from tests.shapes import fibonacci_sphere
@@ -255,17 +258,17 @@ def test_grid_multiple_on_a_cloud_uses_its_components():
     assert len(np.unique(lab)) == 2 and np.all(lab[:400] == lab[0]) and np.all(lab[400:] == lab[400])
     N = P2 - np.repeat([[-0.8, 0, 0], [0.8, 0, 0]], 400, axis=0)
     f = signed_heat_volume(points=(P2, N), resolution=(20, 12, 12), bbox_min=[-1.5, -0.7, -0.7],
-                           bbox_max=[1.5, 0.7, 0.7], level_set_constraint="multiple")
+                           bbox_max=[1.5, 0.7, 0.7], options=VolumeHeatOptions(level_set_constraint="multiple"))
     assert f([[-0.8, 0, 0]])[0] < -0.3 and f([[0.8, 0, 0]])[0] < -0.3 and f([[0, 0.65, 0]])[0] > 0.05
 
 
-def test_grid_default_is_the_fast_penalty_and_none_is_hard():
+def test_grid_default_is_the_fast_penalty_and_none_is_hard(tree_step1):
     """soft_weight="auto": the penalty (c = 10) on grids, so the default call stays as fast as before the core."""
-    from gsdf.heat.volume import signed_heat_volume
+    from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
 
     kw = dict(volume_cases())["grid_mesh_soft"]
-    phi = np.asarray(signed_heat_volume(**kw, step1="yukawa").values).ravel()   # the frozen run's Step I
+    phi = np.asarray(signed_heat_volume(**kw).values).ravel()
     # to the CG tolerance (relative residual 1e-3), see test_volume_core_matches_pre_core_solvers
     assert np.abs(phi - REF["grid_mesh_soft"]).max() <= 1e-3 * max(1.0, float(np.abs(REF["grid_mesh_soft"]).max()))
     with pytest.raises(ValueError, match="soft_weight"):
-        signed_heat_volume(**kw, soft_weight="bogus")
+        signed_heat_volume(**kw, options=VolumeHeatOptions(soft_weight="bogus"))

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from gsdf.heat.volume import signed_heat_volume
+from gsdf.heat.grid._domain import GridDomain
 from gsdf.heat.grid._screened import screened_heat, screened_reach, screened_symbol, splat
+from gsdf.heat.volume import signed_heat_volume
 
 from tests.shapes import uv_sphere
 
@@ -68,11 +69,17 @@ def test_symbol_is_the_stencil_on_the_dct_modes():
     assert np.allclose(lhs, lam * c, atol=1e-12)
 
 
-def _sphere_errors(**kw):
+def _sphere_errors(monkeypatch, **kw):
     """Mean |φ − (|x| − 1)| on a 9³ lattice in [-1.1, 1.1]³ of the default run (checked to take the grid Step I)
     and of the Yukawa tree run, at resolution 24."""
+    import functools
+
+    import gsdf.heat.volume._solve as solve
+
     g = signed_heat_volume(resolution=24, **kw)
-    y = signed_heat_volume(resolution=24, step1="yukawa", **kw)
+    with monkeypatch.context() as m:
+        m.setattr(solve, "GridDomain", functools.partial(GridDomain, step1="yukawa"))
+        y = signed_heat_volume(resolution=24, **kw)
     assert g.meta["step1"] == "heat" and y.meta["step1"] == "yukawa"
     x = np.linspace(-1.1, 1.1, 9)
     Q = np.stack(np.meshgrid(x, x, x, indexing="ij"), axis=-1).reshape(-1, 3)
@@ -80,24 +87,22 @@ def _sphere_errors(**kw):
     return np.abs(g(Q) - exact).mean(), np.abs(y(Q) - exact).mean()
 
 
-def test_cloud_uses_the_grid_solve_and_is_as_accurate_as_the_tree():
+def test_cloud_uses_the_grid_solve_and_is_as_accurate_as_the_tree(monkeypatch):
     P = _sphere()
-    eg, ey = _sphere_errors(points=(P, P))
+    eg, ey = _sphere_errors(monkeypatch, points=(P, P))
     assert eg < 0.03 and eg < 1.1 * ey
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
     F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     assert signed_heat_volume(mesh=(V, F), resolution=12).meta["step1"] == "heat"
-    assert signed_heat_volume(mesh=(V, F), resolution=12, step1="yukawa").meta["step1"] == "yukawa"
 
 
-def test_mesh_uses_the_grid_solve_and_is_as_accurate_as_the_tree():
+def test_mesh_uses_the_grid_solve_and_is_as_accurate_as_the_tree(monkeypatch):
     """A sphere mesh with a hole: Step I on the grid by default, mean error within 5 % of the tree sum's."""
     from gsdf.heat.volume._sources import mesh_sources
-    from gsdf.heat.grid._domain import GridDomain
 
     V, F = uv_sphere(24, 48)
     F = F[V[F][:, :, 0].mean(axis=1) < 0.7]                                           # cut a hole
-    eg, ey = _sphere_errors(mesh=(V, F))
+    eg, ey = _sphere_errors(monkeypatch, mesh=(V, F))
     assert eg < 0.05 and eg < 1.05 * ey
     # sources beyond the box padded by PAD cells: the splat would clamp them, so the tree is used
     d = GridDomain(np.full(3, -0.5), np.full(3, 0.5), (12, 12, 12), t=0.01)
@@ -106,14 +111,17 @@ def test_mesh_uses_the_grid_solve_and_is_as_accurate_as_the_tree():
 
 
 def test_bad_step1_and_too_short_t():
+    from gsdf.heat.volume._sources import point_sources
+
     P = _sphere(300)
-    with pytest.raises(ValueError, match="step1"):
-        signed_heat_volume(points=(P, P), resolution=10, step1="walk")
-    with pytest.raises(ValueError, match="step1"):
-        signed_heat_volume(points=(P, P), resolution=10, step1=True)
+    lo, hi, shape = np.full(3, -1.5), np.full(3, 1.5), (10, 10, 10)
+    for bad in ("walk", True):
+        with pytest.raises(ValueError, match="step1"):
+            GridDomain(lo, hi, shape, t=0.1, step1=bad)
+    d = GridDomain(lo, hi, shape, t=0.05 * (3 / 9) ** 2, step1="heat")
     with pytest.raises(ValueError, match="t: .* too short"):
-        signed_heat_volume(points=(P, P), resolution=10, step1="heat", t_coef=0.05)
-    # auto falls back to the tree when t is short against the grid (t_scale="input" on a coarse grid)
+        d.diffuse(d.prepare(point_sources(P, P)))
+    # the default falls back to the tree when t is short against the grid (t_scale="input" on a coarse grid)
     assert signed_heat_volume(points=(P, P), resolution=10, t_coef=0.05).meta["step1"] == "yukawa"
     with pytest.raises(ValueError, match="t"):
         screened_heat(P, P, np.full(3, -2.0), np.full(3, 0.4), (11, 11, 11), t=-1.0)

@@ -27,7 +27,7 @@ def test_triangular_solve_matches_scipy():
 def test_blas_is_one_thread_during_the_run_and_restored_after():
     from threadpoolctl import threadpool_info
 
-    from gsdf.heat.volume import signed_heat_volume
+    from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
 
     def blas():
         return [d["num_threads"] for d in threadpool_info() if d.get("user_api") == "blas"]
@@ -37,7 +37,8 @@ def test_blas_is_one_thread_during_the_run_and_restored_after():
     i = np.arange(300) + 0.5
     ph, th = np.arccos(1 - 2 * i / 300), np.pi * (1 + 5 ** 0.5) * i
     P = np.column_stack([np.cos(th) * np.sin(ph), np.sin(th) * np.sin(ph), np.cos(ph)])
-    f = signed_heat_volume(points=(P, P), resolution=12, progress=lambda stage, frac: seen.extend(blas()))
+    f = signed_heat_volume(points=(P, P), resolution=12,
+                           options=VolumeHeatOptions(progress=lambda stage, frac: seen.extend(blas())))
     assert seen and all(n == 1 for n in seen)
     assert blas() == before
     # and the field is still a signed distance of the unit sphere

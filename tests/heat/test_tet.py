@@ -8,7 +8,7 @@ from scipy.spatial import Delaunay
 import gsdf
 from gsdf.field import TetField
 from gsdf.contour._tets import locate_in_tets, marching_tetrahedra
-from gsdf.heat.volume import signed_heat_volume
+from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
 from gsdf.heat.tet._mesh import graded_lattice, surface_samples, tet_geometry
 
 from tests.shapes import uv_sphere
@@ -73,7 +73,7 @@ def sphere():
 
 def test_tet_sphere_sdf_close_to_exact_and_zero_on_input(sphere, tmp_path):
     V, F = sphere
-    f = signed_heat_volume(mesh=(V, F), domain="tet", resolution=12, level_set_constraint="zero")
+    f = signed_heat_volume(mesh=(V, F), domain="tet", resolution=12)
     assert np.abs(f(V)).max() < 1e-12  # exactly zero on the input vertices
     rng = np.random.default_rng(0)
     Q = rng.uniform(-1.25, 1.25, (2000, 3))
@@ -93,19 +93,21 @@ def test_tet_multiple_constant_per_component_and_none():
     V1, F1 = uv_sphere(10, 20)
     V = np.vstack([0.45 * V1 - [0.6, 0, 0], 0.45 * V1 + [0.6, 0, 0]])
     F = np.vstack([F1, F1 + len(V1)])
-    f = signed_heat_volume(mesh=(V, F), domain="tet", resolution=11, level_set_constraint="multiple")
+    f = signed_heat_volume(mesh=(V, F), domain="tet", resolution=11,
+                           options=VolumeHeatOptions(level_set_constraint="multiple"))
     assert f.meta["n_components"] == 2
     a, b = f(V[: len(V1)]), f(V[len(V1):])
     assert np.ptp(a) < 1e-10 and np.ptp(b) < 1e-10  # one constant per component
     assert abs(a[0]) < 0.05 and abs(b[0]) < 0.05
     d = f([[-0.6, 0, 0], [0.6, 0, 0], [0, 0, 0]])
     assert d[0] < -0.3 and d[1] < -0.3 and d[2] > 0.0  # the gap between them is outside
-    g = signed_heat_volume(mesh=(V, F), domain="tet", resolution=11, level_set_constraint="none")
+    g = signed_heat_volume(mesh=(V, F), domain="tet", resolution=11,
+                           options=VolumeHeatOptions(level_set_constraint="none"))
     assert np.ptp(g(V[: len(V1)])) > 1e-6  # unconstrained: not constant on the input
     assert abs(np.mean(g(V))) < 0.02
 
 
-def test_tet_point_cloud_and_heat_step1():
+def test_tet_point_cloud():
     i = np.arange(500) + 0.5
     phi, th = np.arccos(1 - 2 * i / 500), np.pi * (1 + 5 ** 0.5) * i
     P = np.column_stack([np.cos(th) * np.sin(phi), np.sin(th) * np.sin(phi), np.cos(phi)])
@@ -113,31 +115,39 @@ def test_tet_point_cloud_and_heat_step1():
     assert np.abs(f(P)).max() < 1e-12
     Q = np.array([[0, 0, 0.0], [0.5, 0, 0], [1.2, 0, 0]])
     assert np.all(np.abs(f(Q) - [-1.0, -0.5, 0.2]) < [0.2, 0.05, 0.03])  # the centre is a cusp of |x|
-    g = signed_heat_volume(points=(P, P), domain="tet", resolution=9, step1="heat")  # CR heat flow (seed)
-    assert np.all(np.abs(g(Q) - [-1.0, -0.5, 0.2]) < [0.25, 0.08, 0.05])
+
+
+def test_tet_soft_weight_tends_to_the_hard_constraint(sphere):
+    """The penalty λ Σ (φ(z_i) − φ(z_0))² on tets (the Poisson system pins one vertex: its constants are free)."""
+    V, F = sphere
+    hard = signed_heat_volume(mesh=(V, F), domain="tet", resolution=10)
+    spread = []
+    for lam in (1.0, 1e3):
+        f = signed_heat_volume(mesh=(V, F), domain="tet", resolution=10, options=VolumeHeatOptions(soft_weight=lam))
+        assert f.meta["soft_weight"] == lam and np.isfinite(f.values).all()
+        spread.append(np.ptp(f(V)))
+    assert spread[1] < 1e-2 * spread[0] and np.abs(f(V)).max() < 1e-4   # measured 0.0072, 2.5e-5
+    Q = np.random.default_rng(0).uniform(-1.2, 1.2, (500, 3))
+    assert np.abs(f(Q) - hard(Q)).max() < 1e-3
 
 
 def test_tet_bad_options(sphere):
     V, F = sphere
-    with pytest.raises(ValueError, match="step1"):
-        signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, step1="walk")
-    with pytest.raises(ValueError, match="mesher"):
-        signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, mesher="gmsh")
-    with pytest.raises(ValueError, match="GiB"):
-        signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, max_memory=1000)
-    with pytest.raises(ValueError, match="soft_weight"):
-        signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, soft_weight=-1.0)
+    for opts, match in [(dict(mesher="gmsh"), "mesher"), (dict(max_memory=1000), "allowed"),
+                        (dict(soft_weight=-1.0), "soft_weight"), (dict(theta=-1.0), "theta")]:
+        with pytest.raises(ValueError, match=match):
+            signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, options=VolumeHeatOptions(**opts))
     try:
         import tetgen  # noqa: F401
     except ImportError:
         with pytest.raises(ImportError, match="pip install tetgen"):
-            signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, mesher="tetgen")
+            signed_heat_volume(mesh=(V, F), domain="tet", resolution=8, options=VolumeHeatOptions(mesher="tetgen"))
 
 
 def test_tet_tetgen_conforming_mesher(sphere):
     pytest.importorskip("tetgen")
     V, F = sphere
-    f = signed_heat_volume(mesh=(V, F), domain="tet", resolution=12, mesher="tetgen")
+    f = signed_heat_volume(mesh=(V, F), domain="tet", resolution=12, options=VolumeHeatOptions(mesher="tetgen"))
     assert f.meta["mesher"] == "tetgen"
     # the mesh conforms to the input, so φ = 0 on the whole input triangles, not only at their vertices
     assert np.abs(f(V)).max() < 1e-10 and np.abs(f(V[F].mean(axis=1))).max() < 1e-10

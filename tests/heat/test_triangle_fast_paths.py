@@ -59,9 +59,10 @@ def test_reordered_factorization_solves_the_same_system():
 
 def test_batched_vertex_polylines_equal_the_per_curve_loop():
     from gsdf.contour._surface_curves import region_boundary_curves
+    from gsdf.curves import as_curves
     from gsdf.data._shapes import grid_mesh
     from gsdf.heat.triangle._operators import TriangleMeshOperators
-    from gsdf.heat.triangle._sources import build_sources
+    from gsdf.heat.triangle._sources import assemble, parse_curves
 
     V, F = grid_mesh(16)
     c = V[F].mean(1)
@@ -70,11 +71,14 @@ def test_batched_vertex_polylines_equal_the_per_curve_loop():
     assert len(loops) == 2
     loops.append(np.array([loops[0][0], loops[0][0], loops[0][1]]))     # a repeated vertex is skipped
     ops = TriangleMeshOperators(V, F)
-    fast = build_sources(ops, loops, None, None)
-    loop = build_sources(ops, loops, None, None, curve_normals=[None] * len(loops))   # the general loop
+    parts = parse_curves(ops, as_curves(loops))
+    fast = assemble(ops, parts)
+    loop = assemble(ops, parts, batch=False)                            # the general loop
     assert np.array_equal(fast.X0, loop.X0)
-    for name in ("node_rows", "seg_mid"):
-        for (i1, w1), (i2, w2) in zip(getattr(fast, name), getattr(loop, name)):
-            assert np.array_equal(i1, i2) and np.array_equal(w1, w2)
-    for a, b in zip(fast.seg_len + fast.node_is_vertex, loop.seg_len + loop.node_is_vertex):
+    for name in ("node_rows", "shift_rows"):
+        a, b = getattr(fast, name), getattr(loop, name)
+        assert (a != b).nnz == 0 and np.array_equal(a.indices, b.indices) and np.array_equal(a.data, b.data)
+    for name in ("node_vertex", "node_curve", "shift_weights"):
+        assert np.array_equal(getattr(fast, name), getattr(loop, name))
+    for a, b in zip(fast.extra["midpoints"], loop.extra["midpoints"]):
         assert np.array_equal(a, b)

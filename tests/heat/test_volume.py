@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import gsdf
-from gsdf.heat.volume import YukawaTree, mesh_sources, signed_heat_volume
+from gsdf.heat.volume import VolumeHeatOptions, YukawaTree, mesh_sources, signed_heat_volume
 from gsdf.heat.grid._poisson import dct_poisson, divergence_rhs, neumann_laplacian
 
 from tests.shapes import cube, fibonacci_sphere, uv_sphere
@@ -48,8 +48,7 @@ def test_sphere_cloud_matches_analytic():
 
 def test_zero_constraint_and_explicit_box_and_shape(sphere):
     V, F = sphere
-    f = signed_heat_volume(mesh=(V, F), resolution=(20, 22, 24), bbox_min=[-1.3] * 3, bbox_max=[1.3, 1.4, 1.5],
-                           level_set_constraint="zero")
+    f = signed_heat_volume(mesh=(V, F), resolution=(20, 22, 24), bbox_min=[-1.3] * 3, bbox_max=[1.3, 1.4, 1.5])
     assert f.shape == (20, 22, 24)
     np.testing.assert_allclose(f.bbox_max, [1.3, 1.4, 1.5])
     assert np.abs(f(V)).mean() < 0.02
@@ -60,8 +59,7 @@ def test_grid_exact_constraint_zero_at_sources(sphere):
 
     V, F = sphere
     src = mesh_sources(V, F)
-    kw = dict(mesh=(V, F), resolution=20, level_set_constraint="zero")
-    f = signed_heat_volume(constraint="exact", **kw)
+    f = signed_heat_volume(mesh=(V, F), resolution=20, options=VolumeHeatOptions(soft_weight=None))
     C, w = cell_constraint_matrix(src.B, src.a, f.bbox_min, f.spacing, f.shape)
     h = f.spacing.max()
     assert np.abs(C @ f.values.ravel()).max() < 1e-3 * h  # exact: every cell's fitted zero level
@@ -142,25 +140,25 @@ def test_input_spacing_and_t_scale_input():
     with pytest.raises(ValueError, match="coincide"):
         input_spacing(np.zeros((5, 3)))
     # a fine sphere mesh with a hole on a coarse grid: the input's own spacing gives a shorter t and a field
-    # closer to the exact SDF (bench/RESULTS.md: the same on every real input), and t= overrides both
+    # closer to the exact SDF (with the soft penalty: the grid default, and gsdf heat's)
     V2, F2 = uv_sphere(40, 80)
     F2 = F2[V2[F2].mean(1)[:, 2] < 0.9]
-    # (with the soft penalty that was the grid default when this was measured, and still is gsdf heat's)
-    f_grid = signed_heat_volume(mesh=(V2, F2), resolution=20, soft_weight=10.0)
-    f_in = signed_heat_volume(mesh=(V2, F2), resolution=20, t_scale="input", soft_weight=10.0)
+    f_grid = signed_heat_volume(mesh=(V2, F2), resolution=20, options=VolumeHeatOptions(soft_weight=10.0))
+    f_in = signed_heat_volume(mesh=(V2, F2), resolution=20,
+                              options=VolumeHeatOptions(t_scale="input", soft_weight=10.0))
     Q = f_grid.grid_points()
     exact = np.linalg.norm(Q, axis=1) - 1.0
     e_grid = np.abs(f_grid.values.ravel() - exact).mean()
     e_in = np.abs(f_in.values.ravel() - exact).mean()
     assert e_in < 0.9 * e_grid  # measured 0.0036 vs 0.0042
-    t = input_spacing(V2, F2) ** 2
-    f_t = signed_heat_volume(mesh=(V2, F2), resolution=20, t=t, soft_weight=10.0)
-    np.testing.assert_allclose(f_t.values, f_in.values)
+    # t = t_coef · (input spacing)²: the same field as t_coef scaled by (input spacing / grid spacing)²
+    h = float(f_grid.spacing.max())
+    np.testing.assert_allclose(f_in.meta["t"], input_spacing(V2, F2) ** 2, rtol=1e-12)
+    np.testing.assert_allclose(f_grid.meta["t"], h ** 2, rtol=1e-12)
 
 
 @pytest.mark.parametrize("kwargs, msg", [
-    (dict(mesh=cube(), t_scale="mesh"), "t_scale"),
-    (dict(mesh=cube(), t=0.0), "t:"),
+    (dict(mesh=cube(), options=VolumeHeatOptions(t_scale="mesh")), "t_scale"),
     (dict(mesh=(np.zeros((0, 3)), np.zeros((0, 3), int))), "empty"),
     (dict(mesh=(np.zeros((3, 3)), np.array([[0, 1, 2]]))), "zero area"),
     (dict(points=(np.eye(3), np.zeros((3, 3)))), "all normals are zero"),
@@ -168,13 +166,15 @@ def test_input_spacing_and_t_scale_input():
     (dict(), "exactly one"),
     (dict(mesh=cube(), resolution=1), "resolution"),
     (dict(mesh=cube(), resolution=10**6), "absurd"),
-    (dict(mesh=cube(), resolution=2000), "GiB"),
-    (dict(mesh=cube(), resolution=64, max_memory=10**6), "GiB"),
+    (dict(mesh=cube(), resolution=2000), "allowed"),
+    (dict(mesh=cube(), resolution=64, options=VolumeHeatOptions(max_memory=10**6)), "allowed"),
+    (dict(mesh=cube(), options=VolumeHeatOptions(max_memory=0)), "max_memory"),
+    (dict(mesh=cube(), options=VolumeHeatOptions(progress=3)), "progress"),
     (dict(mesh=cube(), bbox_min=[0, 0, 0], bbox_max=[1, 1, 1]), "does not contain"),
     (dict(mesh=cube(), bbox_min=[1, 1, 1], bbox_max=[0, 0, 0]), "must exceed"),
     (dict(mesh=cube(), domain="octree"), "domain"),
     (dict(mesh=cube(), t_coef=-1), "t_coef"),
-    (dict(mesh=cube(), level_set_constraint="two"), "level_set_constraint"),
+    (dict(mesh=cube(), options=VolumeHeatOptions(level_set_constraint="two")), "level_set_constraint"),
     (dict(mesh=cube(), resolution=2.5), "resolution"),
 ])
 def test_bad_input(kwargs, msg):

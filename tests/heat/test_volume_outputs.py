@@ -65,16 +65,16 @@ def test_cli_heat(tmp_path):
     src = tmp_path / "s.obj"
     gsdf.write_mesh(str(src), V, F)
     out = tmp_path / "out" / "s.npz"
-    r = CliRunner().invoke(heat, [str(src), "--grid", "20", "--offsets", "0,0.05", "--relative", "-o", str(out), "-q"])
+    r = CliRunner().invoke(heat, [str(src), "--resolution", "20", "--offsets", "0,0.05", "--relative", "-o", str(out), "-q"])
     assert r.exit_code == 0, r.output
     assert out.exists() and (tmp_path / "out" / "s_offset_0.05.ply").exists()
     f = GridField.load(out)
     assert f([[0, 0, 0]])[0] < -0.8
-    r = CliRunner().invoke(heat, [str(src), "--grid", "4000", "-o", str(out), "-q"])
-    assert r.exit_code != 0 and ("absurd" in r.output or "GiB" in r.output)
+    r = CliRunner().invoke(heat, [str(src), "--resolution", "4000", "-o", str(out), "-q"])
+    assert r.exit_code != 0 and ("absurd" in r.output or "allowed" in r.output)
     # --t-scale input: t from the mesh's own edge length, a different (shorter) diffusion time
     out2 = tmp_path / "s2.npz"
-    r = CliRunner().invoke(heat, [str(src), "--grid", "20", "--t-scale", "input", "-o", str(out2), "-q"])
+    r = CliRunner().invoke(heat, [str(src), "--resolution", "20", "--t-scale", "input", "-o", str(out2), "-q"])
     assert r.exit_code == 0, r.output
     f2 = GridField.load(out2)
     assert f2([[0, 0, 0]])[0] < -0.8

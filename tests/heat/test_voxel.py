@@ -30,11 +30,16 @@ def eps(phi, ref, A):
     return float(np.sqrt((A * (phi - ref) ** 2).sum() / A.sum()) / (ref.max() - ref.min()))
 
 
-def sphere_run(N, normal_radius=3.0, broken=False, **kw):
+def sphere_run(N, normal_radius=3.0, broken=False, connection="A", **kw):
     """Digital sphere R = N/2 − 2, curve = boundary of {quads with centre z < z0}, z0 = c + 0.3 R.
     Returns (ε vs R(θ − θ0), fraction of area with the right sign, solver)."""
     R = N / 2 - 2
     s = VoxelSurfaceSignedHeatSolver(ball(N, R), normal_radius=normal_radius, **kw)
+    if connection != "A":                     # the cross-check of the connection Laplacian (Option B)
+        from gsdf.heat._core import SignedHeatCore
+
+        s.domain = VoxelSurfaceDomain(ball(N, R), normal_radius=normal_radius, connection=connection, **kw)
+        s.core = SignedHeatCore(s.domain)
     c = N / 2
     # the curve at the grid plane z = zc nearest to c + 0.3 R (quads with centres below zc + ¼: the region's
     # boundary edges then lie on that plane, not up to half a voxel off it)
@@ -326,14 +331,14 @@ def test_bad_input():
         with pytest.raises(ValueError, match="normal_radius"):
             VoxelSurfaceSignedHeatSolver(occ, normal_radius=bad)
     with pytest.raises(ValueError, match="connection"):
-        VoxelSurfaceSignedHeatSolver(occ, connection="C")
+        VoxelSurfaceDomain(occ, connection="C")
     with pytest.raises(ValueError, match="t_coef"):
         VoxelSurfaceSignedHeatSolver(occ, t_coef=0)
     s = VoxelSurfaceSignedHeatSolver(occ)
     with pytest.raises(ValueError, match="normals"):
-        VoxelSurfaceSignedHeatSolver(occ, normals=-s.normals)
+        VoxelSurfaceDomain(occ, normals=-s.normals)
     with pytest.raises(ValueError, match="normals"):
-        VoxelSurfaceSignedHeatSolver(occ, normals=s.normals[:-1])
+        VoxelSurfaceDomain(occ, normals=s.normals[:-1])
     n = len(s.vertices)
     f = s.faces[0]
     with pytest.raises(ValueError, match=r"curves\[0\].*out of range"):

@@ -11,7 +11,7 @@ def test_library_writers_refuse_wrong_extensions_and_keep_names(tmp_path):
     import gsdf
     from gsdf.contour import write_svg
     from gsdf.ops import load_voxels, save_voxels
-    from gsdf.tori import render_png
+    from gsdf import render_png
 
     occ = np.ones((2, 2, 2), bool)
     with pytest.raises(ValueError, match=r"\.npz"):

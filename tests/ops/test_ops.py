@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
+from gsdf.grid import Grid
 from gsdf.ops import (
+    BooleanOptions,
     load_voxels,
     mesh_boolean,
     save_voxels,
     trim_mesh,
-    voxel_centers,
-    voxel_grid,
     voxelize,
     voxels_to_mesh,
     winding_grid,
@@ -118,31 +118,24 @@ def boolean_results(spheres):
 # ----------------------------------------------------------------------------------------------------------
 
 
-def test_voxel_grid_cubic_cells_centered():
-    shape, lo, hi = voxel_grid([0, 0, 0], [2.0, 1.05, 0.5], 20)
-    assert shape == (20, 11, 5)
-    h = (hi - lo) / np.array(shape)
-    assert np.allclose(h, 0.1)
-    assert np.allclose(0.5 * (lo + hi), [1.0, 0.525, 0.25])  # centred on the requested box
-    C = voxel_centers(lo, hi, shape)
-    assert C.shape == (20 * 11 * 5, 3)
-    assert np.allclose(C[0], lo + 0.05) and np.allclose(C[-1], hi - 0.05)
-
-
 def test_voxelize_cube_exact_count():
     V, F = cube()
-    occ, lo, hi = voxelize(mesh=(V, F), resolution=20, pad=0.05)
+    grid = Grid.around(V, 20, pad=0.05)
+    occ, lo, hi = voxelize(mesh=(V, F), resolution=grid)
     assert occ.shape == (20, 20, 20) and occ.dtype == bool
-    # analytic: centres strictly inside [-0.5, 0.5] on every axis (the default box is the input box padded
-    # by 0.05 * diagonal on every side)
+    # analytic: the voxel centres are the nodes of the grid over the input box padded by 0.05 * diagonal;
+    # inside = centres strictly inside [-0.5, 0.5] on every axis
     p = 0.05 * math.sqrt(3)
-    h = (1 + 2 * p) / 20
-    x = -0.5 - p + (np.arange(20) + 0.5) * h
-    assert np.allclose(lo, -0.5 - p) and np.allclose(hi, 0.5 + p)
+    h = (1 + 2 * p) / 19
+    x = -0.5 - p + np.arange(20) * h
+    assert np.allclose(lo, -0.5 - p - h / 2) and np.allclose(hi, 0.5 + p + h / 2)  # the voxels' corners
     n1 = int(np.sum(np.abs(x) < 0.5))
     assert occ.sum() == n1 ** 3
-    C = voxel_centers(lo, hi, occ.shape)
-    assert np.array_equal(occ.ravel(), np.all(np.abs(C) < 0.5, axis=1))
+    assert np.array_equal(occ.ravel(), np.all(np.abs(grid.points()) < 0.5, axis=1))
+    # the default: resolution voxels along the longest side of the box padded by PAD (0.1) of the diagonal
+    occ2, lo2, hi2 = voxelize(mesh=(V, F), resolution=20)
+    g2 = Grid.around(V, 20)
+    assert occ2.shape == g2.shape and np.allclose(lo2, g2.voxel_box()[0]) and np.allclose(hi2, g2.voxel_box()[1])
 
 
 def test_voxelize_sphere_volume():
@@ -153,11 +146,12 @@ def test_voxelize_sphere_volume():
     assert abs(vol / SPHERE - 1) < 0.02
     assert abs(vol / volume(V, F) - 1) < 0.02
     # the fast field agrees with the independent exact reference on a slab of voxel centres
-    W, lo2, hi2 = winding_grid(mesh=(V, F), resolution=40)
-    C = voxel_centers(lo2, hi2, W.shape).reshape(W.shape + (3,))[:, :, 20]
+    W = winding_grid(mesh=(V, F), resolution=40)
+    assert W.shape == occ.shape and np.array_equal(W.values >= 0.5, occ)
+    C = W.grid_points().reshape(W.shape + (3,))[:, :, 20]
     Wref = ref_winding(V, F, C.reshape(-1, 3)).reshape(C.shape[:2])
-    assert np.abs(W[:, :, 20] - Wref).max() < 1e-2
-    assert np.array_equal(W[:, :, 20] >= 0.5, Wref >= 0.5)
+    assert np.abs(W.values[:, :, 20] - Wref).max() < 1e-2
+    assert np.array_equal(W.values[:, :, 20] >= 0.5, Wref >= 0.5)
 
 
 def test_voxelize_holey_sphere_is_robust():
@@ -165,8 +159,9 @@ def test_voxelize_holey_sphere_is_robust():
     rng = np.random.default_rng(1)
     Fh = F[rng.random(len(F)) >= 0.10]  # delete 10% of the faces
     assert len(Fh) < 0.93 * len(F)
-    occ, lo, hi = voxelize(mesh=(V, F), resolution=40)
-    occh, _, _ = voxelize(mesh=(V, Fh), resolution=40, bbox_min=lo, bbox_max=hi)
+    grid = Grid.around(V, 40)
+    occ, lo, hi = voxelize(mesh=(V, F), resolution=grid)
+    occh, _, _ = voxelize(mesh=(V, Fh), resolution=grid)
     assert (occ == occh).mean() >= 0.99
     assert (occ & occh).sum() >= 0.97 * occ.sum()
 
@@ -174,26 +169,53 @@ def test_voxelize_holey_sphere_is_robust():
 def test_voxelize_point_cloud_matches_mesh():
     P, N, A = fibonacci_sphere(6000)
     V, F = icosphere(4)
-    occ, lo, hi = voxelize(mesh=(V, F), resolution=30)
-    occp, lo2, hi2 = voxelize(points=(P, N, A), resolution=30, bbox_min=lo, bbox_max=hi)
-    assert np.allclose(lo, lo2) and np.allclose(hi, hi2)
+    grid = Grid.around(V, 30)
+    occ, lo, hi = voxelize(mesh=(V, F), resolution=grid)
+    occp, lo2, hi2 = voxelize(points=(P, N, A), resolution=grid)
+    assert np.array_equal(lo, lo2) and np.array_equal(hi, hi2)
     assert (occ == occp).mean() >= 0.99
-    occe, _, _ = voxelize(points=(P, N), resolution=30, bbox_min=lo, bbox_max=hi)  # estimated areas
+    occe, _, _ = voxelize(points=(P, N), resolution=grid)  # estimated areas
     assert (occ == occe).mean() >= 0.98
 
 
-def test_voxelize_progress_and_chunks():
+def test_voxelize_progress_and_chunks(monkeypatch):
+    import gsdf.ops._voxelize as vox
+
     V, F = icosphere(2)
     calls = []
-    W1, lo, hi = winding_grid(mesh=(V, F), resolution=12, chunk=500, progress=lambda d, t: calls.append((d, t)))
-    total = W1.size
-    assert calls[-1] == (total, total)
+    monkeypatch.setattr(vox, "CHUNK", 500)
+    W1 = winding_grid(mesh=(V, F), resolution=12, progress=lambda stage, f: calls.append((stage, f)))
+    total = W1.values.size
+    assert calls[-1] == ("winding numbers", 1.0)
     assert len(calls) == -(-total // 500)
-    assert all(a[0] < b[0] for a, b in zip(calls, calls[1:]))
-    W2, _, _ = winding_grid(mesh=(V, F), resolution=12)
-    assert np.array_equal(W1, W2)
+    assert all(a[1] < b[1] for a, b in zip(calls, calls[1:]))
+    monkeypatch.undo()
+    W2 = winding_grid(mesh=(V, F), resolution=12)
+    assert np.array_equal(W1.values, W2.values)
     occ, _, _ = voxelize(mesh=(V, F), resolution=12)
-    assert np.array_equal(occ, W2 >= 0.5)
+    assert np.array_equal(occ, W2.values >= 0.5)
+
+
+def test_voxelize_same_nodes_same_values_as_before():
+    """The voxel centres of the former cell-grid rule, given as a Grid, get the winding numbers the former code
+    computed there (the fast winding number at the same points, within a few ulps of the node positions)."""
+    from gsdf.winding import FastWindingNumber
+
+    V, F = icosphere(2)
+    # former rule: `resolution` cells along the longest side, cubic, centred on the box; centres lo + (i + 1/2) h
+    lo, hi = V.min(0) - 0.05 * np.linalg.norm(np.ptp(V, 0)), V.max(0) + 0.05 * np.linalg.norm(np.ptp(V, 0))
+    r = 16
+    h = float((hi - lo).max()) / r
+    n = np.maximum(1, np.ceil((hi - lo) / h - 1e-9)).astype(int)
+    gmin = 0.5 * (lo + hi) - 0.5 * n * h
+    old_centres = gmin + (np.stack(np.meshgrid(*[np.arange(k) for k in n], indexing="ij"), -1).reshape(-1, 3)
+                          + 0.5) * h
+    W_old = FastWindingNumber(V, F)(old_centres)
+    grid = Grid((gmin + 0.5 * h, gmin + (n - 0.5) * h), tuple(n))
+    assert np.abs(grid.points() - old_centres).max() < 1e-14
+    W_new = winding_grid(mesh=(V, F), resolution=grid).values.ravel()
+    assert np.abs(W_new - W_old).max() < 1e-12
+    assert np.array_equal(W_new >= 0.5, W_old >= 0.5)
 
 
 def test_save_load_voxels(tmp_path):
@@ -246,15 +268,19 @@ def test_voxelize_bad_input():
     with pytest.raises(ValueError, match="exactly one"):
         voxelize(mesh=(V, F), points=(V, V))
     with pytest.raises(ValueError, match="resolution"):
-        voxelize(mesh=(V, F), resolution=0)
+        voxelize(mesh=(V, F), resolution=1)
+    with pytest.raises(ValueError, match="resolution"):
+        voxelize(mesh=(V, F), resolution=(4, 4, 4))
     with pytest.raises(ValueError, match="NaN"):
         voxelize(mesh=(np.where(np.arange(24).reshape(8, 3) == 4, np.nan, V), F))
     with pytest.raises(ValueError, match="out of range"):
         voxelize(mesh=(V, F + 1))
     with pytest.raises(ValueError, match="bbox_max"):
-        voxelize(mesh=(V, F), bbox_min=[0, 0, 0], bbox_max=[1, -1, 1])
+        voxelize(mesh=(V, F), resolution=Grid(([0, 0, 0], [1, -1, 1]), (2, 2, 2)))
     with pytest.raises(ValueError, match="pad"):
-        voxelize(mesh=(V, F), pad=-1)
+        Grid.around(V, 10, pad=-1)
+    with pytest.raises(ValueError, match="progress"):
+        voxelize(mesh=(V, F), resolution=4, progress=3)
     with pytest.raises(ValueError, match="normals"):
         voxelize(points=(V, None))
     with pytest.raises(ValueError, match="beta"):
@@ -307,7 +333,7 @@ def test_boolean_crossing_points_lie_on_other_surface(boolean_results, spheres):
 def test_boolean_exact_matches_fast():
     VA, FA = icosphere(2)
     VB = VA + [0.8, 0, 0]
-    Ve, Fe = mesh_boolean(VA, FA, VB, FA, "difference", exact=True)
+    Ve, Fe = mesh_boolean(VA, FA, VB, FA, "difference", options=BooleanOptions(exact=True))
     Vf, Ff = mesh_boolean(VA, FA, VB, FA, "difference")
     assert volume(Ve, Fe) == pytest.approx(volume(Vf, Ff), rel=1e-3)
     assert np.all(edge_counts(Fe)[0] == 2)
@@ -322,10 +348,11 @@ def test_boolean_holey_inputs(spheres, boolean_results):
         V, F = mesh_boolean(VA, FAh, VB, FBh, op)
         assert np.isfinite(V).all() and len(F) > 0
         # the holey result still encloses (in the winding-number sense) the right volume
-        occ, lo, hi = voxelize(mesh=(V, F), resolution=40)
+        grid = Grid.around(V[np.unique(F)], 40)
+        occ, lo, hi = voxelize(mesh=(V, F), resolution=grid)
         vol = occ.sum() * np.prod((hi - lo) / np.array(occ.shape))
         assert abs(vol / ref - 1) < 0.03, op
-        occc, _, _ = voxelize(mesh=boolean_results[op], resolution=40, bbox_min=lo, bbox_max=hi)
+        occc, _, _ = voxelize(mesh=boolean_results[op], resolution=grid)
         assert (occ == occc).mean() > 0.995, op
 
 
@@ -358,7 +385,7 @@ def test_boolean_with_point_cloud_field(spheres):
 
 def test_boolean_without_stitching_leaves_the_seam_open(spheres, boolean_results):
     VA, FA, VB, FB = spheres
-    V, F = mesh_boolean(VA, FA, VB, FB, "union", stitch=False)
+    V, F = mesh_boolean(VA, FA, VB, FB, "union", options=BooleanOptions(stitch=False))
     und, dirc = edge_counts(F)
     assert np.all(dirc == 1) and set(np.unique(und)) == {1, 2}
     # the open edges are exactly the two trim loops, whose vertices lie on the intersection circle x = 0.4
@@ -407,9 +434,11 @@ def test_boolean_bad_input():
     with pytest.raises(ValueError, match="shape"):
         mesh_boolean(VA[:, :2], FA, VB, FA, "union")
     with pytest.raises(ValueError, match="bisection_steps"):
-        mesh_boolean(VA, FA, VB, FA, "union", bisection_steps=-1)
+        mesh_boolean(VA, FA, VB, FA, "union", options=BooleanOptions(bisection_steps=-1))
     with pytest.raises(ValueError, match="beta"):
-        mesh_boolean(VA, FA, VB, FA, "union", beta=float("nan"))
+        mesh_boolean(VA, FA, VB, FA, "union", options=BooleanOptions(beta=float("nan")))
+    with pytest.raises(ValueError, match="options"):
+        mesh_boolean(VA, FA, VB, FA, "union", options={"beta": 2.0})
     with pytest.raises(ValueError, match="winding_b"):
         mesh_boolean(VA, FA, VB, FA, "union", winding_b=3)
     with pytest.raises(ValueError, match="winding_b"):

@@ -4,6 +4,7 @@ issue 12."""
 import numpy as np
 import pytest
 
+from gsdf import SWNOptions
 from gsdf.swn._solver import SurfaceWindingNumbers, surface_winding_number
 from tests.shapes import uv_sphere
 from tests.shapes import annulus, double_torus, torus
@@ -212,9 +213,13 @@ def test_bad_input(tor):
     with pytest.raises(ValueError, match="method"):
         swn.solve([idx[5]], method="gurobi")
     with pytest.raises(ValueError, match="epsilon"):
-        swn.solve([idx[5]], epsilon=0)
+        SWNOptions(epsilon=0)
     with pytest.raises(ValueError, match="epsilon"):
-        swn.solve([idx[5]], epsilon=True)
+        SWNOptions(epsilon=True)
+    with pytest.raises(ValueError, match="time_limit"):
+        SWNOptions(time_limit=-1.0)
+    with pytest.raises(ValueError, match="options"):
+        swn.solve([idx[5]], options={"epsilon": 0.1})
     with pytest.raises(ValueError, match="curves"):
         swn.solve("0 1 2")
     with pytest.raises(ValueError, match="repeats"):
@@ -240,7 +245,7 @@ def test_bad_input(tor):
 def test_lp_time_limit_names_the_fallback(tor):
     V, F, idx, swn = tor
     with pytest.raises(ValueError, match="method='reduced'"):
-        swn.solve([idx[5, :12], idx[30, 3:15]], time_limit=1e-4)
+        swn.solve([idx[5, :12], idx[30, 3:15]], options=SWNOptions(time_limit=1e-4))
 
 
 # ------------------------------------------------------------------------------------------ files and CLI

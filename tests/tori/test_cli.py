@@ -20,15 +20,15 @@ def _cloud(path, n=1500, radius=0.5, normals=True):
 
 def test_tori_cli_mesh_offsets_grid_and_tori(tmp_path):
     src = _cloud(tmp_path / "ball.xyz")
-    r = CliRunner().invoke(tori, [src, "-o", str(tmp_path / "zero.ply"), "--grid", "24"])
+    r = CliRunner().invoke(tori, [src, "-o", str(tmp_path / "zero.ply"), "--resolution", "24"])
     assert r.exit_code == 0, r.output
     V, F = read_mesh(tmp_path / "zero.ply")
     np.testing.assert_allclose(np.linalg.norm(V, axis=1), 0.5, atol=5e-3)
-    r = CliRunner().invoke(tori, [src, "-o", str(tmp_path / "s.obj"), "--grid", "20", "--offsets", "-0.1,0.1"])
+    r = CliRunner().invoke(tori, [src, "-o", str(tmp_path / "s.obj"), "--resolution", "20", "--offsets", "-0.1,0.1"])
     assert r.exit_code == 0, r.output
     V, _ = read_mesh(tmp_path / "s_0.1.obj")
     np.testing.assert_allclose(np.linalg.norm(V, axis=1), 0.6, atol=1e-2)
-    r = CliRunner().invoke(tori, [src, "-o", str(tmp_path / "g.npz"), "--grid", "16"])
+    r = CliRunner().invoke(tori, [src, "-o", str(tmp_path / "g.npz"), "--resolution", "16"])
     assert r.exit_code == 0, r.output
     z = np.load(tmp_path / "g.npz")
     assert z["values"].shape == (16, 16, 16) and z["values"].min() < -0.4

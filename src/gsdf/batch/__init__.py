@@ -16,16 +16,18 @@ Example
 >>> out = sdf_samples("bunny.off", n_samples=250_000)                         # doctest: +SKIP
 >>> r = run_batch("meshes/", "sdf-samples", "out/", workers=2)                 # doctest: +SKIP
 >>> r = run_batch("meshes/", "sdf-grid", "grids/", {"resolution": 128},
-...               scheduler="tcp://scheduler:8786")                             # doctest: +SKIP
+...               executor="tcp://scheduler:8786")                              # doctest: +SKIP
 """
 
 from gsdf.batch._executors import DaskExecutor, LocalExecutor
 from gsdf.batch._inputs import Item, collect_inputs
 from gsdf.batch._manifest import file_sha256, read_manifest
-from gsdf.batch._run import BatchInterrupted, BatchResult, run_batch
+from gsdf.batch._run import BatchInterrupted, BatchOptions, BatchResult, run_batch
 from gsdf.batch._tasks import (
     TASKS,
     Geometry,
+    OccupancyOptions,
+    SdfSamplesOptions,
     check_options,
     load_geometry,
     occupancy,
@@ -36,7 +38,7 @@ from gsdf.batch._tasks import (
 )
 from gsdf.batch._worker import process_item, write_npz_atomic
 
-__all__ = ["run_batch", "BatchResult", "BatchInterrupted", "collect_inputs", "Item", "read_manifest",
-           "file_sha256", "TASKS", "Geometry", "load_geometry", "check_options", "run_task", "sdf_samples",
-           "occupancy", "sdf_grid", "surface", "process_item", "write_npz_atomic", "LocalExecutor",
-           "DaskExecutor"]
+__all__ = ["run_batch", "BatchOptions", "BatchResult", "BatchInterrupted", "collect_inputs", "Item",
+           "read_manifest", "file_sha256", "TASKS", "Geometry", "load_geometry", "check_options", "run_task",
+           "sdf_samples", "SdfSamplesOptions", "occupancy", "OccupancyOptions", "sdf_grid", "surface",
+           "process_item", "write_npz_atomic", "LocalExecutor", "DaskExecutor"]

@@ -3,8 +3,8 @@
 :func:`run_batch` validates everything before any work (inputs, options, output folder, executor), skips items
 whose output exists and whose recorded input hash and options still match, keeps a bounded window of items in
 flight (2 per worker slot), gathers them as they complete, appends each record to the manifest, resubmits
-items lost to a dead worker up to ``max_retries`` times, and on Ctrl-C cancels what is in flight, records those
-items as ``cancelled`` and raises :class:`BatchInterrupted` carrying the partial result.
+items lost to a dead worker up to ``BatchOptions.max_retries`` times, and on Ctrl-C cancels what is in flight,
+records those items as ``cancelled`` and raises :class:`BatchInterrupted` carrying the partial result.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from gsdf.batch._tasks import check_options, task_name
 from gsdf.batch._worker import process_item
 
 LOCK_NAME = ".gsdf-batch.lock"
+POLL = 0.5  # seconds between checks of the items in flight
 _PART = re.compile(r"^\..+\.npz\..+\.part$")
 STATUSES = ("done", "failed", "skipped", "cancelled")
 
@@ -35,6 +36,39 @@ class BatchInterrupted(KeyboardInterrupt):
     def __init__(self, result):
         super().__init__("batch interrupted")
         self.result = result
+
+
+@dataclass(frozen=True)
+class BatchOptions:
+    """How :func:`run_batch` runs the items (what each item computes is the task's options).
+
+    Attributes
+    ----------
+    resume : bool, default True
+        Skip items whose output exists and whose input hash and options match their ``done`` record, and items
+        that failed by themselves (a malformed or degenerate input) with the same input and options.
+    retry_failed : bool, default False
+        With ``resume``, run such failed items again (failures of a worker are always retried).
+    max_retries : int, default 2
+        Resubmissions of an item whose worker died, before it is recorded as failed.
+    threads : int, optional
+        BLAS/numba threads per item (default: the cores divided by the concurrent workers).
+    scheduler_timeout : float, default 10.0
+        Seconds to wait for an unreachable Dask scheduler before a ValueError.
+
+    Examples
+    --------
+    >>> from gsdf import BatchOptions
+    >>> BatchOptions(retry_failed=True).resume
+    True
+    >>> r = run_batch("meshes/", "occupancy", "occ/", batch_options=BatchOptions(threads=2))   # doctest: +SKIP
+    """
+
+    resume: bool = True
+    retry_failed: bool = False
+    max_retries: int = 2
+    threads: int | None = None
+    scheduler_timeout: float = 10.0
 
 
 @dataclass
@@ -76,7 +110,7 @@ class BatchResult:
         again = [r for r in self.records if r["status"] == "skipped" and r.get("previous") == "failed"]
         if again:
             lines.append(f"{len(again)} skipped item(s) had failed before with the same input and options "
-                         "(retry_failed / --retry-failed to run them again)")
+                         "(BatchOptions(retry_failed=True) / --retry-failed to run them again)")
         for r in self.failed[:max_failures]:
             lines.append(f"failed: {r['input']}: {r.get('error')}")
         if len(self.failed) > max_failures:
@@ -137,23 +171,42 @@ def _remove_stale_parts(out) -> None:
                     pass
 
 
-def _executor(workers, dask_local, scheduler, threads, scheduler_timeout):
+def _executor_spec(workers, executor):
+    """Validate ``workers`` / ``executor`` before any work; returns a function that builds the executor (None:
+    the caller's own executor object)."""
     from gsdf.batch._executors import DaskExecutor, LocalExecutor
 
-    if scheduler is not None:
-        return DaskExecutor.connect(scheduler, timeout=scheduler_timeout, threads=threads)
-    if dask_local is not None:
-        return DaskExecutor.local(dask_local, threads=threads)
-    return LocalExecutor(workers or 1, threads=threads)
+    _count("workers", workers)
+    if executor is None or isinstance(executor, str):
+        kind = executor or "local"
+        if kind not in ("local", "dask") and workers is not None:
+            raise ValueError(f"conflicting options: workers and the scheduler address {kind!r} (the cluster has "
+                             "its own workers)")
+        return kind
+    if not isinstance(executor, (LocalExecutor, DaskExecutor)):
+        raise ValueError(f"executor: expected 'local', 'dask', a scheduler address or a LocalExecutor / "
+                         f"DaskExecutor, got {type(executor).__name__}")
+    if workers is not None:
+        raise ValueError("conflicting options: workers and executor (an executor object has its own workers)")
+    return None
+
+
+def _executor(kind, workers, threads, scheduler_timeout):
+    from gsdf.batch._executors import DaskExecutor, LocalExecutor
+
+    if kind == "local":
+        return LocalExecutor(workers or 1, threads=threads)
+    if kind == "dask":
+        return DaskExecutor.local(workers or 1, threads=threads)
+    return DaskExecutor.connect(kind, timeout=scheduler_timeout, threads=threads)
 
 
 def _now() -> str:
     return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
 
 
-def run_batch(inputs, task, out, options=None, *, workers=None, dask_local=None, scheduler=None, executor=None,
-              resume: bool = True, retry_failed: bool = False, max_retries: int = 2, threads=None, progress=None,
-              scheduler_timeout: float = 10.0, poll: float = 0.5) -> BatchResult:
+def run_batch(inputs, task, out, options=None, *, workers=None, executor=None, progress=None,
+              batch_options: BatchOptions | None = None) -> BatchResult:
     """Run ``task`` on every input and write one ``.npz`` per item plus ``manifest.jsonl`` into ``out``.
 
     Parameters
@@ -168,26 +221,16 @@ def run_batch(inputs, task, out, options=None, *, workers=None, dask_local=None,
     options : dict, optional
         Task options for every item (per-item options from a manifest override them).
     workers : int, optional
-        Local worker processes (default 1). At most one of ``workers``, ``dask_local``, ``scheduler``.
-    dask_local : int, optional
-        Start a Dask ``LocalCluster`` with this many worker processes.
-    scheduler : str, optional
-        Address of a running Dask scheduler (``tcp://host:8786``).
-    executor : LocalExecutor or DaskExecutor, optional
-        An executor built by the caller (kept open afterwards); excludes the three options above.
-    resume : bool
-        Skip items whose output exists and whose input hash and options match their ``done`` record, and items
-        that failed by themselves (a malformed or degenerate input) with the same input and options.
-    retry_failed : bool
-        With ``resume``, run such failed items again (failures of a worker are always retried).
-    max_retries : int
-        Resubmissions of an item whose worker died, before it is recorded as failed.
-    threads : int, optional
-        BLAS/numba threads per item (default: the cores divided by the concurrent workers).
+        Worker processes of a local executor (default 1).
+    executor : str, LocalExecutor or DaskExecutor, optional
+        Where items run: ``"local"`` (default: ``workers`` local processes), ``"dask"`` (a Dask ``LocalCluster``
+        of ``workers`` processes), a Dask scheduler address (``"tcp://host:8786"``), or an executor built by the
+        caller (kept open afterwards). run_batch starts an executor only when there is work, and closes it.
     progress : callable, optional
-        ``progress(record, counts)`` after every item (``counts``: status -> items so far, and ``total``).
-    scheduler_timeout : float
-        Seconds to wait for an unreachable scheduler before a ValueError.
+        ``progress(stage, fraction)`` after every item: ``stage`` is the item's status (``done``, ``failed``,
+        ``skipped``), ``fraction`` the share of the items finished so far.
+    batch_options : BatchOptions, optional
+        Resume, retries, threads per item, scheduler timeout.
 
     Returns
     -------
@@ -207,17 +250,17 @@ def run_batch(inputs, task, out, options=None, *, workers=None, dask_local=None,
     >>> r = run_batch("meshes/", "sdf-samples", "out/", {"n_samples": 250000}, workers=2)   # doctest: +SKIP
     >>> print(r.summary())                                                                   # doctest: +SKIP
     """
+    bo = BatchOptions() if batch_options is None else batch_options
+    if not isinstance(bo, BatchOptions):
+        raise ValueError(f"batch_options: expected a gsdf.batch.BatchOptions, got {type(bo).__name__}")
     task = task_name(task)
     user_options = dict(options or {})
     check_options(task, user_options, "options")
-    given = [n for n, v in (("workers", workers), ("dask_local", dask_local), ("scheduler", scheduler),
-                            ("executor", executor)) if v is not None]
-    if len(given) > 1:
-        raise ValueError(f"conflicting options: {' and '.join(given)} (choose one executor)")
-    _count("workers", workers)
-    _count("dask_local", dask_local)
-    _count("threads", threads)
-    _count("max_retries", max_retries, lo=0)
+    kind = _executor_spec(workers, executor)
+    _count("threads", bo.threads)
+    _count("max_retries", bo.max_retries, lo=0)
+    report = None if progress is None else (lambda rec, counts: progress(
+        rec["status"], sum(counts[s] for s in STATUSES) / max(1, counts["total"])))
     items = collect_inputs(inputs)
     jobs_options = [check_options(task, {**user_options, **it.options}, it.path) for it in items]
     out = _prepare_output(out)
@@ -225,31 +268,31 @@ def run_batch(inputs, task, out, options=None, *, workers=None, dask_local=None,
     try:
         _remove_stale_parts(out)
         manifest = os.path.join(out, MANIFEST_NAME)
-        state = read_manifest(manifest) if resume else {}
+        state = read_manifest(manifest) if bo.resume else {}
         run_id = uuid.uuid4().hex[:12]
         result = BatchResult(out, manifest)
         todo = collections.deque()
         for it, opts in zip(items, jobs_options):
             job = {"task": task, "input": it.path, "output": it.output, "out_dir": out, "options": opts,
-                   "params_sha256": params_sha256(task, opts), "attempts": 1, "run": run_id, "threads": threads}
+                   "params_sha256": params_sha256(task, opts), "attempts": 1, "run": run_id, "threads": bo.threads}
             prev = state.get(it.output)
-            if _reusable(prev, job, out, retry_failed):
+            if _reusable(prev, job, out, bo.retry_failed):
                 result.records.append({**{k: job[k] for k in ("task", "input", "output", "run")},
                                        "status": "skipped", "previous": prev["status"],
                                        "input_sha256": prev["input_sha256"], "error": prev.get("error")})
             else:
                 todo.append(job)
-        if progress is not None:
+        if report is not None:
             for r in result.records:
-                progress(r, _tally(result.records, len(items)))
-        own = executor is None
+                report(r, _tally(result.records, len(items)))
+        own = kind is not None
         t0 = time.perf_counter()
         if todo:
-            ex = _executor(workers, dask_local, scheduler, threads, scheduler_timeout) if own else executor
+            ex = _executor(kind, workers, bo.threads, bo.scheduler_timeout) if own else executor
             result.executor = ex.describe()
             try:
                 with ManifestWriter(manifest) as writer:
-                    _drive(ex, todo, writer, result, len(items), max_retries, progress, poll)
+                    _drive(ex, todo, writer, result, len(items), bo.max_retries, report, POLL)
             finally:
                 if own:
                     ex.close(cancel=result.interrupted)
@@ -286,15 +329,15 @@ def _hint(ex) -> str:
             "(workers are spawned and import the main module)")
 
 
-def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
+def _drive(ex, todo, writer, result, total, max_retries, report, poll):
     inflight = {}  # future -> job
 
-    def finish(rec, report=True):
+    def finish(rec, announce=True):
         rec.setdefault("time", _now())
         writer.write(rec)
         result.records.append(rec)
-        if report and progress is not None:
-            progress(rec, _tally(result.records, total))
+        if report is not None and announce:
+            report(rec, _tally(result.records, total))
 
     try:
         while todo or inflight:
@@ -343,7 +386,7 @@ def _drive(ex, todo, writer, result, total, max_retries, progress, poll):
         for job in inflight.values():
             finish({**{k: job[k] for k in ("task", "input", "output", "options", "params_sha256", "attempts",
                                            "run")}, "status": "cancelled", "error": "interrupted (Ctrl-C)"},
-                   report=False)
+                   announce=False)
         for job in todo:
             result.records.append({**{k: job[k] for k in ("task", "input", "output", "run")},
                                    "status": "pending"})

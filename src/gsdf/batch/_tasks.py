@@ -17,8 +17,13 @@ every task         ``center`` (3,) float64 and ``scale`` () float64: stored coor
 
 Normalisation frames (``normalize``): ``"sphere"`` maps the input into the unit ball (centre of the bounding
 box, scale = the largest vertex distance from it), ``"cube"`` into [-1, 1]³ (scale = half the longest box side),
-``"none"`` keeps the input's coordinates. Sampling boxes and noise scales are always defined in the frame
-(the sphere frame for ``"none"``), so the same input gives the same samples, up to the stored transform.
+``"none"`` keeps the input's coordinates. Every task works in one cube, fixed in the frame: centred on the
+bounding box, half-side ``1 + margin`` frame scales — so every item of a dataset normalized the same way shares
+the same box, as learning pipelines expect (DeepSDF, Occupancy Networks). Uniform samples are drawn in it, and the
+grids of ``sdf-grid`` and ``surface`` are its :class:`gsdf.Grid` of ``resolution`` nodes per side. Near-surface
+offsets are fractions of the frame scale. With ``normalize="none"`` the samples use the sphere frame's scale and
+the grids the cube frame's (half the longest side, the tightest cube). So the same input gives the same samples
+for every ``normalize``, up to the stored transform.
 
 Signs come from the generalized winding number at 1/2 (Barill et al. 2018 §4; robust to holes, flips and
 soups) or from the signed heat method's zero level set (Feng & Crane 2024 §8.2). Random sampling is seeded
@@ -28,6 +33,7 @@ machine ran the item.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import inspect
 import os
@@ -35,6 +41,7 @@ import os
 import numpy as np
 
 from gsdf._checks import choice, integer, positive
+from gsdf.grid import Grid
 from gsdf.io._geometry import Geometry, load_geometry
 
 NORMALIZE = ("none", "sphere", "cube")
@@ -101,11 +108,20 @@ def _unsigned(geo: Geometry, Q) -> np.ndarray:
 
 
 def _heat(geo: Geometry, resolution, lo, hi):
+    """The signed heat method's grid distance (Feng & Crane 2024 §8.2): ``resolution`` an int or three node
+    counts, in the box ``[lo, hi]``."""
     from gsdf.heat.volume import signed_heat_volume
 
     if geo.is_mesh:
         return signed_heat_volume(mesh=(geo.X, geo.F), resolution=resolution, bbox_min=lo, bbox_max=hi)
     return signed_heat_volume(points=(geo.X, geo.N), resolution=resolution, bbox_min=lo, bbox_max=hi)
+
+
+def cube(X, normalize: str, margin: float, grid: bool = False):
+    """The cube a task works in: centre (the bounding box's) and half-side ``(1 + margin)`` frame scales
+    (:func:`frame`; for ``normalize="none"`` a grid uses the cube frame, half the longest side)."""
+    c, s, _, _ = frame(X, "cube" if grid and normalize == "none" else normalize)
+    return c, (1.0 + float(margin)) * s
 
 
 def _stored(out: dict, c0, s0, dtype) -> dict:
@@ -114,9 +130,9 @@ def _stored(out: dict, c0, s0, dtype) -> dict:
     return out
 
 
-def _sample_queries(geo, n, uniform_fraction, sigmas, box, c, s, rng):
+def _sample_queries(geo, n, uniform_fraction, sigmas, s, centre, half, rng):
     """DeepSDF-style queries: surface points offset by N(0, σ²) at each scale σ·s, plus uniform ones in the
-    cube c ± box·s. Counts: ``round(n·uniform_fraction)`` uniform, the rest split evenly over the scales."""
+    cube centre ± half. Counts: ``round(n·uniform_fraction)`` uniform, the rest split evenly over the scales."""
     n_uniform = int(round(n * uniform_fraction))
     n_near = n - n_uniform
     parts = []
@@ -129,22 +145,100 @@ def _sample_queries(geo, n, uniform_fraction, sigmas, box, c, s, rng):
             start += k
     elif n_near:
         n_uniform = n
-    parts.append(c + box * s * rng.uniform(-1.0, 1.0, (n_uniform, 3)))
+    parts.append(centre + half * rng.uniform(-1.0, 1.0, (n_uniform, 3)))
     return np.concatenate(parts)
 
 
-def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normalize: str = "none",
-                uniform_fraction: float = 0.1, sigmas=(0.05, 0.0158), pad: float = 0.05,
-                heat_resolution: int = 64, beta=None, seed: int = 0, dtype: str = "float32",
-                estimate_normals: bool = False) -> dict:
+@dataclasses.dataclass(frozen=True)
+class SdfSamplesOptions:
+    """The sampling and input options of :func:`sdf_samples` (the same names as ``gsdf batch`` flags).
+
+    Attributes
+    ----------
+    uniform_fraction : float in [0, 1], default 0.1
+        Share of the samples drawn uniformly in the task's cube (the rest: near the surface).
+    sigmas : sequence of float, default (0.05, 0.0158)
+        Near-surface offset scales, fractions of the frame scale: DeepSDF's variances 0.0025 and 0.00025 in the
+        unit sphere.
+    margin : float, default 0.05
+        The task's cube has half-side ``1 + margin`` frame scales (the module docstring).
+    heat_resolution : int, default 64
+        With ``sign="heat"``: nodes along the longest side of the signed heat method's grid.
+    beta : float, optional
+        Fast winding number accuracy (default 2 for meshes, 2.3 for clouds).
+    estimate_normals : bool, default False
+        For a cloud without normals: PCA normals oriented away from the centroid.
+
+    Examples
+    --------
+    >>> from gsdf import SdfSamplesOptions
+    >>> SdfSamplesOptions(sigmas=(0.01,)).uniform_fraction
+    0.1
+    >>> out = sdf_samples("bunny.off", options=SdfSamplesOptions(uniform_fraction=0.5))   # doctest: +SKIP
+    """
+
+    uniform_fraction: float = 0.1
+    sigmas: tuple = (0.05, 0.0158)
+    margin: float = 0.05
+    heat_resolution: int = 64
+    beta: float | None = None
+    estimate_normals: bool = False
+
+
+@dataclasses.dataclass(frozen=True)
+class OccupancyOptions:
+    """The sampling and input options of :func:`occupancy` (the same names as ``gsdf batch`` flags).
+
+    Attributes
+    ----------
+    uniform_fraction : float in [0, 1], default 1.0
+        Share of the points drawn uniformly in the task's cube (the rest: near the surface).
+    sigmas : sequence of float, default (0.01,)
+        Near-surface offset scales, fractions of the frame scale.
+    margin : float, default 0.1
+        The task's cube has half-side ``1 + margin`` frame scales (the module docstring).
+    beta : float, optional
+        Fast winding number accuracy (default 2 for meshes, 2.3 for clouds).
+    estimate_normals : bool, default False
+        For a cloud without normals: PCA normals oriented away from the centroid.
+
+    Examples
+    --------
+    >>> out = occupancy("scan.xyz", options=OccupancyOptions(estimate_normals=True))   # doctest: +SKIP
+    """
+
+    uniform_fraction: float = 1.0
+    sigmas: tuple = (0.01,)
+    margin: float = 0.1
+    beta: float | None = None
+    estimate_normals: bool = False
+
+
+def _task_options(task, values: dict) -> dict:
+    """The flat, validated options of a task called from the library: its keyword values and the fields of its
+    options dataclass (``options=None``: the defaults)."""
+    flat = {k: v for k, v in values.items() if k not in ("source", "options")}
+    opts = values.get("options")
+    cls = OPTIONS_CLASSES.get(task)
+    if cls is not None:
+        if opts is None:
+            opts = cls()
+        if not isinstance(opts, cls):
+            raise ValueError(f"options: expected a gsdf.batch.{cls.__name__}, got {type(opts).__name__}")
+        flat.update(dataclasses.asdict(opts))
+    return check_options(task, flat)
+
+
+def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normalize: str = "none", seed: int = 0,
+                dtype: str = "float32", options: SdfSamplesOptions | None = None) -> dict:
     """DeepSDF-style signed distance samples of one mesh, soup or oriented cloud.
 
     ``n_samples`` queries: ``(1 - uniform_fraction)`` of them are surface points (area-weighted) moved by
-    Gaussian offsets, split evenly over the scales ``sigmas`` (× the frame scale: 0.05 and 0.0158 are DeepSDF's
-    variances 0.0025 and 0.00025 in the unit sphere), the rest uniform in the frame's cube ``±(1 + pad)``.
-    ``|sdf|`` is the exact distance to the triangles (nearest point of a cloud); the sign is negative where
-    the fast winding number exceeds 1/2 (``sign="winding"``), or where the signed heat method's distance
-    (a grid of ``heat_resolution`` nodes) is negative (``sign="heat"``).
+    Gaussian offsets, split evenly over the scales ``sigmas`` (× the frame scale), the rest uniform in the task's
+    cube (the module docstring). ``|sdf|`` is the exact distance to the triangles (nearest point of a cloud); the
+    sign is negative where the fast winding number exceeds 1/2 (``sign="winding"``, Barill et al. 2018 §4), or
+    where the signed heat method's distance (a grid of ``heat_resolution`` nodes along its longest side) is
+    negative (``sign="heat"``, Feng & Crane 2024 §8.2).
 
     Parameters
     ----------
@@ -155,14 +249,11 @@ def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normali
     sign : {"winding", "heat"}
     normalize : {"none", "sphere", "cube"}
         Output frame (see the module docstring); the transform is stored as ``center``, ``scale``.
-    uniform_fraction : float in [0, 1]
-    sigmas : sequence of float
-        Offset scales, fractions of the frame scale.
-    pad : float
-        Half-side of the uniform cube is ``(1 + pad)`` frame scales.
     seed : int
         Random seed (combined with the input's content).
     dtype : {"float32", "float64"}
+    options : SdfSamplesOptions, optional
+        The sampling distribution and input options.
 
     Returns
     -------
@@ -175,32 +266,31 @@ def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normali
     >>> out["points"].shape, out["sdf"].dtype                                     # doctest: +SKIP
     ((10000, 3), dtype('float32'))
     """
-    o = check_options("sdf-samples", locals_without_source(locals()))
+    o = _task_options("sdf-samples", locals())
     geo = _geometry(source, o["estimate_normals"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
+    centre, half = cube(geo.X, o["normalize"], o["margin"])
     rng = _rng(geo, o["seed"], "sdf-samples")
-    half = 1.0 + o["pad"]
-    Q = _sample_queries(geo, o["n_samples"], o["uniform_fraction"], o["sigmas"], half, c, s, rng)
+    Q = _sample_queries(geo, o["n_samples"], o["uniform_fraction"], o["sigmas"], s, centre, half, rng)
     d = _unsigned(geo, Q)
     if o["sign"] == "winding":
         inside = geo.winding(o["beta"])(Q) > 0.5
     else:
-        m = 1.1 * half * s  # the heat grid holds every query, the tails of the Gaussian offsets included
-        m = max(m, float(np.abs(Q - c).max()) * 1.001)
-        inside = _heat(geo, o["heat_resolution"], c - m, c + m)(Q) < 0
+        m = 1.1 * half  # the heat grid holds every query, the tails of the Gaussian offsets included
+        m = max(m, float(np.abs(Q - centre).max()) * 1.001)
+        inside = _heat(geo, o["heat_resolution"], centre - m, centre + m)(Q) < 0
     dt = DTYPES[o["dtype"]]
     return _stored({"points": ((Q - c0) / s0).astype(dt), "sdf": (np.where(inside, -d, d) / s0).astype(dt)},
                    c0, s0, dt)
 
 
-def occupancy(source, n_points: int = 100_000, normalize: str = "none", uniform_fraction: float = 1.0,
-              sigmas=(0.01,), pad: float = 0.1, beta=None, seed: int = 0, dtype: str = "float32",
-              estimate_normals: bool = False) -> dict:
+def occupancy(source, n_points: int = 100_000, normalize: str = "none", seed: int = 0, dtype: str = "float32",
+              options: OccupancyOptions | None = None) -> dict:
     """Occupancy-Networks-style inside/outside labels of points, from the generalized winding number.
 
-    By default all ``n_points`` are uniform in the frame's cube ``±(1 + pad)`` (Occupancy Networks: the
-    unit cube padded by 0.1); ``uniform_fraction < 1`` moves the rest near the surface (offsets ``sigmas``).
-    A point is inside where the fast winding number exceeds 1/2.
+    By default all ``n_points`` are uniform in the task's cube (the module docstring); ``uniform_fraction < 1``
+    moves the rest near the surface (offsets ``sigmas``). A point is inside where the fast winding number
+    exceeds 1/2 (Barill et al. 2018 §4).
 
     Returns
     -------
@@ -213,11 +303,12 @@ def occupancy(source, n_points: int = 100_000, normalize: str = "none", uniform_
     >>> out["occupancy"].mean()                            # doctest: +SKIP
     0.21
     """
-    o = check_options("occupancy", locals_without_source(locals()))
+    o = _task_options("occupancy", locals())
     geo = _geometry(source, o["estimate_normals"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
+    centre, half = cube(geo.X, o["normalize"], o["margin"])
     rng = _rng(geo, o["seed"], "occupancy")
-    Q = _sample_queries(geo, o["n_points"], o["uniform_fraction"], o["sigmas"], 1.0 + o["pad"], c, s, rng)
+    Q = _sample_queries(geo, o["n_points"], o["uniform_fraction"], o["sigmas"], s, centre, half, rng)
     w = geo.winding(o["beta"])(Q)
     dt = DTYPES[o["dtype"]]
     return _stored({"points": ((Q - c0) / s0).astype(dt), "occupancy": w > 0.5, "winding": w.astype(dt)},
@@ -241,21 +332,22 @@ def check_grid_memory(resolution: int, max_memory=None) -> None:
                          f"{max_memory / 2**30:.1f} GiB available (out-of-memory estimate)")
 
 
-def _grid_box(X, normalize, pad):
-    c, s, c0, s0 = frame(X, normalize)
-    half = (1.0 + pad) * (s if normalize != "none" else 0.5 * float((X.max(axis=0) - X.min(axis=0)).max()))
-    return c, half, c0, s0
+def task_grid(X, resolution: int, normalize: str = "none", margin: float = 0.05) -> Grid:
+    """The grid of ``sdf-grid`` and ``surface``: :meth:`gsdf.Grid.fit` of the task's cube (:func:`cube`),
+    ``resolution`` nodes per side."""
+    centre, half = cube(X, normalize, margin, grid=True)
+    return Grid.fit((centre - half, centre + half), resolution)
 
 
-def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str = "none", pad: float = 0.05,
+def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str = "none", margin: float = 0.05,
              beta=None, dtype: str = "float32", estimate_normals: bool = False) -> dict:
     """Signed distance on a dense cubic grid of ``resolution``³ nodes around one input; negative inside.
 
-    The grid is the cube centred on the input's bounding box with half-side ``(1 + pad)`` × the frame scale
-    (× half the longest box side for ``normalize="none"``). Methods: ``"fast"`` — exact distance to the
-    triangles (nearest point of a cloud) signed by the fast winding number at 1/2; ``"heat"`` — the signed heat
-    method on the same grid (Feng & Crane 2024 §8.2; a generalized signed distance, smooth across holes);
-    ``"pat"`` — Points as Tori (oriented clouds only; Feng 2026 ch. 5).
+    The grid is :func:`task_grid`: the task's cube (half-side ``1 + margin`` frame scales, the module
+    docstring), ``resolution`` nodes per side. Methods: ``"fast"`` — :func:`gsdf.signed_distance_grid`
+    (exact distance to the triangles or nearest point of a cloud, signed by the fast winding number at 1/2);
+    ``"heat"`` — the signed heat method on the same grid (Feng & Crane 2024 §8.2; a generalized signed
+    distance, smooth across holes); ``"pat"`` — Points as Tori (oriented clouds only; Feng 2026 ch. 5).
 
     Returns
     -------
@@ -274,37 +366,34 @@ def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str
     if o["method"] == "pat" and geo.is_mesh:
         raise ValueError('method "pat" (Points as Tori) needs an oriented point cloud, not a mesh; '
                          'use "fast" or "heat"')
-    from gsdf.grid import grid_points
-
     check_grid_memory(o["resolution"])
-    c, half, c0, s0 = _grid_box(geo.X, o["normalize"], o["pad"])
-    R = o["resolution"]
-    lo, hi = c - half, c + half
+    c, s, c0, s0 = frame(geo.X, o["normalize"])
+    grid = task_grid(geo.X, o["resolution"], o["normalize"], o["margin"])
     if o["method"] == "heat":
-        values = _heat(geo, (R, R, R), lo, hi).values
+        values = _heat(geo, grid.shape, *grid.box).values
+    elif o["method"] == "pat":
+        from gsdf.tori import PointsAsTori
+
+        values = PointsAsTori(geo.X, geo.N).signed_distance(grid.points())
     else:
-        Q = grid_points(lo, hi, (R, R, R))
-        if o["method"] == "pat":
-            from gsdf.tori import PointsAsTori
+        from gsdf.ops import signed_distance_grid
 
-            values = PointsAsTori(geo.X, geo.N).signed_distance(Q)
-        else:
-            d = _unsigned(geo, Q)
-            values = np.where(geo.winding(o["beta"])(Q) > 0.5, -d, d)
+        kw = dict(V=geo.X, F=geo.F) if geo.is_mesh else dict(V=None, points=(geo.X, geo.N))
+        values = signed_distance_grid(resolution=grid, beta=o["beta"], **kw).values
     dt = DTYPES[o["dtype"]]
-    lo0, hi0 = (lo - c0) / s0, (hi - c0) / s0
-    return _stored({"sdf": (np.asarray(values).reshape(R, R, R) / s0).astype(dt), "bbox_min": lo0,
-                    "bbox_max": hi0, "spacing": (hi0 - lo0) / (R - 1)}, c0, s0, dt)
+    lo0, hi0 = (grid.bbox_min - c0) / s0, (grid.bbox_max - c0) / s0
+    return _stored({"sdf": (np.asarray(values).reshape(grid.shape) / s0).astype(dt), "bbox_min": lo0,
+                    "bbox_max": hi0, "spacing": (hi0 - lo0) / (np.array(grid.shape) - 1)}, c0, s0, dt)
 
 
-def surface(source, resolution: int = 128, method: str = "winding", normalize: str = "none", pad: float = 0.05,
+def surface(source, resolution: int = 128, method: str = "winding", normalize: str = "none", margin: float = 0.05,
             bisection: int = 10, beta=None, dtype: str = "float32", estimate_normals: bool = False) -> dict:
     """A watertight surface of one input: the winding number's 1/2 level set, or the signed heat zero set.
 
-    ``method="winding"``: marching cubes on a ``resolution`` grid of the fast winding number, vertices moved
+    ``method="winding"``: marching cubes on the fast winding number sampled on :func:`task_grid`, vertices moved
     onto the level set by ``bisection`` steps along their grid edges (Barill et al. 2018 Fig. 9).
-    ``method="heat"``: the zero level set of the signed heat method's grid distance (Feng & Crane 2024 §8.2).
-    The grid box is the one of :func:`sdf_grid`.
+    ``method="heat"``: the zero level set of the signed heat method's distance on that grid (Feng & Crane 2024
+    §8.2).
 
     Returns
     -------
@@ -320,16 +409,14 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
     o = check_options("surface", locals_without_source(locals()))
     geo = _geometry(source, o["estimate_normals"])
     check_grid_memory(o["resolution"])
-    c, half, c0, s0 = _grid_box(geo.X, o["normalize"], o["pad"])
-    lo, hi = c - half, c + half
-    R = o["resolution"]
+    c, s, c0, s0 = frame(geo.X, o["normalize"])
+    grid = task_grid(geo.X, o["resolution"], o["normalize"], o["margin"])
     if o["method"] == "heat":
-        V, F = _heat(geo, (R, R, R), lo, hi).isosurface(0.0)
+        V, F = _heat(geo, grid.shape, *grid.box).isosurface(0.0)
     else:
         from gsdf.contour import extract_isosurface
 
-        V, F = extract_isosurface(geo.winding(o["beta"]), lo, hi, resolution=R, level=0.5,
-                                  bisection_steps=o["bisection"])
+        V, F = extract_isosurface(geo.winding(o["beta"]), resolution=grid, level=0.5, bisection_steps=o["bisection"])
     dt = DTYPES[o["dtype"]]
     return _stored({"vertices": ((V - c0) / s0).astype(dt), "faces": np.asarray(F, np.int64)}, c0, s0, dt)
 
@@ -339,6 +426,7 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
 # ------------------------------------------------------------------------------------------------------------
 
 TASKS = {"sdf-samples": sdf_samples, "occupancy": occupancy, "sdf-grid": sdf_grid, "surface": surface}
+OPTIONS_CLASSES = {"sdf-samples": SdfSamplesOptions, "occupancy": OccupancyOptions}
 TASK_ALIASES = {"sdf_samples": "sdf-samples", "sdf_grid": "sdf-grid"}
 
 
@@ -406,7 +494,7 @@ _CHECKS = {
     "sign": lambda x, n: choice(x, n, {"winding", "heat"}),
     "normalize": lambda x, n: choice(x, n, set(NORMALIZE)),
     "dtype": lambda x, n: choice(x, n, set(DTYPES)),
-    "uniform_fraction": _unit, "pad": _nonneg, "sigmas": _sigmas, "beta": _optional_positive,
+    "uniform_fraction": _unit, "margin": _nonneg, "sigmas": _sigmas, "beta": _optional_positive,
     "estimate_normals": _flag,
 }
 _METHODS = {"sdf-grid": {"fast", "heat", "pat"}, "surface": {"winding", "heat"}}
@@ -421,9 +509,13 @@ def task_name(task) -> str:
 
 
 def task_defaults(task) -> dict:
-    """The options of a task and their defaults."""
-    sig = inspect.signature(TASKS[task_name(task)])
-    return {k: p.default for k, p in sig.parameters.items() if k != "source"}
+    """The options of a task and their defaults (its keywords and the fields of its options dataclass)."""
+    task = task_name(task)
+    sig = inspect.signature(TASKS[task])
+    out = {k: p.default for k, p in sig.parameters.items() if k not in ("source", "options")}
+    if task in OPTIONS_CLASSES:
+        out.update(dataclasses.asdict(OPTIONS_CLASSES[task]()))
+    return out
 
 
 def check_options(task, options: dict, where: str = "") -> dict:
@@ -450,5 +542,21 @@ def check_options(task, options: dict, where: str = "") -> dict:
 
 
 def run_task(task, source, options: dict) -> dict:
-    """Run ``task`` on ``source`` with ``options`` (validated): ``run_task("sdf-grid", path, {"resolution": 64})``."""
-    return TASKS[task_name(task)](source, **options)
+    """Run ``task`` on ``source`` with the flat ``options`` (names as in :func:`task_defaults`):
+    ``run_task("sdf-grid", path, {"resolution": 64})``."""
+    task = task_name(task)
+    fn = TASKS[task]
+    keywords = set(inspect.signature(fn).parameters) - {"source", "options"}
+    kw = {k: v for k, v in options.items() if k in keywords}
+    rest = {k: v for k, v in options.items() if k not in keywords}
+    if task in OPTIONS_CLASSES:
+        fields = {f.name for f in dataclasses.fields(OPTIONS_CLASSES[task])}
+        unknown = sorted(set(rest) - fields)
+        if unknown:
+            raise ValueError(f"option {unknown[0]!r} does not apply to task {task!r} "
+                             f"(its options: {', '.join(task_defaults(task))})")
+        return fn(source, options=OPTIONS_CLASSES[task](**rest), **kw)
+    if rest:
+        raise ValueError(f"option {sorted(rest)[0]!r} does not apply to task {task!r} "
+                         f"(its options: {', '.join(task_defaults(task))})")
+    return fn(source, **kw)

@@ -42,7 +42,7 @@ class BackgroundWarmup:
 
         # this process's thread count: kernels that pick a serial or a parallel driver by it pick the same
         cmd = [sys.executable, "-m", "gsdf.cli.main", "--threads", str(get_num_threads()), "warmup", "--only",
-               ",".join(self.jobs), "--jobs", "1"]
+               ",".join(self.jobs), "--workers", "1"]
         try:
             proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
                                     stdin=subprocess.DEVNULL, text=True)

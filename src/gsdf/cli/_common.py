@@ -11,8 +11,9 @@ Output policy (the same for every subcommand; see :mod:`gsdf.io._safe_write`):
 * every file is written to a temporary name in the target folder and renamed when complete; missing parent
   folders are created.
 
-Subcommands get this by decorating with :data:`no_clobber_option` and :func:`report_errors` (which sets the
-policy, refuses any ``OUTPUT_PARAMS`` option naming an input and turns library errors into one-line messages),
+Subcommands get this by decorating with :data:`gsdf.cli._options.no_clobber_option` and :func:`report_errors`
+(which sets the policy, refuses any ``OUTPUT_PARAMS`` option naming an input and turns library errors into
+one-line messages),
 by calling :func:`check_output` on every output name before the work starts, and by writing each file inside
 ``with output_file(path) as tmp:``. Inputs are the values of the command's ``click.Path``
 parameters, so outputs must be declared as plain strings.
@@ -23,8 +24,6 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import functools
-import os
-
 import click
 import numpy as np
 
@@ -58,7 +57,7 @@ def counting(func, desc: str, enabled: bool = True):
 
 
 #: Names of the subcommands' parameters that hold output file names (checked before the work starts).
-OUTPUT_PARAMS = ("output", "out", "mesh_out", "png", "surface_out")
+OUTPUT_PARAMS = ("output", "mesh_output", "png")
 
 _POLICY: contextvars.ContextVar = contextvars.ContextVar("gsdf_output_policy", default=None)
 
@@ -120,12 +119,6 @@ def report_errors(fn):
     return wrapper
 
 
-#: The one ``--no-clobber`` flag (every subcommand that writes files has it; see the module docstring).
-no_clobber_option = click.option("--no-clobber", is_flag=True,
-                                 help="Refuse to replace existing output files (default: replace them; an input "
-                                      "of the command is never replaced).")
-
-
 def check_output(path, extensions=None, what: str = "-o"):
     """Check an output name up front (extension, not an input, ``--no-clobber``) under the running command's
     policy, before any expensive work; returns it unchanged. ``None`` passes (an optional output not asked for)."""
@@ -136,39 +129,7 @@ def check_output(path, extensions=None, what: str = "-o"):
                              make_parents=True, what=what)
 
 
-def parse_view(view: str) -> list[float]:
-    """``--view x,y,z`` of the PNG previews: three numbers, not all zero (a click usage error otherwise)."""
-    try:
-        d = [float(t) for t in view.split(",")]
-        if len(d) != 3 or not all(np.isfinite(d)) or not np.any(d):
-            raise ValueError
-    except ValueError:
-        raise click.BadParameter(f"expected x,y,z (finite, not all zero), got {view!r}", param_hint="--view")
-    return d
-
-
-def ensure_parent(path: str) -> None:
-    """Create the parent folder of ``path`` (kept for older subcommands; :func:`output_file` does this itself)."""
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-
-
 def bbox_of(X: np.ndarray, pad: float) -> tuple[np.ndarray, np.ndarray]:
     from gsdf.mesh._geometry import bounding_box
 
     return bounding_box(X, pad)
-
-
-def parse_floats(text: str | None, name: str) -> list[float] | None:
-    if text is None:
-        return None
-    try:
-        return [float(t) for t in text.split(",") if t.strip()]
-    except ValueError as exc:
-        raise click.BadParameter(f"expected comma-separated numbers, got {text!r}", param_hint=name) from exc
-
-
-beta_option = click.option("--beta", type=float, default=None,
-                           help="Accuracy β of the fast winding number (default 2 for meshes, 2.3 for points).")
-quiet_option = click.option("-q", "--quiet", is_flag=True, help="No progress bars.")
-normals_option = click.option("--estimate-normals", is_flag=True,
-                              help="For clouds without normals: PCA normals oriented away from the centroid.")

@@ -6,10 +6,18 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, no_clobber_option, output_file, report_errors
+from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._options import (
+    beta_option,
+    common_options,
+    exact_option,
+    no_clobber_option,
+    output_option,
+)
 
 
-@click.command("boolean", help="""Boolean of meshes A and B, robust to holes and soups (Barill et al. 2018, Figs. 12-15).
+@click.command("boolean", short_help="Union, intersection, difference of meshes or soups.",
+               help="""Boolean of meshes A and B, robust to holes and soups (Barill et al. 2018, Figs. 12-15).
 
 Each mesh is trimmed against the 1/2 level set of the other's winding number; triangles straddling the
 level set are cut. `difference` is A minus B.
@@ -21,19 +29,20 @@ Example:
 @click.argument("a", type=click.Path(dir_okay=False))
 @click.argument("b", type=click.Path(dir_okay=False))
 @click.option("--op", type=click.Choice(["union", "intersection", "difference"]), required=True)
-@click.option("-o", "--output", required=True, help="Output mesh.")
-@click.option("--exact", is_flag=True, help="Exact winding numbers instead of the fast approximation.")
-@click.option("--beta", type=float, default=2.0, show_default=True)
+@output_option("Output mesh (.ply, .obj, .off, .stl).")
+@exact_option
+@beta_option
+@common_options
 @no_clobber_option
 @report_errors
-def boolean(a, b, op, output, exact, beta):
+def boolean(a, b, op, output, exact, beta, quiet):
     from gsdf.io import MESH_WRITE_FORMATS, read_mesh, write_mesh
-    from gsdf.ops import mesh_boolean
+    from gsdf.ops import BooleanOptions, mesh_boolean
 
     check_output(output, MESH_WRITE_FORMATS)
     VA, FA = read_mesh(a)
     VB, FB = read_mesh(b)
-    V, F = mesh_boolean(VA, FA, VB, FB, op, beta=beta, exact=exact)
+    V, F = mesh_boolean(VA, FA, VB, FB, op, options=BooleanOptions(beta=2.0 if beta is None else beta, exact=exact))
     with output_file(output) as tmp:
         write_mesh(tmp, V, F)
     click.echo(f"{op}: {len(FA)} + {len(FB)} triangles -> {len(F)} triangles -> {os.path.abspath(output)}")

@@ -8,10 +8,12 @@ import time
 import click
 import numpy as np
 
-from gsdf.cli._common import Geometry, bbox_of, no_clobber_option, output_file, report_errors
+from gsdf.cli._common import Geometry, bbox_of, output_file, report_errors
+from gsdf.cli._options import common_options, no_clobber_option, output_dir_option, resolution_option
 
 
-@click.command("demo", help="""Run gsdf on the bundled examples and say where the outputs went.
+@click.command("demo", short_help="Run gsdf on the bundled examples.",
+               help="""Run gsdf on the bundled examples and say where the outputs went.
 
 Inputs: a broken triangle soup (intersecting sphere + torus with holes, duplicated and degenerate faces)
 and an oriented, noisy point cloud of a torus. Outputs: winding numbers, a signed distance grid, the
@@ -21,11 +23,12 @@ extracted surfaces, a PNG slice, SVG print slices.
 Example:
   gsdf demo -o demo-out
 """)
-@click.option("-o", "--output-dir", default="gsdf-demo-output", show_default=True, help="Folder for the outputs.")
-@click.option("--resolution", type=click.IntRange(8, 512), default=64, show_default=True)
+@output_dir_option("Folder for the outputs.", default="gsdf-demo-output")
+@resolution_option(64)
+@common_options
 @no_clobber_option
 @report_errors
-def demo(output_dir, resolution):
+def demo(output_dir, resolution, quiet):
     from gsdf import data
     from gsdf.contour import extract_isosurface, slice_contours, write_svg
     from gsdf.io import read_mesh, read_points, write_mesh

@@ -6,15 +6,17 @@ import os
 
 import click
 
-from gsdf.cli._common import (
-    check_output,
-    load_geometry,
+from gsdf.cli._common import check_output, load_geometry, output_file, report_errors
+from gsdf.cli._options import (
+    common_options,
+    level_set_option,
     no_clobber_option,
     normals_option,
-    output_file,
-    parse_floats,
-    quiet_option,
-    report_errors,
+    offsets_option,
+    output_option,
+    resolution_option,
+    soft_weight_option,
+    t_coef_option,
 )
 
 
@@ -40,52 +42,47 @@ def _stage_progress(enabled: bool):
     return update, close
 
 
-@click.command("heat", help="""Signed distance of INPUT (mesh, soup or oriented cloud) in a volume by the
+@click.command("heat", short_help="Signed distance in a volume (grid or tets).",
+               help="""Signed distance of INPUT (mesh, soup or oriented cloud) in a volume by the
 signed heat method: negative inside, robust to holes, flips and noise.
 
-Writes the field to OUTPUT (.npz, .npy, .vtk, .vtu; .vti for grids) and, with --offsets, one surface per offset next to it
-(OUTPUT stem + _offset_<value>.ply, or --surface-format). Offsets are distances, or fractions of the input's
-bounding-box diagonal with --relative.
+Writes the field to OUTPUT (.npz, .npy, .vtk, .vtu; .vti for grids) and, with --offsets, one surface per offset
+next to it (OUTPUT stem + _offset_<value>.ply, or --surface-format). Offsets are distances, or fractions of the
+input's bounding-box diagonal with --relative.
 
 \b
 Example:
-  gsdf heat bunny.off --grid 128 --offsets 0,0.01,-0.01 --relative -o bunny_heat.npz
+  gsdf heat bunny.off --resolution 128 --offsets 0,0.01,-0.01 --relative -o bunny_heat.npz
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, help="Output field: .npz, .npy, .vtk, .vtu, or .vti (grid only).")
-@click.option("--grid", "grid", type=click.IntRange(2, 4096), default=64, show_default=True,
-              help="Regular grid with this many nodes along the longest side (§8.2).")
+@output_option("Output field: .npz, .npy, .vtk, .vtu, or .vti (grid only).")
+@resolution_option(64, help="Grid nodes along the longest side of the box (§8.2); with --tet, the spacing of the "
+                            "tet mesh near the input.")
 @click.option("--tet", is_flag=True, help="Tetrahedral domain instead of a grid (§8.1).")
-@click.option("--offsets", default=None, help="Comma-separated levels to contour, e.g. 0,0.01,-0.01.")
+@offsets_option("Comma-separated levels to contour, e.g. 0,0.01,-0.01.")
 @click.option("--relative", is_flag=True, help="Offsets are fractions of the bounding-box diagonal.")
-@click.option("--t-coef", type=click.FloatRange(min=0, min_open=True), default=1.0, show_default=True,
-              help="Diffusion time t = t_coef · h².")
+@t_coef_option
 @click.option("--t-scale", type=click.Choice(["grid", "input"]), default="grid", show_default=True,
               help="h of t = t_coef·h²: the grid spacing (robust to flipped/noisy normals) or the input's mean "
-                   "edge length / point spacing (as signedheat3d; more accurate on clean input with holes).")
-@click.option("--constraint", type=click.Choice(["zero", "none", "multiple"]), default="zero", show_default=True,
-              help="Level set (§7.1): φ = 0 at the sources (zero), shift by the source mean only (none), or one "
-                   "constant per connected input component (multiple).")
-@click.option("--soft-weight", type=click.FloatRange(min=0), default=None,
-              help="Impose zero/multiple by a penalty of this weight instead of exactly. Default on grids: 10 "
-                   "(the exact grid constraint is an augmented Lagrangian, minutes at 64³); 0 = exact. Default on "
-                   "tets: exact.")
+                   "edge length / point spacing (more accurate on clean input with holes).")
+@level_set_option
+@soft_weight_option("Default: 10 on grids, exact on tets.")
 @click.option("--surface-format", type=click.Choice(["ply", "obj", "off", "stl"]), default="ply",
-              show_default=True)
+              show_default=True, help="Format of the --offsets surfaces.")
 @normals_option
-@quiet_option
+@common_options
 @no_clobber_option
 @report_errors
-def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constraint, soft_weight, surface_format,
+def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, level_set, soft_weight, surface_format,
          estimate_normals, quiet):
     import numpy as np
 
-    from gsdf.heat.volume import signed_heat_volume
+    from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
 
     from gsdf.field import GridField, TetField
 
     check_output(output, TetField.SAVE_EXTENSIONS if tet else GridField.SAVE_EXTENSIONS)
-    levels = parse_floats(offsets, "--offsets")
+    levels = offsets
     stem = os.path.splitext(output)[0]
     surface_paths = [f"{stem}_offset_{v:g}.{surface_format}" for v in levels or []]
     for path in surface_paths:
@@ -94,12 +91,14 @@ def heat(input, output, grid, tet, offsets, relative, t_coef, t_scale, constrain
     kw = dict(mesh=(geo.X, geo.F)) if geo.is_mesh else dict(points=(geo.X, geo.N))
     if soft_weight is None and not tet:
         soft_weight = 10.0
-    if soft_weight == 0 or constraint == "none":
+    if level_set == "none":
         soft_weight = None
     update, close = _stage_progress(not quiet)
     try:
-        field = signed_heat_volume(domain="tet" if tet else "grid", resolution=grid, t_coef=t_coef, t_scale=t_scale,
-                                   level_set_constraint=constraint, soft_weight=soft_weight, progress=update, **kw)
+        options = VolumeHeatOptions(level_set_constraint=level_set, soft_weight=soft_weight, t_scale=t_scale,
+                                    progress=update)
+        field = signed_heat_volume(domain="tet" if tet else "grid", resolution=resolution, t_coef=t_coef,
+                                   options=options, **kw)
     finally:
         close()
     with output_file(output) as tmp:

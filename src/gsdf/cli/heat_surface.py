@@ -7,10 +7,22 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import check_output, no_clobber_option, output_file, parse_view, quiet_option, report_errors
+from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._options import (
+    NONNEGATIVE,
+    common_options,
+    level_set_option,
+    no_clobber_option,
+    output_option,
+    png_option,
+    soft_weight_option,
+    t_coef_option,
+    view_option,
+)
 
 
-@click.command("heat-surface", help="""Signed distance to curves on the surface MESH (signed heat method).
+@click.command("heat-surface", short_help="Signed distance to curves on a surface mesh.",
+               help="""Signed distance to curves on the surface MESH (signed heat method).
 
 Curves come from --curves FILE: the text format of the signed heat method's demo (blocks signed_curve,
 unsigned_curve, unsigned_point; nodes 'v i', 'e i t', 'f i a b c') or OBJ 'l' lines (1-based vertex
@@ -31,23 +43,20 @@ Example:
               help="Curve file (demo .txt format or OBJ with 'l' lines).  [required without --cut]")
 @click.option("--voxels", is_flag=True, help="MESH is a binary volume (.npy / .npz); use its digital surface.")
 @click.option("--spacing", default=None, help="--voxels: voxel size 's' or 'sx,sy,sz' (default 1, or the .npz's).")
-@click.option("--normal-radius", type=click.FloatRange(min=0), default=3.0, show_default=True,
+@click.option("--normal-radius", type=NONNEGATIVE, default=3.0, show_default=True,
               help="--voxels: integral-invariant radius of the corrected normals, in voxels (0: trivial normals).")
 @click.option("--cut", default=None, help="--voxels: curve = boundary of the quads with centre 'x|y|z < value' "
               "(or '>'), world coordinates.")
-@click.option("-o", "--output", required=True, help="Output mesh (.ply) with the 'distance' vertex property.")
-@click.option("--level-set", type=click.Choice(["zero", "multiple", "none"]), default="zero", show_default=True,
-              help="Level-set constraint (§7.1): zero on all curves, constant per curve component, or none.")
-@click.option("--t-coef", type=click.FloatRange(min=0, min_open=True), default=1.0, show_default=True,
-              help="Diffusion time t = t_coef · h² (h: mean spacing of edge midpoints).")
-@click.option("--soft-weight", type=click.FloatRange(min=0, min_open=True), default=None,
-              help="Soft level-set penalty λ instead of the hard constraint.")
+@output_option("Output mesh (.ply) with the 'distance' vertex property.")
+@level_set_option
+@t_coef_option
+@soft_weight_option("Default: exact.")
 @click.option("--swn", is_flag=True,
               help="First classify the curves with surface winding numbers and keep only their bounding part "
                    "(thesis §6.4.1); curves must run along mesh edges.")
-@click.option("--png", default=None, help="Also write a PNG of the distance with isolines.")
-@click.option("--view", default="0,0,1", show_default=True, help="View direction for the PNG (x,y,z).")
-@quiet_option
+@png_option("Also write a PNG of the distance with isolines.")
+@view_option("0,0,1")
+@common_options
 @no_clobber_option
 @report_errors
 def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output, level_set, t_coef, soft_weight,
@@ -58,7 +67,6 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
 
     check_output(output, (".ply",))  # only PLY stores the distance per vertex
     check_output(png, (".png",), "--png")
-    d = parse_view(view)  # checked before the work, used by the PNG
     if voxels:
         if swn:
             raise click.UsageError("--swn and --voxels cannot be combined")
@@ -100,7 +108,7 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
         from gsdf.view._raster import render_function_png
 
         with output_file(png, what="--png") as tmp:
-            render_function_png(tmp, V, F, phi, view=d)
+            render_function_png(tmp, V, F, phi, view=view)
         click.echo(f"image -> {os.path.abspath(png)}")
 
 

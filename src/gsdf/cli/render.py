@@ -6,10 +6,20 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, no_clobber_option, normals_option, output_file, parse_floats, report_errors
+from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._options import (
+    DIRECTION,
+    NUMBER,
+    common_options,
+    no_clobber_option,
+    normals_option,
+    output_option,
+    view_option,
+)
 
 
-@click.command("render", help="""Sphere-trace a level set of the Points as Tori SDF of POINTS into a PNG.
+@click.command("render", short_help="Sphere-traced PNG of a Points as Tori level set.",
+               help="""Sphere-trace a level set of the Points as Tori SDF of POINTS into a PNG.
 
 Only pointwise signed distance queries are used (Hart 1996; thesis §5.2, Fig. 5.3): no grid, no mesh.
 POINTS is an oriented cloud, or a .npz of tori saved by `gsdf tori ... -o tori.npz`.
@@ -19,15 +29,16 @@ Example:
   gsdf render kitten.xyz -o kitten.png --level 0.01 --size 512
 """)
 @click.argument("points", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", "out", required=True, help="Output PNG.")
-@click.option("--level", type=float, default=0.0, show_default=True, help="Level set (offset) to render.")
+@output_option("Output PNG.")
+@click.option("--level", type=NUMBER, default=0.0, show_default=True, help="Level set (offset) to render.")
 @click.option("--size", type=click.IntRange(8, 4096), default=384, show_default=True, help="Image width and height.")
-@click.option("--view", default="1,0.6,1.4", show_default=True, help="Direction from the centre to the camera.")
-@click.option("--up", default="0,1,0", show_default=True, help="Up vector.")
+@view_option("1,0.6,1.4")
+@click.option("--up", type=DIRECTION, default="0,1,0", show_default=True, help="Up vector of the picture (x,y,z).")
 @normals_option
+@common_options
 @no_clobber_option
 @report_errors
-def render(points, out, level, size, view, up, estimate_normals):
+def render(points, output, level, size, view, up, estimate_normals, quiet):
     import numpy as np
 
     from gsdf.view._png import write_png
@@ -35,10 +46,7 @@ def render(points, out, level, size, view, up, estimate_normals):
     from gsdf.view._trace import sphere_trace
     from gsdf.cli.tori import _load_cloud
 
-    check_output(out, (".png",))
-    v, u = parse_floats(view, "--view"), parse_floats(up, "--up")
-    if len(v) != 3 or len(u) != 3:
-        raise click.BadParameter("--view and --up need three numbers")
+    check_output(output, (".png",))
     if points.lower().endswith(".npz"):
         pat = PointsAsTori.load(points)
     else:
@@ -46,7 +54,7 @@ def render(points, out, level, size, view, up, estimate_normals):
         pat = PointsAsTori(P, N)
     lo, hi = pat.P.min(0), pat.P.max(0)
     m = 0.1 * np.linalg.norm(hi - lo) + abs(level)  # the box of tori.render_png: cloud + 10 % of its diagonal
-    img = sphere_trace(pat, lo - m, hi + m, size, size, level, view=v, up=u)
-    with output_file(out) as tmp:
+    img = sphere_trace(pat, lo - m, hi + m, size, size, level, view=view, up=up)
+    with output_file(output) as tmp:
         write_png(tmp, img, min_size=1)  # gsdf's one PNG writer
-    click.echo(f"{len(pat.P)} tori, level {level:g} -> {os.path.abspath(out)}")
+    click.echo(f"{len(pat.P)} tori, level {level:g} -> {os.path.abspath(output)}")

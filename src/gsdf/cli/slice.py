@@ -7,22 +7,20 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import (
-    bbox_of,
+from gsdf.cli._common import bbox_of, check_output, counting, load_geometry, output_file, report_errors
+from gsdf.cli._options import (
+    FLOATS,
     beta_option,
-    check_output,
-    counting,
-    load_geometry,
+    common_options,
     no_clobber_option,
     normals_option,
-    output_file,
-    parse_floats,
-    quiet_option,
-    report_errors,
+    output_option,
+    resolution_option,
 )
 
 
-@click.command("slice", help="""Slice INPUT into closed contours of its winding-number solid, written as SVG.
+@click.command("slice", short_help="Closed 2D contours at given heights, as SVG.",
+               help="""Slice INPUT into closed contours of its winding-number solid, written as SVG.
 
 Works directly on soups and point clouds, no meshing (Barill et al. 2018, Fig. 3). Heights are given
 explicitly (--heights) or as N evenly spaced layers (--layers) through the bounding box.
@@ -33,16 +31,16 @@ Example:
   gsdf slice scan.pwn -o s.svg --heights 0.1,0.2,0.3 --axis y
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, help="Output .svg.")
+@output_option("Output .svg.")
 @click.option("--layers", type=click.IntRange(1, 100000), default=None, help="Number of evenly spaced slices.")
-@click.option("--heights", default=None, help="Comma-separated slice heights.")
+@click.option("--heights", type=FLOATS, default=None, help="Comma-separated slice heights.")
 @click.option("--axis", type=click.Choice(["x", "y", "z"]), default="z", show_default=True)
-@click.option("--resolution", type=click.IntRange(2, 8192), default=256, show_default=True)
+@resolution_option(256, help="Nodes of each slice's grid along its longer side.")
 @click.option("--layout", type=click.Choice(["layers", "stack"]), default="layers", show_default=True,
               help="SVG layers on top of each other, or slices stacked side by side.")
 @beta_option
 @normals_option
-@quiet_option
+@common_options
 @no_clobber_option
 @report_errors
 def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, estimate_normals, quiet):
@@ -52,7 +50,7 @@ def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, es
     geo = load_geometry(input, estimate_normals)
     ax = "xyz".index(axis)
     lo, hi = bbox_of(geo.X, 0.02)
-    zs = parse_floats(heights, "--heights")
+    zs = heights
     if zs is None:
         n = layers or 10
         zs = list(lo[ax] + (hi[ax] - lo[ax]) * (np.arange(n) + 0.5) / n)

@@ -6,21 +6,23 @@ import os
 
 import click
 
-from gsdf.cli._common import (
-    bbox_of,
+from gsdf.cli._common import bbox_of, check_output, counting, load_geometry, output_file, report_errors
+from gsdf.cli._options import (
+    NUMBER,
     beta_option,
-    check_output,
-    counting,
-    load_geometry,
+    bisection_option,
+    common_options,
     no_clobber_option,
     normals_option,
-    output_file,
-    quiet_option,
-    report_errors,
+    output_option,
+    pad_option,
+    resolution_option,
 )
+from gsdf.grid import PAD
 
 
-@click.command("surface", help="""Extract the surface of INPUT as the winding number's 1/2 level set.
+@click.command("surface", short_help="The winding number's 1/2 level set as a mesh.",
+               help="""Extract the surface of INPUT as the winding number's 1/2 level set.
 
 For oriented point clouds this is the point-set surface of Barill et al. 2018 (Fig. 8); for soups it is a
 watertight reconstruction. Vertices are placed by bisection along grid edges rather than linear
@@ -32,15 +34,14 @@ Example:
   gsdf surface scan.pwn -o scan.obj
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, help="Output mesh (.ply, .obj, .off, .stl).")
-@click.option("--resolution", type=click.IntRange(2, 2048), default=128, show_default=True)
-@click.option("--level", type=float, default=0.5, show_default=True, help="Winding number iso-value.")
-@click.option("--bisection", type=click.IntRange(0, 60), default=10, show_default=True,
-              help="Bisection steps per vertex (0: plain marching cubes).")
-@click.option("--pad", type=click.FloatRange(0), default=0.05, show_default=True)
+@output_option("Output mesh (.ply, .obj, .off, .stl).")
+@resolution_option(128)
+@click.option("--level", type=NUMBER, default=0.5, show_default=True, help="Winding number iso-value.")
+@bisection_option
+@pad_option(PAD)
 @beta_option
 @normals_option
-@quiet_option
+@common_options
 @no_clobber_option
 @report_errors
 def surface(input, output, resolution, level, bisection, pad, beta, estimate_normals, quiet):

@@ -7,7 +7,15 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import check_output, no_clobber_option, output_file, parse_view, quiet_option, report_errors
+from gsdf.cli._common import check_output, output_file, progress_bar, report_errors
+from gsdf.cli._options import (
+    POSITIVE,
+    common_options,
+    no_clobber_option,
+    output_option,
+    png_option,
+    view_option,
+)
 
 
 def write_swn_obj(path, V, F, corner_values, face_labels) -> None:
@@ -41,13 +49,14 @@ def write_swn_ply(path, V, F, corner_values, face_labels) -> None:
     PlyData([PlyElement.describe(v, "vertex"), PlyElement.describe(f, "face")]).write(path)
 
 
-@click.command("swn", help="""Surface winding numbers of the curves in CURVES on the surface MESH.
+@click.command("swn", short_help="Surface winding numbers of broken curves.",
+               help="""Surface winding numbers of the curves in CURVES on the surface MESH.
 
 CURVES: the SWN demo's curve files ('#offset', 'v i', 'e i t' nodes and 'l j k' segments between nodes;
 edge points are inserted into the mesh by cutting, geometry unchanged) or an OBJ with 'l' lines (1-based
 vertex polylines along mesh edges). The mesh must be manifold and consistently oriented.
 
-Writes OUT (.ply: faces with an int 'label' and float corner values 'w0 w1 w2'; .obj: the winding number as
+Writes OUTPUT (.ply: faces with an int 'label' and float corner values 'w0 w1 w2'; .obj: the winding number as
 per-corner texture coordinates 'vt w 0', like the demo's output), for the cut mesh.
 
 \b
@@ -56,27 +65,26 @@ Example:
 """)
 @click.argument("mesh", type=click.Path(dir_okay=False))
 @click.argument("curves", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, help="Output mesh: .ply or .obj.")
+@output_option("Output mesh: .ply or .obj.")
 @click.option("--method", type=click.Choice(["lp", "reduced", "none"]), default="lp", show_default=True,
               help="Residual: full LP (HiGHS), reduced LP (one unknown per curve piece), or none (naive rounding).")
 @click.option("--epsilon", type=click.FloatRange(min=0, min_open=True, max=1), default=1e-2, show_default=True,
               help="LP weight of jumps along the input curves (gap-closing jumps weigh 1).")
-@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=300.0, show_default=True,
+@click.option("--time-limit", type=POSITIVE, default=300.0, show_default=True,
               help="Seconds HiGHS may take.")
-@click.option("--png", default=None, help="Also write a PNG preview of the winding number.")
-@click.option("--view", default="0,0,1", show_default=True, help="View direction for the PNG (x,y,z).")
-@quiet_option
+@png_option("Also write a PNG preview of the winding number.")
+@view_option("0,0,1")
+@common_options
 @no_clobber_option
 @report_errors
 def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     from gsdf.io import read_mesh
     from gsdf.io._swn_curves import read_swn_curves
-    from gsdf.swn._solver import SurfaceWindingNumbers
+    from gsdf.swn._solver import SurfaceWindingNumbers, SWNOptions
     from gsdf.swn._insert import insert_curves
 
     check_output(output, (".ply", ".obj"))
     check_output(png, (".png",), "--png")
-    d = parse_view(view)  # checked before the work, used by the PNG
     ext = os.path.splitext(output)[1].lower()
     say = (lambda s: None) if quiet else (lambda s: click.echo(f"  {s} ...", err=True))
     say("reading")
@@ -86,11 +94,10 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     V2, F2, segs, _ = insert_curves(V, F, c)
     say("building operators")
     solver = SurfaceWindingNumbers(V2, F2)
-    from gsdf.cli._common import progress_bar
-
     bar, update = progress_bar(5, "swn steps", enabled=not quiet)
     try:
-        res = solver.solve(list(segs), method=method, epsilon=epsilon, time_limit=time_limit, progress=update)
+        res = solver.solve(list(segs), method=method, options=SWNOptions(epsilon=epsilon, time_limit=time_limit),
+                           progress=update)
     finally:
         bar.close()
     with output_file(output, (".ply", ".obj")) as tmp:
@@ -109,5 +116,5 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
         m = len(F2)
         with output_file(png, (".png",), what="--png") as tmp:
             render_function_png(tmp, V2[F2].reshape(-1, 3), np.arange(3 * m).reshape(m, 3),
-                                res.corner_values.ravel() - 0.5, view=d)
+                                res.corner_values.ravel() - 0.5, view=view)
         click.echo(f"image -> {os.path.abspath(png)}")

@@ -3,7 +3,7 @@
 gsdf's kernels are compiled on first use and cached on disk (:mod:`gsdf._jit`). A cold first command
 therefore spends most of its time compiling. ``gsdf warmup`` runs each subcommand once on tiny inputs (the
 bundled examples, a small generated sphere) so that every kernel those commands use is compiled with the
-argument types they use; the jobs are independent and run in ``--jobs`` processes side by side (numba
+argument types they use; the jobs are independent and run in ``--workers`` processes side by side (numba
 compiles on one thread per process, so on 2 cores two jobs take about half the time).
 
 Each job is a list of real ``gsdf`` command lines: :data:`JOBS`. :func:`warm` is the library entry point.
@@ -19,6 +19,7 @@ import time
 import click
 
 from gsdf.cli._common import report_errors
+from gsdf.cli._options import COUNT, common_options
 
 # name -> what it compiles; the command lines are built by _job_commands (they need the temp files)
 JOBS = {
@@ -74,7 +75,7 @@ def _job_commands(name: str, f: dict) -> list[list[str]]:
     if name == "soup":
         return [["winding", f["soup"], f["queries"], "-o", o("w.npy"), "-q"],
                 ["winding", f["soup"], f["queries"], "--exact", "-o", o("we.npy"), "-q"],
-                ["sdf", f["soup"], "-o", o("s.npz"), "--resolution", "12", "--surface", o("s.ply"), "-q"],
+                ["sdf", f["soup"], "-o", o("s.npz"), "--resolution", "12", "--mesh-output", o("s.ply"), "-q"],
                 ["sdf", f["soup"], "-o", o("sp.npz"), "--resolution", "8", "--sign", "pseudonormal", "-q"],
                 ["slice", f["soup"], "-o", o("s.svg"), "--layers", "2", "--resolution", "16"]]
     if name == "demo-cloud":
@@ -91,10 +92,10 @@ def _job_commands(name: str, f: dict) -> list[list[str]]:
     if name == "heat-surface":
         return [["heat-surface", f["sphere"], "--curves", f["curves"], "-o", o("h.ply")]]
     if name == "heat":
-        return [["heat", f["soup"], "--grid", "10", "-o", o("h.npz")]]
+        return [["heat", f["soup"], "--resolution", "10", "-o", o("h.npz")]]
     if name == "tori":
         return [["tori", f["cloud"], "-o", o("t.npz")],
-                ["tori", f["cloud"], "-o", o("t.ply"), "--grid", "8"],
+                ["tori", f["cloud"], "-o", o("t.ply"), "--resolution", "8"],
                 ["render", o("t.npz"), "-o", o("t.png"), "--size", "8"]]
     raise ValueError(f"unknown warm-up job {name!r}; known: {', '.join(JOBS)}")
 
@@ -195,26 +196,29 @@ def _line(result) -> str:
     return f"  {name:<13} {seconds:6.1f} s  " + (f"FAILED: {error}" if error else {**JOBS, **_PARTIAL}[name])
 
 
-@click.command("warmup", help="""Compile all of gsdf's kernels now (once per install), in parallel.
+@click.command("warmup", short_help="Compile all kernels now, in parallel.",
+               help="""Compile all of gsdf's kernels now (once per install), in parallel.
 
 Every command compiles the kernels it needs on first use and caches them; this runs each command once on
-tiny inputs so that later first runs start at full speed. Jobs run in parallel processes (--jobs, default:
+tiny inputs so that later first runs start at full speed. Jobs run in parallel processes (--workers, default:
 the --threads setting, i.e. all cores).
 
 \b
 Example:
   gsdf warmup
-  gsdf warmup --only soup,cloud --jobs 2
+  gsdf warmup --only soup,cloud --workers 2
 """)
 @click.option("--only", default=None, help=f"Comma-separated jobs (default all): {', '.join(JOBS)}.")
-@click.option("--jobs", "processes", type=click.IntRange(1, 64), default=None,
-              help="Parallel processes (default: the thread setting).")
+@click.option("--workers", type=COUNT, default=None,
+              help="Parallel worker processes (default: the thread setting).")
+@common_options
 @report_errors
-def warmup(only, processes):
+def warmup(only, workers, quiet):
     names = None if only is None else [t.strip() for t in only.split(",") if t.strip()]
     t0 = time.perf_counter()
-    click.echo(f"compiling gsdf's kernels ({', '.join(names or JOBS)}) ...")
-    results = warm(names, processes, echo=click.echo)
+    if not quiet:
+        click.echo(f"compiling gsdf's kernels ({', '.join(names or JOBS)}) ...")
+    results = warm(names, workers, echo=None if quiet else click.echo)
     failed = [r for r in results if r[2]]
     click.echo(f"done in {time.perf_counter() - t0:.1f} s" + (f", {len(failed)} job(s) failed" if failed else ""))
     if failed:

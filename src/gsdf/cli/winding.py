@@ -7,16 +7,14 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import (
+from gsdf.cli._common import check_output, load_geometry, output_file, progress_bar, report_errors
+from gsdf.cli._options import (
     beta_option,
-    check_output,
-    load_geometry,
+    common_options,
+    exact_option,
     no_clobber_option,
     normals_option,
-    output_file,
-    progress_bar,
-    quiet_option,
-    report_errors,
+    output_option,
 )
 
 VALUE_EXTENSIONS = (".npy", ".txt", ".csv")
@@ -51,7 +49,8 @@ def write_values(path: str, values: np.ndarray) -> None:
             np.savetxt(tmp, values, fmt="%.10g")
 
 
-@click.command("winding", help="""Winding numbers of INPUT (mesh, soup or oriented cloud) at the points of QUERIES.
+@click.command("winding", short_help="Winding numbers at query points.",
+               help="""Winding numbers of INPUT (mesh, soup or oriented cloud) at the points of QUERIES.
 
 QUERIES is any point file (XYZ, PLY, OBJ, NPY (q,3)). Writes one value per query (.npy or text).
 
@@ -62,12 +61,13 @@ Example:
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
 @click.argument("queries", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, help="Output file: .npy, or text (.txt/.csv, one value per line).")
-@click.option("--exact", is_flag=True, help="Exact direct sum instead of the fast tree approximation.")
-@click.option("--order", type=click.IntRange(0, 2), default=2, show_default=True, help="Taylor order.")
+@output_option("Output file: .npy, or text (.txt/.csv, one value per line).")
+@exact_option
+@click.option("--order", type=click.IntRange(0, 2), default=2, show_default=True,
+              help="Taylor order of the fast winding number.")
 @beta_option
 @normals_option
-@quiet_option
+@common_options
 @no_clobber_option
 @report_errors
 def winding(input, queries, output, exact, order, beta, estimate_normals, quiet):

@@ -17,10 +17,12 @@ import numpy as np
 
 from gsdf._checks import as_points, choice, finite, integer
 from gsdf._memory import check_bytes, grid_bytes
-from gsdf.grid import grid_shape
 
 #: More bisection steps than this cannot improve a float64 root (the bracket reaches one ulp well before).
 MAX_BISECTION = 200
+
+#: Most query points passed to the field in one call (bounds memory).
+CHUNK = 1 << 20
 
 __all__ = ["extract_isosurface", "refine_on_edges"]
 
@@ -37,6 +39,19 @@ def _check_func(func):
 
 
 _finite = finite  # one spelling: gsdf._checks.finite
+
+
+def _grid(bbox_min, bbox_max, resolution):
+    """The Grid of a contouring call: ``resolution`` itself (a Grid), or ``Grid.fit`` of the given box."""
+    from gsdf.grid import Grid, as_grid
+
+    if isinstance(resolution, Grid):
+        if bbox_min is not None or bbox_max is not None:
+            raise ValueError("bbox_min/bbox_max: a Grid as resolution already has its box; omit them")
+        return resolution
+    if bbox_min is None or bbox_max is None:
+        raise ValueError("bbox_min, bbox_max: the box to sample is needed (or a gsdf.Grid as resolution)")
+    return as_grid(resolution, box=_check_bbox(bbox_min, bbox_max))
 
 
 def _check_bbox(bbox_min, bbox_max, axes=(0, 1, 2)) -> tuple[np.ndarray, np.ndarray]:
@@ -183,22 +198,20 @@ def refine_on_edges(func, A, B, fa, fb, level: float = 0.5, steps: int = 10, chu
 
 def extract_isosurface(
     func,
-    bbox_min,
-    bbox_max,
-    resolution: int = 128,
+    bbox_min=None,
+    bbox_max=None,
+    resolution=128,
     level: float = 0.5,
     bisection_steps: int = 10,
-    chunk: int = 2**20,
     inside: str = "above",
 ) -> tuple[np.ndarray, np.ndarray]:
     """Triangle mesh of the level set ``func = level`` inside a box (Barill et al. 2018, Fig. 9).
 
-    ``func`` is evaluated on a regular grid (``resolution`` nodes along the longest side of the
-    box, the same spacing on the others: :func:`gsdf.field.grid_shape`), scikit-image's marching
-    cubes extracts the level set, and each vertex is then moved to the root of ``func - level``
-    on its grid edge by ``bisection_steps`` vectorized bisection iterations
-    (:func:`refine_on_edges`).  Total cost: ``prod(grid shape)`` evaluations plus
-    ``bisection_steps * n_vertices``.
+    ``func`` is evaluated on the nodes of a :class:`gsdf.Grid` (``Grid.fit((bbox_min, bbox_max), resolution)``:
+    ``resolution`` nodes along the longest side of the box, cubic cells), scikit-image's marching cubes
+    extracts the level set, and each vertex is then moved to the root of ``func - level`` on its grid edge by
+    ``bisection_steps`` vectorized bisection iterations (:func:`refine_on_edges`). Total cost: the number of
+    nodes in evaluations plus ``bisection_steps * n_vertices``.
 
     Parameters
     ----------
@@ -206,17 +219,15 @@ def extract_isosurface(
         ``func(Q (q, 3) float64) -> (q,)`` finite values, e.g.
         ``FastWindingNumberPoints(...)`` or any signed distance.
     bbox_min, bbox_max : (3,) array_like
-        Box to polygonize (pad it if the surface may touch its sides: the mesh is cut open at
-        the box).
-    resolution : int >= 2
-        Grid nodes along the longest box side.
+        Box to polygonize (pad it if the surface may touch its sides: the mesh is cut open at the box). Its
+        upper corner moves up to the last node (by less than one cell). Omit them when ``resolution`` is a Grid.
+    resolution : int >= 2 or gsdf.Grid, default 128
+        Grid nodes along the longest box side; or the :class:`gsdf.Grid` to sample.
     level : float, default 0.5
         Iso-value; 1/2 separates inside from outside for winding numbers (§3.2, Fig. 8).
     bisection_steps : int >= 0, default 10
         ``0`` gives plain marching cubes (linear interpolation along edges); each step halves the
         bracket around the root (10 steps: 1/1024 of a cell).
-    chunk : int
-        Maximum number of query points per ``func`` call.
     inside : {"above", "below"}
         Which side of ``level`` is the solid; faces are oriented with normals pointing out of
         it (``"above"`` for winding numbers / occupancy, ``"below"`` for signed distances).
@@ -236,9 +247,10 @@ def extract_isosurface(
 
     Notes
     -----
-    The grid edge of a vertex is recovered from its index-space coordinates, exactly one of
-    which is fractional.  Vertices with all-integral coordinates (the field equals ``level``
-    exactly at a node, or lies within float32 rounding of it) stay where marching cubes put them.
+    ``func`` is called with at most :data:`CHUNK` points at a time. The grid edge of a vertex is recovered from
+    its index-space coordinates, exactly one of which is fractional. Vertices with all-integral coordinates (the
+    field equals ``level`` exactly at a node, or lies within float32 rounding of it) stay where marching cubes
+    put them.
 
     Examples
     --------
@@ -252,25 +264,22 @@ def extract_isosurface(
     from skimage.measure import marching_cubes
 
     _check_func(func)
-    lo, hi = _check_bbox(bbox_min, bbox_max)
-    resolution = integer(resolution, "resolution", 2)
+    grid = _grid(bbox_min, bbox_max, resolution)
     level = _finite(level, "level")
     bisection_steps = integer(bisection_steps, "bisection_steps", 0, hi=MAX_BISECTION)
-    chunk = integer(chunk, "chunk", 1)
     choice(inside, "inside", {"above", "below"})
+    chunk = CHUNK
 
-    shape = grid_shape(lo, hi, resolution)
+    shape = grid.shape
     # values (8 B/node) and scikit-image's marching cubes (a float32 copy, edge caches: ~24 B/node measured
     # loosely), plus one chunk of query points
     check_bytes(grid_bytes(shape, 32) + 48 * min(chunk, grid_bytes(shape, 1)),
                 f"extract_isosurface: resolution={resolution} gives a {shape[0]}x{shape[1]}x{shape[2]} grid")
-    axes = [np.linspace(lo[d], hi[d], shape[d]) for d in range(3)]  # same nodes as field.grid_points
-    spacing = (hi - lo) / (np.asarray(shape) - 1)
-    total = int(np.prod(shape))
+    lo, spacing = grid.bbox_min, grid.spacing
+    total = grid.size
     values = np.empty(total)
     for s in range(0, total, chunk):
-        I = np.unravel_index(np.arange(s, min(total, s + chunk)), shape)
-        Q = np.column_stack([axes[d][I[d]] for d in range(3)])
+        Q = grid.points(np.arange(s, min(total, s + chunk)))
         values[s : s + Q.shape[0]] = _evaluate(func, Q, chunk)
     values = values.reshape(shape)
 

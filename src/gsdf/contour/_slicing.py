@@ -15,10 +15,13 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from gsdf._checks import as_points, choice, integer
-from gsdf.grid import grid_shape
-from gsdf.contour._isosurface import _check_bbox, _check_func, _edges_of_vertices, _evaluate, _finite, refine_on_edges
+from gsdf.contour._isosurface import (CHUNK, _check_bbox, _check_func, _edges_of_vertices, _evaluate, _finite,
+                                      refine_on_edges)
 
 __all__ = ["slice_contours", "write_svg", "write_slices_svg"]
+
+#: Bisection steps that place each contour vertex on its grid edge (the bracket shrinks to 1/256 of a cell).
+BISECTION_STEPS = 8
 
 _SVG_NS = "http://www.w3.org/2000/svg"
 _INKSCAPE_NS = "http://www.inkscape.org/namespaces/inkscape"
@@ -92,28 +95,41 @@ def _dedupe_closed(P: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 
 
+def _plane_grid(bbox_min, bbox_max, resolution, axis):
+    """The Grid whose in-plane nodes (the axes other than ``axis``) are sampled on every slice."""
+    from gsdf.grid import Grid, as_grid
+
+    if isinstance(resolution, Grid):
+        if bbox_min is not None or bbox_max is not None:
+            raise ValueError("bbox_min/bbox_max: a Grid as resolution already has its box; omit them")
+        return resolution
+    if bbox_min is None or bbox_max is None:
+        raise ValueError("bbox_min, bbox_max: the box to slice is needed (or a gsdf.Grid as resolution)")
+    lo, hi = _check_bbox(bbox_min, bbox_max, axes=((axis + 1) % 3, (axis + 2) % 3))
+    flat_hi = hi.copy()
+    flat_hi[axis] = lo[axis]
+    return as_grid(resolution, box=(lo, flat_hi))
+
+
 def slice_contours(
     func,
     z_values,
-    bbox_min,
-    bbox_max,
-    resolution: int = 256,
+    bbox_min=None,
+    bbox_max=None,
+    resolution=256,
     level: float = 0.5,
     axis: int = 2,
-    bisection_steps: int = 8,
     inside: str = "above",
-    chunk: int = 2**20,
 ) -> list:
     """Closed polygons of the level set ``func = level`` on planes ``q[axis] = z`` (Barill et al. 2018, Fig. 3).
 
-    For every height, ``func`` is evaluated on a 2D grid over the box's cross-section
-    (``resolution`` nodes along its longer side, same spacing on the other), the grid is padded
-    with one ring of *outside* values so that every contour closes (shapes that leave the box
-    are cut along its border), scikit-image's ``find_contours`` (marching squares) extracts the
-    level set, and every contour vertex is moved to the root of ``func - level`` on its grid edge
-    by ``bisection_steps`` bisection iterations (Fig. 9; one ``func`` call per iteration for all
-    vertices of all slices).  Outer boundaries are oriented counter-clockwise and holes
-    clockwise, by nesting parity.
+    For every height, ``func`` is evaluated on the nodes of a 2D grid over the box's cross-section (the
+    in-plane axes of ``Grid.fit`` of the box flattened along ``axis``: ``resolution`` nodes along its longer
+    side, cubic cells), the grid is padded with one ring of *outside* values so that every contour closes
+    (shapes that leave the box are cut along its border), scikit-image's ``find_contours`` (marching squares)
+    extracts the level set, and every contour vertex is moved to the root of ``func - level`` on its grid edge
+    by :data:`BISECTION_STEPS` bisection iterations (Fig. 9; one ``func`` call per iteration for all vertices
+    of all slices). Outer boundaries are oriented counter-clockwise and holes clockwise, by nesting parity.
 
     Parameters
     ----------
@@ -123,22 +139,19 @@ def slice_contours(
     z_values : float or (s,) array_like
         Heights (coordinates along ``axis``); they need not lie inside the box.
     bbox_min, bbox_max : (3,) array_like
-        Box whose cross-section is sampled (only the two in-plane axes matter).
-    resolution : int >= 2
-        Grid nodes along the longer in-plane side.
+        Box whose cross-section is sampled (only the two in-plane axes matter). Omit them when
+        ``resolution`` is a Grid.
+    resolution : int >= 2 or gsdf.Grid, default 256
+        Grid nodes along the longer in-plane side; or a :class:`gsdf.Grid` whose in-plane nodes are used.
     level : float, default 0.5
         Iso-value (1/2 for winding numbers).
     axis : {0, 1, 2}, default 2
         Slicing direction.  In-plane 2D coordinates are the cyclically next axes
         ``((axis + 1) % 3, (axis + 2) % 3)`` — (x, y) for z, (y, z) for x, (z, x) for y — so that
         counter-clockwise means counter-clockwise seen from the +axis side.
-    bisection_steps : int >= 0, default 8
-        ``0``: plain marching squares (linear interpolation).
     inside : {"above", "below"}
         Which side of ``level`` is the solid (``"above"`` for winding numbers, ``"below"`` for
         signed distances); the padding ring uses outside values.
-    chunk : int
-        Maximum number of query points per ``func`` call.
 
     Returns
     -------
@@ -154,9 +167,9 @@ def slice_contours(
 
     Notes
     -----
-    Vertices on the box border (where the solid is cut by the box) are placed on the border
-    nodes, not refined.  Vertices of degenerate cases (the field equals ``level`` at a node)
-    stay at the node.
+    ``func`` is called with at most :data:`gsdf.contour._isosurface.CHUNK` points at a time. Vertices on the
+    box border (where the solid is cut by the box) are placed on the border nodes, not refined. Vertices of
+    degenerate cases (the field equals ``level`` at a node) stay at the node.
 
     Examples
     --------
@@ -174,27 +187,23 @@ def slice_contours(
     if axis > 2:
         raise ValueError(f"axis: must be 0, 1 or 2, got {axis}")
     ua, va = (axis + 1) % 3, (axis + 2) % 3
-    lo, hi = _check_bbox(bbox_min, bbox_max, axes=(ua, va))
+    grid = _plane_grid(bbox_min, bbox_max, resolution, axis)
     Z = np.atleast_1d(np.asarray(z_values))
     if Z.ndim != 1 or Z.size == 0 or not np.issubdtype(Z.dtype, np.number):
         raise ValueError(f"z_values: expected a number or a non-empty 1D array of numbers, got shape {Z.shape}")
     Z = Z.astype(np.float64)
     if not np.isfinite(Z).all():
         raise ValueError("z_values: contains NaN or infinite values")
-    resolution = integer(resolution, "resolution", 2)
     level = _finite(level, "level")
-    bisection_steps = integer(bisection_steps, "bisection_steps", 0, hi=200)
-    chunk = integer(chunk, "chunk", 1)
+    bisection_steps = BISECTION_STEPS
+    chunk = CHUNK
     choice(inside, "inside", {"above", "below"})
 
-    flat_hi = hi.copy()
-    flat_hi[axis] = lo[axis]
-    shp = grid_shape(lo, flat_hi, resolution)
-    nu, nv = shp[ua], shp[va]
-    gu = np.linspace(lo[ua], hi[ua], nu)
-    gv = np.linspace(lo[va], hi[va], nv)
-    h = np.array([(hi[ua] - lo[ua]) / (nu - 1), (hi[va] - lo[va]) / (nv - 1)])
-    o2 = np.array([lo[ua], lo[va]])
+    nu, nv = grid.shape[ua], grid.shape[va]
+    ax = grid.axes()
+    gu, gv = ax[ua], ax[va]
+    h = grid.spacing[[ua, va]]
+    o2 = grid.bbox_min[[ua, va]]
     U, W = np.meshgrid(gu, gv, indexing="ij")
     plane = np.empty((nu * nv, 3))
     plane[:, ua] = U.ravel()
@@ -331,9 +340,7 @@ def write_svg(
     layout: str = "layers",
     unit_mm: float = 1.0,
     margin: float | None = None,
-    fill: str = "#000000",
-    stroke: str = "none",
-    stroke_width: float | None = None,
+    style: dict | None = None,
 ) -> str:
     """Write slices (from :func:`slice_contours`) to one SVG file for toolpath software / inspection.
 
@@ -369,8 +376,9 @@ def write_svg(
         Millimetres per data unit (1 for data in mm, 1000 for data in metres, 25.4 for inches).
     margin : float, optional
         Blank border in data units; default 2 % of the larger frame side.
-    fill, stroke, stroke_width
-        Path style.
+    style : dict, optional
+        SVG attributes of every path, over the defaults ``{"fill": "#000000", "stroke": "none",
+        "stroke-width": 0.2 % of the larger frame side}`` (e.g. ``{"fill": "none", "stroke": "red"}``).
 
     Returns
     -------
@@ -445,7 +453,10 @@ def write_svg(
     if W <= 0 or H <= 0:
         W, H1 = max(W, size), max(H1, size)
         H = H1 * ns if layout == "stack" else H1
-    sw = stroke_width if stroke_width is not None else 0.002 * size
+    if style is not None and not isinstance(style, dict):
+        raise ValueError(f"style: expected a dict of SVG attributes, got {type(style).__name__}")
+    attrs_path = {"fill": "#000000", "fill-rule": "evenodd", "stroke": "none", "stroke-width": _fmt(0.002 * size)}
+    attrs_path.update({str(k): str(v) for k, v in (style or {}).items()})
 
     ET.register_namespace("", _SVG_NS)
     ET.register_namespace("inkscape", _INKSCAPE_NS)
@@ -488,14 +499,7 @@ def write_svg(
             ET.SubElement(
                 grp,
                 f"{{{_SVG_NS}}}path",
-                {
-                    "id": f"slice-{s:04d}-island-{n_isl}",
-                    "d": " ".join(parts),
-                    "fill": fill,
-                    "fill-rule": "evenodd",
-                    "stroke": stroke,
-                    "stroke-width": _fmt(sw),
-                },
+                {"id": f"slice-{s:04d}-island-{n_isl}", "d": " ".join(parts), **attrs_path},
             )
     tree = ET.ElementTree(root)
     ET.indent(tree)
@@ -504,10 +508,10 @@ def write_svg(
     return path
 
 
-def write_slices_svg(path, func, z_values, bbox_min, bbox_max, svg_options=None, **slice_options) -> list:
+def write_slices_svg(path, func, z_values, bbox_min=None, bbox_max=None, svg_options=None, **slice_options) -> list:
     """Slice ``func`` at ``z_values`` (:func:`slice_contours`) and write the SVG (:func:`write_svg`).
 
-    The drawing frame is the box's cross-section, so every slice shares the same coordinates.
+    The drawing frame is the cross-section of the sampled grid, so every slice shares the same coordinates.
     ``slice_options`` go to :func:`slice_contours` (``resolution``, ``level``, ``axis``, ...),
     ``svg_options`` (a dict) to :func:`write_svg`.  Returns the contours.
 
@@ -524,7 +528,8 @@ def write_slices_svg(path, func, z_values, bbox_min, bbox_max, svg_options=None,
     C = slice_contours(func, z_values, bbox_min, bbox_max, **slice_options)
     axis = int(slice_options.get("axis", 2))
     ua, va = (axis + 1) % 3, (axis + 2) % 3
-    lo, hi = _check_bbox(bbox_min, bbox_max, axes=(ua, va))
+    grid = _plane_grid(bbox_min, bbox_max, slice_options.get("resolution", 256), axis)
+    lo, hi = grid.box
     opts = dict(svg_options or {})
     opts.setdefault("bbox", [[lo[ua], lo[va]], [hi[ua], hi[va]]])
     write_svg(path, C, z_values=np.atleast_1d(np.asarray(z_values, dtype=np.float64)), **opts)

@@ -16,6 +16,7 @@ _LAZY = {
     "PointCloudSignedHeatSolver": "gsdf.heat.pointcloud._solver",
     "VoxelSurfaceSignedHeatSolver": "gsdf.heat.voxel._domain",
     "signed_heat_volume": "gsdf.heat.volume",
+    "VolumeHeatOptions": "gsdf.heat.volume",
     "YukawaTree": "gsdf.heat._yukawa",
 }
 

@@ -1,7 +1,8 @@
 """The signed heat method, written once (Feng & Crane 2024, §3 Alg. 1, §7.1, Alg. 13), for every domain.
 
-A *domain* (:mod:`gsdf.heat.domains`: triangle mesh, intrinsic Delaunay, polygon mesh, point cloud, grid, tet
-mesh, voxel surface) supplies operators and assembled sources (:class:`~gsdf.heat._domain.HeatDomain`);
+A *domain* (one subpackage of :mod:`gsdf.heat` each: triangle mesh, intrinsic Delaunay, polygon mesh, point
+cloud, grid, tet mesh, voxel surface) supplies operators and assembled sources
+(:class:`~gsdf.heat._domain.HeatDomain`);
 :class:`SignedHeatCore` does the rest:
 
 Step I    X = (M + t L∇)⁻¹ X⁰ (Eq. 12) — factorized once per domain (complex Hermitian, or the real 2×2-block
@@ -27,7 +28,7 @@ repeated call with the same sources costs only solves).
 
 Progress: every heat path reports through one callback signature, ``progress(stage: str, fraction: float)``
 with ``fraction`` in [0, 1]; stages are ``"sources"``, ``"heat (step I)"``, ``"poisson (step III)"`` (and
-``"tet mesh"`` on tets). :func:`adapt_progress` accepts the older ``progress(stage, done, total)`` form too.
+``"tet mesh"`` on tets).
 
 Example
 -------
@@ -46,7 +47,6 @@ Example
 from __future__ import annotations
 
 import hashlib
-import inspect
 
 import numpy as np
 import scipy.sparse as sp
@@ -66,24 +66,22 @@ from gsdf.heat._domain import PoissonSolver
 from gsdf.heat._sources import Sources
 from gsdf.curves import as_curves, as_point_sources
 
-__all__ = ["SignedHeatCore", "FactorizedPoisson", "LEVEL_SETS", "unique_rows", "adapt_progress", "normalize"]
+__all__ = ["SignedHeatCore", "FactorizedPoisson", "LEVEL_SETS", "unique_rows", "reporter", "normalize"]
 
 LEVEL_SETS = ("zero", "multiple", "none")
 
 
-def adapt_progress(progress):
-    """``progress(stage, fraction)`` from a user callback taking ``(stage, fraction)`` or the older
-    ``(stage, done, total)``; a no-op for None."""
+def reporter(progress):
+    """The ``progress(stage, fraction)`` callback to call: a no-op for None; ValueError when not callable."""
     if progress is None:
-        return lambda stage, fraction: None
-    try:
-        nparams = len([p for p in inspect.signature(progress).parameters.values()
-                       if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) and p.default is p.empty])
-    except (TypeError, ValueError):
-        nparams = 2
-    if nparams >= 3:
-        return lambda stage, fraction: progress(stage, int(round(1000 * fraction)), 1000)
+        return _quiet
+    if not callable(progress):
+        raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
     return progress
+
+
+def _quiet(stage: str, fraction: float) -> None:
+    pass
 
 
 def hash_key(*arrays) -> str:
@@ -318,14 +316,23 @@ class FactorizedPoisson(PoissonSolver):
         w = np.broadcast_to(np.asarray(w, np.float64), (A.shape[0],))
         key = hash_key(np.array([3]), w, A.indptr, A.indices, A.data)
 
+        # the exact gauge: the penalty (differences) leaves the constants free, so the first active unknown is
+        # pinned and nodes in no element get 0, as for the free solve
+        keep = np.flatnonzero(self._active)[1:] if self.exact_gauge else None
+
         def build():
             if np.all(w == w[0]):
                 K = self.L + w[0] * (A.T @ A) + sp.diags(self._eps * self.Mv)
             else:
                 K = self.L + A.T @ sp.diags(w) @ A + sp.diags(self._eps * self.Mv)
-            return self._spd(K.tocsc())
+            K = K.tocsc()
+            return self._spd(K if keep is None else K[keep][:, keep])
 
-        return self._cached(key, build).solve(b)
+        if keep is None:
+            return self._cached(key, build).solve(b)
+        phi = np.zeros(self.n)
+        phi[keep] = self._cached(key, build).solve(b[keep])
+        return phi
 
 
 class SignedHeatCore:
@@ -334,7 +341,7 @@ class SignedHeatCore:
     Parameters
     ----------
     domain : HeatDomain
-        The operators (``gsdf.heat.domains``).
+        The operators of one discretization (``gsdf.heat.triangle``, ``gsdf.heat.grid``, …).
 
     Attributes
     ----------
@@ -415,7 +422,7 @@ class SignedHeatCore:
         """Validate, assemble and solve (Alg. 1 with §7.1); returns φ (n,) on the domain's nodes."""
         mode = _checks.choice(level_set_constraint, "level_set_constraint", LEVEL_SETS)
         lam = None if soft_weight is None else _checks.positive(soft_weight, "soft_weight")
-        report = adapt_progress(progress)
+        report = reporter(progress)
         report("sources", 0.0)
         # repeated calls with the same curves reuse the validated, assembled sources (domains whose sources do
         # not depend on a changing state declare ``cache_sources``)
@@ -430,7 +437,7 @@ class SignedHeatCore:
 
     def solve(self, S: Sources, mode: str = "zero", lam=None, report=None) -> np.ndarray:
         """Steps I–III for assembled sources; ``mode`` a level-set constraint, ``lam`` the soft weight or None."""
-        report = report or (lambda stage, fraction: None)
+        report = report or _quiet
         if S.X0 is not None and not np.any(S.X0):
             raise ValueError("curves: the sources have zero total length / weight")
         with blas_region():               # one BLAS limit for all factorizations and solves of the call

@@ -102,7 +102,7 @@ class HeatDomain(ABC):
     difference_order: str = "first"
     shift_hard_zero: bool = True        # apply the shift of Alg. 13 after a hard "zero" constraint too
     cache_sources: bool = False         # sources depend only on the arguments: the core may reuse the last ones
-    renumber: bool = True               # RCM renumbering before SuperLU's ordering (bench --solver-rule)
+    renumber: bool = True               # RCM renumbering before SuperLU's ordering
     heat_ordering: str = "auto"         # the LDLᴴ ordering of Step I's operator (gsdf.linalg._ldl)
     heat_on_nodes: bool = False         # Step I's unknowns are the Laplacian's nodes, same pattern: Step III
     #                                     reuses Step I's fill-reducing ordering (core.FactorizedPoisson)

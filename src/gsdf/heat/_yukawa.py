@@ -28,8 +28,7 @@ u = (c − x)/r the second-order expansion of Σ w g(|x − c − δ|) is
 
     g S0 + g' uᵀS1 + ½ [ (g'' − g'/r) Σ_ab u_a u_b S2_ab + (g'/r) T ].
 
-Cost: O(m log m) precompute, and per node O(log m + number of clusters in the band d* ≤ d ≤ d* + τ/λ);
-``bench/bench_heat_volume.py`` measures the growth with resolution and face count.
+Cost: O(m log m) precompute, and per node O(log m + number of clusters in the band d* ≤ d ≤ d* + τ/λ).
 """
 
 from __future__ import annotations
@@ -47,8 +46,8 @@ _W = 37  # c(3) rho(1) S0(3) S1(9) S2(18) T(3)
 
 @njit(cache=True)
 def _moments(start, end, B, W):
-    # serial: O(m log m) flops, well under a millisecond for 10⁵ sources, while a parallel launch on a loaded
-    # machine waits for a descheduled thread (60 ms measured for 1.4k sources under load 3; issue 17)
+    # serial: O(m log m) flops, well under a millisecond for 10⁵ sources (a parallel launch can wait for a
+    # descheduled thread on a loaded machine, docs/decisions.md)
     k = start.shape[0]
     D = np.zeros((k, _W))
     for i in range(k):
@@ -262,7 +261,7 @@ class YukawaTree:
         return out
 
     def direct(self, Q) -> np.ndarray:
-        """The O(q × m) direct sum with the same scaling (the anchor's Step I), for testing."""
+        """The O(q × m) direct sum with the same scaling (signedheat3d's Step I), for testing."""
         Q = np.ascontiguousarray(Q, dtype=np.float64)
         out = np.empty((len(Q), 3))
         _direct_kernel(Q, self.nearest_distance(Q), self._B, self._W, self.lam, self._rmin, out)

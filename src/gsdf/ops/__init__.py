@@ -5,14 +5,12 @@ winding number at voxel centers (Fig. 11) and booleans that trim each operand ag
 the other instead of intersecting triangles (Figs. 12-15).
 """
 
-from gsdf.ops._boolean import mesh_boolean, trim_mesh
+from gsdf.ops._boolean import BooleanOptions, mesh_boolean, trim_mesh
 from gsdf.ops._distance_grid import signed_distance_grid
 from gsdf.ops._morphology import dilate_erode, erode_dilate, offset_surface
 from gsdf.ops._voxelize import (
     load_voxels,
     save_voxels,
-    voxel_centers,
-    voxel_grid,
     voxelize,
     voxels_to_mesh,
     winding_grid,
@@ -21,12 +19,11 @@ from gsdf.ops._voxelize import (
 __all__ = [
     "voxelize",
     "winding_grid",
-    "voxel_grid",
-    "voxel_centers",
     "save_voxels",
     "load_voxels",
     "voxels_to_mesh",
     "mesh_boolean",
+    "BooleanOptions",
     "trim_mesh",
     "signed_distance_grid",
     "offset_surface",

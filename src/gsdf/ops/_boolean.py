@@ -24,16 +24,52 @@ Finally (optional, on by default) the two trim curves are *stitched*: each close
 to the matching closed cut loop of B with a strip of (thin) triangles, so that the result of closed inputs
 is a closed, consistently oriented surface. The paper leaves these seams open ("Triangle edges are not
 stitched in the few areas where they do touch. While this is possible, it is insignificant"); pass
-``stitch=False`` for that behaviour.
+``BooleanOptions(stitch=False)`` for that behaviour.
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
 from gsdf._checks import as_mesh, choice, positive
 
-__all__ = ["mesh_boolean", "trim_mesh"]
+__all__ = ["mesh_boolean", "trim_mesh", "BooleanOptions"]
+
+
+@dataclasses.dataclass(frozen=True)
+class BooleanOptions:
+    """How :func:`mesh_boolean` evaluates the winding fields and joins the trimmed operands.
+
+    Attributes
+    ----------
+    beta : float, default 2.0
+        Accuracy of the fast winding number (Barill et al. 2018 §3.4); ignored with ``exact=True`` and for
+        winding fields passed in.
+    exact : bool, default False
+        The exact winding number (O(m) per query) instead of the fast tree approximation.
+    bisection_steps : int, default 12
+        Bisection iterations locating each crossing point on a cut edge (error <= edge length / 2**steps).
+    stitch : bool, default True
+        Zip the closed trim loops of A and B together with thin triangle strips, so that closed inputs give
+        a closed, consistently oriented result; ``False`` leaves the seams open, as in the paper. Open trim
+        curves (where the other operand has holes) are left as they are.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1.0]])  # a tetrahedron
+    >>> F = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
+    >>> opts = gsdf.BooleanOptions(exact=True, stitch=False)
+    >>> gsdf.mesh_boolean(V, F, V + 5.0, F, "union", options=opts)[1].shape
+    (8, 3)
+    """
+
+    beta: float = 2.0
+    exact: bool = False
+    bisection_steps: int = 12
+    stitch: bool = True
 
 _OPS = ("union", "intersection", "difference")
 
@@ -333,8 +369,7 @@ def _stitch(V, cutA, cutB):
 # ----------------------------------------------------------------------------------------------------------
 
 
-def mesh_boolean(VA, FA, VB, FB, op, beta=2.0, exact=False, bisection_steps=12, winding_a=None, winding_b=None,
-                 stitch=True):
+def mesh_boolean(VA, FA, VB, FB, op, winding_a=None, winding_b=None, options: BooleanOptions | None = None):
     """Boolean of two meshes or triangle soups by trimming each against the other's winding field.
 
     Barill et al. 2018, §4 "Booleans" (Figs. 12-15), after Jacobson 2016: no triangle-triangle intersection
@@ -351,21 +386,13 @@ def mesh_boolean(VA, FA, VB, FB, op, beta=2.0, exact=False, bisection_steps=12, 
         the trimmed surface should stay connected.
     op : {"union", "intersection", "difference"}
         ``difference`` is A minus B (the kept part of B is flipped so the result faces outward).
-    beta : float
-        Accuracy of the fast winding number (§3.4); ignored with ``exact=True`` and for overridden fields.
-    exact : bool
-        Use the exact winding number (O(m) per query) instead of the fast tree approximation.
-    bisection_steps : int
-        Bisection iterations locating each crossing point on a cut edge.
     winding_a, winding_b : callable, optional
         Override the winding field of A (evaluated at B's vertices) or of B (evaluated at A's vertices):
         ``f(Q (q, 3)) -> (q,)``. E.g. pass ``FastWindingNumberPoints(P, N)`` of an oriented point cloud and,
         as ``VB, FB``, a surface reconstructed from it (e.g. its winding isosurface) — the hybrid
         point/mesh boolean of Fig. 15.
-    stitch : bool
-        Zip the closed trim loops of A and B together with thin triangle strips, so that closed inputs give
-        a closed, consistently oriented result. Open trim curves (which arise where the other operand has
-        holes) are left as they are.
+    options : BooleanOptions, optional
+        Winding accuracy (``beta``, ``exact``), ``bisection_steps`` and ``stitch``.
 
     Returns
     -------
@@ -379,8 +406,8 @@ def mesh_boolean(VA, FA, VB, FB, op, beta=2.0, exact=False, bisection_steps=12, 
     Raises
     ------
     ValueError
-        Unknown ``op``, NaN/inf coordinates, out-of-range or non-integer faces, bad ``beta`` /
-        ``bisection_steps``, or a winding override that is not callable or returns bad values.
+        Unknown ``op``, NaN/inf coordinates, out-of-range or non-integer faces, bad options, or a winding
+        override that is not callable or returns bad values.
 
     Notes
     -----
@@ -413,8 +440,14 @@ def mesh_boolean(VA, FA, VB, FB, op, beta=2.0, exact=False, bisection_steps=12, 
     choice(op, "op", _OPS)
     VA, FA = as_mesh(VA, FA)
     VB, FB = as_mesh(VB, FB)
-    beta = positive(beta, "beta")
-    steps = _steps(bisection_steps)
+    o = BooleanOptions() if options is None else options
+    if not isinstance(o, BooleanOptions):
+        raise ValueError(f"options: expected a gsdf.BooleanOptions, got {type(o).__name__}")
+    beta, exact, stitch = positive(o.beta, "beta"), o.exact, o.stitch
+    for name, flag in (("exact", exact), ("stitch", stitch)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise ValueError(f"{name}: expected True or False, got {flag!r}")
+    steps = _steps(o.bisection_steps)
     # scale invariance: trim and stitch in the normalised frame of both operands (gsdf._normalize)
     from gsdf._normalize import Frame
 

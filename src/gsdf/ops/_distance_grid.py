@@ -1,47 +1,29 @@
 """Signed distance sampled on a regular grid: the library form of ``gsdf sdf``.
 
-Owns :func:`signed_distance_grid`: the box and node layout (as :func:`gsdf.field.grid_shape`: ``resolution``
-nodes along the longest side, cubic cells), the exact unsigned distance (:class:`TriangleDistance`, or the nearest
-point of a cloud), and the sign — from the fast winding number at 1/2 (Barill et al. 2018 §4, robust to holes and
-soups) or from angle-weighted pseudonormals (Bærentzen & Aanæs 2005, closed manifold meshes). With
-``return_closest=True`` it also returns what libigl's ``signed_distance`` does: closest face, closest point, normal.
+:func:`signed_distance_grid` samples, on the nodes of a :class:`gsdf.Grid`, the exact unsigned distance
+(:class:`gsdf.TriangleDistance`, or the nearest point of a cloud) signed by the fast winding number at 1/2
+(Barill et al. 2018 §4, robust to holes and soups) or by angle-weighted pseudonormals (Bærentzen & Aanæs 2005,
+closed manifold meshes). With ``return_closest=True`` it also returns what libigl's ``signed_distance`` does:
+closest face, closest point, normal.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_normals, as_points, choice, integer, positive
+from gsdf._checks import as_mesh, as_normals, as_points, choice, positive
 
 __all__ = ["signed_distance_grid"]
 
 
-def _grid_box(X, resolution, bbox_min, bbox_max, pad):
-    from gsdf.grid import grid_shape
-
-    if (bbox_min is None) != (bbox_max is None):
-        raise ValueError("bbox_min, bbox_max: give both or neither")
-    if bbox_min is None:
-        pad = float(pad)
-        if not np.isfinite(pad) or pad < 0:
-            raise ValueError(f"pad: expected a finite number >= 0, got {pad}")
-        lo, hi = X.min(axis=0), X.max(axis=0)
-        d = float(np.linalg.norm(hi - lo)) or 1.0
-        lo, hi = lo - pad * d, hi + pad * d
-    else:
-        lo = as_points(bbox_min, "bbox_min")[0]
-        hi = as_points(bbox_max, "bbox_max")[0]
-        if np.any(hi <= lo):
-            raise ValueError(f"bbox_max {hi} must exceed bbox_min {lo} on every axis")
-    shape = grid_shape(lo, hi, resolution)
-    h = (hi - lo).max() / (resolution - 1)
-    return lo, lo + (np.array(shape) - 1) * h, shape  # the upper corner grows so that cells are cubes
-
-
-def signed_distance_grid(V, F=None, *, points=None, resolution: int = 64, bbox_min=None, bbox_max=None,
-                         pad: float = 0.05, sign: str = "winding", beta: float | None = None,
+def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "winding", beta: float | None = None,
                          return_closest: bool = False, progress=None):
     """Signed distance (negative inside) on the nodes of a regular grid around a mesh/soup or oriented cloud.
+
+    ``|S|`` is the exact distance to the triangles (:class:`gsdf.TriangleDistance`) or to the nearest point of a
+    cloud (:class:`gsdf.PointCloudDistance`); the sign is negative where the fast winding number exceeds 1/2
+    (Barill et al. 2018 §4: robust to holes and soups), or, with ``sign="pseudonormal"``, the sign of the
+    angle-weighted pseudonormal of the closest feature (Bærentzen & Aanæs 2005; closed manifold meshes).
 
     Parameters
     ----------
@@ -50,22 +32,18 @@ def signed_distance_grid(V, F=None, *, points=None, resolution: int = 64, bbox_m
     F : (m, 3) int, optional
         Triangles (any soup: holes, duplicates, degenerate faces are fine with ``sign="winding"``).
     points : tuple ``(P, N)``, optional
-        An oriented point cloud instead of a mesh, P and N (p, 3): distance to the nearest point, sign from the
-        points' fast winding number.
-    resolution : int, default 64
-        Grid nodes along the longest side of the box (>= 2); the other sides get the same spacing.
-    bbox_min, bbox_max : (3,) float, optional
-        The box; default: the input's bounding box grown by ``pad`` times its diagonal. The upper corner is moved
-        up to a whole number of cubic cells.
-    pad : float, default 0.05
+        An oriented point cloud instead of a mesh, P and N (p, 3).
+    resolution : int or gsdf.Grid, default 64
+        Grid nodes along the longest side of the input's bounding box grown by :data:`gsdf.grid.PAD` × its
+        diagonal (:meth:`gsdf.Grid.around`: cubic cells); or the :class:`gsdf.Grid` to sample.
     sign : {"winding", "pseudonormal"}
         ``"pseudonormal"`` needs a mesh and is only meaningful for closed, consistently oriented manifolds.
     beta : float, optional
         Accuracy of the fast winding number (default 2 for meshes, 2.3 for points).
     return_closest : bool, default False
         Also return libigl's ``I, C, N``.
-    progress : callable ``progress(done, total)``, optional
-        Called while the winding numbers are evaluated.
+    progress : callable ``progress(stage, fraction)``, optional
+        Called while the winding numbers are evaluated (``stage="winding numbers"``, fraction in [0, 1]).
 
     Returns
     -------
@@ -89,15 +67,16 @@ def signed_distance_grid(V, F=None, *, points=None, resolution: int = 64, bbox_m
     >>> S = gsdf.signed_distance_grid(V, F, resolution=16)
     >>> S.shape, bool(S([[0.1, 0.1, 0.1]])[0] < 0)
     ((16, 16, 16), True)
-    >>> S, I, C, N = gsdf.signed_distance_grid((V, F), resolution=8, return_closest=True)
+    >>> S, I, C, N = gsdf.signed_distance_grid((V, F), resolution=gsdf.Grid(([0, 0, 0], [1, 1, 1]), (8, 8, 8)),
+    ...                                        return_closest=True)
     """
     from gsdf.field import GridField
-    from gsdf.grid import grid_points
+    from gsdf.grid import as_grid
 
     choice(sign, "sign", ("winding", "pseudonormal"))
     if not isinstance(return_closest, (bool, np.bool_)):
         raise ValueError(f"return_closest: expected True or False, got {return_closest!r}")
-    resolution = integer(resolution, "resolution", 2)
+    report = _progress(progress)
     if points is not None:
         if V is not None or F is not None:
             raise ValueError("points: give either a mesh (V, F) or points=(P, N), not both")
@@ -117,20 +96,19 @@ def signed_distance_grid(V, F=None, *, points=None, resolution: int = 64, bbox_m
             raise ValueError("V, F: expected a triangle mesh (V, F) or points=(P, N)")
         V, F = as_mesh(V, F)
         X = V
-    lo, hi, shape = _grid_box(X, resolution, bbox_min, bbox_max, pad)
-    Q = grid_points(lo, hi, shape)
+    grid = as_grid(resolution, X=X)
+    Q = grid.points()
 
     if points is not None:
-        from scipy.spatial import cKDTree
-
+        from gsdf.distance import PointCloudDistance
         from gsdf.winding import FastWindingNumberPoints
 
-        d, idx = cKDTree(P).query(Q, workers=-1)
-        b = positive(2.3 if beta is None else beta, "beta")
-        w = FastWindingNumberPoints(P, Nrm, beta=b)(Q, progress=progress)
+        d, idx, _ = PointCloudDistance(P).query(Q)
+        w = _chunked(FastWindingNumberPoints(P, Nrm, beta=positive(2.3 if beta is None else beta, "beta")), Q,
+                     report)
         s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
-        S = GridField(s.reshape(shape), lo, hi)
-        return (S, idx.astype(np.int64), P[idx], Nrm[idx]) if return_closest else S
+        S = GridField(s.reshape(grid.shape), *grid.box)
+        return (S, idx, P[idx], Nrm[idx]) if return_closest else S
 
     from gsdf.distance._signed import _pseudonormal_sign
     from gsdf.distance._triangles import TriangleDistance
@@ -144,10 +122,10 @@ def signed_distance_grid(V, F=None, *, points=None, resolution: int = 64, bbox_m
 
         # the winding numbers first: on a cold cache `gsdf sdf` compiles the distance kernels in a background
         # process meanwhile (gsdf.cli._background), which are then ready when the distance is reached
-        w = FastWindingNumber(V, F, beta=positive(2.0 if beta is None else beta, "beta"))(Q, progress=progress)
+        w = _chunked(FastWindingNumber(V, F, beta=positive(2.0 if beta is None else beta, "beta")), Q, report)
         d, face, closest = TriangleDistance(V, F).query(Q)
         s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
-    S = GridField(s.reshape(shape), lo, hi)
+    S = GridField(s.reshape(grid.shape), *grid.box)
     if not return_closest:
         return S
     if sign == "pseudonormal":
@@ -158,6 +136,33 @@ def signed_distance_grid(V, F=None, *, points=None, resolution: int = 64, bbox_m
         n = np.divide(n, ln, out=np.zeros_like(n), where=ln > 0)
         N = n[face]
     return S, face, closest, N
+
+
+#: Queries per winding-number call (the chunk of gsdf.winding's own query loop: the same calls, the same numbers).
+CHUNK = 1 << 20
+
+
+def _progress(progress):
+    """``progress`` validated: a callable ``progress(stage, fraction)`` or None."""
+    if progress is not None and not callable(progress):
+        raise ValueError("progress: expected a callable progress(stage, fraction) or None")
+    return progress
+
+
+def _chunked(winding, Q, progress, stage: str = "winding numbers") -> np.ndarray:
+    """``winding(Q)`` in chunks of :data:`CHUNK` queries, reporting ``progress(stage, fraction)`` after each."""
+    n = len(Q)
+    if progress is None or n <= CHUNK:
+        w = np.asarray(winding(Q), dtype=np.float64)
+        if progress is not None:
+            progress(stage, 1.0)
+        return w
+    w = np.empty(n)
+    for s in range(0, n, CHUNK):
+        e = min(n, s + CHUNK)
+        w[s:e] = winding(Q[s:e])
+        progress(stage, e / n)
+    return w
 
 
 def _closest_pseudonormal(V, F, face, bary):

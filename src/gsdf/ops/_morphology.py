@@ -34,7 +34,7 @@ def offset_surface(field, distance: float):
     Examples
     --------
     >>> import numpy as np
-    >>> from gsdf.field import GridField, grid_points
+    >>> from gsdf.field import GridField
     >>> from gsdf.ops._morphology import offset_surface
     >>> x = np.linspace(-1, 1, 41); X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
     >>> f = GridField(np.sqrt(X**2 + Y**2 + Z**2) - 0.5, [-1] * 3, [1] * 3)

@@ -7,21 +7,19 @@ on triangle soups and oriented point clouds, not only on closed meshes (Fig. 4).
 with ``beta = 2`` (triangles) / ``beta = 2.3`` (points) gives the same voxelization as the exact sum in
 practice (§4, "Even a small value of beta = 2 produces the identical voxelization").
 
-The grid here is a grid of *cells*: ``resolution`` cubic cells along the longest axis of the box, values
-sampled at cell centers. (Contrast :class:`gsdf.field.GridField`, whose values live on nodes.)
+The voxel centers are the nodes of a :class:`gsdf.Grid` (``resolution`` voxels = nodes along the longest side);
+a voxel is the cube of side ``spacing`` centred on its node (:meth:`gsdf.Grid.voxel_box`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_normals, as_points, as_weights, integer, nonnegative, positive
+from gsdf._checks import as_mesh, as_normals, as_points, as_weights, positive
 from gsdf._memory import check_bytes, grid_bytes
 from gsdf.mesh._topology import manifold_report, split_nonmanifold_vertices
 
 __all__ = [
-    "voxel_grid",
-    "voxel_centers",
     "winding_grid",
     "voxelize",
     "save_voxels",
@@ -29,10 +27,8 @@ __all__ = [
     "voxels_to_mesh",
 ]
 
-
-# ----------------------------------------------------------------------------------------------------------
-# grid geometry
-# ----------------------------------------------------------------------------------------------------------
+#: Voxel centers evaluated per winding-number call (bounds memory; progress is reported per chunk).
+CHUNK = 1 << 20
 
 
 def _bbox(bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
@@ -44,68 +40,6 @@ def _bbox(bbox_min, bbox_max) -> tuple[np.ndarray, np.ndarray]:
     if np.any(hi <= lo):
         raise ValueError(f"bbox_max {hi} must exceed bbox_min {lo} on every axis")
     return lo, hi
-
-
-def voxel_grid(bbox_min, bbox_max, resolution) -> tuple[tuple[int, int, int], np.ndarray, np.ndarray]:
-    """Shape and exact extent of a cubic-cell voxel grid covering a box.
-
-    The longest axis of ``[bbox_min, bbox_max]`` gets ``resolution`` cells of size
-    ``h = longest / resolution``; the other axes get ``ceil(extent / h)`` cells of the same size, and the
-    grid is centred on the requested box (so it may overhang it by less than one cell on the shorter axes).
-
-    Parameters
-    ----------
-    bbox_min, bbox_max : (3,) float
-        Requested box.
-    resolution : int
-        Number of cells along the longest axis (>= 1).
-
-    Returns
-    -------
-    shape : (nx, ny, nz)
-        Number of cells per axis.
-    grid_min, grid_max : (3,) float64
-        Corners of the voxel grid actually used; cell ``(i, j, k)`` spans
-        ``grid_min + [i, i+1] x [j, j+1] x [k, k+1] * h``.
-
-    Examples
-    --------
-    >>> from gsdf.ops import voxel_grid
-    >>> voxel_grid([0, 0, 0], [2, 1, 1], 4)[0]
-    (4, 2, 2)
-    """
-    lo, hi = _bbox(bbox_min, bbox_max)
-    r = integer(resolution, "resolution", 1)
-    ext = hi - lo
-    h = float(ext.max()) / r
-    n = np.maximum(1, np.ceil(ext / h - 1e-9)).astype(np.int64)
-    n[int(np.argmax(ext))] = r
-    c = 0.5 * (lo + hi)
-    gmin = c - 0.5 * n * h
-    gmax = gmin + n * h
-    return (int(n[0]), int(n[1]), int(n[2])), gmin, gmax
-
-
-def voxel_centers(bbox_min, bbox_max, shape, flat_index=None) -> np.ndarray:
-    """Centers of the cells of a voxel grid, (k, 3), in C order of an array of ``shape``.
-
-    ``flat_index`` (optional, int array) selects cells by their C-order flat index (used for chunking).
-
-    Examples
-    --------
-    >>> from gsdf.ops import voxel_centers
-    >>> voxel_centers([0, 0, 0], [2, 2, 2], (2, 2, 2))[-1].tolist()
-    [1.5, 1.5, 1.5]
-    """
-    lo, hi = _bbox(bbox_min, bbox_max)
-    shape = tuple(int(s) for s in shape)
-    if len(shape) != 3 or min(shape) < 1:
-        raise ValueError(f"shape: expected 3 positive cell counts, got {shape}")
-    h = (hi - lo) / np.array(shape, dtype=np.float64)
-    if flat_index is None:
-        flat_index = np.arange(int(np.prod(shape)), dtype=np.int64)
-    ijk = np.column_stack(np.unravel_index(np.asarray(flat_index, dtype=np.int64), shape)).astype(np.float64)
-    return lo + (ijk + 0.5) * h
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -139,11 +73,11 @@ def _winding_object(mesh, points, beta):
     return FastWindingNumberPoints(P, N, areas=areas, **kw), P
 
 
-def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max=None, pad=0.05, beta=None,
-                 chunk=2**20, progress=None):
-    """Fast generalized winding number of a mesh/soup or an oriented point cloud at voxel centers.
+def winding_grid(mesh=None, points=None, resolution=100, beta=None, progress=None):
+    """Fast generalized winding number of a mesh/soup or an oriented point cloud on the nodes of a grid.
 
-    This is :func:`voxelize` without the final threshold (Barill et al. 2018, §4 "Voxelization").
+    This is :func:`voxelize` without the final threshold (Barill et al. 2018, §4 "Voxelization"): the nodes are
+    the voxel centers.
 
     Parameters
     ----------
@@ -153,27 +87,20 @@ def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max
     points : tuple (P, N) or (P, N, areas), optional
         Oriented point cloud, evaluated with :class:`gsdf.winding.FastWindingNumberPoints` (``areas=None``:
         estimated). Give exactly one of ``mesh`` and ``points``.
-    resolution : int
-        Number of cubic cells along the longest axis of the box.
-    bbox_min, bbox_max : (3,) float, optional
-        Box to voxelize; by default the input's bounding box grown by ``pad`` times its diagonal.
-    pad : float
-        Padding as a fraction of the bounding-box diagonal (used only for the default box), >= 0.
+    resolution : int or gsdf.Grid, default 100
+        Nodes (voxels) along the longest side of the input's bounding box grown by :data:`gsdf.grid.PAD` × its
+        diagonal (:meth:`gsdf.Grid.around`; a mesh's box is that of its referenced vertices); or the
+        :class:`gsdf.Grid` to sample.
     beta : float, optional
         Accuracy parameter of the tree approximation (§3.4); ``None`` uses the evaluator's default
         (2.0 for triangles, 2.3 for points).
-    chunk : int
-        Number of voxel centers evaluated per call (bounds memory; ``progress`` is called per chunk).
-    progress : callable(done, total), optional
-        Called after each chunk with the number of voxels done so far and the total.
+    progress : callable ``progress(stage, fraction)``, optional
+        Called after each chunk of nodes with ``stage="winding numbers"`` and the fraction done.
 
     Returns
     -------
-    W : (nx, ny, nz) float64
-        Winding number at cell centers; cell ``(i, j, k)`` is centred at
-        ``grid_min + (i + 0.5, j + 0.5, k + 0.5) * h``.
-    grid_min, grid_max : (3,) float64
-        Corners of the voxel grid (see :func:`voxel_grid`; may overhang the requested box by < 1 cell).
+    gsdf.GridField
+        The winding numbers on the grid's nodes (``.values`` (nx, ny, nz), ``.bbox_min``, ``.bbox_max``).
 
     Examples
     --------
@@ -181,76 +108,64 @@ def winding_grid(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max
     >>> from gsdf.ops import winding_grid
     >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
     >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
-    >>> W, lo, hi = winding_grid(mesh=(V, F), resolution=8)
-    >>> W.shape
+    >>> winding_grid(mesh=(V, F), resolution=8).shape
     (8, 8, 8)
     """
+    from gsdf.field import GridField
+    from gsdf.grid import as_grid
+
     wn, X = _winding_object(mesh, points, beta)
-    r = integer(resolution, "resolution", 1)
-    pad = nonnegative(pad, "pad", most=1e6)
-    chunk = integer(chunk, "chunk", 1)
     if progress is not None and not callable(progress):
-        raise ValueError("progress: expected a callable(done, total) or None")
-
-    from gsdf.mesh._geometry import bounding_box
-
-    dlo, dhi = bounding_box(X, pad)
-    if np.any(dhi <= dlo):  # flat input (e.g. a single planar facet): grow the flat axes
-        d = float(np.linalg.norm(dhi - dlo)) or 1.0
-        flat = dhi - dlo <= 1e-12 * d
-        dlo = np.where(flat, dlo - 0.5 * max(pad, 0.05) * d, dlo)
-        dhi = np.where(flat, dhi + 0.5 * max(pad, 0.05) * d, dhi)
-    lo = dlo if bbox_min is None else bbox_min
-    hi = dhi if bbox_max is None else bbox_max
-    shape, gmin, gmax = voxel_grid(lo, hi, r)
-
-    # the grid (8 B/cell, +1 B for voxelize's occupancy) plus one chunk of centres, indices and values
-    check_bytes(grid_bytes(shape, 9) + 64 * min(chunk, grid_bytes(shape, 1)),
-                f"winding grid: resolution={r} gives {shape[0]}x{shape[1]}x{shape[2]} cells")
-    total = int(np.prod(shape))
+        raise ValueError("progress: expected a callable progress(stage, fraction) or None")
+    grid = as_grid(resolution, X=X)
+    shape = grid.shape
+    # the grid (8 B/node, +1 B for voxelize's occupancy) plus one chunk of centres, indices and values
+    check_bytes(grid_bytes(shape, 9) + 64 * min(CHUNK, grid_bytes(shape, 1)),
+                f"winding grid: {shape[0]}x{shape[1]}x{shape[2]} voxels")
+    total = grid.size
     W = np.empty(total, dtype=np.float64)
-    for s in range(0, total, chunk):
-        e = min(total, s + chunk)
-        Q = voxel_centers(gmin, gmax, shape, np.arange(s, e, dtype=np.int64))
-        W[s:e] = np.asarray(wn(Q), dtype=np.float64).reshape(-1)
+    for s in range(0, total, CHUNK):
+        e = min(total, s + CHUNK)
+        W[s:e] = np.asarray(wn(grid.points(np.arange(s, e, dtype=np.int64))), dtype=np.float64).reshape(-1)
         if progress is not None:
-            progress(e, total)
-    return W.reshape(shape), gmin, gmax
+            progress("winding numbers", e / total)
+    return GridField(W.reshape(shape), *grid.box)
 
 
-def voxelize(mesh=None, points=None, resolution=100, bbox_min=None, bbox_max=None, pad=0.05, beta=None,
-             chunk=2**20, progress=None):
+def voxelize(mesh=None, points=None, resolution=100, beta=None, progress=None):
     """Voxelize a mesh, triangle soup or oriented point cloud: inside where the winding number >= 1/2.
 
-    Barill et al. 2018, §4 "Voxelization" and Fig. 11: the occupancy of each cubic cell is decided by the fast
+    Barill et al. 2018, §4 "Voxelization" and Fig. 11: the occupancy of each cubic voxel is decided by the fast
     generalized winding number at its center, which is robust to holes, self-intersections, duplicated and
     inconsistently connected geometry (Fig. 4), and works on point clouds (§3.2).
 
     Parameters
     ----------
-    mesh, points, resolution, bbox_min, bbox_max, pad, beta, chunk, progress
-        As in :func:`winding_grid`.
+    mesh, points, resolution, beta, progress
+        As in :func:`winding_grid` (``resolution``: voxels along the longest side, or the :class:`gsdf.Grid`
+        of the voxel centers).
 
     Returns
     -------
     occupancy : (nx, ny, nz) bool
-        True for cells whose center has winding number >= 1/2.
-    grid_min, grid_max : (3,) float64
-        Corners of the voxel grid (cell size ``(grid_max - grid_min) / occupancy.shape``, equal on all axes).
+        True for voxels whose center has winding number >= 1/2.
+    bbox_min, bbox_max : (3,) float64
+        Corners of the voxels (:meth:`gsdf.Grid.voxel_box`; voxel size ``(bbox_max - bbox_min) /
+        occupancy.shape``, equal on all axes).
 
     Examples
     --------
     >>> import numpy as np
+    >>> from gsdf import Grid
     >>> from gsdf.ops import voxelize
     >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
     >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
-    >>> occ, lo, hi = voxelize(mesh=(V, F), resolution=16, pad=0.0)
+    >>> occ, lo, hi = voxelize(mesh=(V, F), resolution=Grid.around(V, 16, pad=0.0))
     >>> bool(occ[1, 1, 1]), bool(occ[-1, -1, -1])
     (True, False)
     """
-    W, gmin, gmax = winding_grid(mesh=mesh, points=points, resolution=resolution, bbox_min=bbox_min,
-                                 bbox_max=bbox_max, pad=pad, beta=beta, chunk=chunk, progress=progress)
-    return W >= 0.5, gmin, gmax
+    W = winding_grid(mesh=mesh, points=points, resolution=resolution, beta=beta, progress=progress)
+    return (W.values >= 0.5, *W.grid.voxel_box())
 
 
 # ----------------------------------------------------------------------------------------------------------

@@ -13,10 +13,10 @@ from gsdf.tori._baselines import (
     SmoothedSignedPlanarDistance,
     WindingNumberPipeline,
 )
-from gsdf.tori._pat import PointsAsTori
+from gsdf.tori._pat import PointsAsTori, PointsAsToriOptions
 from gsdf.tori._ops import contour, difference, intersection, offset, union
 from gsdf.tori._torus import coefficients_to_tori, torus_sdf
 
-__all__ = ["PointsAsTori", "SignedHopfCole", "SmoothedSignedPlanarDistance", "LogSumExpDistance",
+__all__ = ["PointsAsTori", "PointsAsToriOptions", "SignedHopfCole", "SmoothedSignedPlanarDistance", "LogSumExpDistance",
            "WindingNumberPipeline", "coefficients_to_tori", "torus_sdf", "union", "intersection", "difference",
            "offset", "contour"]

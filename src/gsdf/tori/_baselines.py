@@ -190,9 +190,10 @@ class WindingNumberPipeline:
     P, N : (n, 3) float
         Oriented points.
     bbox_min, bbox_max : (3,) float, optional
-        Box contoured (default: the cloud's box padded by 10 % of its diagonal).
-    resolution : int
-        Marching-cubes grid nodes along the longest side (64 as in §7.2).
+        Box contoured (default: the cloud's bounding box grown by :data:`gsdf.grid.PAD` × its diagonal).
+    resolution : int or gsdf.Grid
+        Marching-cubes grid nodes along the longest side of the box (64 as in §7.2); or the
+        :class:`gsdf.Grid` to contour on (then omit the box).
     areas : (n,) float, optional
         Point areas for the winding number.
 
@@ -211,14 +212,13 @@ class WindingNumberPipeline:
         from gsdf.distance import TriangleDistance
         from gsdf.winding import FastWindingNumber, FastWindingNumberPoints
 
+        from gsdf.grid import Grid, padded_box
+
         P = as_points(P, "P")
         fwn = FastWindingNumberPoints(P, N, areas=areas)
-        if bbox_min is None or bbox_max is None:
-            lo, hi = P.min(0), P.max(0)
-            m = 0.1 * np.linalg.norm(hi - lo)
-            bbox_min, bbox_max = lo - m, hi + m
-        self.V, self.F = extract_isosurface(fwn, bbox_min, bbox_max, integer(resolution, "resolution", lo=2),
-                                            level=0.5, inside="above")
+        if (bbox_min is None or bbox_max is None) and not isinstance(resolution, Grid):
+            bbox_min, bbox_max = padded_box(P)
+        self.V, self.F = extract_isosurface(fwn, bbox_min, bbox_max, resolution, level=0.5, inside="above")
         if len(self.F) == 0:
             raise ValueError("the winding number of the cloud never crosses 1/2 in the box: no surface to measure")
         self._dist = TriangleDistance(self.V, self.F)

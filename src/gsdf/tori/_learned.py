@@ -11,7 +11,7 @@ neighbour
 
 plus the scale-normalized jet-fit coefficients (a00/h, a10, a01, a20 h, a11 h, a02 h) of
 :func:`gsdf.tori._fit.jet_coefficients` (clipped to ±8). Architecture (a PointNet-style stand-in for the
-transformer of Fig. 5.6, small enough to train on a 2-core CPU): a shared per-neighbour MLP 7 → 32 → 64 → 64
+transformer of Fig. 5.6): a shared per-neighbour MLP 7 → 32 → 64 → 64
 (ReLU), max and mean pooling over the neighbours (permutation invariant), concatenation with the jet
 coefficients, and an MLP 134 → 64 → 64 → 6 whose output is a *correction* added to the scaled jet
 coefficients (the last layer is zero-initialized, so training starts from the classical estimator — the

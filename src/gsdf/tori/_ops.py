@@ -57,9 +57,9 @@ def offset(field, r: float):
     return lambda Q: _call(field, Q) - r
 
 
-def contour(field, bbox_min, bbox_max, resolution: int = 64, level: float = 0.0):
-    """Mesh of ``field = level`` on a grid in the box (marching cubes + bisection, ``inside="below"``)."""
+def contour(field, bbox_min=None, bbox_max=None, resolution=64, level: float = 0.0):
+    """Mesh of ``field = level``: :func:`gsdf.extract_isosurface` with ``inside="below"`` (marching cubes +
+    bisection) on ``resolution`` nodes along the longest side of the box, or on a :class:`gsdf.Grid`."""
     from gsdf.contour import extract_isosurface
 
-    lo, hi = as_points(bbox_min, "bbox_min")[0], as_points(bbox_max, "bbox_max")[0]
-    return extract_isosurface(field, lo, hi, resolution, level=level, inside="below")
+    return extract_isosurface(field, bbox_min, bbox_max, resolution, level=level, inside="below")

@@ -17,17 +17,20 @@ w_i the weights and ℓ_i = −λ_x ‖x − p_i‖ their log (terms common to a
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_points, choice, integer, nonnegative, positive
+from gsdf._checks import as_points, choice, finite, integer, nonnegative, positive
 from gsdf._normalize import Frame
+from gsdf.grid import PAD, Grid, padded_box
 from gsdf.threads import apply_env
 from gsdf.tori._blend import NeighbourBlend
 from gsdf.tori._fit import jet_coefficients
 from gsdf.tori._torus import TORUS_WIDTH, coefficients_to_tori, torus_eval
 
-__all__ = ["PointsAsTori"]
+__all__ = ["PointsAsTori", "PointsAsToriOptions", "level_grid"]
 
 
 @njit(cache=True, inline="always")
@@ -128,6 +131,44 @@ def _clean_cloud(P, N, k):
     return np.ascontiguousarray(P), np.ascontiguousarray(N)
 
 
+@dataclasses.dataclass(frozen=True)
+class PointsAsToriOptions:
+    """Neighbour-selection and jet-fitting options of :class:`PointsAsTori` (thesis §5.1).
+
+    Attributes
+    ----------
+    k_eval : int, default 64
+        Most points summed per query (neighbour query size).
+    k_fallback : int, default 32
+        Points always summed per query, even beyond R_eval (the 32 nearest of §5.1.3).
+    normal_weight : float, default 1.0
+        Jet fitting: weight of the normal (slope) rows.
+    ridge : float, default 1e-3
+        Jet fitting: ridge on the curvature terms.
+    curvature_cap : float, default 4.0
+        Jet fitting: largest curvature in units of 1/h_i (h_i: median distance to the k-th neighbour).
+    kd_eps : float, default 0.0
+        Approximate neighbour search for queries far from the cloud: every neighbour distance used is within a
+        factor (1 + kd_eps) of the true one (0 = exact).
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> P = np.random.default_rng(0).normal(size=(500, 3))
+    >>> P /= np.linalg.norm(P, axis=1, keepdims=True)
+    >>> pat = gsdf.PointsAsTori(P, P, k=32, options=gsdf.PointsAsToriOptions(kd_eps=0.3))
+    >>> bool(pat.signed_distance([[0, 0, 0]])[0] < 0)
+    True
+    """
+
+    k_eval: int = 64
+    k_fallback: int = 32
+    normal_weight: float = 1.0
+    ridge: float = 1e-3
+    curvature_cap: float = 4.0
+    kd_eps: float = 0.0
+
+
 class PointsAsTori:
     """Generalized signed distance of an oriented point cloud, evaluated pointwise (thesis ch. 5).
 
@@ -140,22 +181,17 @@ class PointsAsTori:
         points are merged (their normals averaged); ``None`` raises ``ValueError``.
     estimator : {"jet", "learned"}
         Coefficient estimator: weighted least-squares jet fitting (:func:`gsdf.tori._fit.jet_coefficients`), or
-        the learned regressor of §5.1.2 (:mod:`gsdf.tori._learned`; a small network trained by
-        ``scripts/train_pat.py``, weights shipped in ``gsdf/tori/pat_weights.npz``, evaluated in numpy; it
-        corrects the jet coefficients, so ``normal_weight``/``ridge`` do not apply to it).
+        the learned regressor of §5.1.2 (:mod:`gsdf.tori._learned`; a small network, weights shipped in
+        ``gsdf/tori/pat_weights.npz``, evaluated in numpy; it corrects the jet coefficients, so
+        ``normal_weight``/``ridge`` do not apply to it).
     k : int
         Neighbours per fit (64 in the thesis); the cloud needs at least ``k`` distinct points.
     C : float
         Screening constant of Eq. 5.7 (λ_x = C/σ_x).
     r_eval : float, optional
         Summation radius R_eval; default twice the median distance of a point to its 32nd neighbour.
-    k_eval : int
-        Most points summed per query (neighbour query size); ``k_fallback`` (32) are always summed.
-    normal_weight, ridge, curvature_cap : float
-        Jet-fitting options: weight of the normal (slope) rows, ridge on the curvature terms, and the
-        largest curvature in units of 1/h_i (h_i: median distance to the k-th neighbour).
-    kd_eps : float
-        Approximate neighbour search for queries (0 = exact; e.g. 0.3 is ~2x faster far from the cloud).
+    options : PointsAsToriOptions, optional
+        Neighbour selection and jet-fitting options.
 
     Examples
     --------
@@ -169,21 +205,33 @@ class PointsAsTori:
     """
 
     def __init__(self, P, N, estimator: str = "jet", k: int = 64, C: float = 64.0, r_eval=None,
-                 k_eval: int = 64, k_fallback: int = 32, normal_weight: float = 1.0, ridge: float = 1e-3,
-                 curvature_cap: float = 4.0, kd_eps: float = 0.0, _state=None):
+                 options: PointsAsToriOptions | None = None):
+        self._setup(P, N, estimator, k, C, r_eval, options, None)
+
+    @classmethod
+    def _from_state(cls, state, estimator, k, C, r_eval, options):
+        self = cls.__new__(cls)
+        self._setup(None, None, estimator, k, C, r_eval, options, state)
+        return self
+
+    def _setup(self, P, N, estimator, k, C, r_eval, options, _state):
         apply_env()  # GSDF_NUM_THREADS
+        if options is None:
+            options = PointsAsToriOptions()
+        if not isinstance(options, PointsAsToriOptions):
+            raise ValueError(f"options: expected a gsdf.PointsAsToriOptions, got {type(options).__name__}")
         self.estimator = choice(estimator, "estimator", {"jet", "learned"})
         self.k = integer(k, "k", lo=6)
         self.C = positive(C, "C", most=1e300)
-        self.k_eval = integer(k_eval, "k_eval", lo=1)
-        self.k_fallback = integer(k_fallback, "k_fallback", lo=1)
-        self.options = dict(normal_weight=nonnegative(normal_weight, "normal_weight"),
-                            ridge=nonnegative(ridge, "ridge"),
-                            curvature_cap=positive(curvature_cap, "curvature_cap"))
+        self.k_eval = integer(options.k_eval, "k_eval", lo=1)
+        self.k_fallback = integer(options.k_fallback, "k_fallback", lo=1)
+        self.options = dict(normal_weight=nonnegative(options.normal_weight, "normal_weight"),
+                            ridge=nonnegative(options.ridge, "ridge"),
+                            curvature_cap=positive(options.curvature_cap, "curvature_cap"))
         if r_eval is not None:
             r_eval = positive(r_eval, "r_eval")
         # (1 + kd_eps)² scales squared box distances in the neighbour walk: keep it a modest finite factor
-        kd_eps = nonnegative(kd_eps, "kd_eps", most=1e3)
+        kd_eps = nonnegative(options.kd_eps, "kd_eps", most=1e3)
         if _state is not None:
             self.P, self.N, coefficients, tori, framed = _state
         else:
@@ -263,13 +311,15 @@ class PointsAsTori:
         """Analytic gradient ∇φ(Q) of Eq. 5.6, (q, 3) float64."""
         return self._eval(Q, True)
 
-    def isosurface(self, level: float = 0.0, resolution: int = 64, pad: float = 0.1):
-        """Mesh of the level set φ = ``level`` on a grid around the cloud (padded by ``pad`` × diagonal + ``|level|``)."""
+    def isosurface(self, level: float = 0.0, resolution=64, pad: float = PAD):
+        """Mesh of the level set φ = ``level`` (marching cubes + bisection, :func:`gsdf.extract_isosurface`).
+
+        ``resolution``: nodes along the longest side of the cloud's bounding box grown by ``pad`` × its diagonal
+        and by ``|level|`` (:func:`level_grid`), or the :class:`gsdf.Grid` to sample."""
         from gsdf.contour import extract_isosurface
 
-        lo, hi = self.P.min(0), self.P.max(0)
-        m = pad * np.linalg.norm(hi - lo) + abs(float(level))
-        return extract_isosurface(self.signed_distance, lo - m, hi + m, resolution, level=level, inside="below")
+        grid = resolution if isinstance(resolution, Grid) else level_grid(self.P, resolution, level, pad)
+        return extract_isosurface(self.signed_distance, resolution=grid, level=level, inside="below")
 
     def save(self, path) -> None:
         """Write the fitted tori (and the cloud) to an ``.npz`` file; reload with :meth:`load`.
@@ -332,10 +382,20 @@ class PointsAsTori:
                   np.ascontiguousarray(arrays["tori_frame"], dtype=np.float64)) if frame_copies else None)
         if n < 1:
             raise ValueError(f"{path}: no points")
-        return cls(None, None, estimator=str(_scalar(arrays["estimator"], path, "estimator")),
-                   k=_scalar(arrays["k"], path, "k"), C=_scalar(arrays["C"], path, "C"),
-                   r_eval=_scalar(arrays["r_eval"], path, "r_eval"), k_eval=_scalar(arrays["k_eval"], path, "k_eval"),
-                   k_fallback=_scalar(arrays["k_fallback"], path, "k_fallback"), _state=state)
+        options = PointsAsToriOptions(k_eval=_scalar(arrays["k_eval"], path, "k_eval"),
+                                      k_fallback=_scalar(arrays["k_fallback"], path, "k_fallback"))
+        return cls._from_state(state, estimator=str(_scalar(arrays["estimator"], path, "estimator")),
+                               k=_scalar(arrays["k"], path, "k"), C=_scalar(arrays["C"], path, "C"),
+                               r_eval=_scalar(arrays["r_eval"], path, "r_eval"), options=options)
+
+
+def level_grid(X, resolution, level: float = 0.0, pad: float = PAD) -> Grid:
+    """The grid for the level set φ = ``level`` of a cloud ``X``: :meth:`gsdf.Grid.fit` of its bounding box grown
+    by ``pad`` × its diagonal (:func:`gsdf.grid.padded_box`) and by ``|level|`` (an offset surface lies up to
+    ``|level|`` outside the cloud)."""
+    lo, hi = padded_box(X, pad)
+    m = abs(finite(level, "level"))
+    return Grid.fit((lo - m, hi + m), resolution)
 
 
 def _coefficients_units(A, exponent):

@@ -422,8 +422,14 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     (0.01, 0.81)
     """
     P = as_points(P, "P")
+    return _point_areas(P, as_normals(N, P.shape[0], "N"), k, boundary, candidates)
+
+
+def _point_areas(P: np.ndarray, N: np.ndarray, k: int = 20, boundary: str = "hull",
+                 candidates: int = 8) -> np.ndarray:
+    """:func:`point_areas` of a validated cloud (``P`` (n, 3) float64 and ``N`` (n, 3) finite, as
+    :func:`gsdf._checks.as_points` / ``as_normals`` return them)."""
     n = P.shape[0]
-    N = as_normals(N, n, "N")
     k = integer(k, "k", 1)
     if boundary not in ("hull", "square"):
         raise ValueError(f"boundary: must be one of ['hull', 'square'], got {boundary!r}")

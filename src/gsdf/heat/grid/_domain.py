@@ -1,7 +1,8 @@
 """Regular grids as a signed-heat domain (Feng & Crane 2024, §8.2); operators in :mod:`gsdf.heat.grid._poisson`.
 
-Step I    X at the grid nodes: the Yukawa potential of the sources (``diffuse``: a tree walk, :mod:`.yukawa`, or
-          one screened solve on the grid itself, :mod:`.screened` — ``step1``, below).
+Step I    X at the grid nodes: the Yukawa potential of the sources (``diffuse``: a tree walk,
+          :mod:`gsdf.heat._yukawa`, or one screened solve on the grid itself, :mod:`gsdf.heat.grid._screened` —
+          ``step1``, below).
 Step II   normalized at the nodes (by the core).
 Step III  the 7-point Neumann Laplacian against the forward-difference divergence; :class:`GridPoisson` solves it
           exactly by DCT (no constraint), by CG with the coarse-block + band Gauss–Seidel + DCT preconditioner
@@ -12,7 +13,7 @@ source would force φ ≡ 0 on every cell a dense input crosses). ``"zero"`` imp
 shifted); ``"multiple"`` makes them equal within each connected component of the input (rows per component and
 cell, differences to the first), then shifts; ``soft_weight=c`` penalizes c Σ_f a_f φ(b_f)² / h⁴ (φ at every
 source, not differences — this pulls the zero level through the input), then shifts. The shift is the
-area-weighted mean of φ over the sources (the anchor's evaluateAverageAlongSourceGeometry).
+area-weighted mean of φ over the sources (signedheat3d's evaluateAverageAlongSourceGeometry).
 
 Example
 -------
@@ -60,11 +61,7 @@ class GridPoisson(PoissonSolver):
     def free(self, b):
         return dct_poisson(b, self.d.shape, self.d.spacing)
 
-    #: CG's relative residual for the soft penalty. On the 10 inputs of bench/bench_heat_volume_speed.py at 32³,
-    #: 1e-3 instead of 1e-4 takes 1-3 fewer iterations (4-9 instead of 7-12; ~1 ms each) and moves the mean
-    #: error by at most 2.6e-4 of its value (the broken bunny 0.015171 → 0.015167, lower; holes 0.565549 →
-    #: 0.565574): far under the discretization error, which 1e-4 → 1e-5 did not change either
-    #: (bench/bench_volume_choices.py, RESULTS section "volume-choices"). signedheat3d stops its Step III at 1e-2.
+    #: CG's relative residual for the soft penalty (docs/decisions.md).
     penalty_tol = 1e-3
 
     def penalized(self, A, w, b):
@@ -90,21 +87,16 @@ class GridDomain(HeatDomain):
     Parameters
     ----------
     lo, hi : (3,) box corners; shape : (3,) node counts; t : diffusion time;
-    theta, eps : the Yukawa tree's cluster tolerance and source pruning (:class:`~gsdf.heat.volume.YukawaTree`);
+    theta, eps : the Yukawa tree's cluster tolerance and source pruning (a source weighing less than ``eps`` ×
+        the nearest one is skipped, :class:`~gsdf.heat._yukawa.YukawaTree`);
     rho, tol : penalty and tolerance (× h) of the augmented Lagrangian of the hard constraints;
     progress : ``progress(stage, fraction)`` for step I;
     step1 : {"auto", "yukawa", "heat"} — Step I by the Yukawa tree sum, or by the screened solve on the grid
-        (:func:`~gsdf.heat.grid._screened.screened_heat`, ~1 ms at 32³ instead of 10–60 ms). "auto": "heat"
-        on cubic cells when t ≥ h²/2, every source lies in the box padded by
+        (:func:`~gsdf.heat.grid._screened.screened_heat`). "auto" (what :func:`gsdf.signed_heat_volume` uses):
+        "heat" on cubic cells when t ≥ h²/2, every source lies in the box padded by
         :data:`~gsdf.heat.grid._screened.PAD` cells (the splat clamps the others to it) and the farthest node
-        is within :data:`~gsdf.heat.grid._screened.MAX_DECAY` decay lengths of the sources, else "yukawa".
-        Measured on the 10 inputs of bench/bench_heat_volume_speed.py (7 meshes and soups, 3 clouds): at 32³
-        the grid solve's mean error is lower than the tree sum's on 9 of 10 (fandisk 0.015075 vs 0.015237,
-        holes 0.565574 vs 0.565918, kitten 0.008569 vs 0.008618), higher on couplingdown (0.013035 vs
-        0.013013, +0.2 %), and the whole solve takes 0.25–0.5 of the time. At 64³ (t = h²) the farthest nodes
-        lie beyond MAX_DECAY on those inputs, so "auto" keeps the tree there; forced (``step1="heat"``) the
-        grid solve's error is within −0.2 … +1.2 % of the tree's on five meshes at 0.3–0.5 of the time
-        (bench/bench_volume_choices.py, RESULTS section "volume-choices").
+        is within :data:`~gsdf.heat.grid._screened.MAX_DECAY` decay lengths of the sources, else "yukawa"
+        (docs/decisions.md).
     """
 
     heat_form = "direct"

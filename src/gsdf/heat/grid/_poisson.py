@@ -1,15 +1,16 @@
 """Operators and Poisson solvers of the grid signed-heat domain (Feng & Crane 2024, §8.2). The steps run in
-:mod:`gsdf.heat._core` over :class:`gsdf.heat.grid._domain.GridDomain`; ``solve_grid`` is in :mod:`.solve`.
+:mod:`gsdf.heat._core` over :class:`gsdf.heat.grid._domain.GridDomain`; ``solve_grid`` is in
+:mod:`gsdf.heat.volume._solve`.
 
 Step I   X_t(x) = Σ_f |f| N_f G_t(x, b_f), the Yukawa potential of the sources (the fundamental solution of
-         id − tΔ, λ = 1/√t), by a tree walk (:mod:`.yukawa`) instead of the anchor's O(nodes × faces) sum, or
-         (clouds, ``step1="auto"``) by one screened solve on the grid itself (:mod:`.screened`).
+         id − tΔ, λ = 1/√t), by a tree walk (:mod:`gsdf.heat._yukawa`) or by one screened solve on the grid
+         itself (:mod:`gsdf.heat.grid._screened`), as :class:`~gsdf.heat.grid._domain.GridDomain` chooses.
 Step II  Y = X / |X| (Eq. 3 of the seed: only the direction is kept).
 Step III Δφ = ∇·Y with the seven-point Laplacian, Neumann boundary and forward differences: we minimise
          Σ_edges (φ_j − φ_i − h Ŷ_ij)² over the grid edges, Ŷ_ij the edge component of Y averaged over the
          edge's two nodes. Its normal equations are the 7-point graph Laplacian (natural Neumann boundary) against
          the forward-difference divergence of Y (the transpose of the forward-difference gradient).
-Level set: "none": φ is shifted so that its area-weighted mean over the source points is 0 (as the anchor
+Level set: "none": φ is shifted so that its area-weighted mean over the source points is 0 (as signedheat3d
          does). ``soft_weight=c``: the zero level set is pulled through the sources by a penalty on the
          trilinear values φ(b_f), then the same shift. "zero" (hard): the seed's constrained solve with
          trilinear rows (§8.2), one row per grid cell holding sources (the area-weighted mean of their trilinear
@@ -18,8 +19,7 @@ Level set: "none": φ is shifted so that its area-weighted mean over the source 
          component.
 
 Linear algebra: the Neumann 7-point Laplacian on a box is diagonal in the DCT-II basis, so Step III is solved
-*exactly* by two fast cosine transforms, O(N log N) at every size (128³ in well under a second) — faster than
-a sparse factorization or algebraic multigrid (pyamg took 7 s setup + 5 s solve at 64³ here). With the soft
+*exactly* by two fast cosine transforms, O(N log N) at every size (128³ in well under a second). With the soft
 level-set constraint the system becomes L + P and is solved by CG preconditioned with that fast solver between
 Gauss–Seidel sweeps over the penalized nodes and a coarse block-aggregate correction. The
 exact constraint factorizes L + ρCᵀWC once (CHOLMOD / SuperLU, grids up to 50k nodes) and reuses it for every
@@ -35,7 +35,6 @@ import scipy.sparse as sp
 from numba import njit
 
 from gsdf.linalg import Factorization, pcg
-from gsdf.heat.volume._memory import available_memory, check_memory  # noqa: F401  (re-exported)
 
 
 
@@ -44,7 +43,7 @@ def neumann_laplacian(shape, spacing) -> sp.csr_matrix:
 
     K_a is the path Laplacian along axis a (2 on the diagonal, 1 at both ends, −1 off it). Assembled directly in
     CSR by :func:`_laplacian_csr` — entry for entry what ``kron(K_x, I, I) + kron(I, K_y, I) + kron(I, I, K_z)``
-    gives (:func:`_neumann_laplacian_kron`, kept for the test), ~10× faster at 32³.
+    gives (:func:`_neumann_laplacian_kron`, kept for the test).
     """
     shape = tuple(int(s) for s in shape)
     w = np.array([float(spacing[a]) ** 2 for a in range(3)])
@@ -303,10 +302,8 @@ def dct3(X, inverse: bool = False) -> np.ndarray:
     ``dctn(X, type=2, norm="ortho")`` / ``idctn``.
 
     Small grids (n0 + n1 + n2 ≤ :data:`DCT_MATRIX_MAX_SUM`) apply the dense n_a × n_a DCT matrix along each axis
-    (three matrix products, 2 N Σ n_a flops, in BLAS): at 32³-sized grids that is 2-3× faster than pocketfft,
-    whose odd and prime lengths (23, 27, …, the cubic-cell grids of a box) are its slow case — (23, 32, 27):
-    0.12 vs 0.31 ms, (32, 32, 32): 0.18 vs 0.37 ms; at 48³ and 64³ pocketfft is faster (1.2 vs 2.1 ms,
-    3.8 vs 6.0 ms) and is used. The two agree to ~3e-14 of the values.
+    (three matrix products, 2 N Σ n_a flops, in BLAS); larger ones scipy.fft (pocketfft). The two agree to
+    ~3e-14 of the values.
     """
     X = np.asarray(X, np.float64)
     shape = X.shape
@@ -328,9 +325,8 @@ def dct3(X, inverse: bool = False) -> np.ndarray:
 
 
 def _fft_workers(n: int) -> int:
-    """Threads of scipy.fft for an n-node transform: one below 2¹⁸ nodes (a 32³ DCT takes ~1 ms, starting and
-    joining threads costs more, and under load a descheduled worker stalls the call), else gsdf's thread
-    setting (:func:`gsdf.threads.get_num_threads`). The result is the same for any count."""
+    """Threads of scipy.fft for an n-node transform: one below 2¹⁸ nodes, else gsdf's thread setting
+    (:func:`gsdf.threads.get_num_threads`). The result is the same for any count."""
     if n < 1 << 18:
         return 1
     from gsdf.threads import get_num_threads
@@ -369,15 +365,9 @@ def solve_poisson(rhs, shape, spacing, penalty=None, tol: float = 1e-5, maxiter:
     application therefore costs one DCT pair, two tiny coarse solves and O(N) vector work — no full product
     with A (the same operator as recomputing r − A x after each stage, in fewer flops). The stages are numba
     kernels on the grid (:class:`PenalizedPoisson`: L applied as its stencil, never assembled), so a CG
-    iteration makes a dozen calls instead of ~40 SciPy ones.
+    iteration makes a dozen calls.
 
-    Iterations on the broken bunny at 64³: 14 (DCT alone: 116); 10–16 at 32³. The start is the unconstrained
-    DCT solution plus the best constant. ``tol`` is CG's relative residual (1e-5 moves φ by ~1e-5 of the
-    box diagonal, far under the discretization error). Blocks of at least 4 nodes: at 32³ the coarse LU of
-    2-node blocks (2.7k unknowns) cost 10–30 ms, more than the 1–3 extra iterations of 3-node blocks; with the
-    numba stages an iteration is cheap enough that 4-node blocks (~350 coarse unknowns at 32³, LU < 1 ms) win
-    again: on 7 of bench/bench_heat_volume_speed.py's inputs the solve took 0.84–1.0× the time of 3-node blocks
-    for 1–2 more iterations, the mean errors equal to 5–6 digits.
+    The start is the unconstrained DCT solution plus the best constant. ``tol`` is CG's relative residual.
     """
     shape = tuple(shape)
     if penalty is None:

@@ -1,15 +1,14 @@
 """Step I of the grid signed heat method on the grid itself: one screened solve (id − tΔ) X = X⁰ by fast cosine
-transforms, instead of the Yukawa sum of :mod:`.yukawa` (Feng & Crane 2024, §8.2 "the diffused field is the
-convolution with the fundamental solution of id − tΔ"; the seed solves Step I on the domain's own mesh on tets,
-§8.1, and so does signedheat3d on its grid).
+transforms, in place of the Yukawa sum of :mod:`gsdf.heat._yukawa` (Feng & Crane 2024, §8.2 "the diffused field
+is the convolution with the fundamental solution of id − tΔ"; the seed solves Step I on the domain's own mesh on
+tets, §8.1, and so does signedheat3d on its grid).
 
 X⁰ is the source vector field splatted onto the nodes: every source point b_f gives its charge w_f = |f| N_f to
 the 8 nodes of its cell with trilinear weights, divided by the cell volume (a density). The screened operator is
-diagonal in the separable DCT-II basis, so X is three forward and three inverse 3D transforms — O(N log N), about
-a millisecond at 32³, independent of the number of sources — where the tree walk costs tens of milliseconds.
+diagonal in the separable DCT-II basis, so X is three forward and three inverse 3D transforms — O(N log N),
+independent of the number of sources.
 
-Two choices make it as accurate as the continuous sum (measured: bench/bench_heat_volume_speed.py, RESULTS
-section ``heat-volume-speed``):
+Two choices bring it to the accuracy of the continuous sum:
 
 * **an isotropic Laplacian.** The 7-point Laplacian's Green's function decays faster along the axes than along
   the diagonals, which tilts the direction of X far from the input. On cubic cells we use the 19-point stencil

@@ -25,9 +25,17 @@ import numpy as np
 from gsdf.heat._core import hash_key
 from gsdf.heat.intrinsic._kernels import face_coords, intrinsic_delaunay, layout, locate_points, trace_paths
 from gsdf.heat.triangle._operators import TriangleMeshOperators
-from gsdf.heat.triangle._sources import _bary_curve_segments, _faces_of_node, _parse_curve, _to_face, build_sources
 from gsdf.heat._domain import HeatDomain
-from gsdf.heat.triangle._domain import TriangleDomain, raw_curves, raw_points, to_core_sources
+from gsdf.heat.triangle._domain import TriangleDomain
+from gsdf.heat.triangle._sources import (
+    _bary_curve_segments,
+    _faces_of_node,
+    _to_face,
+    assemble,
+    parse_curves,
+    parse_points,
+    surface_points,
+)
 
 __all__ = ["IntrinsicDomain"]
 
@@ -109,52 +117,47 @@ class IntrinsicDomain(HeatDomain):
     def assemble_sources(self, curves, points, curve_normals=None):
         if curve_normals is not None:
             raise ValueError("curve_normals: not available with intrinsic_delaunay=True")
-        raw, signs, _ = raw_curves(curves)
-        raw, pts = self.transfer(raw, raw_points(points), signs)
-        return to_core_sources(build_sources(self.ops, raw, pts, signs), self.n_nodes)
+        pts = parse_points(self.input_ops, points)
+        parts, pts = self.transfer(parse_curves(self.input_ops, curves), pts)
+        return assemble(self.ops, parts, pts)
 
-    def transfer(self, curves, points, curve_signs):
+    def transfer(self, parts, points):
         """Re-express the sources on an intrinsic Delaunay triangulation (§9.4): vertex polylines and curve
         segments along input edges stay on those edges (kept unflippable); segments inside input faces are
         carried through the flips (their midpoints and directions, :func:`~gsdf.heat.intrinsic._kernels.
         locate_points`) and re-split along the intrinsic edges by tracing (:func:`~gsdf.heat.intrinsic._kernels.
-        trace_paths`); point sources inside faces are carried through the flips. Switches to the triangulation
-        that keeps the needed edges and returns (curves, points) for :func:`~gsdf.heat.triangle._sources.build_sources` on it."""
+        trace_paths`); point sources inside faces are carried through the flips. ``parts`` and ``points`` are
+        parsed on the input mesh (:func:`~gsdf.heat.triangle._sources.parse_curves`, ``parse_points``).
+        Switches to the triangulation that keeps the needed edges and returns (parts, points) parsed on it, for
+        :func:`~gsdf.heat.triangle._sources.assemble`."""
 
         ops0 = self.input_ops
         F0, V0 = ops0.F, ops0.V
-        if curves is None:
-            curves = []
-        if isinstance(curves, np.ndarray) and curves.ndim == 1 and np.issubdtype(curves.dtype, np.integer):
-            curves = [curves]
-        curves = list(curves)
-        signs = [True] * len(curves) if curve_signs is None else [bool(x) for x in curve_signs]
         specs, pairs = [], []
         mids_f, mids_b, mids_v = [], [], []                  # face-segment midpoints to carry through the flips
-        for k, c in enumerate(curves):
-            parsed = _parse_curve(c, ops0, k)
-            vs = None
-            if parsed[0] == "v":
-                vs = parsed[1]
-            elif ((parsed[2] > 0).sum(1) == 1).all():          # surface points that are all vertices
-                vs = F0[parsed[1], np.argmax(parsed[2], axis=1)]
+        for part in parts:
+            vs = part.vertices
+            if vs is None and ((part.bary > 0).sum(1) == 1).all():   # surface points that are all vertices
+                vs = F0[part.faces, np.argmax(part.bary, axis=1)]
             if vs is not None:
                 keep = np.concatenate([[True], vs[1:] != vs[:-1]])
                 vs = vs[keep]
+                if len(vs) < 2:
+                    raise ValueError(f"{part.name}: a curve needs at least 2 points, got {len(vs)}")
                 e = ops0.edge_lookup(vs[:-1], vs[1:])
                 if np.any(e < 0):
                     q = int(np.flatnonzero(e < 0)[0])
-                    raise ValueError(f"curves[{k}]: vertices {vs[q]} and {vs[q + 1]} (points {q}, {q + 1}) are not "
+                    raise ValueError(f"{part.name}: vertices {vs[q]} and {vs[q + 1]} (points {q}, {q + 1}) are not "
                                      "joined by a mesh edge (give the curve as (face, barycentric) points)")
-                if k < len(signs) and not signs[k] and vs[0] != vs[-1]:
-                    raise ValueError(f"curves[{k}]: open unsigned curves are not supported with "
+                if not part.signed and vs[0] != vs[-1]:
+                    raise ValueError(f"{part.name}: open unsigned curves are not supported with "
                                      "intrinsic_delaunay=True (close the curve or use the input triangulation)")
-                specs.append(("v", vs))
+                specs.append((part, vs))
                 pairs.append(np.stack([vs[:-1], vs[1:]], 1))
                 continue
-            if k < len(signs) and not signs[k]:
-                raise ValueError(f"curves[{k}]: unsigned curves must run along mesh edges (give vertex indices)")
-            nf, nb, *_ = _bary_curve_segments(ops0, parsed[1], parsed[2], f"curves[{k}]", return_faces=True)
+            if not part.signed:
+                raise ValueError(f"{part.name}: unsigned curves must run along mesh edges (give vertex indices)")
+            nf, nb, *_ = _bary_curve_segments(ops0, part.faces, part.bary, part.name, return_faces=True)
             segs = []
             for q in range(len(nf) - 1):
                 fa, ba, fb, bb = nf[q], nb[q], nf[q + 1], nb[q + 1]
@@ -176,25 +179,16 @@ class IntrinsicDomain(HeatDomain):
                 mids_v.append(0.5 * (wb - wa) @ V0[F0[g]])
                 segs.append(("f", len(mids_f) - 1))
             if not segs:
-                raise ValueError(f"curves[{k}]: the curve has zero length")
-            specs.append(("b", segs))
+                raise ValueError(f"{part.name}: the curve has zero length")
+            specs.append((part, segs))
         # point sources: vertices stay, points inside faces / on edges are carried through the flips
         pts_v, pts_track = [], []
         if points is not None:
-            items = list(np.asarray(points).reshape(-1)) if isinstance(points, np.ndarray) else list(points)
-            for q, it in enumerate(items):
-                if np.isscalar(it):
-                    v = int(it)
-                    if v != it or not 0 <= v < ops0.n_vertices:
-                        raise ValueError(f"points[{q}]: vertex index {it!r} out of range for {ops0.n_vertices} "
-                                         "vertices")
-                    pts_v.append(v)
-                    continue
-                _, f, bq = _parse_curve([it, it], ops0, 0)
-                if (bq[0] > 0).sum() == 1:
-                    pts_v.append(int(F0[f[0], np.argmax(bq[0])]))
+            for ids, w, f in zip(points.ids, points.w, points.faces):
+                if (w > 0).sum() == 1:
+                    pts_v.append(int(ids[np.argmax(w)]))
                 else:
-                    pts_track.append((int(f[0]), bq[0]))
+                    pts_track.append((int(f), w))
         P = np.concatenate(pairs) if pairs else np.zeros((0, 2), np.int64)
         P = np.unique(np.sort(P, axis=1), axis=0)
         if self.state_key is None:
@@ -241,12 +235,12 @@ class IntrinsicDomain(HeatDomain):
             return g, out
 
         out = []
-        for spec in specs:
-            if spec[0] == "v":
-                out.append(spec[1])
+        for part, spec in specs:
+            if isinstance(spec, np.ndarray):
+                out.append(part._replace(vertices=spec, faces=None, bary=None))
                 continue
             nodes = []
-            for sg in spec[1]:
+            for sg in spec:
                 if sg[0] == "e":
                     chain = [on_edge(sg[1]), on_edge(sg[2])]
                 else:
@@ -256,6 +250,7 @@ class IntrinsicDomain(HeatDomain):
                     chain = [(int(f), b) for f, b in zip(bf[::-1], bb[::-1])] + \
                             [(int(f), b) for f, b in zip(ff, fb)]
                 nodes.extend(chain if not nodes else chain[1:])
-            out.append(nodes)
-        pts = pts_v + [(int(f), b) for f, b in zip(tf[nm:], tb[nm:])]
-        return out, (pts if pts else None)
+            faces, bary = surface_points(ops, [(f, np.asarray(b, np.float64).ravel()) for f, b in nodes], part.name)
+            out.append(part._replace(faces=faces, bary=bary))
+        pts = pts_v + [(int(f), np.asarray(b, np.float64).ravel()) for f, b in zip(tf[nm:], tb[nm:])]
+        return out, parse_points(ops, pts)

@@ -35,7 +35,8 @@ from gsdf.heat.polygon._domain import connection_laplacian
 
 
 def point_cloud_operators(P: np.ndarray, k: int = 30, mollify_factor: float = 1e-5):
-    """Tufted-cover Laplacian (PSD, n × n) and lumped masses (n,) of a point cloud (Sharp & Crane 2020)."""
+    """Tufted-cover Laplacian (PSD, n × n) and lumped masses (n,) of a point cloud (Sharp & Crane 2020), with
+    robust-laplacian's intrinsic mollification ``mollify_factor``."""
     try:
         import robust_laplacian
     except ImportError as exc:                                   # pragma: no cover - a declared dependency
@@ -52,7 +53,7 @@ class PointCloudDomain(VertexSurfaceDomain):
     """A point cloud as the domain (§8.4; see module docs).
 
     Parameters: those of :class:`gsdf.heat.pointcloud._solver.PointCloudSignedHeatSolver`, the public
-    front-end (points, normals, neighbours k, diffusion-time coefficient, mollification).
+    front-end (points, normals, neighbours k, diffusion-time coefficient).
 
     Example
     -------
@@ -60,15 +61,12 @@ class PointCloudDomain(VertexSurfaceDomain):
     >>> phi = SignedHeatCore(PointCloudDomain(P, N)).compute_distance([loop])   # doctest: +SKIP
     """
 
-    def __init__(self, P, N=None, k: int = 30, t_coef: float = 1.0, mollify_factor: float = 1e-5):
+    def __init__(self, P, N=None, k: int = 30, t_coef: float = 1.0):
         P = _checks.as_points(P, "P")
         if len(P) < 4:
             raise ValueError(f"P: need at least 4 points, got {len(P)}")
         k = _checks.integer(k, "k", lo=3)
         t_coef = _checks.positive(t_coef, "t_coef")
-        mollify_factor = float(mollify_factor)
-        if not np.isfinite(mollify_factor) or mollify_factor < 0:
-            raise ValueError(f"mollify_factor: must be a finite number >= 0, got {mollify_factor}")
         if N is None:
             from gsdf.winding._point_areas import estimate_normals
 
@@ -78,7 +76,7 @@ class PointCloudDomain(VertexSurfaceDomain):
         if (nrm == 0).any():
             raise ValueError("N: contains zero normals")
         self.P, N = P, N / nrm
-        L, self.M = point_cloud_operators(P, min(k, len(P) - 1), mollify_factor)
+        L, self.M = point_cloud_operators(P, min(k, len(P) - 1))
         C = sp.triu(L, k=1).tocoo()
         self._ei, self._ej, self._w = C.row, C.col, -C.data          # cover edges i < j, cotan weights
         self.n_edges = len(self._w)

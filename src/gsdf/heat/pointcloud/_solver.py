@@ -24,8 +24,8 @@ class PointCloudSignedHeatSolver:
     ----------
     P : (n, 3) points; N : (n, 3) consistently oriented normals, or None for PCA normals oriented away from
         the centroid (fine for star-shaped clouds); k : neighbours per local triangulation of the tufted cover
-        (``n_neighbors`` of robust-laplacian); t_coef : diffusion time ``t = t_coef · ℓ̄²``;
-        mollify_factor : intrinsic mollification of the cover (robust-laplacian's default 1e-5).
+        (``n_neighbors`` of robust-laplacian); t_coef : diffusion time ``t = t_coef · ℓ̄²``, ℓ̄ the mean cover
+        edge length.
 
     Attributes
     ----------
@@ -39,15 +39,14 @@ class PointCloudSignedHeatSolver:
     >>> phi = solver.compute_distance([np.array([3, 17, 42, 8, 3])])    # doctest: +SKIP
     """
 
-    def __init__(self, P, N=None, k: int = 30, t_coef: float = 1.0, mollify_factor: float = 1e-5):
+    def __init__(self, P, N=None, k: int = 30, t_coef: float = 1.0):
         P = _checks.as_points(P, "P")
         _check_spread(P)
         # scale invariance: the cloud is solved in its frame (centred, power-of-two scale: exact), distances
         # are mapped back on output (gsdf._normalize); the attributes below are in input units
         self.frame = Frame.of(P)
         self.P_world = P
-        self.domain = d = PointCloudDomain(self.frame.geometry(P, "P"), N, k=k, t_coef=t_coef,
-                                           mollify_factor=mollify_factor)
+        self.domain = d = PointCloudDomain(self.frame.geometry(P, "P"), N, k=k, t_coef=t_coef)
         self.core = SignedHeatCore(d)
         fr = self.frame  # attributes in input units (L, Lconn and the frames are scale-free)
         self.P, self.N, self.L, self.M, self.Lconn = P, d.N, d.L, fr.area(d.M), d.Lconn

@@ -247,16 +247,12 @@ class PolygonDomain(VertexSurfaceDomain):
     (4, 4)
     """
 
-    # polygon meshes: SuperLU's minimum degree alone factorizes faster than after an RCM renumbering (1.2–2.4×
-    # on every polygon row of bench_heat_surface.py --solver-rule)
+    # SuperLU's own minimum-degree ordering, no RCM renumbering first (docs/decisions.md)
     renumber = False
     # Lconn has L's pattern exactly (connection_laplacian): the Dirichlet systems of step III take step I's
     # ordering restricted to their free vertices (no ordering pass of their own, ldl.HINT_AMD_FLOPS)
     heat_on_nodes = True
-    # step I's operator ordered by AMD alone: of the 6 polygon meshes of bench_heat_surface.py --speed
-    # --polygon the "auto" rule's nested-dissection attempt ran on 4 (≤ 10k vertices) and won on one (UV
-    # sphere, 0.68× AMD's flops); on the others (bear 1.5×, quad torus 1.2×, cube sphere 32 0.96× — under the
-    # 0.9 gain) it cost 1.5–6 ms of a 20–50 ms first solve for nothing
+    # step I's operator ordered by AMD alone, no nested-dissection attempt (docs/decisions.md)
     heat_ordering = "amd"
 
     def __init__(self, V, polygons, t_coef: float = 1.0):

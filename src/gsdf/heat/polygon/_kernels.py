@@ -11,8 +11,7 @@ simple"), one pass over the polygons each:
 * :func:`refine_polygons` — the weights, virtual vertices, fans and prolongation of all polygons at once;
 * :func:`polygon_csr_pattern` — L's CSR pattern from the polygons' incidence and the slot of every triplet.
 
-Used by :mod:`gsdf.heat.polygon._domain` (which owns the formulas' description); measured in
-bench/bench_heat_surface.py --speed (polygon rows).
+Used by :mod:`gsdf.heat.polygon._domain` (which owns the formulas' description).
 """
 
 from __future__ import annotations

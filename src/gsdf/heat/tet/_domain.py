@@ -1,8 +1,8 @@
 """Tetrahedral meshes as a signed-heat domain (Feng & Crane 2024, §8.1, App. B); meshing and operators in
 :mod:`gsdf.heat.tet._mesh`.
 
-Step I    per kept tet: the Yukawa sum at its barycenter (``step1="yukawa"``) or the seed's Crouzeix–Raviart
-          heat solve averaged over its faces (``step1="heat"``, :func:`~gsdf.heat.tet._mesh.cr_heat`).
+Step I    per kept tet: the Yukawa sum at its barycenter (:class:`~gsdf.heat._yukawa.YukawaTree`), the closed
+          form of the short-time heat flow in R³ that the authors' implementation also uses on tets.
 Step II   normalized per tet (by the core).
 Step III  the P1 (cotangent) Laplacian against the weak divergence b_i = Σ_T |T| ∇λ_i · Y_T (Eq. 22), natural
           Neumann boundary; solved by :class:`gsdf.linalg.SPDSolver` (factorized small, CG/AMG large) through
@@ -15,7 +15,7 @@ the input one unknown; the shift is the area-weighted mean of φ over the source
 
 Example
 -------
->>> # TetDomain is built by gsdf.signed_heat_volume(..., domain="tet"), see gsdf.heat.volume.solve_tet
+>>> # TetDomain is built by gsdf.signed_heat_volume(..., domain="tet"), see gsdf.heat.volume._solve.solve_tet
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import scipy.sparse as sp
 from gsdf.linalg import SPDSolver
 from gsdf.heat._core import FactorizedPoisson
 from gsdf.heat._sources import Sources
-from gsdf.heat.tet._mesh import cr_heat, p1_laplacian, weak_divergence
+from gsdf.heat.tet._mesh import p1_laplacian, weak_divergence
 from gsdf.heat._domain import HeatDomain
 
 __all__ = ["TetDomain", "tet_interpolation_rows"]
@@ -70,20 +70,19 @@ class TetDomain(HeatDomain):
     P, T, D : vertices (n, 3), tets (m, 4), the scipy Delaunay locator (or None);
     keep : (m,) bool, tets used by the operators (quality ≥ min_quality); vol, G : volumes and barycentric
     gradients of all tets; n_input : number of input points (the first vertices); comp : (n_input,) their
-    connected components; t : diffusion time; step1 : "yukawa" | "heat"; theta : Yukawa tree tolerance;
-    amg_above : CR faces above which the step-I system is solved by CG.
+    connected components; t : diffusion time; theta : Yukawa tree tolerance.
     """
 
     heat_form = "direct"
     difference_order = "first"
     shift_hard_zero = False
 
-    def __init__(self, P, T, D, keep, vol, G, n_input, comp, t, step1="yukawa", theta=1.5, amg_above=400_000):
+    def __init__(self, P, T, D, keep, vol, G, n_input, comp, t, theta=1.5):
         self.P, self.T, self.D, self.keep, self.vol, self.G = P, T, D, keep, vol, G
         self.Tk, self.volk, self.Gk = T[keep], vol[keep], G[keep]
         self.n_nodes = len(P)
         self.n_input, self.comp = int(n_input), np.asarray(comp)
-        self.t, self.step1, self.theta, self.amg_above = float(t), step1, theta, amg_above
+        self.t, self.theta = float(t), theta
         self.used = np.zeros(self.n_nodes, bool)
         self.used[self.Tk.ravel()] = True
         self._K = None
@@ -106,11 +105,9 @@ class TetDomain(HeatDomain):
         return S
 
     def diffuse(self, S: Sources):
-        if self.step1 == "yukawa":
-            from gsdf.heat._yukawa import YukawaTree
+        from gsdf.heat._yukawa import YukawaTree
 
-            return YukawaTree(S.B, S.W, self.t, theta=self.theta)(self.P[self.Tk].mean(axis=1))
-        return cr_heat(S, self.P, self.T, self.D, self.keep, self.vol, self.G, self.t, self.amg_above)
+        return YukawaTree(S.B, S.W, self.t, theta=self.theta)(self.P[self.Tk].mean(axis=1))
 
     def gather(self, X):
         return X

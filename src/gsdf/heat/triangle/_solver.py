@@ -13,13 +13,11 @@ from gsdf import _checks
 from gsdf._normalize import Frame
 from gsdf.heat._core import SignedHeatCore
 from gsdf.heat.intrinsic._domain import IntrinsicDomain
-from gsdf.heat.triangle._domain import TriangleDomain, raw_curves, raw_points
-from gsdf.curves import as_curves, as_point_sources
+from gsdf.heat.triangle._domain import TriangleDomain
+from gsdf.curves import Curve, as_curves, as_point_sources
 from gsdf.heat.triangle._operators import TriangleMeshOperators
-from gsdf.heat.triangle._sources import build_sources
+from gsdf.heat.triangle._sources import assemble, parse_curves, parse_points
 
-LEVEL_SETS = ("zero", "multiple", "none")
-CONNECTIONS = ("auto", "complex", "real")
 
 
 class SurfaceSignedHeatSolver:
@@ -37,9 +35,10 @@ class SurfaceSignedHeatSolver:
     F : (m, 3) int array
         Triangle mesh of any topology: boundary, several components, nonmanifold edges/vertices (operators are
         per-face sums, §9.4). Nonorientable meshes (and faces whose orientation disagrees with a neighbour's)
-        are handled exactly: transport across such an edge is a reflection, so the connection Laplacian is then
-        assembled as a real 2|E|×2|E| block matrix (see ``connection``); give the curve normals
-        (``curve_normals=`` of :meth:`compute_distance`) there, since face normals flip across the seam.
+        are handled exactly: transport across such an edge is a reflection, so the connection Laplacian of step I
+        is then assembled as a real 2|E|×2|E| block matrix that represents the reflections (the complex |E|×|E|
+        form of Eq. 9 when all faces agree); give the curve normals (``curve_normals=`` of
+        :meth:`compute_distance`) there, since face normals flip across the seam.
         Faces with repeated vertices or zero area raise ValueError (remove them first).
     t_coef : float
         Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6) of the input mesh.
@@ -55,11 +54,6 @@ class SurfaceSignedHeatSolver:
         applied per intrinsic face. Unsigned curves must be closed vertex polylines; ``curve_normals`` is not
         available; ``compute_distance_l1`` raises NotImplementedError. On a mesh that is already Delaunay no
         edge flips and the results equal those on the input triangulation.
-    connection : {"auto", "complex", "real"}
-        Form of the connection Laplacian of step I. ``"auto"``: complex ``|E|×|E|`` (Eq. 9) when all faces are
-        consistently oriented, else the real 2|E|×2|E| block form that also represents the reflections across
-        orientation flips. ``"real"`` forces the block form (same result on orientable meshes, ~2× slower);
-        ``"complex"`` forces Eq. 9 (wrong transport across orientation flips; for comparisons only).
 
     Scale: the mesh is mapped once into its frame (:class:`gsdf._normalize.Frame`: centred, power-of-two
     scale) and solved there, so results are scale-covariant (φ of ``s·V`` is ``s·φ``) from 1e-150 to 1e150;
@@ -82,13 +76,12 @@ class SurfaceSignedHeatSolver:
     -0.5
     """
 
-    def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False, connection: str = "auto"):
+    def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False):
         V, F = _checks.as_mesh(V, F)
         # scale invariance: everything runs in the geometry's frame (centre, power-of-two scale, exact);
         # distances are mapped back on output (gsdf._normalize)
         self.frame = Frame.of_mesh(V, F) if len(F) else Frame.of(V)
         self.V_world, V = V, self.frame.geometry(V)
-        self.connection = _checks.choice(connection, "connection", CONNECTIONS)
         self.t_coef = _checks.positive(t_coef, "t_coef")
         rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
         if rep.any():
@@ -109,9 +102,9 @@ class SurfaceSignedHeatSolver:
         if self.intrinsic_delaunay:
             # the triangulation is built on first use: by the first solve (with its curve edges kept
             # unflippable), or without fixed edges when an operator is accessed before any solve
-            self.domain = IntrinsicDomain(V, F, t=self.t, connection=self.connection, input_ops=self.input_ops)
+            self.domain = IntrinsicDomain(V, F, t=self.t, input_ops=self.input_ops)
         else:
-            self.domain = TriangleDomain(t=self.t, connection=self.connection, ops=self.input_ops)
+            self.domain = TriangleDomain(t=self.t, ops=self.input_ops)
         self.core = SignedHeatCore(self.domain)
         self.t = float(self.frame.area(self.t))  # reported in input units (the domain keeps the frame's)
 
@@ -222,16 +215,13 @@ class SurfaceSignedHeatSolver:
 
         if self.intrinsic_delaunay:
             raise NotImplementedError("compute_distance_l1 is not available with intrinsic_delaunay=True")
-        cs = as_curves(curves, curve_signs)
-        raw, signs, _ = raw_curves(cs)
-        S = build_sources(self.ops, raw, raw_points(as_point_sources(points)), signs)
+        S = self.core.sources(curves, points, curve_signs)
         Y = self.unit_field(self.diffuse(S))
         Phi = integrate_l1(self.ops, Y)
         # shift: mean over the curve segments of the value in a face containing the segment midpoint
-        if S.node_rows:
-            ids = np.concatenate([mm[0] for mm in S.seg_mid])
-            w = np.concatenate([mm[1] for mm in S.seg_mid])
-            L = np.concatenate(S.seg_len)
+        if S.node_rows.shape[0]:
+            ids, w = S.extra["midpoints"]
+            L = S.shift_weights
             vf = self.ops.vertex_faces()
             # value of the face of the first vertex of the midpoint's support: average of its corner values
             v0 = ids[np.arange(len(ids)), np.argmax(w, axis=1)]
@@ -259,30 +249,34 @@ class SurfaceSignedHeatSolver:
         if phi0.shape != (self.ops.n_vertices,) or not np.isfinite(phi0).all():
             raise ValueError(f"phi0: expected {self.ops.n_vertices} finite values, got shape {phi0.shape}")
         phi0 = self.frame.inverse_length(phi0)
-        raw, signs, _ = raw_curves(as_curves(curves))
-        pts = raw_points(as_point_sources(points))
+        ops0 = self.input_ops
+        parts = parse_curves(ops0, as_curves(curves))
+        pts = parse_points(ops0, as_point_sources(points))
         if self.intrinsic_delaunay:
-            raw, pts = self.domain.transfer(raw, pts, signs)
-        S = build_sources(self.ops, raw, pts, None)
-        ids, w, isv = self._all_nodes(S)
+            parts, pts = self.domain.transfer(parts, pts)
+        S = assemble(self.ops, [p._replace(signed=True) for p in parts], pts)   # only the source nodes count
+        rows, vertex = S.all_rows()
+        inner = rows[np.flatnonzero(vertex < 0)]
         fixed = np.zeros(self.ops.n_vertices, bool)
-        fixed[ids[isv < 0][w[isv < 0] > 0]] = True
+        fixed[inner.indices[inner.data > 0]] = True
         values = phi0.copy()
-        fixed[isv[isv >= 0]] = True
-        values[isv[isv >= 0]] = 0.0
+        fixed[vertex[vertex >= 0]] = True
+        values[vertex[vertex >= 0]] = 0.0
         out = sharpen(self.ops, phi0, fixed, values, iterations=_checks.integer(iterations, "iterations"))[0]
         return self.frame.length(out)
 
     def split_curve(self, curve) -> list:
         """The nodes of ``curve`` as (face, barycentric) points, split where segments cross edges, so that
         consecutive nodes share a face (the form potpourri3d requires)."""
-        from gsdf.heat.triangle._sources import _bary_curve_segments, _parse_curve
+        from gsdf.heat.triangle._sources import _bary_curve_segments
 
-        parsed = _parse_curve(curve, self.input_ops, 0)
-        if parsed[0] == "v":
-            vs = parsed[1]
-            return [(int(v), np.zeros(0)) for v in vs]
-        ids, w, _, _, _ = _bary_curve_segments(self.input_ops, parsed[1], parsed[2], "curve", return_faces=True)
+        parts = parse_curves(self.input_ops, [Curve(curve)])
+        if len(parts) != 1:
+            raise ValueError(f"curve: expected one curve, got an edge set of {len(parts)} paths")
+        (part,) = parts
+        if part.vertices is not None:
+            return [(int(v), np.zeros(0)) for v in part.vertices]
+        ids, w, _, _, _ = _bary_curve_segments(self.input_ops, part.faces, part.bary, "curve", return_faces=True)
         return list(zip(ids, w))
 
     def split_segments(self, curve) -> list:
@@ -308,13 +302,3 @@ class SurfaceSignedHeatSolver:
             pa, pb = ba @ Vf[self.F[fa]], bb @ Vf[self.F[fb]]
             out.append([(f, _bary_in_face(self.input_ops, pa, f)), (f, _bary_in_face(self.input_ops, pb, f))])
         return out
-
-    def _all_nodes(self, S):
-        rows = list(S.node_rows)
-        isv = list(S.node_is_vertex)
-        if S.point_rows is not None:
-            rows.append(S.point_rows)
-            isv.append(S.point_is_vertex)
-        ids = np.concatenate([r[0] for r in rows])
-        w = np.concatenate([r[1] for r in rows])
-        return ids, w, np.concatenate(isv)

@@ -6,13 +6,15 @@ the curve — the region a counter-clockwise curve encloses — negative ("negat
 and unoriented curves (whose normals point away from the source) still give positive distance. Compared with
 potpourri3d, signed curves give the opposite sign and unsigned sources the same values.
 
-Curves come in two forms (the contract of ``SurfaceSignedHeatSolver.compute_distance``):
+Curves arrive as :class:`gsdf.Curve` (type-checked by :func:`gsdf.curves.as_curves`); :func:`parse_curves` checks
+them against the mesh and :func:`assemble` turns them, with the point sources of :func:`parse_points`, into the
+one :class:`~gsdf.heat._sources.Sources` of the core:
 
-* an integer array of vertex indices: a polyline along mesh edges;
-* a list of surface points ``(face_index, barycentric (3,))`` (``(vertex_index, ())`` is also accepted, the
-  potpourri3d spelling of a vertex). Consecutive points normally share a face (or lie on one edge); a segment
-  whose end points share no face is split where it crosses mesh edges: it is traced face by face, heading in each face
-  for the end point projected into the face's plane (exactly the straight segment on planar regions, an
+* vertex polylines (and edge sets, chained into polylines) run along mesh edges;
+* surface points ``(face_index, barycentric (3,))`` (``(vertex_index, ())`` is also accepted, the potpourri3d
+  spelling of a vertex). Consecutive points normally share a face (or lie on one edge); a segment whose end
+  points share no face is split where it crosses mesh edges: it is traced face by face, heading in each face for
+  the end point projected into the face's plane (exactly the straight segment on planar regions, an
   approximation of it on curved ones).
 
 Every node becomes a row of a sparse interpolation matrix (nodes × |V|), which serves the level-set
@@ -21,71 +23,54 @@ constraints (§7.1, Eq. 14) and the shift of Alg. 13.
 
 from __future__ import annotations
 
-import numpy as np
+from typing import NamedTuple
 
+import numpy as np
+import scipy.sparse as sp
+
+from gsdf.heat._sources import Sources
 from gsdf.heat.triangle._operators import NEXT, TriangleMeshOperators
 
 BARY_TOL = 1e-6
 
 
-class ParsedSources:
-    """Sources parsed on a triangle mesh (per-curve node and segment data, X0 of Eq. 12); turned into the one
-    :class:`gsdf.heat._sources.Sources` of the core by :func:`gsdf.heat.triangle._domain.to_core_sources`."""
+class CurvePart(NamedTuple):
+    """One source curve parsed on a triangle mesh: a vertex polyline (``vertices``) or surface points (``faces``,
+    ``bary``), with its sign, its ``curve_normals`` entry and the name errors use (``curves[k]``, k the index
+    of the :class:`~gsdf.curves.Curve` it comes from; an edge set gives one part per chained polyline)."""
 
-    def __init__(self):
-        self.X0 = None
-        self.node_rows = []          # list of (vertex ids (k,3), weights (k,3)) per curve, nodes in order
-        self.node_is_vertex = []     # per curve: (k,) vertex id or -1
-        self.seg_len = []            # per curve: lengths of segments
-        self.seg_mid = []            # per curve: (vertex ids (s,6), weights (s,6)) segment midpoints
-        self.point_rows = None       # (vertex ids (p,3), weights (p,3)) of point sources
-        self.point_is_vertex = None
-        self.signed = []
+    vertices: np.ndarray | None
+    faces: np.ndarray | None
+    bary: np.ndarray | None
+    signed: bool
+    normals: object
+    index: int
+
+    @property
+    def name(self) -> str:
+        return f"curves[{self.index}]"
+
+
+class PointSources(NamedTuple):
+    """Isolated point sources parsed on a triangle mesh: per point the three vertices ``ids`` (p, 3) and weights
+    ``w`` (p, 3) of its interpolation row, and the face it was given in (-1 for a vertex index)."""
+
+    ids: np.ndarray
+    w: np.ndarray
+    faces: np.ndarray
 
 
 # ---------------------------------------------------------------------------------------------- parsing
-def vertex_polyline(c, n: int, name: str) -> np.ndarray:
-    """``c`` as a validated int64 array of ≥ 2 vertex indices in [0, n); ValueError naming ``name`` otherwise."""
-    a = np.asarray(c)
-    if a.dtype == object or a.ndim != 1:
-        raise ValueError(f"{name}: a vertex polyline must be a 1-D index array, got shape {a.shape}")
-    if a.size < 2:
-        raise ValueError(f"{name}: a curve needs at least 2 points, got {a.size}")
-    if not np.issubdtype(a.dtype, np.integer):
-        if not (np.issubdtype(a.dtype, np.floating) and np.all(a == np.round(a))):
-            raise ValueError(f"{name}: vertex indices must be integers, got dtype {a.dtype}")
-    a = a.astype(np.int64)
-    if a.min() < 0 or a.max() >= n:
-        bad = int(a[(a < 0) | (a >= n)][0])
-        raise ValueError(f"{name}: vertex index {bad} out of range for {n} vertices")
-    return a
-
-
-def _parse_curve(c, ops: TriangleMeshOperators, k: int):
-    """Return ('v', verts) or ('b', faces (q,), bary (q,3)) for curve number k, validating indices."""
-    name = f"curves[{k}]"
+def surface_points(ops: TriangleMeshOperators, nodes, name: str):
+    """Typed ``(face, barycentric)`` pairs (:class:`~gsdf.curves.Curve` nodes) checked against the mesh:
+    ``(vertex, ())`` is a vertex (as a corner of its first face), face indices in range, three finite
+    coordinates summing to 1 (tolerance ``BARY_TOL``), none below ``-BARY_TOL``; clipped at 0 and renormalized.
+    Returns ``(faces (q,), bary (q, 3))``."""
     n, m = ops.n_vertices, ops.n_faces
-    if isinstance(c, np.ndarray) and c.dtype != object or (
-            isinstance(c, (list, tuple)) and len(c) > 0 and all(np.isscalar(x) for x in c)):
-        return "v", vertex_polyline(c, n, name)
-    try:
-        items = list(c)
-    except TypeError as exc:
-        raise ValueError(f"{name}: expected a vertex index array or a list of (face, barycentric) points") from exc
-    if len(items) < 2:
-        raise ValueError(f"{name}: a curve needs at least 2 points, got {len(items)}")
-    faces = np.empty(len(items), np.int64)
-    bary = np.zeros((len(items), 3))
+    faces = np.empty(len(nodes), np.int64)
+    bary = np.zeros((len(nodes), 3))
     vf = ops.vertex_faces()
-    for q, it in enumerate(items):
-        try:
-            e, b = it
-            b = np.asarray(b, dtype=np.float64).ravel()
-            e = int(e) if float(e) == int(e) else None
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"{name}[{q}]: expected (face_index, barycentric (3,)), got {it!r}") from exc
-        if e is None:
-            raise ValueError(f"{name}[{q}]: element index must be an integer, got {it[0]!r}")
+    for q, (e, b) in enumerate(nodes):
         if b.size == 0:                                       # potpourri3d spelling of a vertex: (v, [])
             if not 0 <= e < n:
                 raise ValueError(f"{name}[{q}]: vertex index {e} out of range for {n} vertices")
@@ -108,34 +93,56 @@ def _parse_curve(c, ops: TriangleMeshOperators, k: int):
         b = np.clip(b, 0.0, None)
         b[b < 1e-12] = 0.0
         faces[q], bary[q] = e, b / b.sum()
-    return "b", faces, bary
+    return faces, bary
 
 
-def parse_points(points, ops: TriangleMeshOperators):
-    """Point sources: vertex indices, or (face, barycentric) tuples. Returns (vertex ids (p,3), weights (p,3))."""
-    n, m = ops.n_vertices, ops.n_faces
-    if points is None:
+def _vertex_range(a: np.ndarray, n: int, name: str) -> np.ndarray:
+    if a.min() < 0 or a.max() >= n:
+        bad = int(a[(a < 0) | (a >= n)][0])
+        raise ValueError(f"{name}: vertex index {bad} out of range for {n} vertices")
+    return a
+
+
+def parse_curves(ops: TriangleMeshOperators, curves, curve_normals=None) -> list:
+    """:class:`~gsdf.curves.Curve` objects (already type-checked) as :class:`CurvePart` on the mesh ``ops``: vertex
+    indices in range, surface points checked (:func:`surface_points`), edge sets chained into polylines.
+    ``curve_normals``: one entry per curve (or one (3,) vector for all), see :func:`assemble`."""
+    normals = per_curve_normals(curve_normals, len(curves))
+    parts = []
+    for k, c in enumerate(curves):
+        nk = None if normals is None else normals[k]
+        if c.kind == "points":
+            f, b = surface_points(ops, c.nodes, f"curves[{k}]")
+            parts.append(CurvePart(None, f, b, c.signed, nk, k))
+            continue
+        if c.kind == "edges" and nk is not None and np.asarray(nk).shape != (3,):
+            raise ValueError(f"curve_normals[{k}]: an edge-set curve takes one (3,) normal")
+        for p in c.polylines():
+            parts.append(CurvePart(_vertex_range(p, ops.n_vertices, f"curves[{k}]"), None, None, c.signed, nk, k))
+    return parts
+
+
+def parse_points(ops: TriangleMeshOperators, points) -> PointSources | None:
+    """Point sources (:func:`gsdf.curves.as_point_sources`: vertex indices or ``(face, barycentric)`` pairs) on
+    the mesh ``ops``; None when there are none."""
+    if not points:
         return None
-    items = list(points) if not isinstance(points, np.ndarray) else list(points.reshape(-1)) \
-        if points.ndim <= 1 else None
-    if items is None:
-        raise ValueError(f"points: expected vertex indices or (face, barycentric) tuples, got shape {points.shape}")
-    if len(items) == 0:
-        return None
-    ids = np.zeros((len(items), 3), np.int64)
-    w = np.zeros((len(items), 3))
-    for q, it in enumerate(items):
-        if np.isscalar(it):
-            v = int(it)
-            if v != it or not 0 <= v < n:
+    n = ops.n_vertices
+    ids = np.zeros((len(points), 3), np.int64)
+    w = np.zeros((len(points), 3))
+    faces = np.full(len(points), -1, np.int64)
+    for q, it in enumerate(points):
+        if isinstance(it, (int, np.integer)):
+            if not 0 <= it < n:
                 raise ValueError(f"points[{q}]: vertex index {it!r} out of range for {n} vertices")
-            ids[q] = v
+            ids[q] = it
             w[q, 0] = 1.0
             continue
-        _, f, b = _parse_curve([it, it], ops, 0)
+        f, b = surface_points(ops, [it], f"points[{q}]")
         ids[q] = ops.F[f[0]]
         w[q] = b[0]
-    return ids, w
+        faces[q] = f[0]
+    return PointSources(ids, w, faces)
 
 
 # ---------------------------------------------------------------------------------------------- segments
@@ -213,16 +220,6 @@ def _trace(ops, fa, ba, fb, bb, name):
                      "must share a face, or be joined by a straight path across edges)")
 
 
-def _edge_faces(ops):
-    if getattr(ops, "_e2f", None) is None:
-        order = np.argsort(ops.face_edges.ravel(), kind="stable")
-        fe = ops.face_edges.ravel()[order]
-        fid = order // 3
-        splits = np.searchsorted(fe, np.arange(ops.n_edges + 1))
-        ops._e2f = [fid[splits[e]:splits[e + 1]].tolist() for e in range(ops.n_edges)]
-    return ops._e2f
-
-
 def _bary_curve_segments(ops, faces, bary, name, return_faces=False):
     """Split a barycentric curve into face segments and edge segments (python over nodes; cheap)."""
     F = ops.F
@@ -297,22 +294,20 @@ def per_curve_normals(curve_normals, n_curves: int):
     return curve_normals
 
 
-def _parse_normals(curve_normals, k, n_nodes, name="curve_normals"):
-    """Normals of curve k: None, or unit (n_nodes, 3) per node (a single (3,) vector is broadcast)."""
-    if curve_normals is None:
+def _parse_normals(part: CurvePart, n_nodes: int):
+    """Normals of a curve part: None, or unit (n_nodes, 3) per node (a single (3,) vector is broadcast)."""
+    if part.normals is None:
         return None
-    nk = curve_normals[k]
-    if nk is None:
-        return None
-    a = np.asarray(nk, dtype=np.float64)
+    name = f"curve_normals[{part.index}]"
+    a = np.asarray(part.normals, dtype=np.float64)
     if a.shape == (3,):
         a = np.broadcast_to(a, (n_nodes, 3))
     if a.shape != (n_nodes, 3):
-        raise ValueError(f"{name}[{k}]: expected a (3,) vector or one per curve point ({n_nodes}, 3), "
+        raise ValueError(f"{name}: expected a (3,) vector or one per curve point ({n_nodes}, 3), "
                          f"got shape {a.shape}")
     nrm = np.linalg.norm(a, axis=1)
     if not np.isfinite(a).all() or np.any(nrm == 0):
-        raise ValueError(f"{name}[{k}]: normals must be finite and nonzero")
+        raise ValueError(f"{name}: normals must be finite and nonzero")
     return a / nrm[:, None]
 
 
@@ -324,13 +319,13 @@ def _edge_vectors_to_basis(ops, e, N):
     return np.einsum("kj,kj->k", ops.slot_u[f, a], N) + 1j * np.einsum("kj,kj->k", ops.slot_w[f, a], N)
 
 
-def _signed_vertex_polylines(ops, parsed, signs, curve_normals):
+def _signed_vertex_polylines(ops, parts):
     """The per-curve source data of signed vertex polylines with face normals, for all curves at once (the
-    loop of :func:`build_sources` costs tens of µs per curve; scans with many holes give hundreds of loops).
+    loop of :func:`assemble` costs tens of µs per curve; scans with many holes give hundreds of loops).
     Same values, in the same order, as the loop. None unless every curve is such a polyline."""
-    if not parsed or curve_normals is not None or not all(signs) or any(p[0] != "v" for p in parsed):
+    if not parts or any(p.vertices is None or not p.signed or p.normals is not None for p in parts):
         return None
-    vs_list = [p[1] for p in parsed]
+    vs_list = [p.vertices for p in parts]
     lens = np.fromiter(map(len, vs_list), np.int64, count=len(vs_list))
     vs = np.concatenate(vs_list)
     start = np.concatenate([[0], np.cumsum(lens)[:-1]])
@@ -346,81 +341,63 @@ def _signed_vertex_polylines(ops, parsed, signs, curve_normals):
     a, b, e = a_all[keep], b_all[keep], e_all[keep]
     ln = ops.edge_len[e]
     val = -1j * np.where(a < b, 1.0, -1.0) * ln                 # along an edge: N = -i|γ| in the edge basis
-    cuts_nodes = np.cumsum(lens)[:-1]
-    cuts_segs = np.cumsum(np.bincount(pair_curve[keep], minlength=len(lens)))[:-1]
     ids = np.repeat(vs[:, None], 3, axis=1)
     w = np.zeros((len(vs), 3))
     w[:, 0] = 1.0
     mw = np.zeros((len(a), 6))
     mw[:, :2] = 0.5
     mid = np.stack([a, b, a, b, a, b], 1)
-    def split(a, cuts):                                         # np.split without its per-piece overhead
-        b = [0, *cuts.tolist(), len(a)]
-        return [a[i:j] for i, j in zip(b[:-1], b[1:])]
-
-    node_rows = list(zip(split(ids, cuts_nodes), split(w, cuts_nodes)))
-    node_is_vertex = [v.copy() for v in vs_list]
-    seg_len = split(ln, cuts_segs)
-    seg_mid = list(zip(split(mid, cuts_segs), split(mw, cuts_segs)))
-    return e, val, node_rows, node_is_vertex, seg_len, seg_mid
+    node_curve = np.repeat(np.arange(len(lens)), lens)
+    return e, val, ids, w, vs.copy(), node_curve, ln, mid, mw
 
 
-def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve_normals=None):
-    """Parse and validate all sources; return :class:`ParsedSources` with X0 (Eq. 11, App. A).
+def assemble(ops: TriangleMeshOperators, parts, points=None, batch: bool = True) -> Sources:
+    """The :class:`~gsdf.heat._sources.Sources` of curves (:func:`parse_curves`) and points
+    (:func:`parse_points`) on the mesh ``ops``: X0 of Eq. 12 per edge (Eq. 11 for signed curves, App. A.1 for
+    points, App. A.2 for unsigned curves), the interpolation rows of the curve nodes and points, and the shift
+    rows (segment midpoints, weighted by the segment lengths, Alg. 13).
 
-    ``curve_normals`` (optional, one entry per curve: None, a (3,) vector, or (k, 3) per curve point) replaces
-    the face normals n in N = T × n (Eq. 11) for signed curves, e.g. on nonorientable domains; segment normals
-    are the mean of the two end-point normals (for vertex polylines) or the normal of the input point nearest
-    to the segment midpoint (for surface-point curves, whose segments may be split)."""
-    if curves is None:
-        curves = []
-    if isinstance(curves, np.ndarray) and curves.ndim == 1 and np.issubdtype(curves.dtype, np.integer):
-        curves = [curves]
-    curves = list(curves)
-    if curve_signs is None:
-        signs = [True] * len(curves)
-    else:
-        signs = [bool(s) for s in curve_signs]
-        if len(signs) != len(curves):
-            raise ValueError(f"curve_signs: has {len(signs)} entries but there are {len(curves)} curves")
-    curve_normals = per_curve_normals(curve_normals, len(curves))
-    pts = parse_points(points, ops)
-    if not curves and pts is None:
+    A part's ``normals`` (None, a (3,) vector, or (k, 3) per curve point) replaces the face normals n in
+    N = T × n (Eq. 11) for signed curves, e.g. on nonorientable domains; segment normals are the mean of the
+    two end-point normals (for vertex polylines) or the normal of the input point nearest to the segment
+    midpoint (for surface-point curves, whose segments may be split). ``batch=False`` takes the per-curve loop
+    for signed vertex polylines too (the same values; for tests)."""
+    if not parts and points is None:
         raise ValueError("curves: no sources given (empty curve list and no points)")
-
-    S = ParsedSources()
-    S.signed = signs
-    nE = ops.n_edges
-    X0 = np.zeros(nE, np.complex128)
-    V, F = ops.V, ops.F
+    n = ops.n_vertices
+    X0 = np.zeros(ops.n_edges, np.complex128)
+    node_ids, node_w, node_vertex, node_curve = [], [], [], []
+    mid_ids, mid_w, seg_len = [], [], []
     face_segs_f, face_segs_N = [], []
     edge_e, edge_val = [], []
     unsigned_edges, unsigned_ends = [], []
-    parsed_all = [_parse_curve(c, ops, k) for k, c in enumerate(curves)]
-    batch = _signed_vertex_polylines(ops, parsed_all, signs, curve_normals)
-    for k, c in enumerate(curves):
-        parsed = parsed_all[k]
-        if batch is not None:
-            # every curve is a signed vertex polyline with face normals: all of them at once (below)
-            break
-        if parsed[0] == "v":
-            vs = parsed[1]
+    fast = _signed_vertex_polylines(ops, parts) if batch else None
+    if fast is not None:
+        # every curve is a signed vertex polyline with face normals: all of them at once
+        e_all, val_all, ids, w, isv, cur, ln, mid, mw = fast
+        edge_e.append(e_all)
+        edge_val.append(val_all)
+        node_ids, node_w, node_vertex, node_curve = [ids], [w], [isv], [cur]
+        mid_ids, mid_w, seg_len = [mid], [mw], [ln]
+    for k, part in enumerate(parts if fast is None else ()):
+        if part.vertices is not None:
+            vs = part.vertices
             e = ops.edge_lookup(vs[:-1], vs[1:])
             same = vs[:-1] == vs[1:]
             if np.any((e < 0) & ~same):
                 q = int(np.flatnonzero((e < 0) & ~same)[0])
-                raise ValueError(f"curves[{k}]: vertices {vs[q]} and {vs[q + 1]} (points {q}, {q + 1}) are not "
+                raise ValueError(f"{part.name}: vertices {vs[q]} and {vs[q + 1]} (points {q}, {q + 1}) are not "
                                  "joined by a mesh edge; give the curve as (face, barycentric) points instead")
             keep = ~same
             a, b, e = vs[:-1][keep], vs[1:][keep], e[keep]
             ln = ops.edge_len[e]
-            nrm = _parse_normals(curve_normals, k, len(vs)) if signs[k] else None
+            nrm = _parse_normals(part, len(vs)) if part.signed else None
             if nrm is not None:
                 nseg = (nrm[:-1] + nrm[1:])[keep]
                 N = np.cross(ops.V[b] - ops.V[a], nseg / np.linalg.norm(nseg, axis=1, keepdims=True))
                 edge_e.append(e)
                 edge_val.append(_edge_vectors_to_basis(ops, e, N))
-            elif signs[k]:
+            elif part.signed:
                 s = np.where(a < b, 1.0, -1.0)
                 edge_e.append(e)
                 edge_val.append(-1j * s * ln)                 # along an edge: N = -i|γ| in the edge basis
@@ -432,22 +409,20 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve
             ids = np.repeat(vs[:, None], 3, axis=1)
             w = np.zeros((len(vs), 3))
             w[:, 0] = 1.0
-            S.node_rows.append((ids, w))
-            S.node_is_vertex.append(vs.copy())
-            S.seg_len.append(ln)
+            isv = vs.copy()
             mw = np.zeros((len(a), 6))
             mw[:, :2] = 0.5
-            S.seg_mid.append((np.stack([a, b, a, b, a, b], 1), mw))
+            mid = np.stack([a, b, a, b, a, b], 1)
         else:
-            _, fs, bs = parsed
-            if not signs[k]:
-                raise ValueError(f"curves[{k}]: unsigned curves must run along mesh edges (give vertex indices)")
-            ids, w, L, seg_face, seg_edge = _bary_curve_segments(ops, fs, bs, f"curves[{k}]")
-            nrm = _parse_normals(curve_normals, k, len(fs))
+            fs, bs = part.faces, part.bary
+            if not part.signed:
+                raise ValueError(f"{part.name}: unsigned curves must run along mesh edges (give vertex indices)")
+            ids, w, ln, seg_face, seg_edge = _bary_curve_segments(ops, fs, bs, part.name)
+            nrm = _parse_normals(part, len(fs))
             if nrm is not None:
                 if ops.intrinsic:
-                    raise ValueError(f"curve_normals[{k}]: not available for surface-point curves on an intrinsic "
-                                     "triangulation")
+                    raise ValueError(f"curve_normals[{part.index}]: not available for surface-point curves on an "
+                                     "intrinsic triangulation")
                 Pin = np.einsum("kj,kjd->kd", bs, ops.V[ops.F[fs]])
 
                 def seg_normal(mid):
@@ -472,15 +447,14 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve
                 edge_val.append(-1j * np.array([s[1] * s[2] for s in seg_edge]))
             onehot = (w > 0).sum(1) == 1
             isv = np.where(onehot, ids[np.arange(len(ids)), np.argmax(w, 1)], -1)
-            S.node_rows.append((ids, w))
-            S.node_is_vertex.append(isv)
-            S.seg_len.append(L)
-            S.seg_mid.append((np.concatenate([ids[:-1], ids[1:]], 1), 0.5 * np.concatenate([w[:-1], w[1:]], 1)))
-    if batch is not None:
-        e_all, val_all, node_rows, node_is_vertex, seg_len, seg_mid = batch
-        edge_e.append(e_all)
-        edge_val.append(val_all)
-        S.node_rows, S.node_is_vertex, S.seg_len, S.seg_mid = node_rows, node_is_vertex, seg_len, seg_mid
+            mid, mw = np.concatenate([ids[:-1], ids[1:]], 1), 0.5 * np.concatenate([w[:-1], w[1:]], 1)
+        node_ids.append(ids)
+        node_w.append(w)
+        node_vertex.append(isv)
+        node_curve.append(np.full(len(ids), k))
+        mid_ids.append(mid)
+        mid_w.append(mw)
+        seg_len.append(ln)
     if edge_e:
         np.add.at(X0, np.concatenate(edge_e), np.concatenate(edge_val))
     if face_segs_f:
@@ -489,15 +463,33 @@ def build_sources(ops: TriangleMeshOperators, curves, points, curve_signs, curve
         np.add.at(X0, ee.ravel(), zz.ravel())
     if unsigned_edges:
         _unsigned_curve_source(ops, np.concatenate(unsigned_edges), unsigned_ends, X0)
-    if pts is not None:
-        S.point_rows = pts
-        ids, w = pts
+
+    S = Sources(X0=X0)
+    if node_ids:
+        S.node_rows = _rows(np.concatenate(node_ids), np.concatenate(node_w), n)
+        S.node_vertex = np.concatenate(node_vertex).astype(np.int64)
+        S.node_curve = np.concatenate(node_curve)
+        mids = np.concatenate(mid_ids), np.concatenate(mid_w)
+        S.shift_rows = _rows(*mids, n)
+        S.shift_weights = np.concatenate(seg_len)
+        S.extra["midpoints"] = mids                    # (s, 6) vertices and weights, for the L1 shift (§7.2)
+    else:
+        S.node_rows = sp.csr_matrix((0, n))
+        S.node_vertex = S.node_curve = np.zeros(0, np.int64)
+    if points is not None:
+        ids, w = points.ids, points.w
         onehot = (w > 0).sum(1) == 1
-        S.point_is_vertex = np.where(onehot, ids[np.arange(len(ids)), np.argmax(w, 1)], -1)
-        wv = np.bincount(ids.ravel(), weights=w.ravel(), minlength=ops.n_vertices)
+        S.point_rows = _rows(ids, w, n)
+        S.point_vertex = np.where(onehot, ids[np.arange(len(ids)), np.argmax(w, 1)], -1).astype(np.int64)
+        wv = np.bincount(ids.ravel(), weights=w.ravel(), minlength=n)
         _vertex_point_source(ops, wv, X0)
-    S.X0 = X0
     return S
+
+
+def _rows(ids: np.ndarray, w: np.ndarray, n: int) -> sp.csr_matrix:
+    """Sparse interpolation rows (k, n) from per-row vertices ``ids`` (k, c) and weights ``w`` (k, c)."""
+    k = len(ids)
+    return sp.csr_matrix((w.ravel(), (np.repeat(np.arange(k), ids.shape[1]), ids.ravel())), shape=(k, n))
 
 
 def _corner_frames(ops):

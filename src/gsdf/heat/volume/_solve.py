@@ -9,59 +9,44 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from gsdf._checks import choice, positive
+from gsdf._memory import check_bytes
 from gsdf._normalize import Frame
 from gsdf.field import GridField, TetField
-from gsdf.heat._core import SignedHeatCore, adapt_progress
+from gsdf.heat._core import SignedHeatCore, reporter
 from gsdf.heat.grid._domain import GridDomain
 from gsdf.heat.tet._domain import TetDomain
 from gsdf.heat._sources import Sources
-from gsdf.heat.volume._memory import available_memory
 from gsdf.heat.volume._sources import source_components
 from gsdf.heat.tet._mesh import BYTES_PER_TET_VERTEX, delaunay_mesh, input_points, tet_geometry, tetgen_mesh
 
-__all__ = ["solve_grid", "solve_tet"]
+__all__ = ["solve_grid", "solve_tet", "BYTES_PER_NODE"]
 
 _IDENTITY = Frame(np.zeros(3), 0, True)
 
-
-def _mode(level_set_constraint, soft_weight, constraint, constraint_weight):
-    """(mode, λ) from the public options and the older ``constraint="soft"|"exact"`` spelling."""
-    mode = choice(level_set_constraint, "level_set_constraint", {"none", "zero", "multiple"})
-    lam = None if soft_weight is None else positive(soft_weight, "soft_weight")
-    if constraint is not None:
-        constraint = choice(constraint, "constraint", {"soft", "exact"})
-        if constraint == "soft" and mode != "none" and lam is None:
-            lam = positive(constraint_weight, "constraint_weight")
-    return mode, lam
+BYTES_PER_NODE = 400  # positions, X, Y, d*, DCT work arrays (≈ 250 B/node measured); the constrained CG more
+TET_LEVELS = 2        # lattice levels of the graded tet mesh (spacing ≤ 2h), gsdf.heat.tet._mesh.delaunay_mesh
+TET_GRADING = 2.0     # spacing ratio between consecutive lattice levels
+TET_MIN_QUALITY = 0.02  # tets of lower quality (6√2 |T| / l_rms³) are left out of the operators
+TET_SURFACE_SPACING = 1.0  # Steiner points on the input every h (× this) for the "zero" rows on tets
 
 
-def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=None,
-               level_set_constraint: str = "zero", soft_weight=None, theta: float = 1.5, eps: float = 1e-4,
-               progress=None, constraint_tol: float = 1e-4, exact_rho: float = 1e5, constraint=None,
-               constraint_weight: float = 10.0, frame=None, step1: str = "auto") -> GridField:
+def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=None, mode: str = "zero", lam=None,
+               theta: float = 1.5, max_memory=None, progress=None, frame=None) -> GridField:
     """Run Steps I–III on the grid ``shape`` spanning ``[bbox_min, bbox_max]``; returns a :class:`GridField`.
 
-    ``t`` defaults to ``t_coef · h²``, h the largest grid spacing (the seed's t = h², §10). Level sets
-    (:mod:`gsdf.heat.grid._domain`): ``"zero"`` exact cell rows by the augmented Lagrangian (tolerance
-    ``constraint_tol`` · h, penalty ``exact_rho``), ``"multiple"`` one constant per input component,
-    ``soft_weight=c`` the penalty c Σ a_f φ(b_f)²/h⁴ (fast at every size; CG with the band/coarse/DCT
-    preconditioner), ``"none"``. ``constraint="soft"|"exact"`` (with ``constraint_weight``) is the older
-    spelling of ``soft_weight`` / hard. ``progress(stage, fraction)``. ``frame``: the
-    :class:`gsdf._normalize.Frame` the inputs are in; the field is returned in world units. ``eps`` prunes sources weighing less than
-    ``eps`` × the nearest one (Step I, :class:`YukawaTree`); 1e-4 instead of 1e-6 moves φ by < 3e-6 of the box
-    diagonal on the broken bunny at 64³ and saves ~25 % of Step I. ``step1``: "yukawa" (the tree sum), "heat" (one
-    screened solve on the grid, :mod:`gsdf.heat.grid._screened`) or "auto" (:class:`GridDomain`'s rule: the
-    grid solve for clouds where it is trusted).
+    ``t`` defaults to ``t_coef · h²``, h the largest grid spacing (the seed's t = h², §10). ``mode`` is the
+    level-set constraint, ``lam`` the soft weight or None (hard), both as :class:`GridDomain` imposes them;
+    ``theta`` the Yukawa tree tolerance; ``progress(stage, fraction)``; ``frame``: the
+    :class:`gsdf._normalize.Frame` the inputs are in (the field is returned in world units).
     """
-    mode, lam = _mode(level_set_constraint, soft_weight, constraint, constraint_weight)
-    report = adapt_progress(progress)
+    report = reporter(progress)
     lo, hi = np.asarray(bbox_min, float), np.asarray(bbox_max, float)
     shape = tuple(int(s) for s in shape)
+    n = int(np.prod(shape))
+    check_bytes(n * BYTES_PER_NODE, f"signed_heat_volume: a grid of {n:,} nodes {shape}", max_memory)
     h = float(((hi - lo) / (np.array(shape) - 1)).max())
-    t = float(t_coef) * h * h if t is None else positive(t, "t")
-    domain = GridDomain(lo, hi, shape, t, theta=theta, eps=eps, rho=exact_rho, tol=constraint_tol, progress=report,
-                        step1=step1)
+    t = float(t_coef) * h * h if t is None else t
+    domain = GridDomain(lo, hi, shape, t, theta=theta, progress=report)
     core = SignedHeatCore(domain)
     S = domain.prepare(src, source_components(src) if mode == "multiple" else None)
     timings = {}
@@ -81,42 +66,33 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     fr = frame if frame is not None else _IDENTITY
     field = GridField(fr.length(phi.reshape(shape)), fr.point(lo), fr.point(hi))
     info = core.poisson.info if (mode != "none" and lam is None) else {}
-    field.meta = {"method": "signed heat (grid)", "t": float(fr.area(t)), "theta": theta, "eps": eps, "timings": timings,
-                  "level_set_constraint": mode, "soft_weight": lam, "n_sources": len(src.B),
+    field.meta = {"method": "signed heat (grid)", "t": float(fr.area(t)), "theta": theta, "eps": domain.eps,
+                  "timings": timings, "level_set_constraint": mode, "soft_weight": lam, "n_sources": len(src.B),
                   "step1": domain.step1_used, **info}
     return field
 
 
-def solve_tet(src: Sources, X, lo, hi, shape, t_coef: float = 1.0, level_set_constraint: str = "zero",
-              soft_weight=None, max_memory=None, progress=None, levels: int = 2, step1: str = "yukawa",
-              mesher: str = "delaunay", min_quality: float = 0.02, theta: float = 1.5, faces=None,
-              amg_above: int = 400_000, grading: float = 2.0, surface_spacing: float = 1.0, t=None,
-              frame=None) -> TetField:
+def solve_tet(src: Sources, X, faces, lo, hi, shape, t_coef: float = 1.0, t=None, mode: str = "zero", lam=None,
+              theta: float = 1.5, mesher: str = "delaunay", max_memory=None, progress=None, frame=None) -> TetField:
     """Steps I–III on a tet mesh of the box graded toward the input; returns a :class:`TetField`.
 
     ``t`` defaults to ``t_coef · h²``, h the grid spacing the resolution gives (the lattice spacing near the input).
-    ``faces`` are the input triangles (indices into ``X``) for meshes, None for clouds. ``soft_weight=λ``
-    replaces the hard constraint by the penalty λ Σ (φ(z_i) − φ(z_0))² over the input points.
-    ``progress(stage, fraction)``. ``frame``: the :class:`gsdf._normalize.Frame` the inputs are in; the field is
-    returned in world units.
+    ``faces`` are the input triangles (indices into ``X``) for meshes, None for clouds. ``lam`` replaces the hard
+    constraint by the penalty λ Σ (φ(z_i) − φ(z_0))² over the input points. ``mesher``: "delaunay" or "tetgen"
+    (:mod:`gsdf.heat.tet._mesh`). ``progress(stage, fraction)``; ``frame``: the :class:`gsdf._normalize.Frame`
+    the inputs are in (the field is returned in world units).
     """
-    mode, lam = _mode(level_set_constraint, soft_weight, None, None)
-    step1 = choice(step1, "step1", {"yukawa", "heat"})
-    mesher = choice(mesher, "mesher", {"delaunay", "tetgen"})
-    report = adapt_progress(progress)
+    report = reporter(progress)
     timings = {}
     t0 = time.perf_counter()
     h = float((hi - lo).max()) / (max(shape) - 1)
     kind = "mesh" if faces is not None else "points"
     # TetGen conforms to the input triangles, so φ = 0 on their vertices is φ = 0 on the whole input
-    ss = np.inf if mesher == "tetgen" else surface_spacing
+    ss = np.inf if mesher == "tetgen" else TET_SURFACE_SPACING
     Z, comp = input_points(kind, np.asarray(X, float), faces, h, ss)
     nZ = len(Z)
     est = (nZ + 2 * int(np.prod(np.asarray(shape)) ** (2 / 3) * 8)) * BYTES_PER_TET_VERTEX
-    limit = int(0.8 * available_memory()) if max_memory is None else int(max_memory)
-    if est > limit:
-        raise ValueError(f"resolution too large: the tet mesh would need about {est / 2**30:.1f} GiB, more than "
-                         f"the {limit / 2**30:.1f} GiB allowed")
+    check_bytes(est, "signed_heat_volume: the tet mesh", max_memory)
     report("tet mesh", 0.0)
     if mesher == "tetgen":
         Fz = None
@@ -125,19 +101,17 @@ def solve_tet(src: Sources, X, lo, hi, shape, t_coef: float = 1.0, level_set_con
             Fz = kd.query(np.asarray(X, float)[faces].reshape(-1, 3))[1].reshape(-1, 3)
         P, T, D = tetgen_mesh(Z, Fz, lo, hi, h)
     else:
-        P, T, D = delaunay_mesh(Z, lo, hi, h, levels=levels, grading=grading)
+        P, T, D = delaunay_mesh(Z, lo, hi, h, levels=TET_LEVELS, grading=TET_GRADING)
     nV = len(P)
-    if nV * BYTES_PER_TET_VERTEX > limit:
-        raise ValueError(f"resolution too large: the tet mesh has {nV:,} vertices and needs about "
-                         f"{nV * BYTES_PER_TET_VERTEX / 2**30:.1f} GiB, more than the {limit / 2**30:.1f} GiB allowed")
+    check_bytes(nV * BYTES_PER_TET_VERTEX, f"signed_heat_volume: the tet mesh of {nV:,} vertices", max_memory)
     vol, G, q = tet_geometry(P, T)
-    keep = q >= min_quality
+    keep = q >= TET_MIN_QUALITY
     timings["mesh"] = time.perf_counter() - t0
     report("tet mesh", 1.0)
 
     t0 = time.perf_counter()
-    tt = float(t_coef) * h * h if t is None else positive(t, "t")
-    domain = TetDomain(P, T, D, keep, vol, G, nZ, comp, tt, step1=step1, theta=theta, amg_above=amg_above)
+    tt = float(t_coef) * h * h if t is None else t
+    domain = TetDomain(P, T, D, keep, vol, G, nZ, comp, tt, theta=theta)
     core = SignedHeatCore(domain)
     S = domain.prepare(src, shift=(mode != "zero" or lam is not None))     # hard "zero" is not shifted
     report("heat (step I)", 0.0)
@@ -157,9 +131,9 @@ def solve_tet(src: Sources, X, lo, hi, shape, t_coef: float = 1.0, level_set_con
     timings["step3"] = time.perf_counter() - t0
     fr = frame if frame is not None else _IDENTITY
     field = TetField(P, T, phi, D) if fr.identity else FramedTetField(fr, P, T, phi, D)
-    field.meta = {"method": "signed heat (tet)", "t": float(fr.area(tt)), "h": float(fr.length(h)), "timings": timings, "n_vertices": nV,
-                  "n_tets": len(T), "n_input_points": nZ, "n_dropped_tets": int((~keep).sum()),
-                  "level_set_constraint": mode, "soft_weight": lam, "step1": step1, "mesher": mesher,
+    field.meta = {"method": "signed heat (tet)", "t": float(fr.area(tt)), "h": float(fr.length(h)), "timings": timings,
+                  "n_vertices": nV, "n_tets": len(T), "n_input_points": nZ, "n_dropped_tets": int((~keep).sum()),
+                  "level_set_constraint": mode, "soft_weight": lam, "step1": "yukawa", "mesher": mesher,
                   "n_components": int(comp.max()) + 1}
     return field
 

@@ -14,12 +14,16 @@ import scipy.sparse as sp
 from gsdf._checks import as_mesh, as_normals, as_points, as_weights
 from gsdf.heat._sources import Sources
 
-__all__ = ["Sources", "mesh_sources", "point_sources", "cloud_components", "source_components"]
+__all__ = ["Sources", "mesh_sources", "point_sources", "check_cloud", "cloud_components", "source_components"]
 
 
 def mesh_sources(V, F) -> Sources:
     """Sources of a triangle mesh or soup: barycenters and area-weighted normals ½ (e₁ × e₂)."""
-    V, F = as_mesh(V, F)
+    return _mesh_sources(*as_mesh(V, F))
+
+
+def _mesh_sources(V: np.ndarray, F: np.ndarray) -> Sources:
+    """:func:`mesh_sources` of a validated mesh."""
     T = V[F]
     W = 0.5 * np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
     a = np.linalg.norm(W, axis=1)
@@ -31,20 +35,27 @@ def mesh_sources(V, F) -> Sources:
                    kind="mesh", mean_spacing=float(E.mean()), extra={"faces": F[keep]})
 
 
-def point_sources(P, N, areas=None, k: int = 20, candidates: int = 2) -> Sources:
-    """Sources of an oriented point cloud: points, unit normals times point areas (estimated when omitted).
-
-    The areas are :func:`gsdf.point_areas` with ``k`` neighbours chosen among the ``candidates · k`` nearest.
-    ``candidates=2`` (not point_areas' 8, meant for shells thicker than the spacing): on the three clouds of
-    ``bench/bench_heat_volume_speed.py`` (kitten, oni, hippo1) the 32³ mean error is lower with 2 than with 8
-    (0.00862 / 0.02430 / 0.15537 vs 0.00864 / 0.02548 / 0.15612) and the neighbour search is 4× smaller
-    (41 instead of 161 candidates per point: on hippo1, 6k points, the areas took longer than Step I).
-    """
+def check_cloud(P, N) -> tuple[np.ndarray, np.ndarray]:
+    """An oriented point cloud validated: ``P`` (n, 3) finite, ``N`` (n, 3) finite and not all zero (ValueError
+    naming the problem; N None asks for normals)."""
     if N is None:
         raise ValueError("points: an oriented cloud is needed (normals N is None); estimate them with "
                          "gsdf.estimate_normals(P) or pass --estimate-normals on the command line")
     P = as_points(P, "P")
-    N = as_normals(N, len(P), "N")
+    return P, as_normals(N, len(P), "N")
+
+
+def point_sources(P, N, areas=None, k: int = 20, candidates: int = 2) -> Sources:
+    """Sources of an oriented point cloud: points, unit normals times point areas (estimated when omitted).
+
+    The areas are :func:`gsdf.point_areas` with ``k`` neighbours chosen among the ``candidates · k`` nearest
+    (Barill et al. 2018, §3.1).
+    """
+    return _cloud_sources(*check_cloud(P, N), areas=areas, k=k, candidates=candidates)
+
+
+def _cloud_sources(P: np.ndarray, N: np.ndarray, areas=None, k: int = 20, candidates: int = 2) -> Sources:
+    """:func:`point_sources` of a validated cloud (:func:`check_cloud`)."""
     nrm = np.linalg.norm(N, axis=1)
     keep = nrm > 0
     U = np.zeros_like(N)
@@ -52,9 +63,9 @@ def point_sources(P, N, areas=None, k: int = 20, candidates: int = 2) -> Sources
     if areas is None:
         if len(P) < 4:
             raise ValueError(f"points: need at least 4 points to estimate point areas, got {len(P)}")
-        from gsdf.winding._point_areas import point_areas
+        from gsdf.winding._point_areas import _point_areas
 
-        areas = point_areas(P, U, k=min(k, len(P) - 1), candidates=candidates)
+        areas = _point_areas(P, U, k=min(k, len(P) - 1), candidates=candidates)
     a = as_weights(areas, len(P), "areas")
     keep &= a > 0
     if not keep.any():

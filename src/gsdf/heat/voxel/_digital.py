@@ -5,7 +5,7 @@ Surface. A *surfel* is the unit square between an occupied voxel and an empty 6-
 padded with empty voxels, so the box faces count). Each surfel becomes a quad oriented outward (its corners run
 counter-clockwise seen from the empty side); its corners are *pointels* (grid nodes).
 
-Non-manifold configurations are split by one fixed rule (notes wave2 §3(e)): across each edge of a surfel the
+Non-manifold configurations are split by one fixed rule: across each edge of a surfel the
 surfel is glued to the *first* boundary surfel met when turning around the edge through the occupied voxel. For
 surfel (c, d) (voxel c occupied, c + d empty) and its edge on the side e (the in-plane unit step from the
 surfel's centre to the edge):

@@ -4,7 +4,7 @@
 :class:`~gsdf.heat._domain.VertexSurfaceDomain`); steps I–III, the constraints and the shift are
 :class:`gsdf.heat._core.SignedHeatCore`'s. :class:`VoxelSurfaceSignedHeatSolver` is the front-end.
 
-Pipeline (notes wave2-swn-recon-voxel §3):
+Pipeline:
 
 1. **Surface** (:mod:`._digital`): the quads between occupied and empty 6-neighbours, outward, split into a
    closed 2-manifold by a fixed gluing rule at edges shared by four quads (occupied voxels 6-connected);
@@ -344,15 +344,10 @@ class VoxelSurfaceSignedHeatSolver:
     normal_radius : float
         Integral-invariant radius of the corrected normals, in voxels (of the smallest spacing); 0 = trivial
         normals. Default 3 (DGtal's). A fixed radius in voxels leaves a normal bias that stops the convergence
-        under refinement (digital sphere: ε ≈ 0.005 from N = 64 on); for convergence studies let it grow like
-        ``0.5 · N^(2/3)`` voxels for an object N voxels across (r ∝ h^(1/3) in world units, Coeurjolly et al.
-        2014; bench/RESULTS.md "heat-voxel").
+        under refinement; for convergence let it grow like ``0.5 · N^(2/3)`` voxels for an object N voxels
+        across (r ∝ h^(1/3) in world units, Coeurjolly et al. 2014).
     t_coef : float
         Diffusion time ``t = t_coef · h²``, h the mean edge length (≈ the voxel size).
-    normals : None, "trivial" or (m, 3) array
-        Override the corrected normals (one per quad of :attr:`faces`, pointing out).
-    connection : {"A", "B"}
-        Connection Laplacian (module :mod:`gsdf.heat.voxel._domain`, item 6).
 
     Attributes
     ----------
@@ -372,14 +367,12 @@ class VoxelSurfaceSignedHeatSolver:
     True
     """
 
-    def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, *, t_coef: float = 1.0, normals=None,
-                 connection: str = "A"):
+    def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, *, t_coef: float = 1.0):
         # scale invariance: solve with the spacing divided by the power of two 2^e that brings its largest
         # entry into [1, 2) (exact; e = 0 for unit voxels), and scale lengths back by 2^e on output
         sp = as_spacing(spacing)
         self.exponent = e = int(np.frexp(float(sp.max()))[1]) - 1
-        self.domain = d = VoxelSurfaceDomain(occupancy, np.ldexp(sp, -e), normal_radius, normals=normals,
-                                             connection=connection, t_coef=t_coef)
+        self.domain = d = VoxelSurfaceDomain(occupancy, np.ldexp(sp, -e), normal_radius, t_coef=t_coef)
         self.vertices, self.face_centres = np.ldexp(d.vertices, e), np.ldexp(d.face_centres, e)
         self.faces, self.normals = d.faces, d.normals
         self.t = float(np.ldexp(d.t, 2 * e))
