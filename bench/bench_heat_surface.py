@@ -28,6 +28,7 @@ section of bench/RESULTS.md:
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import time
@@ -1511,11 +1512,30 @@ def vx_ball(N, R):
     return (x ** 2).sum(0) <= R ** 2
 
 
+@contextlib.contextmanager
+def vx_domain(**forced):
+    """Inside the block the voxel solver's domain gets ``forced`` options (``normals=``: analytic normals,
+    ``connection="B"``: the other connection Laplacian), which are not options of the public solver."""
+    from gsdf.heat.voxel._domain import VoxelSurfaceDomain
+
+    init = VoxelSurfaceDomain.__init__
+
+    def patched(self, *args, **kwargs):
+        init(self, *args, **{**kwargs, **forced})
+
+    VoxelSurfaceDomain.__init__ = patched
+    try:
+        yield
+    finally:
+        VoxelSurfaceDomain.__init__ = init
+
+
 def vx_sphere(N, radius=3.0, broken=False, connection="A", timings=None, t_coef=1.0):
     R = N / 2 - 2
     occ = vx_ball(N, R)
     t0 = time.perf_counter()
-    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, connection=connection, t_coef=t_coef)
+    with vx_domain(connection=connection):
+        s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, t_coef=t_coef)
     t_build = time.perf_counter() - t0
     c = N / 2
     # the curve at the grid plane z = zc nearest to c + 0.3 R (quads with centres below zc + ¼: the region's
@@ -1553,7 +1573,8 @@ def vx_plane(N, nrm, mdir, radius=3.0, exact=False, t_coef=1.0):
         S = digital_surface(occ, np.ones(3))
         on = ((S.trivial_normals @ nrm) > 0) & (np.abs((S.centres - N / 2) @ nrm) < 1.0)
         normals = np.where(on[:, None], nrm, S.trivial_normals)
-    s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, normals=normals, t_coef=t_coef)
+    with vx_domain(normals=normals):
+        s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, t_coef=t_coef)
     ctr = np.full(3, N / 2)
     phi = s.compute_distance(region_boundary_curves(s.faces, (s.face_centres - ctr) @ m < 0))
     P = s.vertices - ctr

@@ -29,6 +29,7 @@ reference (its convention).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import resource
@@ -50,6 +51,7 @@ from gsdf.grid import grid_points  # noqa: E402
 from gsdf.heat._yukawa import YukawaTree, grid_nearest_distance  # noqa: E402
 from gsdf.heat.grid import _poisson as G  # noqa: E402
 from gsdf.heat.grid._domain import GridPoisson  # noqa: E402
+from gsdf.heat.volume import VolumeHeatOptions as VO  # noqa: E402
 from gsdf.heat.volume import input_spacing, signed_heat_volume, volume_grid_box  # noqa: E402
 from gsdf.heat.volume import _sources as S  # noqa: E402
 from gsdf.heat.volume._sources import mesh_sources  # noqa: E402
@@ -159,20 +161,21 @@ def run_accuracy(quick, write):
             Q = grid_points(lo, hi, shape)
             phi_ref = reference(ref, Q, is_mesh)
             diag = np.linalg.norm(X.max(0) - X.min(0))
-            f = signed_heat_volume(level_set_constraint="none", **box, **kw)
+            f = signed_heat_volume(options=VO(level_set_constraint="none"), **box, **kw)
             eg = np.abs(f.values.ravel() - phi_ref).mean()
             t = time.perf_counter()
-            fz = signed_heat_volume(level_set_constraint="zero", soft_weight=10.0, **box, **kw)
+            fz = signed_heat_volume(options=VO(level_set_constraint="zero", soft_weight=10.0), **box, **kw)
             tz = time.perf_counter() - t
             ez = np.abs(fz.values.ravel() - phi_ref).mean()
             uz = unsigned_error(fz.values.ravel(), phi_ref)
             # t from the input's own spacing, as signedheat3d sets it (meanEdgeLength²)
-            fi = signed_heat_volume(level_set_constraint="zero", soft_weight=10.0, t_scale="input", **box, **kw)
+            fi = signed_heat_volume(options=VO(level_set_constraint="zero", soft_weight=10.0, t_scale="input"), **box,
+                                    **kw)
             ei = np.abs(fi.values.ravel() - phi_ref).mean()
             ui = unsigned_error(fi.values.ravel(), phi_ref)
             ex = "—"
             if res == 32:
-                fx = signed_heat_volume(level_set_constraint="zero", soft_weight=None, **box, **kw)  # hard (exact rows)
+                fx = signed_heat_volume(options=VO(level_set_constraint="zero", soft_weight=None), **box, **kw)  # hard (exact rows)
                 ex = f"{np.abs(fx.values.ravel() - phi_ref).mean():.5f}"
             ea = ta = ua = "—"
             if res == 32:
@@ -194,13 +197,13 @@ def run_accuracy(quick, write):
                 continue
             # tet domain: both solvers evaluated (piecewise linearly) at the same grid nodes
             t = time.perf_counter()
-            ft = signed_heat_volume(domain="tet", level_set_constraint="zero", **box, **kw)
+            ft = signed_heat_volume(domain="tet", options=VO(level_set_constraint="zero"), **box, **kw)
             tt = time.perf_counter() - t
             et = np.abs(ft(Q) - phi_ref).mean()
             ut = unsigned_error(ft(Q), phi_ref)
-            ftm = signed_heat_volume(domain="tet", level_set_constraint="multiple", **box, **kw)
+            ftm = signed_heat_volume(domain="tet", options=VO(level_set_constraint="multiple"), **box, **kw)
             em = np.abs(ftm(Q) - phi_ref).mean()
-            fti = signed_heat_volume(domain="tet", level_set_constraint="zero", t_scale="input", **box, **kw)
+            fti = signed_heat_volume(domain="tet", options=VO(level_set_constraint="zero", t_scale="input"), **box, **kw)
             eti, uti = np.abs(fti(Q) - phi_ref).mean(), unsigned_error(fti(Q), phi_ref)
             try:
                 va, ta2, nva = anchor_tet(kw, lo, hi, shape, Q)
@@ -248,7 +251,7 @@ def run_accuracy(quick, write):
     for res in ((64, 128) if not small else (64,)):
         lo, hi, shape = volume_grid_box(V, res)
         t = time.perf_counter()
-        f = signed_heat_volume(mesh=(V, Fb), resolution=shape, bbox_min=lo, bbox_max=hi, soft_weight=10.0)
+        f = signed_heat_volume(mesh=(V, Fb), resolution=shape, bbox_min=lo, bbox_max=hi, options=VO(soft_weight=10.0))
         el = time.perf_counter() - t
         tm = f.meta["timings"]  # level_set_constraint "zero" with the soft penalty (gsdf heat's default)
         rows.append([f"{shape}", f"{el:.2f}", f"{tm['step1']:.2f}", f"{tm['step3']:.2f}"])
@@ -286,7 +289,7 @@ def run_accuracy(quick, write):
     # 4. offsets ±1 % and ±3 % of the bbox diagonal
     rows = []
     lo, hi, shape = volume_grid_box(V, 96)
-    f = signed_heat_volume(mesh=(V, Fb), resolution=shape, bbox_min=lo, bbox_max=hi, soft_weight=10.0)
+    f = signed_heat_volume(mesh=(V, Fb), resolution=shape, bbox_min=lo, bbox_max=hi, options=VO(soft_weight=10.0))
     diag = float(np.linalg.norm(V.max(0) - V.min(0)))
     for frac in (-0.03, -0.01, 0.0, 0.01, 0.03):
         Vc, Fc = f.isosurface(frac * diag)
@@ -368,18 +371,18 @@ def box_of(kw, res):
 
 # ---------------------------------------------------------------- workers (one process per case)
 STAGES = [  # (label, file suffix, function name): disjoint stages of the grid path
-    ("sources", "volume/sources.py", "mesh_sources"),
-    ("sources", "volume/sources.py", "point_sources"),
-    ("step I tree build", "volume/yukawa.py", "__init__"),
-    ("step I nearest", "volume/yukawa.py", "grid_nearest_distance"),
-    ("step I sum", "volume/yukawa.py", "__call__"),
-    ("step I sum", "volume/screened.py", "screened_heat"),  # the grid solve of clouds (step1="auto")
-    ("step II normalize", "heat/core.py", "unit_field"),
-    ("divergence", "domains/grid.py", "divergence"),
-    ("factorization (coarse)", "linalg/direct.py", "__init__"),
-    ("CG solve", "linalg/iterative.py", "pcg"),
-    ("CG solve", "linalg/iterative.py", "cg_loop"),       # the grid's soft-penalty solve (numba operators)
-    ("shift", "heat/core.py", "shift"),
+    ("sources", "heat/volume/_sources.py", "mesh_sources"),
+    ("sources", "heat/volume/_sources.py", "point_sources"),
+    ("step I tree build", "heat/_yukawa.py", "__init__"),
+    ("step I nearest", "heat/_yukawa.py", "grid_nearest_distance"),
+    ("step I sum", "heat/_yukawa.py", "__call__"),
+    ("step I sum", "heat/grid/_screened.py", "screened_heat"),  # the grid solve of Step I (chosen per input)
+    ("step II normalize", "heat/_core.py", "unit_field"),
+    ("divergence", "heat/grid/_domain.py", "divergence"),
+    ("factorization (coarse)", "linalg/_direct.py", "__init__"),
+    ("CG solve", "linalg/_iterative.py", "pcg"),
+    ("CG solve", "linalg/_iterative.py", "cg_loop"),       # the grid's soft-penalty solve (numba operators)
+    ("shift", "heat/_core.py", "shift"),
 ]
 
 
@@ -494,7 +497,7 @@ def worker(args):
         from gsdf.heat.volume import signed_heat_volume
 
         out["stages"] = profile_stages(lambda: signed_heat_volume(resolution=shape, bbox_min=lo, bbox_max=hi, **kw))
-        fi = signed_heat_volume(resolution=shape, bbox_min=lo, bbox_max=hi, t_scale="input", **kw)
+        fi = signed_heat_volume(resolution=shape, bbox_min=lo, bbox_max=hi, options=VO(t_scale="input"), **kw)
     if ref is not None:
         import gsdf
         from gsdf.grid import grid_points
@@ -700,6 +703,24 @@ def part_tol():
             table(["input", "1e-4", "1e-3", "3e-3"], rows), ""]
 
 
+@contextlib.contextmanager
+def forced_step1(step1):
+    """Step I by ``step1`` ("yukawa": the tree sum, "heat": the screened grid solve) instead of the library's
+    choice per input, inside the block (the grid domain's ``step1`` is not a public option)."""
+    from gsdf.heat.grid._domain import GridDomain
+
+    init = GridDomain.__init__
+
+    def forced(self, *args, **kwargs):
+        init(self, *args, **{**kwargs, "step1": step1})
+
+    GridDomain.__init__ = forced
+    try:
+        yield
+    finally:
+        GridDomain.__init__ = init
+
+
 def part_step1():
     rows = []
     for res, names in ((32, ALL), (64, MESHES_64)):
@@ -708,7 +729,8 @@ def part_step1():
             row = [name, res]
             errs = []
             for s1 in ("yukawa", "heat"):
-                t, f = timed(kw, box, repeat=3 if res == 64 else 5, step1=s1)
+                with forced_step1(s1):
+                    t, f = timed(kw, box, repeat=3 if res == 64 else 5)
                 errs.append(np.abs(f.values.ravel() - ref).mean())
                 row += [f"{1e3 * t:.1f}", f"{errs[-1]:.6f}"]
             auto = solve(kw, box).meta["step1"]
@@ -876,7 +898,7 @@ def t_scale_study(res=48):
                 for ts in ("grid", "input"):
                     try:
                         v = signed_heat_volume(points=(P, N), resolution=(res,) * 3, bbox_min=[-1] * 3,
-                                               bbox_max=[1] * 3, t_scale=ts)(X)
+                                               bbox_max=[1] * 3, options=VO(t_scale=ts))(X)
                     except ValueError:  # e.g. an outlier outside the box: φ = 0
                         v = np.zeros(len(X))
                     errs[ts] = float(np.abs(v - tr).mean())

@@ -101,8 +101,8 @@ def main():
         row = [name]
         for t_scale in ("grid", "input"):
             for t_coef in (0.25, 1.0, 4.0):
-                sec, field = timed(lambda: gsdf.signed_heat_volume(mesh=(V, F), resolution=32, t_coef=t_coef,
-                                                                    t_scale=t_scale))
+                sec, field = timed(lambda: gsdf.signed_heat_volume(
+                    mesh=(V, F), resolution=32, t_coef=t_coef, options=gsdf.VolumeHeatOptions(t_scale=t_scale)))
                 X = grid_nodes(field)
                 ref = ref_sdf(X)
                 near = np.abs(ref) < 0.1 * diag

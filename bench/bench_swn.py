@@ -53,7 +53,7 @@ from common import command, data_dir, heading, output_dir, write_section
 from load import uptime  # noqa: E402  # noqa: E402
 
 from gsdf.io import read_mesh  # noqa: E402
-from gsdf.swn._solver import SurfaceWindingNumbers  # noqa: E402
+from gsdf.swn import SurfaceWindingNumbers, SWNOptions  # noqa: E402
 
 AUTHOR = "/work/shared/data/swn"
 CSV = None  # the per-case rows (main: --rows)
@@ -608,7 +608,7 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random"):
             status = "ok"
             for meth in ("lp", "reduced"):
                 try:
-                    r = mc.swn.solve(gb, method=meth, time_limit=time_limit)
+                    r = mc.swn.solve(gb, method=meth, options=SWNOptions(time_limit=time_limit))
                     row[f"err_{meth}"] = mislabeled(r.face_labels, truth, mc.area)
                     row[f"t_{meth}_total" if meth == "reduced" else "t_lp_total"] = r.timings["total"]
                     row["t_lp_highs" if meth == "lp" else "t_reduced_lp"] = r.timings.get("lp", 0.0)
@@ -713,7 +713,7 @@ def scaling(time_limit, sizes):
         res = {}
         for meth in ("lp", "reduced"):
             try:
-                r = swn.solve(g, method=meth, time_limit=time_limit)
+                r = swn.solve(g, method=meth, options=SWNOptions(time_limit=time_limit))
                 res[meth] = r
                 line.append(f" {r.timings.get('lp', 0):.3f} s / {r.timings['total']:.2f} s |")
             except ValueError as exc:

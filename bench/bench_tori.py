@@ -35,6 +35,7 @@ from load import BusyLoad, uptime  # noqa: E402
 from gsdf.data import _shapes as S  # noqa: E402
 from gsdf.tori._baselines import SignedHopfCole, SmoothedSignedPlanarDistance, WindingNumberPipeline, _conv_kernel
 from gsdf.heat.volume import signed_heat_volume  # noqa: E402
+from gsdf.tori import PointsAsToriOptions  # noqa: E402
 from gsdf.tori._pat import PointsAsTori, _pat_kernel  # noqa: E402
 
 METHODS = ["PAT (learned)", "PAT (jet)", "SSPD", "SHC", "WN pipeline", "SHM (grid)"]
@@ -312,11 +313,7 @@ def speed(args):
             pat.signed_distance(Q)
             cpu.append(time.process_time() - c0)
         tcpu = float(np.median(cpu))
-        pat2 = PointsAsTori.__new__(PointsAsTori)
-        pat2.__dict__.update(pat.__dict__)
-        from gsdf.tori._blend import NeighbourBlend
-        pat2._blend = NeighbourBlend(pat.P, pat.C, pat.r_eval, pat.k_eval, pat.k_fallback, tree=pat._blend.knn,
-                                     kd_eps=0.5)
+        pat2 = PointsAsTori(P, N, options=PointsAsToriOptions(kd_eps=0.5))
         tq2, _ = median_time(lambda: pat2.signed_distance(Q), repeat=2)
         tg, _ = median_time(lambda: pat.gradient(Q), repeat=1)
         rows.append([n, f"{tfit:.2f}", f"{tfitl:.2f}", f"{nq / tq:.3g}", f"{2 * nq / tcpu:.3g}", f"{nq / tq2:.3g}",
