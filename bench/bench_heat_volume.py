@@ -951,10 +951,12 @@ def main(argv=None):
         start = uptime()
         flags = [f"--only {part}"] + (["--quick"] if args.quick and part in ("accuracy", "speed", "scaling") else []) \
             + (["--load"] if args.load and part == "speed" else [])
-        head = heading(TITLES[part], command("bench_heat_volume.py", flags, python="/work/anchors/bin/python"), start)
+        cmd = command("bench_heat_volume.py", flags, python="/work/anchors/bin/python")
 
-        def write(body, part=part, head=head):
-            write_section(SECTIONS[part], head + body.strip() + "\n")
+        def write(body, part=part, cmd=cmd, start=start):
+            text = heading(TITLES[part], cmd, start) + body.strip() + "\n"
+            write_section(SECTIONS[part], text)
+            return text
 
         if part == "accuracy":
             body = run_accuracy(args.quick, write)
@@ -964,8 +966,7 @@ def main(argv=None):
             body = run_choices(args.rounds)
         else:
             body = "\n".join([hermitian(), tet_step3(), t_scale_study()])
-        print(head + body, flush=True)
-        write(body)
+        print(write(body), flush=True)
 
 
 if __name__ == "__main__":

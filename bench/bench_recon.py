@@ -207,14 +207,13 @@ def table2(quick: bool):
     rng = np.random.default_rng(0)
     failures = []
     start = uptime()
-    head = heading("Guaranteed simply connected reconstruction: Table 2 protocol, thin tubes, torus",
-                   command("bench_recon.py", ["--only table2"] + (["--quick"] if quick else []),
-                           python="/work/anchors/bin/python"), start)
+    cmd = command("bench_recon.py", ["--only table2"] + (["--quick"] if quick else []), python="/work/anchors/bin/python")
     lines = ["Absolute times on a shared machine are inflated; compare methods within a row.", ""]
 
     def flush(extra):
         """Write what is measured so far (a loaded machine may not finish the whole run)."""
-        write_section("recon", head + "\n".join(lines + extra))
+        write_section("recon", heading("Guaranteed simply connected reconstruction: Table 2 protocol, thin tubes, "
+                                       "torus", cmd, start) + "\n".join(lines + extra))
 
     def check(name, V, F):
         c, g, man, t = topo(V, F)
