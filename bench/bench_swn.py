@@ -752,7 +752,7 @@ def author_data(out_dir=None):
         rows.append(f"| {mesh} / {cur} | {len(F2)} | {swn.betti_1} | {int(r.endpoints.sum())} | {share} | "
                     f"{nb:.2f} | {r.timings['total']:.2f} s | {agree:.1f} % / {rr.timings['total']:.2f} s |")
         if out_dir:
-            from gsdf.view._raster import render_function_png
+            from gsdf.render._raster import render_function_png
 
             m = len(F2)
             png = os.path.join(out_dir, f"swn_author_{os.path.splitext(cur)[0]}.png")

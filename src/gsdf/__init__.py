@@ -43,8 +43,10 @@ _EXPORTS = {
     "TetField": "field", "marching_tetrahedra": "contour",
     "offset_surface": "ops", "dilate_erode": "ops", "erode_dilate": "ops",
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
-    "PointsAsTori": "tori", "PointsAsToriOptions": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
-    "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "view",
+    "PointsAsTori": "tori", "PointsAsToriOptions": "tori", "SignedHopfCole": "tori",
+    "SmoothedSignedPlanarDistance": "tori", "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori",
+    # pictures and the viewer (polyscope: the extra gsdf[view])
+    "view": "render", "ViewOptions": "render", "render_png": "render",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
     "reconstruct_simply_connected": "recon", "ReconstructionOptions": "recon", "mesh_topology": "mesh",
     # dataset batches

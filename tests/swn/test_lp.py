@@ -8,7 +8,7 @@ import gsdf.swn._solver as S
 from gsdf import SWNOptions
 from gsdf.swn._solver import SurfaceWindingNumbers
 from tests.swn.test_solver import boundary_chain, mislabeled
-from tests.shapes import annulus, double_torus, torus
+from tests.shapes import annulus, torus
 
 
 # -------------------------------------------------------------------------------- the final jump solve

@@ -353,8 +353,10 @@ def test_cli_swn(tmp_path):
 def test_progress_callback(tor):
     V, F, idx, swn = tor
     seen = []
-    swn.solve([idx[5, :12]], progress=lambda d, t: seen.append((d, t)))
-    assert seen[-1] == (5, 5) and all(t == 5 for _, t in seen) and [d for d, _ in seen] == sorted(d for d, _ in seen)
+    swn.solve([idx[5, :12]], progress=lambda stage, f: seen.append((stage, f)))
+    fractions = [f for _, f in seen]
+    assert seen[0] == ("jump Laplace solve", 0.0) and seen[-1] == ("done", 1.0)
+    assert fractions == sorted(fractions) and all(isinstance(s, str) for s, _ in seen)
     with pytest.raises(ValueError, match="progress"):
         swn.solve([idx[5, :12]], progress=3)
 

@@ -60,8 +60,8 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
     check_output(png, (".png",), "--png")
     P, N = read_points(cloud)
 
-    def say(stage):
-        if not quiet:
+    def say(stage, fraction):
+        if not quiet and fraction < 1:
             click.echo(f"  {stage} ...", err=True)
 
     click.echo(f"{cloud}: {len(P)} points{' with normals' if N is not None else ''}; method {method}")
@@ -87,7 +87,7 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
         write_mesh(tmp, V, F)
     click.echo(f"mesh -> {os.path.abspath(output)}")
     if png is not None:
-        from gsdf.view._raster import render_function_png
+        from gsdf.render._raster import render_function_png
         with output_file(png, (".png",), what="--png") as tmp:
             render_function_png(tmp, V, F, np.asarray(V)[:, 1], view=view)
         click.echo(f"preview -> {os.path.abspath(png)}")

@@ -111,7 +111,7 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
                f"method {method}: labels (area) {share}; nonbounding share of the input {nb:.2f}; "
                f"{res.timings['total']:.2f} s -> {os.path.abspath(output)}")
     if png:
-        from gsdf.view._raster import render_function_png
+        from gsdf.render._raster import render_function_png
 
         m = len(F2)
         with output_file(png, (".png",), what="--png") as tmp:

@@ -55,7 +55,7 @@ import numpy as np
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-from gsdf._checks import choice, integer
+from gsdf._checks import choice, integer, progress_callback
 from gsdf.dec._tet import TetComplex
 from gsdf.recon._cloud import dense_points, on_side, on_surface, pca_normals, prefilter, prepare_cloud
 from gsdf.recon._grow import carve_regions, grow_regions, region_boundary
@@ -97,8 +97,9 @@ class ReconstructionOptions:
 
     A ValueError names the attribute when a value is out of range.
 
-    Example
-    -------
+    Examples
+    --------
+    >>> from gsdf import ReconstructionOptions
     >>> ReconstructionOptions(subdivide=0).fit_k
     8
     """
@@ -140,7 +141,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     clusters : bool — split the inliers by single-linkage clustering (§6.1) and output one sphere per cluster
         (vertex-disjoint); False: exactly one sphere.
     options : ReconstructionOptions, optional — alternation rounds, gaps, subdivision, fit.
-    progress : callable(str) or None — called with a short stage description.
+    progress : callable ``progress(stage, fraction)``, optional — called as each stage starts.
     return_report : bool — also return a dict (iterations, F0 sizes, outlier mask, timings, sizes).
 
     Returns
@@ -187,21 +188,21 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
         options = ReconstructionOptions()
     elif not isinstance(options, ReconstructionOptions):
         raise ValueError(f"options: expected a ReconstructionOptions, got {type(options).__name__}")
-    say = progress if callable(progress) else (lambda s: None)
+    say = progress_callback(progress)
     timings = {}
     t0 = time.perf_counter()
     X, Nk, keep, scale, centre = prepare_cloud(P, N)
     inl, n_planar = _clean_cloud(X, outliers)
     timings["prefilter"] = time.perf_counter() - t0
     t = time.perf_counter()
-    say("normals")
+    say("normals", 0.0)
     Ni = _oriented_normals(X[inl], Nk, inl)
     timings["orientation"] = time.perf_counter() - t
     t = time.perf_counter()
     inl, Xi, Ni, n_side = _side_rescue(X, inl, Ni, outliers, n_planar)
     timings["side_rescue"] = time.perf_counter() - t
     t = time.perf_counter()
-    say("tetrahedralisation")
+    say("tetrahedralisation", 0.1)
     K, S, spacing = _tetrahedralise(Xi)
     timings["tetrahedralisation"] = time.perf_counter() - t
     allowed, n_regions = _cluster_regions(K, Xi, spacing, clusters, options.cluster_gap)
@@ -213,6 +214,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     orig_rows = keep[np.flatnonzero(inl)]
     V = _output_vertices(Vn, exact, used, orig_rows, P, scale, centre)
     timings["total"] = time.perf_counter() - t0
+    say("done", 1.0)
     if not return_report:
         return V, F
     report = _report(len(np.asarray(P)), keep, inl, orig_rows, n_planar, n_side, grown, K, S, n_regions)
@@ -332,14 +334,14 @@ def _alternate(K, Xi, Ni, spacing, allowed, n_regions, rounds, opts, say, timing
     best = None
     for it in range(rounds):
         t = time.perf_counter()
-        say(f"jump Laplace (round {it + 1})")
+        say(f"jump Laplace (round {it + 1})", 0.2 + 0.5 * it / rounds)
         h["inlier_counts"].append(int(use.sum()))
         w, wn, dS, n_f0, n_cav = _inside_field(K, Xi[use], Ni[use], spacing, opts.band)
         h["f0_sizes"].append(n_f0)
         h["cavities"].append(n_cav)
         timings["core"] += time.perf_counter() - t
         t = time.perf_counter()
-        say(f"growing the ball (round {it + 1})")
+        say(f"growing the ball (round {it + 1})", 0.2 + 0.5 * (it + 0.5) / rounds)
         label, rejected = _grow_ball(K, w, wn, dS, allowed, n_regions, n_p)
         label, n_add, n_cut = _sculpt(K, label, allowed, wn, dS, n_p, use, spacing)
         label, n_reach = _reach(K, label, allowed, use, spacing)
@@ -425,24 +427,24 @@ def _refine(V, F, is_pt, Xu, spacing, opts, say, timings):
     k, enough = opts.fit_k, len(Xu) >= 3
     out = {"relocation": None, "fit": None, "flips": None, "subdivision": None}
     t = time.perf_counter()
-    say("relocating vertices")
+    say("relocating vertices", 0.7)
     V, exact, out["relocation"] = _relocate(V, F, is_pt, Xu, spacing, k=k)
     timings["relocate"] = time.perf_counter() - t
     t = time.perf_counter()
     if opts.fit and enough:
-        say("fitting all vertices to the samples")
+        say("fitting all vertices to the samples", 0.75)
         V, rep = fit_to_samples(V, F, Xu, spacing, k=k, return_report=True)
         exact = np.zeros(len(V), dtype=bool)          # no vertex stays at its input coordinates
         out["fit"] = {"before_flips": rep}
     timings["fit"] = time.perf_counter() - t
     t = time.perf_counter()
     if enough:
-        say("flipping edges onto the samples")
+        say("flipping edges onto the samples", 0.8)
         F, out["flips"] = _flip(V, F, exact, Xu, spacing, k=k)
     timings["remesh"] = time.perf_counter() - t
     t = time.perf_counter()
     if opts.subdivide and enough:
-        say("subdividing onto the samples")
+        say("subdividing onto the samples", 0.85)
         nv = len(V)
         V, F, out["subdivision"] = subdivide_onto_samples(V, F, Xu, spacing, levels=opts.subdivide, k=k,
                                                           return_report=True)
@@ -451,13 +453,13 @@ def _refine(V, F, is_pt, Xu, spacing, opts, say, timings):
     if opts.subdivide and enough:
         # the split of a closed oriented manifold is one: no need to re-check it
         t = time.perf_counter()
-        say("flipping edges of the subdivided mesh")
+        say("flipping edges of the subdivided mesh", 0.9)
         F, rep = flip_to_samples(V, F, Xu, spacing, k=k, check=False, return_report=True)
         out["flips"]["flipped_subdivided"] = rep["flipped"]
         timings["remesh"] += time.perf_counter() - t
     if out["fit"] is not None and opts.subdivide:
         t = time.perf_counter()
-        say("fitting the subdivided mesh to the samples")
+        say("fitting the subdivided mesh to the samples", 0.95)
         V, out["fit"]["subdivided"] = fit_to_samples(V, F, Xu, spacing, k=k, return_report=True)
         timings["fit"] += time.perf_counter() - t
     return V, F, exact, out

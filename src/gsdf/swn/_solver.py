@@ -58,6 +58,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, dijkstra
 
+from gsdf._checks import progress_callback
 from gsdf.dec._hodge import HodgeDecomposition
 from gsdf.dec._triangle import TriangleDEC
 from gsdf.linalg._dual_l1 import dual_graph_l1
@@ -319,8 +320,8 @@ class SurfaceWindingNumbers:
         method : "lp" (full residual LP, thesis §6.1), "reduced" (reduced LP, §6.3) or "none" (naive rounding of
             u). On simply connected surfaces no LP is needed and "lp" and "reduced" give the same result.
         options : SWNOptions, optional — the residual LP's weight ε and time limit
-        progress : callable(done, total), optional — called after each of the steps (jump solve, Darboux
-            derivative, Hodge decomposition, residual LP, final solve)
+        progress : callable ``progress(stage, fraction)``, optional — called as each step starts (jump solve,
+            Darboux derivative, Hodge decomposition, residual LP, final solve) and once at the end (fraction 1)
 
         Returns
         -------
@@ -338,16 +339,13 @@ class SurfaceWindingNumbers:
             options = SWNOptions()
         elif not isinstance(options, SWNOptions):
             raise ValueError(f"options: expected a SWNOptions, got {type(options).__name__}")
-        if progress is not None and not callable(progress):
-            raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
+        progress = progress_callback(progress)
         endpoint_rule = "branch" if self.simply_connected else "exclude"
         labels = "global" if method == "none" else "gaps"
         steps = iter(range(1, 6))
 
-        def say(_name):
-            if progress is not None:
-                k = next(steps, 5)
-                progress(k - 1, 5)
+        def say(name):
+            progress(name, (next(steps, 5) - 1) / 5)
         dec, topo = self.dec, self.topology
         T = {}
         t0 = time.perf_counter()
@@ -367,8 +365,7 @@ class SurfaceWindingNumbers:
         if method == "none" or self.simply_connected:
             om = dec.darboux(u, ends) if method != "none" else zero
             res = self._finish(u, u, g, zero, ends, om, om, method, T, labels=labels)
-            if progress is not None:
-                progress(5, 5)
+            progress("done", 1.0)
             return res
 
         say("Darboux derivative")
@@ -390,8 +387,7 @@ class SurfaceWindingNumbers:
         res = self._finish(w, u, g, Jv, ends, om, gamma, method, T, bnd, labels=labels)
         res.lp_objective = obj
         res.passes = passes
-        if progress is not None:
-            progress(5, 5)
+        progress("done", 1.0)
         return res
 
     def _passes(self, u, g, ends, method, options, endpoint_rule, T, say):
