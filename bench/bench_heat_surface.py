@@ -677,7 +677,6 @@ def time_step_study(levels):
     §9.5.1 planar setup (barycentric level-set star) and on the paper's setup (star inserted as mesh edges); plus
     the far-field direction error of the diffused field Y at fixed c (what limits the order at t = h²)."""
     from gsdf.data._shapes import polygon_sdf_2d
-    from gsdf.heat.triangle._sources import build_sources
 
     res, hs, far = {}, {"bary": [], "edges": []}, {}
     for n in levels:
@@ -701,7 +700,7 @@ def time_step_study(levels):
                     res.setdefault((setup, name, mode), []).append(e)
                 if setup == "bary" and tc in (1.0, 4.0):
                     # direction error of Y (degrees) in faces farther than 0.3 from the curve
-                    Y = s.unit_field(s.diffuse(build_sources(s.ops, curves, None, None)))
+                    Y = s.unit_field(s.diffuse(s.core.sources(curves, (), None)))
                     Cc = V[F].mean(1)
                     sel = np.abs(star_sdf(Cc)) > 0.3
                     d = 1e-4
