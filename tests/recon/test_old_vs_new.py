@@ -1,6 +1,6 @@
 """Old-vs-new: ``gsdf.reconstruct_simply_connected`` as named stages with :class:`gsdf.ReconstructionOptions` gives
 bit-identical meshes (V, F) to the 437-line function it replaced (the previous checkout, ``GSDF_OLD_SRC``,
-default /work/main/src, run in a subprocess). Skipped when that checkout is absent."""
+set it to a checkout's src folder, run in a subprocess). Skipped unless GSDF_OLD_SRC is set."""
 
 import os
 import pathlib
@@ -11,7 +11,7 @@ import tempfile
 import numpy as np
 import pytest
 
-OLD_SRC = pathlib.Path(os.environ.get("GSDF_OLD_SRC", "/work/main/src"))
+OLD_SRC = pathlib.Path(os.environ.get("GSDF_OLD_SRC", "/nonexistent"))
 NEW_SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 
 pytestmark = pytest.mark.skipif(not (OLD_SRC / "gsdf").is_dir() or OLD_SRC.resolve() == NEW_SRC.resolve(),

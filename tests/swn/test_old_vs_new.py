@@ -1,6 +1,5 @@
 """Old-vs-new: ``gsdf.surface_winding_number`` with its defaults gives bit-identical results to the code before the
-options were folded into :class:`gsdf.SWNOptions` (the previous checkout, ``GSDF_OLD_SRC``, default
-/work/main/src, run in a subprocess). Skipped when that checkout is absent."""
+options were folded into :class:`gsdf.SWNOptions` (the previous checkout, ``GSDF_OLD_SRC``, set it to a checkout's src folder, run in a subprocess). Skipped unless GSDF_OLD_SRC is set."""
 
 import os
 import pathlib
@@ -11,7 +10,7 @@ import tempfile
 import numpy as np
 import pytest
 
-OLD_SRC = pathlib.Path(os.environ.get("GSDF_OLD_SRC", "/work/main/src"))
+OLD_SRC = pathlib.Path(os.environ.get("GSDF_OLD_SRC", "/nonexistent"))
 NEW_SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 SHAPES = pathlib.Path(__file__).resolve().parents[1] / "shapes.py"
 
