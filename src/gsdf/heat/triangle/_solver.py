@@ -38,8 +38,8 @@ class SurfaceSignedHeatSolver:
         Triangle mesh of any topology: boundary, several components, nonmanifold edges/vertices (operators are
         per-face sums, §9.4). Nonorientable meshes (and faces whose orientation disagrees with a neighbour's)
         are handled exactly: transport across such an edge is a reflection, so the connection Laplacian of step I
-        is then assembled as a real 2|E|×2|E| block matrix that represents the reflections (the complex |E|×|E|
-        form of Eq. 9 when all faces agree); give the curve normals (``curve_normals=`` of
+        is then assembled as a real ``2|E| × 2|E|`` block matrix that represents the reflections (the complex
+        ``|E| × |E|`` form of Eq. 9 when all faces agree); give the curve normals (``curve_normals=`` of
         :meth:`compute_distance`) there, since face normals flip across the seam.
         Faces that repeat a vertex have no area and are dropped with a warning (``F`` of the solver lists the
         faces kept; face indices given in curves and point sources still refer to the input ``F``); other faces
