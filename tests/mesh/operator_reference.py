@@ -81,6 +81,52 @@ def put(out, key, A):
         out[key] = np.asarray(A)
 
 
+def load(key):
+    """The frozen array or sparse matrix (COO) stored under ``key``."""
+    ref = _reference()
+    if key + "/row" in ref.files:
+        return sp.coo_matrix((ref[key + "/val"], (ref[key + "/row"], ref[key + "/col"])),
+                             shape=tuple(ref[key + "/shape"]))
+    return ref[key]
+
+
+def canonical(A):
+    """``A`` as :func:`put` stores it (sparse: canonical COO, duplicates summed, zeros dropped)."""
+    if sp.issparse(A):
+        C = sp.coo_matrix(A.tocsr())
+        C.sum_duplicates()
+        C.eliminate_zeros()
+        return C
+    return np.asarray(A)
+
+
+def identical(key, A) -> bool:
+    """Is ``A`` bit-identical (values, dtype, sparsity pattern) to the frozen ``key``?"""
+    ref, new = load(key), canonical(A)
+    if sp.issparse(ref):
+        return (sp.issparse(new) and ref.shape == new.shape and ref.dtype == new.dtype
+                and all(np.array_equal(a, b) for a, b in ((ref.row, new.row), (ref.col, new.col),
+                                                         (ref.data, new.data))))
+    return ref.shape == new.shape and ref.dtype == new.dtype and np.array_equal(ref, new)
+
+
+def relative_difference(key, A) -> float:
+    """max |A − frozen| / max |frozen|."""
+    ref, new = load(key), canonical(A)
+    if sp.issparse(ref):
+        return float(abs(ref.tocsr() - new.tocsr()).max() / abs(ref).max())
+    return float(np.abs(new - ref).max() / np.abs(ref).max())
+
+
+_REF = []
+
+
+def _reference():
+    if not _REF:
+        _REF.append(np.load(OUT))
+    return _REF[0]
+
+
 def main():                                                        # pragma: no cover - runs on the old code
     from gsdf.dec._tet import TetComplex
     from gsdf.dec._triangle import TriangleDEC

@@ -83,10 +83,10 @@ def test_final_solve_jumps_only_across_the_input():
     ends = r.endpoints | swn.dec.chain_endpoints(r.bounding, tol=1e-6)   # incl. where the bounding part ends
     inner = ~swn.topology.boundary_edges & ~ends[swn.dec.edges].any(1)
     assert np.abs(J[off & inner]).max() < 1e-8                 # ... but w does not jump there
-    assert mislabeled(r, truth, swn.dec.face_area) < 0.01
+    assert mislabeled(r, truth, swn.dec.areas) < 0.01
     # the former behaviour (with one global rounding level, as then)
     old = swn.solve(g, method="lp", _final="all", bounding="fractional", labels="global")
-    assert mislabeled(old, truth, swn.dec.face_area) > 0.015   # the former behaviour, for the record
+    assert mislabeled(old, truth, swn.dec.areas) > 0.015   # the former behaviour, for the record
 
 
 def test_integer_class_skips_the_lp_for_a_broken_bounding_curve():
@@ -95,7 +95,7 @@ def test_integer_class_skips_the_lp_for_a_broken_bounding_curve():
     naive = swn.solve(g, method="none")
     assert r.timings["lp"] == 0.0 and not np.any(r.residual)   # class 0.45 rounds to 0: nothing nonbounding
     assert np.array_equal(r.face_labels, naive.face_labels)
-    assert mislabeled(r, truth, swn.dec.face_area) == 0.0
+    assert mislabeled(r, truth, swn.dec.areas) == 0.0
 
 
 def test_integer_class_removes_a_broken_meridian_completely():
@@ -155,7 +155,7 @@ def test_bounding_part_is_a_subset_of_the_input():
     assert not np.any(r.bounding[mer])                           # ... and still read as nonbounding
     assert np.array_equal(r.bounding[~mer], r.chain[~mer])      # the patch boundary stays whole
     assert np.ptp(r.corner_values[~R]) < 1e-6 and np.ptp(r.corner_values[R]) < 1e-6
-    assert mislabeled(r, truth, swn.dec.face_area) == 0.0
+    assert mislabeled(r, truth, swn.dec.areas) == 0.0
     old = swn.solve(g, method="lp", bounding="fractional")     # the former reading, for the record
     assert 0.4 < np.abs(old.bounding[mer]).max() < 0.5
     assert np.ptp(old.corner_values[~R]) > 0.4
@@ -168,7 +168,7 @@ def test_subset_reading_stops_when_nothing_is_left_to_remove():
     g = g + swn.chain([[5 * 24 + 23, 5 * 24]])                  # the closing edge: a whole meridian
     r = swn.solve(g, method="lp")
     assert r.passes == 2 and np.allclose(r.residual[mer], r.chain[mer], atol=1e-6)
-    assert not np.any(r.bounding[mer]) and mislabeled(r, R.astype(int), swn.dec.face_area) == 0.0
+    assert not np.any(r.bounding[mer]) and mislabeled(r, R.astype(int), swn.dec.areas) == 0.0
     with pytest.raises(ValueError, match="bounding"):
         swn.solve(g, bounding="all")
     with pytest.raises(ValueError, match="bounding"):
@@ -228,7 +228,7 @@ def test_cycle_choice_keeps_the_whole_loop_not_the_band_side():
     LP again without that side's edges, finds the loop, and keeps it: 3/4 of its jump mass lies on the input
     against 2/3 on the side."""
     swn, g, loop, truth = _band_and_long_loop()
-    A = swn.dec.face_area
+    A = swn.dec.areas
     lp = swn.solve(g, method="lp", cycle_choice="lp")
     assert np.abs(lp.residual[loop]).max() < 0.1                 # the LP's cycle avoids the loop ...
     assert mislabeled(lp, truth, A) > 0.1                        # ... and cuts the band
@@ -270,7 +270,7 @@ def test_broken_meridian_is_the_nonbounding_part_beside_a_broken_region():
         r = swn.solve(g, method="lp")
         assert not np.any(np.round(r.bounding[mer]))
         assert np.array_equal(np.round(r.bounding[~mer]), g[~mer])
-        assert mislabeled(r, truth, swn.dec.face_area) < 0.002
+        assert mislabeled(r, truth, swn.dec.areas) < 0.002
         assert np.allclose(np.round(r.bounding) + np.where(g != 0, np.round(r.residual), 0), g)   # g = bnd + N
 
 

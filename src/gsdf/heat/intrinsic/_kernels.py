@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from gsdf.heat.triangle._operators import NEXT
+from gsdf.mesh._connectivity import unique_edges
+from gsdf.mesh._triangle_ops import NEXT
 
 
 @njit(cache=True)
@@ -347,11 +348,11 @@ def _initial_state(V, F):
     n, m = len(V), len(F)
     Fv = np.array(F, dtype=np.int64, copy=True)
     FL = np.linalg.norm(V[F[:, NEXT]] - V[F], axis=2)
-    a, b = Fv, Fv[:, NEXT]
-    key = (np.minimum(a, b) * n + np.maximum(a, b)).ravel()
-    uniq, inv = np.unique(key, return_inverse=True)
+    b = Fv[:, NEXT]
+    edges, FE, _ = unique_edges(Fv, n)
+    uniq = edges[:, 0] * n + edges[:, 1]                   # sorted edge keys lo * n + hi
+    inv = FE.ravel()
     nE = len(uniq)
-    FE = inv.reshape(m, 3).astype(np.int64)
     cnt = np.bincount(inv, minlength=nE)
     order = np.argsort(inv, kind="stable")
     start = np.concatenate([[0], np.cumsum(cnt)])
