@@ -160,7 +160,7 @@ def test_spd_solver_iterative_and_direct_agree():
     """Above ``direct_max`` the solver runs preconditioned CG; it must match the factorization."""
     import scipy.sparse as sp
 
-    from gsdf.heat.tet._mesh import SPDSolver
+    from gsdf.linalg import SPDSolver
 
     n = 40
     K1 = sp.diags([2.0 * np.ones(n), -np.ones(n - 1), -np.ones(n - 1)], [0, -1, 1])
