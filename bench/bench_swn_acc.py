@@ -116,7 +116,7 @@ def joint_residual(swn, mu=1.0):
         A = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                           shape=(2 * k, 2 * n + 2 * k + 2 * ko))
         b = np.concatenate([-d, np.zeros(ko), g[interior][onn]])
-        wl = dec.edge_length[interior]
+        wl = dec.edge_len[interior]
         cost = np.concatenate([np.zeros(2 * n), w, w, mu * wl[off], mu * wl[off]])
         nc, lab = connected_components(sp.coo_matrix((one(k), (P[:, 0], P[:, 1])), shape=(n, n)), directed=False)
         first = np.full(nc, n, dtype=np.int64)
@@ -137,7 +137,7 @@ def mode_offset(swn, wf, g, bnd, bw=0.05):
     """Rounding offset at the densest level of the bounding edges' mid-values (von Mises kernel, bandwidth bw)."""
     dec, topo = swn.dec, swn.topology
     ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
-    wt = dec.edge_length[ce] * np.abs(bnd[ce]) * (np.round(bnd[ce]) != 0)
+    wt = dec.edge_len[ce] * np.abs(bnd[ce]) * (np.round(bnd[ce]) != 0)
     if not wt.sum() > 0:
         return None
     mid = 0.5 * (wf[topo.edge_faces[ce, 0]] + wf[topo.edge_faces[ce, 1]])

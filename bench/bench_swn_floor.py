@@ -95,7 +95,7 @@ def shortest_path_closure(swn, g, gb):
     truth's pairing; an oracle). A gap without exactly two ends (a run touching itself) gets its deleted edges."""
     d = swn.dec
     n = d.n_vertices
-    G = sp.coo_matrix((d.edge_length, (d.edges[:, 0], d.edges[:, 1])), shape=(n, n)).tocsr()
+    G = sp.coo_matrix((d.edge_len, (d.edges[:, 0], d.edges[:, 1])), shape=(n, n)).tocsr()
     key = d.edges[:, 0] * n + d.edges[:, 1]
     out = gb.copy()
     for mem, a, b in gap_pieces(d, g, gb):
@@ -240,7 +240,7 @@ def piece_vote(swn, gb, bnd, ends):
     deg = np.bincount(d.edges[S].ravel(), minlength=n)
     nc, lab = _split(d, S, n, deg == 2)
     on = gb[S] != 0
-    L = d.edge_length[S] * on
+    L = d.edge_len[S] * on
     rem = (np.abs(np.round(gb[S] - bnd[S])) > 0) * L
     frac = np.bincount(lab, weights=rem, minlength=nc) / np.maximum(np.bincount(lab, weights=L, minlength=nc),
                                                                     1e-300)
@@ -273,7 +273,7 @@ def run_smoothing(swn, gb, bnd, ends, iters=3):
         rs = sorted({int(vrun[x]) for x in vs[ends[vs]] if vrun[x] >= 0})
         for i in rs:
             nbr[i].update(j for j in rs if j != i)
-    L = d.edge_length[S]
+    L = d.edge_len[S]
     rem = (np.abs(np.round(gb[S] - bnd[S])) > 0) * L
     st0 = np.bincount(lab, weights=rem, minlength=nc) / np.bincount(lab, weights=L, minlength=nc) > 0.5
     st = st0.copy()
@@ -342,7 +342,7 @@ def input_runs(d, g):
     vrun = np.full(n, -1)
     vrun[d.edges[S, 0]] = lab
     vrun[d.edges[S, 1]] = lab
-    return vrun, np.bincount(lab, weights=d.edge_length[S], minlength=nc)
+    return vrun, np.bincount(lab, weights=d.edge_len[S], minlength=nc)
 
 
 def complete_no_self(swn, g, ends, ratio=3.0):
@@ -359,7 +359,7 @@ def complete_no_self(swn, g, ends, ratio=3.0):
     vrun, runlen = input_runs(d, g)
     E = d.edges
     free = g == 0
-    Gm = sp.coo_matrix((d.edge_length[free], (E[free, 0], E[free, 1])), shape=(n, n)).tocsr()
+    Gm = sp.coo_matrix((d.edge_len[free], (E[free, 0], E[free, 1])), shape=(n, n)).tocsr()
     D, pred = dijkstra(Gm, directed=False, indices=pos, return_predecessors=True)
     need_p, need_n = np.rint(div[pos]).astype(np.int64), np.rint(-div[neg]).astype(np.int64)
     dd = D[:, neg].copy()
@@ -408,7 +408,7 @@ def completion_part(per_mesh, ratio=3.0):
                 if len(ev) == 2:
                     n_paths += 1
                     n_self += int(vrun[ev[0]] == vrun[ev[1]] and vrun[ev[0]] >= 0 and
-                                  runlen[vrun[ev[0]]] < ratio * d.edge_length[C[labc == q]].sum())
+                                  runlen[vrun[ev[0]]] < ratio * d.edge_len[C[labc == q]].sum())
             e1 = B.mislabeled(sw.solve(gb, method="reduced").face_labels, truth, A)
             sw._complete_chain = lambda g_, e_, _sw=sw: complete_no_self(_sw, g_, e_, ratio)
             try:

@@ -130,7 +130,7 @@ def local_level(swn, r, gb, g, truth, weight="dw", pairing="auto", eps=0.1):
     eA, eB = topo.edge_faces[:, 0], np.maximum(topo.edge_faces[:, 1], 0)
     mid = np.where(inter, 0.5 * (wf[eA] + wf[eB]), np.nan)
     dw = np.where(inter, np.abs(wf[eA] - wf[eB]), 0.0)
-    wt = d.edge_length if weight == "len" else d.edge_length / (dw + eps)
+    wt = d.edge_len if weight == "len" else d.edge_len / (dw + eps)
     free = gg == 0
     G = sp.coo_matrix((wt[free], (E[free, 0], E[free, 1])), shape=(n, n)).tocsr()
     if pairing == "oracle":
@@ -171,7 +171,7 @@ def oracle_closure(swn, r, gb, g, truth):
 
 
 def oracle_gap_threshold(swn, r, gb, g, truth):
-    d, topo, A = swn.dec, swn.topology, swn.dec.face_area
+    d, topo, A = swn.dec, swn.topology, swn.dec.areas
     wf = fill_values(swn, r)
     s, _ = _offset(swn, wf, gb)
     W = np.round(wf - s)
@@ -272,7 +272,7 @@ def main():
         V, F = loadf()
         mc = B.MeshCases(mname, V, F, seed=1000 + mi)
         swn = SurfaceWindingNumbers(np.asarray(mc.dec.V), np.asarray(mc.dec.F))
-        A = swn.dec.face_area
+        A = swn.dec.areas
         cases = [c for c in B.generate_cases(mc, 42, "random") if np.any(c[5])]
         for c, cid, kind, truth, g, gb, frac, nb in cases[::a.every]:
             r = swn.solve(gb, labels="global")

@@ -167,7 +167,7 @@ def _lp_without(swn, forbid):
         hi = np.where(on, np.maximum(0.0, gi), np.inf)
         lo[forbid[inter]] = 0.0
         hi[forbid[inter]] = 0.0
-        r = dual_graph_l1(dec.n_faces, topo.edge_faces[inter], d, dec.edge_length[inter] * np.where(on, eps, 1.0),
+        r = dual_graph_l1(dec.n_faces, topo.edge_faces[inter], d, dec.edge_len[inter] * np.where(on, eps, 1.0),
                           bounds=np.column_stack([lo, hi]), time_limit=time_limit, algorithm=algorithm)
         Jv = np.zeros(dec.n_edges)
         Jv[inter] = r.jumps

@@ -79,7 +79,7 @@ def complete_runs(sw, g, same=None):
     """Completion (nE,) of g by shortest off-input paths, arriving endpoints assigned to leaving ones at least
     total length; ``same(a, b)`` (optional) forbids pairs; also returns the pairs."""
     dec = sw.dec
-    n, E, ell = dec.n_vertices, dec.edges, dec.edge_length
+    n, E, ell = dec.n_vertices, dec.edges, dec.edge_len
     div = np.rint(dec.d0.T @ g).astype(np.int64)
     pos, neg = np.flatnonzero(div > 0), np.flatnonzero(div < 0)
     comp = np.zeros(dec.n_edges)
@@ -200,7 +200,7 @@ def curves_split(sw, g, same=None):
     hs = np.rint(np.array([Om @ C for C in curves]))
     nz = [i for i in range(len(curves)) if np.any(hs[i])]
     info["curves"], info["class curves"] = len(curves), len(nz)
-    ell, inp = dec.edge_length, g != 0
+    ell, inp = dec.edge_len, g != 0
     if len(nz) > 14:                      # never reached on the bench; keep the enumeration bounded
         nz = sorted(nz, key=lambda i: -np.abs(hs[i]).sum())[:14]
     best = None

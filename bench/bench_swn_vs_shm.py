@@ -115,7 +115,7 @@ class Domain:
         if connected_components(adj, directed=False)[0] != 1:
             raise ValueError(f"{name}: several components (eigenfunctions 2-6 would be constant on each)")
         self.dec, self.topo = d, d.topology
-        self.area = d.face_area
+        self.area = d.areas
         self.vA = d.star0                                       # barycentric vertex areas (§9.1's A_i)
         self.vface = np.empty(d.n_vertices, np.int64)           # one incident face per vertex
         self.vface[self.F.ravel()] = np.repeat(np.arange(len(self.F)), 3)
@@ -159,7 +159,7 @@ class Domain:
 
     def contour_mode(self, W, g):
         e, L, R = self.left_right(g)
-        ell = self.dec.edge_length[e]
+        ell = self.dec.edge_len[e]
         ok = W[L] > W[R]
         if not ok.any():
             return None
@@ -169,7 +169,7 @@ class Domain:
 
     def contour_mean(self, w, g):
         e, L, R = self.left_right(g)
-        ell = self.dec.edge_length[e]
+        ell = self.dec.edge_len[e]
         level = float(np.sum(ell * 0.5 * (w[L] + w[R])) / ell.sum())
         return w > level
 
