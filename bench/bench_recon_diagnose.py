@@ -205,7 +205,7 @@ def main(png: bool):
                           f"{floor:.3f}" if key == "SPSR" else ""])
             print(rows[-1], rows2[-1], rows3[-1], rows4[-1], flush=True)
         if png:
-            from gsdf.view._raster import render_function_png
+            from gsdf.render._raster import render_function_png
             tag = name.replace(" ", "_").replace("+", "p")
             for key, lab in (("ours", "ours"), ("SPSR", "spsr")):
                 V, F = (Vo, Fo) if key == "ours" else (Vs, Fs)

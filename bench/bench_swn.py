@@ -866,7 +866,7 @@ def author_data():
         nb = float(np.abs(r.residual[r.chain != 0]).sum() / max(np.abs(r.chain).sum(), 1))
         rows.append(f"| {mesh} / {cur} | {len(F2)} | {swn.betti_1} | {int(r.endpoints.sum())} | {share} | "
                     f"{nb:.2f} | {r.timings['total']:.2f} s | {agree:.1f} % / {rr.timings['total']:.2f} s |")
-        from gsdf.view._raster import render_function_png
+        from gsdf.render._raster import render_function_png
 
         m = len(F2)
         png = os.path.join(HERE, f"swn_author_{os.path.splitext(cur)[0]}.png")

@@ -217,7 +217,7 @@ def _closed(V, F, lo, hi):
 
 def real_clouds(args):
     import gsdf
-    from gsdf.view._trace import render_png
+    from gsdf.render._trace import render_png
 
     root = os.path.join(data_dir(), "points_3")
     rows = []

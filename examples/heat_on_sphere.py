@@ -4,7 +4,7 @@ import numpy as np
 import trimesh
 
 import gsdf
-from gsdf.view._raster import render_function_png
+from gsdf.render._raster import render_function_png
 
 mesh = trimesh.creation.icosphere(subdivisions=3)
 V, F = np.asarray(mesh.vertices), np.asarray(mesh.faces)

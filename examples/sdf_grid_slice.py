@@ -2,7 +2,7 @@
 
 import gsdf
 from gsdf.data import path
-from gsdf.view._png import write_field_slice_png
+from gsdf.render._png import write_field_slice_png
 
 V, F = gsdf.read_mesh(path("broken_soup.obj"))
 field = gsdf.signed_distance_grid(V, F, resolution=32)

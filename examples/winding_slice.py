@@ -4,7 +4,7 @@ import numpy as np
 
 import gsdf
 from gsdf.data import path
-from gsdf.view._png import field_to_rgb, write_png
+from gsdf.render._png import field_to_rgb, write_png
 
 V, F = gsdf.read_mesh(path("broken_soup.obj"))        # holes, duplicated and degenerate faces
 fwn = gsdf.FastWindingNumber(V, F)

@@ -81,7 +81,7 @@ def test_library_writers_refuse_unknown_extensions_without_writing(tmp_path):
     with pytest.raises(ValueError, match="not a folder"):
         gsdf.write_mesh(tmp_path / "f" / "x.ply", V, F)
     with pytest.raises(ValueError, match=r"\.png"):
-        from gsdf.view._png import write_png
+        from gsdf.render._png import write_png
 
         write_png(tmp_path / "i.jpg", np.zeros((2, 2, 3), np.uint8))
     assert sorted(os.listdir(tmp_path)) == ["f"]
@@ -331,3 +331,35 @@ def test_load_field_dispatches_on_the_arrays(tmp_path):
         gsdf.load_field(tmp_path / "other.npz")
     with pytest.raises(FileNotFoundError):
         gsdf.load_field(tmp_path / "missing.npz")
+
+
+def test_load_field_reads_every_saved_form_back(tmp_path):
+    """load_field(field.save(path)): the same values, box or mesh, for every form that stores the domain."""
+    from scipy.spatial import Delaunay
+
+    x = np.linspace(-1, 1, 5)
+    X, Y, Z = np.meshgrid(x, np.linspace(0, 2, 6), np.linspace(-1, 0.5, 4), indexing="ij")
+    g = GridField(X + 2 * Y + 3 * Z, [-1, 0, -1], [1, 2, 0.5])
+    for ext in (".npz", ".vti", ".vtk", ".vtu"):
+        h = gsdf.load_field(g.save(tmp_path / f"g{ext}") or tmp_path / f"g{ext}")
+        assert isinstance(h, GridField), ext
+        assert np.array_equal(h.values, g.values) and np.allclose(h.bbox_min, g.bbox_min, rtol=0, atol=1e-15)
+        assert np.allclose(h.bbox_max, g.bbox_max, rtol=0, atol=1e-15), ext
+    P = np.random.default_rng(0).random((40, 3))
+    t = TetField(P, Delaunay(P).simplices, P[:, 1])
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    s = SurfaceField(V, [[0, 1, 2], [0, 1, 3]], V[:, 1] - 0.5)
+    for f, exts in ((t, (".vtk", ".vtu")), (s, (".ply", ".vtk", ".vtu"))):
+        for ext in exts:
+            f.save(tmp_path / f"f{ext}")
+            h = gsdf.load_field(tmp_path / f"f{ext}")
+            assert type(h) is type(f) and np.array_equal(h.values, f.values), ext
+            assert np.array_equal(h.vertices, f.vertices), ext
+    g.save(tmp_path / "g.npy")
+    with pytest.raises(ValueError, match="without their grid"):
+        gsdf.load_field(tmp_path / "g.npy")
+    (tmp_path / "bad.vti").write_text("<VTKFile><nothing/></VTKFile>")
+    with pytest.raises(ValueError, match="bad.vti: not a VTK ImageData"):
+        gsdf.load_field(tmp_path / "bad.vti")
+    with pytest.raises(FileNotFoundError):
+        gsdf.load_field(tmp_path / "missing.vti")

@@ -22,7 +22,7 @@ _EXPORTS = {
     "fast_winding_number": "winding", "fast_winding_number_points": "winding",
     "point_areas": "winding", "estimate_normals": "winding",
     # surface winding numbers (thesis ch. 6)
-    "SurfaceWindingNumbers": "swn", "surface_winding_number": "swn",
+    "SurfaceWindingNumbers": "swn", "surface_winding_number": "swn", "SWNOptions": "swn",
     # distance
     "TriangleDistance": "distance", "PointCloudDistance": "distance", "unsigned_distance": "distance",
     "point_cloud_distance": "distance", "signed_distance": "distance", "signed_distance_points": "distance",
@@ -43,10 +43,12 @@ _EXPORTS = {
     "TetField": "field", "marching_tetrahedra": "contour",
     "offset_surface": "ops", "dilate_erode": "ops", "erode_dilate": "ops",
     # Points as Tori and the convolutional baselines (Feng 2026, ch. 3 and 5)
-    "PointsAsTori": "tori", "PointsAsToriOptions": "tori", "SignedHopfCole": "tori", "SmoothedSignedPlanarDistance": "tori",
-    "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori", "render_png": "view",
+    "PointsAsTori": "tori", "PointsAsToriOptions": "tori", "SignedHopfCole": "tori",
+    "SmoothedSignedPlanarDistance": "tori", "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori",
+    # pictures and the viewer (polyscope: the extra gsdf[view])
+    "view": "render", "ViewOptions": "render", "render_png": "render",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
-    "reconstruct_simply_connected": "recon", "mesh_topology": "mesh",
+    "reconstruct_simply_connected": "recon", "ReconstructionOptions": "recon", "mesh_topology": "mesh",
     # dataset batches
     "run_batch": "batch", "BatchOptions": "batch", "sdf_samples": "batch", "SdfSamplesOptions": "batch",
     # one thread setting for numba kernels and BLAS (gsdf.threads)

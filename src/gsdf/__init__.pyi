@@ -65,8 +65,15 @@ from gsdf.ops import (
     voxels_to_mesh as voxels_to_mesh,
     winding_grid as winding_grid,
 )
-from gsdf.recon import reconstruct_simply_connected as reconstruct_simply_connected
-from gsdf.swn import SurfaceWindingNumbers as SurfaceWindingNumbers, surface_winding_number as surface_winding_number
+from gsdf.recon import (
+    ReconstructionOptions as ReconstructionOptions,
+    reconstruct_simply_connected as reconstruct_simply_connected,
+)
+from gsdf.swn import (
+    SurfaceWindingNumbers as SurfaceWindingNumbers,
+    SWNOptions as SWNOptions,
+    surface_winding_number as surface_winding_number,
+)
 from gsdf.threads import get_num_threads as get_num_threads, set_num_threads as set_num_threads
 from gsdf.tori import (
     LogSumExpDistance as LogSumExpDistance,
@@ -76,7 +83,7 @@ from gsdf.tori import (
     SmoothedSignedPlanarDistance as SmoothedSignedPlanarDistance,
     WindingNumberPipeline as WindingNumberPipeline,
 )
-from gsdf.view import render_png as render_png
+from gsdf.render import ViewOptions as ViewOptions, render_png as render_png, view as view
 from gsdf.winding import (
     ExactWindingNumber as ExactWindingNumber,
     FastWindingNumber as FastWindingNumber,

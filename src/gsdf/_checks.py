@@ -161,3 +161,19 @@ def choice(x, name: str, options) -> str:
     if not isinstance(x, (str, int)) or isinstance(x, bool) or x not in options:
         raise ValueError(f"{name}: must be one of {sorted(options)}, got {x!r}")
     return x
+
+
+def progress_callback(progress, name: str = "progress"):
+    """The one progress signature of gsdf: ``progress(stage: str, fraction: float)``, fraction in [0, 1].
+
+    Returns ``progress`` itself, or a no-op for None; a ValueError naming the argument when it is not callable.
+    """
+    if progress is None:
+        return _no_progress
+    if not callable(progress):
+        raise ValueError(f"{name}: expected a callable progress(stage, fraction) or None, got {type(progress).__name__}")
+    return progress
+
+
+def _no_progress(stage: str, fraction: float) -> None:
+    return None

@@ -210,8 +210,13 @@ class GridField(Field):
 
 
 def load_field(path) -> Field:
-    """Read any field written by ``field.save(path)`` to ``.npz``: a :class:`GridField`, :class:`TetField` or
-    :class:`SurfaceField`, chosen by the arrays the file holds.
+    """Read a field written by ``field.save(path)``: a :class:`GridField`, :class:`TetField` or
+    :class:`SurfaceField`.
+
+    ``.npz``: chosen by the arrays the file holds. ``.vti``, ``.vtk``, ``.vtu``: the point data ``values`` (else
+    the only point data array) on a regular grid (VTK image data, or hexahedra whose points form a grid) →
+    GridField, on tetrahedra → TetField, on triangles → SurfaceField. ``.ply``: the vertex property ``values``
+    (else the only one) → SurfaceField. (``.npy`` holds the values without their domain: not readable here.)
 
     Examples
     --------
@@ -221,6 +226,19 @@ def load_field(path) -> Field:
     >>> type(load_field(p)).__name__
     'GridField'
     """
+    import os
+
+    p = os.fspath(path)
+    ext = os.path.splitext(p)[1].lower()
+    if ext in (".vti", ".vtk", ".vtu", ".ply"):
+        if not os.path.exists(p):
+            raise FileNotFoundError(2, "No such file or directory", p)
+        if os.path.isdir(p):
+            raise ValueError(f"{p}: is a directory, not a field file")
+        return _load_vti(p) if ext == ".vti" else _load_mesh_field(p, ext)
+    if ext == ".npy":
+        raise ValueError(f"{p}: a .npy file holds the values without their grid or mesh; save the field as .npz "
+                         "(or .vti/.vtk/.vtu) to read it back")
     d = _load_npz(path, (), "field")
     keys = set(d["__files__"])
     if {"values", "bbox_min", "bbox_max"} <= keys:
@@ -231,6 +249,89 @@ def load_field(path) -> Field:
         return SurfaceField.load(path)
     raise ValueError(f"{path}: not a gsdf field file (arrays {sorted(keys)}; a grid has values/bbox_min/bbox_max, "
                      "a tet field vertices/tets/values, a surface field vertices/faces/values)")
+
+
+def _pick_values(p: str, data: dict) -> np.ndarray:
+    """The point data array ``values``, else the only scalar one."""
+    scalars = {k: np.asarray(v).reshape(len(v), -1) for k, v in data.items()}
+    scalars = {k: v[:, 0] for k, v in scalars.items() if v.shape[1] == 1}
+    if "values" in scalars:
+        return scalars["values"].astype(np.float64)
+    if len(scalars) == 1:
+        return next(iter(scalars.values())).astype(np.float64)
+    raise ValueError(f"{p}: expected point data 'values' (or one scalar array), found {sorted(data) or 'none'}")
+
+
+def _load_mesh_field(p: str, ext: str) -> Field:
+    """A field from the cells of a VTK/VTU file (meshio) or the vertices of a PLY file."""
+    if ext == ".ply":
+        from gsdf.io import read_mesh, read_vertex_data
+
+        V, F = read_mesh(p)
+        return SurfaceField(V, F, _pick_values(p, read_vertex_data(p)))
+    from gsdf.io._external import _read_meshio_raw
+
+    m = _read_meshio_raw(p, ext)
+    P = np.asarray(m.points, dtype=np.float64)
+    vals = _pick_values(p, m.point_data)
+    cells = {c.type: np.asarray(c.data) for c in m.cells}
+    if "tetra" in cells:
+        return TetField(P, cells["tetra"], vals)
+    if "triangle" in cells:
+        return SurfaceField(P, cells["triangle"], vals)
+    if "hexahedron" in cells or "voxel" in cells:
+        axes = [np.unique(P[:, a]) for a in range(3)]
+        shape = tuple(len(x) for x in axes)
+        if int(np.prod(shape)) == len(P):
+            idx = [np.searchsorted(axes[a], P[:, a]) for a in range(3)]
+            grid = np.full(shape, np.nan)
+            grid[idx[0], idx[1], idx[2]] = vals
+            if np.isfinite(grid).all():
+                return GridField(grid, [x[0] for x in axes], [x[-1] for x in axes])
+        raise ValueError(f"{p}: the hexahedra's points do not form a regular grid")
+    raise ValueError(f"{p}: no tetra, triangle or hexahedron cells to hold a field (cells: {sorted(cells)})")
+
+
+def _load_vti(p: str) -> GridField:
+    """VTK XML ImageData with one point data array (inline ``binary`` base64 with a UInt32/UInt64 byte-count
+    header, uncompressed, or ``ascii``), as :meth:`GridField.save` writes it."""
+    import base64
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(p).getroot()
+        img = root.find("ImageData")
+        ext = [int(t) for t in img.get("WholeExtent").split()]
+        origin = np.array([float(t) for t in img.get("Origin", "0 0 0").split()])
+        spacing = np.array([float(t) for t in img.get("Spacing", "1 1 1").split()])
+        arrays = img.findall("Piece/PointData/DataArray")
+    except (ET.ParseError, AttributeError, ValueError) as exc:
+        raise ValueError(f"{p}: not a VTK ImageData (.vti) file ({exc})") from exc
+    if root.get("compressor"):
+        raise ValueError(f"{p}: compressed .vti data is not supported (write it uncompressed)")
+    named = [a for a in arrays if a.get("Name") == "values"] or arrays
+    if len(named) != 1 or named[0].get("NumberOfComponents", "1") != "1":
+        raise ValueError(f"{p}: expected one scalar point data array 'values'")
+    a = named[0]
+    dtype = np.dtype({"Float64": "f8", "Float32": "f4", "Int32": "i4", "Int64": "i8", "UInt8": "u1"}
+                     .get(a.get("type"), "f8"))
+    dtype = dtype.newbyteorder("<" if root.get("byte_order", "LittleEndian") == "LittleEndian" else ">")
+    shape = (ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1)
+    n = int(np.prod(shape))
+    text = (a.text or "").strip()
+    if a.get("format") == "ascii":
+        v = np.array(text.split(), dtype=np.float64)
+    elif a.get("format") == "binary":
+        raw = base64.b64decode(text)
+        head = 8 if root.get("header_type", "UInt32") == "UInt64" else 4
+        v = np.frombuffer(raw[head:head + n * dtype.itemsize], dtype=dtype).astype(np.float64)
+    else:
+        raise ValueError(f"{p}: .vti data in '{a.get('format')}' format is not supported (ascii or binary)")
+    if v.size != n:
+        raise ValueError(f"{p}: expected {n} values for the extent {ext}, got {v.size}")
+    values = v.reshape(shape[::-1]).transpose(2, 1, 0)               # VTK: x fastest
+    lo = origin + spacing * np.array(ext[0::2])
+    return GridField(values, lo, lo + spacing * (np.array(shape) - 1))
 
 
 def _load_npz(path, keys, what: str) -> dict:

@@ -34,7 +34,8 @@ COMMANDS = {
 }
 # subcommands with their own safety tests here or elsewhere
 EXEMPT = {"demo": "test_demo_output_folder_that_is_a_file", "warmup": "reads and writes no user files",
-          "batch": "writes a folder of items; tests/batch/test_batch.py"}
+          "batch": "writes a folder of items; tests/batch/test_batch.py",
+          "view": "renders with polyscope where EGL works; tests/cli/test_view.py"}
 COMMANDS = {k: v for k, v in COMMANDS.items() if k in main.commands}  # rows for subcommands of other branches
 INPUT_KEYS = ("mesh", "mesh2", "queries", "sphere", "curves", "swn_curves", "cloud")
 

@@ -1,6 +1,6 @@
-"""The network simplex (gsdf.linalg._netflow) against HiGHS: min-cost circulations, the L1 dual-graph program, and the
-full residual LP of surface winding numbers (lp_algorithm="network") on small meshes of genus 1 and 2 and with
-boundary — equal optimal objectives (the same program, solved through its LP dual)."""
+"""The network simplex (gsdf.linalg._netflow) and the banded LP (gsdf.linalg._band_lp) against HiGHS: min-cost
+circulations, the L1 dual-graph program, and the full residual LP of surface winding numbers on small meshes of
+genus 1 and 2 and with boundary — equal optimal objectives (the same program, solved through its LP dual)."""
 
 import numpy as np
 import pytest
@@ -37,6 +37,18 @@ def cases():
         curves.append(walk)
     yield "double torus", V, F, curves
 
+
+
+def _residual_lp(V, F, curves, eps):
+    """The full residual LP of surface winding numbers (the first decomposition of ``solve``) as dual-graph L1 data:
+    (n_faces, pairs, offsets, weights, bounds, band seeds: the faces along the curves and their completions)."""
+    swn = SurfaceWindingNumbers(V, F)
+    r = swn.solve(curves, method="lp")
+    interior, d, w, bounds = swn._full_lp_terms(r.gamma, r.chain, eps)
+    topo = swn.topology
+    path = (r.chain != 0) | (swn._complete_chain(r.chain, r.endpoints) != 0)
+    seeds = np.unique(topo.edge_faces[path & (topo.edge_face_count == 2)])
+    return swn.dec.n_faces, topo.edge_faces[interior], d, w, bounds, seeds
 
 
 def _random_graph(rng, n, m):
@@ -94,7 +106,7 @@ def test_l1_network_matches_highs(seed):
     hi = np.maximum(hi, J0)
     B = np.column_stack([lo, hi])
     r1 = dual_graph_l1(n, P, d, w, bounds=B)
-    r2 = dual_graph_l1(n, P, d, w, bounds=B, algorithm="network")
+    r2 = dual_graph_l1_network(n, P, d, w, bounds=B)
     assert abs(r1.objective - r2.objective) <= 1e-8 * max(1.0, r1.objective)
     assert np.all(r2.jumps >= lo - 1e-9) and np.all(r2.jumps <= hi + 1e-9)
     assert np.allclose(r2.jumps, d + r2.shifts[a] - r2.shifts[b], atol=1e-9)
@@ -103,12 +115,12 @@ def test_l1_network_matches_highs(seed):
 
 @pytest.mark.parametrize("name,V,F,curves", list(cases()), ids=lambda x: x if isinstance(x, str) else "")
 def test_network_residual_lp_equals_face_form(name, V, F, curves):
-    swn = SurfaceWindingNumbers(V, F)
     for eps in (1e-2, 0.5):
-        rh = swn.solve(curves, method="lp", epsilon=eps, lp_algorithm="highs-ds")
-        rn = swn.solve(curves, method="lp", epsilon=eps, lp_algorithm="network")
-        assert rh.lp_objective > 1e-6
-        assert abs(rh.lp_objective - rn.lp_objective) <= 1e-7 * max(1.0, rh.lp_objective), (name, eps)
+        n, pairs, d, w, bounds, _ = _residual_lp(V, F, curves, eps)
+        rh = dual_graph_l1(n, pairs, d, w, bounds=bounds, algorithm="highs-ds")
+        rn = dual_graph_l1_network(n, pairs, d, w, bounds=bounds)
+        assert rh.objective > 1e-6
+        assert abs(rh.objective - rn.objective) <= 1e-7 * max(1.0, rh.objective), (name, eps)
 
 
 def test_network_bad_input(monkeypatch):
@@ -125,7 +137,7 @@ def test_network_bad_input(monkeypatch):
     with pytest.raises(ValueError, match="unbounded"):                 # negative cycle of unbounded arcs
         network_simplex(2, [0, 1], [1, 0], [np.inf, np.inf], [-1.0, 0.5])
     with pytest.raises(ValueError, match="algorithm"):
-        dual_graph_l1(2, [[0, 1]], [0.0], [1.0], algorithm="simplex")
+        dual_graph_l1(2, [[0, 1]], [0.0], [1.0], algorithm="network")
     with pytest.raises(ValueError, match="weights"):
         dual_graph_l1_network(2, [[0, 1]], [0.0], [-1.0])
     with pytest.raises(ValueError, match="infeasible"):                # J = 1 on the three links of a cycle
@@ -142,13 +154,12 @@ from gsdf.linalg._band_lp import banded_l1, certify  # noqa: E402
 
 @pytest.mark.parametrize("name,V,F,curves", list(cases()), ids=lambda x: x if isinstance(x, str) else "")
 def test_band_residual_lp_equals_face_form(name, V, F, curves):
-    swn = SurfaceWindingNumbers(V, F)
     for eps in (1e-2, 0.5):
-        kw = dict(method="lp", epsilon=eps, bounding="fractional")        # one pass: the same LP data
-        rh = swn.solve(curves, lp_algorithm="highs-ds", **kw)
-        rb = swn.solve(curves, lp_algorithm="band", **kw)
-        assert rh.lp_objective > 1e-6
-        assert abs(rh.lp_objective - rb.lp_objective) <= 1e-7 * max(1.0, rh.lp_objective), (name, eps)
+        n, pairs, d, w, bounds, seeds = _residual_lp(V, F, curves, eps)
+        rh = dual_graph_l1(n, pairs, d, w, bounds=bounds, algorithm="highs-ds")
+        rb = banded_l1(n, pairs, d, w, bounds=bounds, seeds=seeds)
+        assert rh.objective > 1e-6
+        assert abs(rh.objective - rb.objective) <= 1e-7 * max(1.0, rh.objective), (name, eps)
 
 
 def test_band_is_proven_on_a_small_band():
@@ -157,7 +168,7 @@ def test_band_is_proven_on_a_small_band():
     swn = SurfaceWindingNumbers(V, F)
     curves = [idx[5, :15]]
     g = swn.chain(curves)
-    gamma = swn.solve(curves, method="lp", bounding="fractional").gamma
+    gamma = swn.solve(curves, method="lp").gamma
     interior, d, w, bounds = swn._full_lp_terms(gamma, g, 1e-2)
     pairs = swn.topology.edge_faces[interior]
     seeds = np.unique(pairs[g[interior] != 0])
@@ -209,8 +220,6 @@ def test_band_bad_input():
         banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], rings=True)
     with pytest.raises(ValueError, match="max_rounds"):
         banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], max_rounds=0)
-    with pytest.raises(ValueError, match="fallback"):
-        banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], fallback="simplex")
     with pytest.raises(ValueError, match="seeds"):
         banded_l1(3, P, [1.0, 0, 0], [1.0, 1, 1], seeds=[5])
     with pytest.raises(ValueError, match="seeds"):

@@ -94,14 +94,15 @@ def test_reconstruct_fit_keeps_the_promise_and_the_faces_count():
     out = rng.uniform(-1.2, 1.2, (60, 3))
     P = np.vstack([P, out])
     V1, F1, rep = gsdf.reconstruct_simply_connected(P, return_report=True)
-    V0, F0 = gsdf.reconstruct_simply_connected(P, fit=False)
+    V0, F0, rep0 = gsdf.reconstruct_simply_connected(P, options=gsdf.ReconstructionOptions(fit=False),
+                                                    return_report=True)
     assert is_sphere(V1, F1) and is_sphere(V0, F0)
     assert rep["fit"]["before_flips"]["iterations"] == 4 and rep["fit"]["subdivided"]["iterations"] == 4
     assert rep["timings"]["fit"] > 0
     # both are close to the analytic ellipsoid; the fit is not worse
     e1, e0 = _ellipsoid_error(V1, F1, abc), _ellipsoid_error(V0, F0, abc)
     assert e1 < 0.01 and e1 <= 1.05 * e0
-    assert gsdf.reconstruct_simply_connected(P, fit=False, return_report=True)[2]["fit"] is None
+    assert rep0["fit"] is None
 
 
 @pytest.mark.parametrize("kw, word", [
@@ -131,9 +132,8 @@ def test_fit_to_samples_validates(kw, word):
 
 @pytest.mark.parametrize("bad", ["yes", 1, None, np.array([True])])
 def test_reconstruct_fit_option_validates(bad):
-    P = _fibonacci(300)
     with pytest.raises(ValueError, match="fit"):
-        gsdf.reconstruct_simply_connected(P, fit=bad)
+        gsdf.ReconstructionOptions(fit=bad)
 
 
 def _scipy_normal_equations(X, F, S, face, bary, a, foot, nrm, c, membrane, prox):

@@ -11,7 +11,8 @@ from gsdf.dec._tet import TetComplex
 from gsdf.distance import unsigned_distance
 from gsdf.mesh._topology import is_sphere
 from gsdf.recon._grow import grow_regions, region_boundary
-from gsdf.recon._pipeline import _circumradii, _dense, _reach
+from gsdf.recon._cloud import dense_points
+from gsdf.recon._pipeline import _circumradii, _reach
 from gsdf.recon._relocate import subdivide_onto_samples
 from gsdf.recon._steiner import octree_steiner_points
 
@@ -35,7 +36,7 @@ def test_dense_keeps_samples_not_sparse_outliers():
     O = O[np.abs(np.linalg.norm(O, axis=1) - 1) > 0.3]
     X = np.concatenate([S, O])
     keep = np.r_[np.ones(2000, bool), np.zeros(len(X) - 2000, bool)]
-    d = _dense(X, keep)
+    d = dense_points(X, keep)
     # random samples: ~95 % have their 5th neighbour within 3 spacings (the planar test keeps the rest)
     assert d[:3000].mean() > 0.9 and d[3000:].mean() < 0.05
 
@@ -83,8 +84,6 @@ def test_reconstruction_keeps_a_thin_tube_and_the_promise():
     assert is_sphere(V, F)
     tip = X[ns:][X[ns:, 0] > 1.1]
     assert np.mean(unsigned_distance(V, F, tip) <= sp) > 0.9
-    Va, Fa = gsdf.reconstruct_simply_connected(X, reach=False, subdivide=0)
-    assert is_sphere(Va, Fa)
 
 
 # ---------------------------------------------------------------- subdivision
@@ -149,14 +148,12 @@ def test_subdivision_bad_input(kw, match):
         subdivide_onto_samples(V_, F_, S_, sp_, **args)
 
 
-def test_reconstruction_subdivide_and_reach_validate():
+def test_reconstruction_subdivide_validates_and_splits_each_face_in_four():
     P = _sphere(300)
     with pytest.raises(ValueError, match="subdivide"):
-        gsdf.reconstruct_simply_connected(P, subdivide=True)
+        gsdf.ReconstructionOptions(subdivide=True)
     with pytest.raises(ValueError, match="subdivide"):
-        gsdf.reconstruct_simply_connected(P, subdivide=4)
-    with pytest.raises(ValueError, match="reach"):
-        gsdf.reconstruct_simply_connected(P, reach="yes")
-    V0, F0 = gsdf.reconstruct_simply_connected(P, subdivide=0)
+        gsdf.ReconstructionOptions(subdivide=4)
+    V0, F0 = gsdf.reconstruct_simply_connected(P, options=gsdf.ReconstructionOptions(subdivide=0))
     V1, F1 = gsdf.reconstruct_simply_connected(P)
     assert len(F1) == 4 * len(F0) and is_sphere(V1, F1)

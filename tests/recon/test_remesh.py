@@ -122,27 +122,17 @@ def test_flip_bad_input(kw, match):
         flip_to_samples(args.pop("V"), args.pop("F"), args.pop("S"), args.pop("spacing"), **args)
 
 
-def test_reconstruction_remesh_keeps_vertices_and_sphere_and_lowers_the_error():
+def test_reconstruction_flips_lower_the_fit_error_and_keep_the_sphere():
     # a plate (oblate ellipsoid, rim radius 0.02 below the spacing): the grown ball's Delaunay edges cut
-    # across the rim; the flips follow it.  Same vertices with and without, one sphere both times.
+    # across the rim; the flips follow it (the report's summed face fit error before / after), and the
+    # subdivided mesh is flipped again
     abc = (1.0, 1.0, 0.15)
     P = _ellipsoid(1200, abc, np.random.default_rng(3))
-    V0, F0 = gsdf.reconstruct_simply_connected(P, remesh=False, subdivide=0, relocate=False)
-    V1, F1, rep = gsdf.reconstruct_simply_connected(P, subdivide=0, relocate=False, return_report=True)
-    assert np.array_equal(V0, V1) and F0.shape == F1.shape and not np.array_equal(F0, F1)
-    assert is_sphere(V0, F0) and is_sphere(V1, F1)
+    V, F, rep = gsdf.reconstruct_simply_connected(P, options=gsdf.ReconstructionOptions(fit=False),
+                                                  return_report=True)
+    assert is_sphere(V, F)
     assert rep["flips"]["flipped"] > 0 and rep["flips"]["error_after"] < rep["flips"]["error_before"]
-    assert _ellipsoid_error(V1, F1, abc) < _ellipsoid_error(V0, F0, abc)
-    Vd, Fd = gsdf.reconstruct_simply_connected(P, fit=False)                      # the default, without the global fit
-    Vn, Fn = gsdf.reconstruct_simply_connected(P, remesh=False, fit=False)
-    assert is_sphere(Vd, Fd)
-    assert _ellipsoid_error(Vd, Fd, abc) < _ellipsoid_error(Vn, Fn, abc)
-
-
-def test_reconstruction_remesh_must_be_bool():
-    P = _ellipsoid(300, (1, 1, 1), np.random.default_rng(0))
-    with pytest.raises(ValueError, match="remesh"):
-        gsdf.reconstruct_simply_connected(P, remesh=1)
+    assert rep["flips"]["flipped_subdivided"] > 0
 
 
 def test_flip_tree_must_be_of_the_samples():
@@ -172,22 +162,6 @@ def test_flip_memory_follows_each_vertex_degree():
     assert t["components"] == 1 and t["genus"] == [0] and t["closed"] and t["oriented"]
 
 
-def test_flips_on_the_subdivided_mesh_keep_vertices_and_sphere_and_lower_the_error():
-    # the 1-to-4 split keeps each parent's diagonals; flipping the subdivided mesh follows the rim closer
-    abc = (1.0, 1.0, 0.15)
-    P = _ellipsoid(1200, abc, np.random.default_rng(3))
-    V0, F0 = gsdf.reconstruct_simply_connected(P, flip_subdivided=False, fit=False)
-    V1, F1, rep = gsdf.reconstruct_simply_connected(P, return_report=True, fit=False)
-    assert np.array_equal(V0, V1) and F0.shape == F1.shape and not np.array_equal(F0, F1)
-    assert is_sphere(V0, F0) and is_sphere(V1, F1)
-    assert rep["flips"]["flipped_subdivided"] > 0
-    assert _ellipsoid_error(V1, F1, abc) < _ellipsoid_error(V0, F0, abc)
-    # without a subdivision there is nothing more to flip: the same mesh either way
-    Va, Fa = gsdf.reconstruct_simply_connected(P, subdivide=0, fit=False)
-    Vb, Fb = gsdf.reconstruct_simply_connected(P, subdivide=0, flip_subdivided=False, fit=False)
-    assert np.array_equal(Va, Vb) and np.array_equal(Fa, Fb)
-
-
 def test_flip_check_false_gives_the_same_flips_on_a_valid_mesh():
     rng = np.random.default_rng(5)
     abc = (1.0, 0.6, 0.35)
@@ -195,9 +169,3 @@ def test_flip_check_false_gives_the_same_flips_on_a_valid_mesh():
     F = _random_flips(_hull_mesh(V), 100, rng)
     S = _ellipsoid(4000, abc, rng)
     assert np.array_equal(flip_to_samples(V, F, S, 0.03), flip_to_samples(V, F, S, 0.03, check=False))
-
-
-def test_reconstruction_flip_subdivided_must_be_bool():
-    P = _ellipsoid(300, (1, 1, 1), np.random.default_rng(0))
-    with pytest.raises(ValueError, match="flip_subdivided"):
-        gsdf.reconstruct_simply_connected(P, flip_subdivided="yes")

@@ -7,7 +7,8 @@ from scipy.spatial import Delaunay
 
 from gsdf.dec._tet import TetComplex
 from gsdf.recon._grow import carve_regions, grow_regions, region_boundary
-from gsdf.recon._pipeline import _prefilter, _sculpt, _winding_evidence, _with_winding
+from gsdf.recon._cloud import prefilter
+from gsdf.recon._pipeline import _sculpt, _winding_evidence, _with_winding
 from gsdf.recon._steiner import octree_steiner_points
 from gsdf.mesh._topology import is_sphere
 
@@ -173,7 +174,7 @@ def test_prefilter_rescues_thin_tube_samples_but_not_outliers():
     P = np.concatenate([S, T, O])
     X = (P - 0.5 * (P.min(0) + P.max(0))) / np.linalg.norm(P.max(0) - P.min(0))
     tube = slice(3000, 3000 + nt)
-    without = _prefilter(X, rescue=False)
-    with_ = _prefilter(X)
+    without = prefilter(X, rescue=False)
+    with_ = prefilter(X)
     assert without[tube].mean() < 0.3 < 0.45 < with_[tube].mean()
     assert with_[:3000].mean() > 0.99 and with_[3000 + nt:].mean() < 0.05

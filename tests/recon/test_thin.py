@@ -1,6 +1,6 @@
-"""Tests of the stages that choose the surface before the fitting (issue 13: missed thin parts, spurious
-sheets): the spectral orientation of the normals, the depth-ordered growth and its seed, the on-surface rescue
-of dropped points — each on analytic clouds, and the topology promise on every output."""
+"""Tests of the stages that choose the surface before the fitting (missed thin parts, spurious sheets): the
+spectral orientation of the normals, the depth-ordered growth and its seed, the on-surface rescue of dropped
+points — each on analytic clouds, and the topology promise on every output."""
 
 import numpy as np
 import pytest
@@ -11,7 +11,8 @@ from gsdf.dec._tet import TetComplex
 from gsdf.distance import unsigned_distance
 from gsdf.mesh._topology import is_sphere
 from gsdf.recon._orient import orient_normals
-from gsdf.recon._pipeline import _on_surface, _prefilter, _seeds
+from gsdf.recon._cloud import dense_points, on_surface, pca_normals, prefilter
+from gsdf.recon._pipeline import _seeds
 
 
 def _ellipsoid(n, axes, seed=0):
@@ -74,36 +75,32 @@ def _dumbbell(n_ball=2500, r=0.12, seed=0):
 # ---------------------------------------------------------------- orientation
 def test_spectral_orientation_across_a_thin_slab_with_the_crossing_term():
     """A flat ellipsoid 4.4 spacings thick: the kNN graph links the two sides near the rim, whose normal lines
-    agree but whose outward signs are opposite.  From PCA normals, the spanning tree and the sheet term alone
-    orient both sides alike; the crossing term recovers nearly all signs."""
-    from gsdf.recon._pipeline import _pca_normals
+    agree but whose outward signs are opposite.  From PCA normals, the crossing term recovers nearly all
+    signs."""
     X, Nt = _ellipsoid(6000, (1.0, 0.8, 0.03), seed=3)
-    N0 = _pca_normals(X)
+    N0 = pca_normals(X)
     ok = lambda N: np.mean(np.einsum("ij,ij->i", N, Nt) > 0)      # noqa: E731
     assert ok(orient_normals(X, N0, crossing=1.0)) > 0.93
-    assert ok(orient_normals(X, N0, method="mst")) < 0.7
     # with the true lines (random signs) it is exact
     flip = np.random.default_rng(4).random(len(X)) < 0.5
     assert ok(orient_normals(X, np.where(flip[:, None], -Nt, Nt), crossing=1.0)) > 0.99
 
 
-def test_spectral_orientation_of_a_thin_tube_beats_the_spanning_tree():
+def test_spectral_orientation_of_a_thin_tube():
     """A thin torus-like tube (a bent cylinder, radius 2 spacings) from PCA normals: the sheet term damps the
-    edges across the tube, which the spanning tree takes (|n_i·n_j| ≈ 1 across)."""
-    from gsdf.recon._pipeline import _pca_normals
+    edges across the tube (|n_i·n_j| ≈ 1 across, the sign opposite)."""
     rng = np.random.default_rng(5)
     n = 6000
     R, r = 1.0, 0.04
     u, v = rng.uniform(0, 2 * np.pi, n), rng.uniform(0, 2 * np.pi, n)
     X = np.column_stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)])
     Nt = np.column_stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)])
-    N0 = _pca_normals(X)
+    N0 = pca_normals(X)
     ok = lambda N: np.mean(np.einsum("ij,ij->i", N, Nt) > 0)      # noqa: E731
-    s, m = ok(orient_normals(X, N0)), ok(orient_normals(X, N0, method="mst"))
-    assert s > 0.9 and s >= m
+    assert ok(orient_normals(X, N0)) > 0.9
 
 
-def test_spectral_orientation_of_a_sphere_and_bad_method():
+def test_spectral_orientation_of_a_sphere():
     rng = np.random.default_rng(0)
     P = rng.normal(size=(800, 3))
     P /= np.linalg.norm(P, axis=1)[:, None]
@@ -113,8 +110,6 @@ def test_spectral_orientation_of_a_sphere_and_bad_method():
     Q = np.concatenate([P, P + [5.0, 0, 0]])
     Nq = orient_normals(Q, np.concatenate([P, -P]))
     assert np.all(np.einsum("ij,ij->i", Nq, np.concatenate([P, P])) > 0)
-    with pytest.raises(ValueError, match="method"):
-        orient_normals(P, P, method="bfs")
 
 
 # ---------------------------------------------------------------- seed and growth order
@@ -169,7 +164,6 @@ def test_on_surface_rescue_keeps_thin_cylinder_samples_not_outliers():
     """A ball with a thin cylinder (radius ≈ 2.3 spacings, same sampling density) and 300 outliers moved along
     the normal by 9–23 spacings: the planar and dense tests drop cylinder samples (curved neighbourhoods in
     the gaps of the random sampling); the rescue takes a part of them back and no outlier."""
-    from gsdf.recon._pipeline import _dense
     rng = np.random.default_rng(0)
     S, NS = _ellipsoid(6000, (0.8, 0.8, 0.8), seed=2)
     S = S + [0, 0, 1.0]
@@ -183,30 +177,14 @@ def test_on_surface_rescue_keeps_thin_cylinder_samples_not_outliers():
     i = rng.integers(0, len(X), 300)
     O = X[i] + Nn[i] * rng.choice([-1, 1], (300, 1)) * rng.uniform(0.15, 0.4, (300, 1))
     Y = np.concatenate([X, O])
-    planar = _prefilter(Y, rescue=False)
-    keep = planar | _dense(Y, planar)
-    res = _on_surface(Y, keep)
+    planar = prefilter(Y, rescue=False)
+    keep = planar | dense_points(Y, planar)
+    res = on_surface(Y, keep)
     assert not (res & keep).any()
     dropped = ~keep[:n]                                            # cylinder samples the two tests drop
     assert dropped.sum() > 20 and (~keep[n:len(X)]).sum() <= 5
     assert res[:n][dropped].mean() > 0.25                          # a part of them is back
     assert res[len(X):].sum() == 0                                 # and no outlier
-
-
-# ---------------------------------------------------------------- options
-@pytest.mark.parametrize("kw, msg", [({"orientation": "pca"}, "orientation"), ({"order": "random"}, "order"),
-                                     ({"rescue": "yes"}, "rescue")])
-def test_bad_options(kw, msg):
-    P = np.random.default_rng(0).normal(size=(200, 3))
-    with pytest.raises(ValueError, match=msg):
-        gsdf.reconstruct_simply_connected(P, **kw)
-
-
-def test_before_options_still_give_a_sphere():
-    X, Nn = _ellipsoid(2000, (1.0, 0.5, 0.5), seed=7)
-    P = _with_outliers(X, Nn, 200, seed=8)
-    V, F = gsdf.reconstruct_simply_connected(P, orientation="mst", order="seed", rescue=False)
-    assert is_sphere(V, F)
 
 
 # ---------------------------------------------------------------- the promise on a Table-2-style grid

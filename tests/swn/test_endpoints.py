@@ -1,5 +1,5 @@
-"""Interior endpoints in the jump Laplace solve (gsdf.dec.TriangleDEC.branch_coordinates, the default
-``endpoint_rule="branch"`` of gsdf.SurfaceWindingNumbers.solve) against analytic answers.
+"""Interior endpoints in the jump Laplace solve (gsdf.dec.TriangleDEC.branch_coordinates, the branch points that
+gsdf.SurfaceWindingNumbers.solve uses on simply connected surfaces) against analytic answers.
 
 Analytic answer used: on the unit sphere, stereographic projection from the south pole maps the equator to the
 unit circle and the north pole to its centre, and it is conformal, so harmonic functions with jumps map to
@@ -37,7 +37,13 @@ def pieces(ring, run, gap, start=0):
 
 
 def pole_difference(swn, F, n, curves, rule):
-    w = swn.solve(curves, method="none", endpoint_rule=rule).corner_values.mean(1)
+    """u(north) − u(south): through ``solve`` (branch points on the sphere), or with the exclusion rule of the
+    surfaces that are not simply connected (``_jump_solve(..., "exclude")``)."""
+    if rule == "branch":
+        w = swn.solve(curves, method="none").corner_values.mean(1)
+    else:
+        g = swn.chain(curves)
+        w = swn._jump_solve(g, swn.dec.chain_endpoints(g), rule).mean(1)
     return w[np.any(F == 0, 1)].mean() - w[np.any(F == n - 1, 1)].mean()
 
 
@@ -50,7 +56,7 @@ def test_broken_equator_pole_difference_is_the_fraction_present(sphere, run, gap
     present = len(cur) * run / N_LON
     d = pole_difference(swn, F, len(V), cur, "branch")
     assert abs(d - present) < 0.01, (d, present)
-    # the old rule (endpoints and their halfedges excluded) is off on all of these: 1-edge runs vanish,
+    # the exclusion rule (endpoints and their halfedges excluded) is off on all of these: 1-edge runs vanish,
     # 1-edge gaps close, longer runs and gaps are shrunk / widened by about a one-ring each
     d_old = pole_difference(swn, F, len(V), cur, "exclude")
     assert abs(d_old - present) > 0.02, (d_old, present)
@@ -98,13 +104,9 @@ def test_branch_coordinates_ramp_closes_around_an_endpoint():
     assert jx.endpoints[[a, b]].all() and not jx.walked[[a, b]].any()
 
 
-def test_endpoint_rule_and_endpoints_bad_input(sphere):
+def test_endpoints_bad_input(sphere):
     V, F, swn = sphere
     cur = pieces(equator(V), 2, 2)
-    with pytest.raises(ValueError, match="endpoint_rule"):
-        swn.solve(cur, endpoint_rule="drop")
-    with pytest.raises(ValueError, match="endpoint_rule"):
-        swn.solve(cur, endpoint_rule=True)
     g = swn.chain(cur)
     with pytest.raises(ValueError, match="endpoints: expected shape"):
         swn.dec.branch_coordinates(g, np.zeros(3, bool))

@@ -1,5 +1,5 @@
-"""Gap labels of surface winding numbers (``labels="gaps"``, SurfaceWindingNumbers.gap_shift): the faces at each
-gap of a broken curve rounded at the level of w across that gap."""
+"""Gap labels of surface winding numbers (SurfaceWindingNumbers.gap_shift, used with an LP): the faces at each gap of
+a broken curve rounded at the level of w across that gap, against one global rounding level."""
 
 import numpy as np
 import pytest
@@ -39,11 +39,16 @@ def gap_faces(swn, full, broken):
     return f[f >= 0]
 
 
-def wrong(res, ref, faces=None):
+def wrong(labels, ref, faces=None):
     """Faces whose label differs from ``ref`` after the best integer shift (on ``faces``, or all)."""
-    k = np.bincount(ref - res.face_labels + 50).argmax() - 50
-    bad = (res.face_labels + k) != ref
+    k = np.bincount(ref - labels + 50).argmax() - 50
+    bad = (labels + k) != ref
     return int(bad.sum() if faces is None else bad[faces].sum())
+
+
+def global_labels(res):
+    """The labels of one global rounding level from the same solve (SWNResult.label_shift), up to a shift."""
+    return np.round(res.corner_values.mean(1) + res.label_shift).astype(np.int64)
 
 
 def test_straight_gap_closes_along_the_deleted_edges(grid):
@@ -55,16 +60,11 @@ def test_straight_gap_closes_along_the_deleted_edges(grid):
     broken = [sq[:3], sq[5:]]
     ref = grid.solve([sq]).face_labels
     fs = gap_faces(grid, [sq], broken)
-    new = grid.solve(broken)                      # labels="gaps" is the default
-    old = grid.solve(broken, labels="global")
-    assert wrong(new, ref) == 0
-    assert wrong(old, ref, fs) >= 1
+    new = grid.solve(broken)
+    assert wrong(new.face_labels, ref) == 0
+    assert wrong(global_labels(new), ref, fs) >= 1
     assert np.abs(new.label_shift).max() > 0
-    assert np.all(old.label_shift == 0)
     assert np.array_equal(np.round(new.corner_values.mean(1)).astype(np.int64), new.face_labels)
-    # the global-level labels from the same solve (SWNResult.label_shift)
-    g = np.round(new.corner_values.mean(1) + new.label_shift).astype(np.int64)
-    assert wrong(old, g) == 0
 
 
 def test_latitude_circle_with_gaps_on_a_sphere():
@@ -75,28 +75,25 @@ def test_latitude_circle_with_gaps_on_a_sphere():
     ref = swn.solve([ring]).face_labels
     res = swn.solve(pieces)
     assert res.endpoints.sum() == 8
-    assert wrong(res, ref, gap_faces(swn, [ring], pieces)) == 0      # every gap closed along the deleted edges
-    assert wrong(res, ref) == 0
+    assert wrong(res.face_labels, ref, gap_faces(swn, [ring], pieces)) == 0   # every gap closed along the gap
+    assert wrong(res.face_labels, ref) == 0
 
 
 def test_labels_unchanged_without_gaps(grid):
     # closed curves: no endpoints, no gap, shift 0 everywhere, the same labels as one global level
     sq = square(4, 12)
     a = grid.solve([sq])
-    b = grid.solve([sq], labels="global")
     assert np.all(a.label_shift == 0)
-    assert np.array_equal(a.face_labels, b.face_labels)
-    assert np.allclose(a.corner_values, b.corner_values)
+    assert np.array_equal(a.face_labels, grid.solve([sq], method="none").face_labels)
 
 
 def test_faces_away_from_the_gaps_keep_the_global_labels(grid):
     sq, sq2 = square(3, 10), square(14, 21)
     broken = [sq[:3], sq[5:], sq2]              # a gap in one square, the other closed
     new = grid.solve(broken)
-    old = grid.solve(broken, labels="global")
     far = new.label_shift == 0
     assert far.sum() > 0.9 * len(far)
-    assert np.array_equal(new.face_labels[far], old.face_labels[far])
+    assert wrong(new.face_labels[far], global_labels(new)[far]) == 0
     # the relabelled faces sit round the gap: every one touches a vertex within 2 edges of the deleted ones
     touched = np.unique(grid.dec.F[~far])
     gapv = np.array(sq[2:6])
@@ -115,8 +112,8 @@ def test_annulus_broken_circle_not_simply_connected():
     pieces = [ring[0:14], ring[16:30], ring[33:49]]
     ref = swn.solve([ring]).face_labels
     res = swn.solve(pieces)
-    assert wrong(res, ref, gap_faces(swn, [ring], pieces)) == 0
-    assert wrong(res, ref) == 0
+    assert wrong(res.face_labels, ref, gap_faces(swn, [ring], pieces)) == 0
+    assert wrong(res.face_labels, ref) == 0
 
 
 def test_gap_paths_kernel_matches_scipy_dijkstra():
@@ -157,11 +154,6 @@ def test_gap_paths_kernel_matches_scipy_dijkstra():
 
 
 def test_bad_input(grid):
-    sq = square(4, 12)
-    with pytest.raises(ValueError, match="labels"):
-        grid.solve([sq], labels="local")
-    with pytest.raises(ValueError, match="labels"):
-        grid.solve([sq], labels=None)
     m, nE, n = grid.dec.n_faces, grid.dec.n_edges, grid.dec.n_vertices
     wf, g, ends = np.zeros(m), np.zeros(nE), np.zeros(n, bool)
     assert np.all(grid.gap_shift(wf, g, ends, 0.0) == 0)

@@ -1,52 +1,14 @@
-"""Surface winding numbers on surfaces that are not simply connected: the fixes of the residual / final-solve
-path (bench/RESULTS.md section "swn-lp") and the tree–cotree homology basis (gsdf.dec._cycles)."""
+"""Surface winding numbers on surfaces that are not simply connected: the residual LP, the final solve with the
+bounding part as a subset of the input, the second candidate cycle, and the LP solvers behind the default."""
 
 import numpy as np
 import pytest
 
+import gsdf.swn._solver as S
+from gsdf import SWNOptions
 from gsdf.swn._solver import SurfaceWindingNumbers
 from tests.swn.test_solver import boundary_chain, mislabeled
-from tests.shapes import annulus, double_torus, torus
-
-
-# ------------------------------------------------------------------------------------------- tree–cotree
-@pytest.mark.parametrize("shape, b1", [("torus", 2), ("annulus", 1), ("double_torus", 4), ("disk", 0)])
-def test_tree_cotree_generators_and_periods(shape, b1):
-    if shape == "torus":
-        V, F, _ = torus(16, 8)
-    elif shape == "annulus":
-        V, F, _ = annulus(4, 24)
-    elif shape == "double_torus":
-        V, F = double_torus(24)
-    else:                                                      # an annulus cut open: a disk
-        V, F, _ = annulus(4, 24)
-        F = F[(F % 24).max(1) - (F % 24).min(1) < 2]
-    swn = SurfaceWindingNumbers(V, F)
-    tc = swn.tree_cotree()
-    assert tc.n_generators == b1 == swn.betti_1
-    assert not (tc.tree & tc.cotree).any()
-    rng = np.random.default_rng(1)
-    p = rng.integers(-3, 4, b1).astype(float)
-    w = tc.closed_form(p)
-    assert np.abs(swn.dec.d1 @ w).max() < 1e-9                 # closed
-    assert np.allclose(tc.periods(w), p)                       # with the asked periods
-    # exact forms have no periods; the harmonic basis has full period rank (the loops span H1)
-    assert np.all(np.abs(tc.periods(swn.dec.d0 @ rng.standard_normal(swn.dec.n_vertices))) < 1e-9)
-    if b1:
-        H = swn._hodge_decomposition().harmonic_basis()
-        P = np.array([tc.periods(H[:, i]) for i in range(H.shape[1])])
-        assert np.linalg.matrix_rank(P, tol=1e-6) == b1
-    with pytest.raises(ValueError, match="periods"):
-        tc.closed_form(np.zeros(b1 + 1))
-
-
-def test_tree_cotree_annulus_period_is_the_circulation():
-    V, F, idx = annulus(4, 24)
-    swn = SurfaceWindingNumbers(V, F)
-    th = np.arctan2(V[:, 1], V[:, 0])
-    E = swn.dec.edges
-    dth = np.angle(np.exp(1j * (th[E[:, 1]] - th[E[:, 0]])))   # dθ, closed, period 2π around the hole
-    assert np.allclose(np.abs(swn.tree_cotree().periods(dth)), 2 * np.pi)
+from tests.shapes import annulus, torus
 
 
 # -------------------------------------------------------------------------------- the final jump solve
@@ -84,50 +46,19 @@ def test_final_solve_jumps_only_across_the_input():
     inner = ~swn.topology.boundary_edges & ~ends[swn.dec.edges].any(1)
     assert np.abs(J[off & inner]).max() < 1e-8                 # ... but w does not jump there
     assert mislabeled(r, truth, swn.dec.areas) < 0.01
-    # the former behaviour (with one global rounding level, as then)
-    old = swn.solve(g, method="lp", _final="all", bounding="fractional", labels="global")
-    assert mislabeled(old, truth, swn.dec.areas) > 0.015   # the former behaviour, for the record
 
 
-def test_integer_class_skips_the_lp_for_a_broken_bounding_curve():
-    swn, g, truth = _annulus_spoke(0.8)
-    r = swn.solve(g, method="lp", homology="integer")
-    naive = swn.solve(g, method="none")
-    assert r.timings["lp"] == 0.0 and not np.any(r.residual)   # class 0.45 rounds to 0: nothing nonbounding
-    assert np.array_equal(r.face_labels, naive.face_labels)
-    assert mislabeled(r, truth, swn.dec.areas) == 0.0
-
-
-def test_integer_class_removes_a_broken_meridian_completely():
-    V, F, idx = torus(48, 24)
-    swn = SurfaceWindingNumbers(V, F)
-    for method, alg in (("lp", "highs-ds"), ("lp", "highs-ipm"), ("reduced", "auto")):
-        r = swn.solve([idx[5, :17]], method=method, homology="integer", lp_algorithm=alg)   # 2/3 of a meridian
-        on = r.chain != 0
-        assert np.array_equal(r.residual, np.round(r.residual))           # an integer nonbounding chain
-        assert np.allclose(r.residual[on], r.chain[on])                   # the whole input is nonbounding
-        assert not np.any(np.round(r.bounding))
-        assert len(np.unique(r.face_labels)) == 1
-        # the real class leaves a partial jump (coefficient < 1, thesis Fig. 6.6) on the input
-        rr = swn.solve([idx[5, :17]], method=method)
-        assert np.median(np.abs(rr.residual[on])) < 0.95
-
-
-def test_homology_option_is_checked():
-    V, F, idx = torus(16, 8)
-    swn = SurfaceWindingNumbers(V, F)
-    with pytest.raises(ValueError, match="homology"):
-        swn.solve([idx[2, :5]], homology="rational")
-
-
-def test_lp_algorithms_agree_and_are_checked():
+def test_band_solver_agrees_with_highs(monkeypatch):
+    """From ``BAND_FACES`` faces on the full LP is solved on a proven band of faces (gsdf.linalg._band_lp); forced
+    on a small torus it gives HiGHS' optimum and the same labels."""
     V, F, idx = torus(24, 12)
     swn = SurfaceWindingNumbers(V, F)
     curves = [idx[3, :9]]
-    obj = [swn.solve(curves, lp_algorithm=a).lp_objective for a in ("highs-ds", "highs-ipm", "auto")]
-    assert np.allclose(obj, obj[0], rtol=1e-6)
-    with pytest.raises(ValueError, match="lp_algorithm"):
-        swn.solve(curves, lp_algorithm="simplex")
+    r = swn.solve(curves)
+    monkeypatch.setattr(S, "BAND_FACES", 0)
+    rb = swn.solve(curves)
+    assert r.lp_objective > 1e-6 and np.isclose(rb.lp_objective, r.lp_objective, rtol=1e-6)
+    assert np.array_equal(rb.face_labels, r.face_labels)
 
 
 # ------------------------------------------------------------------ the bounding part as a subset of Γ
@@ -156,9 +87,6 @@ def test_bounding_part_is_a_subset_of_the_input():
     assert np.array_equal(r.bounding[~mer], r.chain[~mer])      # the patch boundary stays whole
     assert np.ptp(r.corner_values[~R]) < 1e-6 and np.ptp(r.corner_values[R]) < 1e-6
     assert mislabeled(r, truth, swn.dec.areas) == 0.0
-    old = swn.solve(g, method="lp", bounding="fractional")     # the former reading, for the record
-    assert 0.4 < np.abs(old.bounding[mer]).max() < 0.5
-    assert np.ptp(old.corner_values[~R]) > 0.4
 
 
 def test_subset_reading_stops_when_nothing_is_left_to_remove():
@@ -169,10 +97,6 @@ def test_subset_reading_stops_when_nothing_is_left_to_remove():
     r = swn.solve(g, method="lp")
     assert r.passes == 2 and np.allclose(r.residual[mer], r.chain[mer], atol=1e-6)
     assert not np.any(r.bounding[mer]) and mislabeled(r, R.astype(int), swn.dec.areas) == 0.0
-    with pytest.raises(ValueError, match="bounding"):
-        swn.solve(g, bounding="all")
-    with pytest.raises(ValueError, match="bounding"):
-        swn.solve(g, bounding=True)
 
 
 def test_time_limit_bounds_the_lps_of_all_passes(monkeypatch):
@@ -182,17 +106,18 @@ def test_time_limit_bounds_the_lps_of_all_passes(monkeypatch):
     calls = []
     real = swn._residual_full
 
-    def slow(gamma, g_, eps, time_limit, algorithm="highs-ds"):
+    def slow(gamma, g_, eps, time_limit, ends, forbid=None):
         calls.append(time_limit)
-        Jv, obj, _ = real(gamma, g_, eps, time_limit, algorithm)
+        Jv, obj, _ = real(gamma, g_, eps, time_limit, ends, forbid)
         return Jv, obj, 0.75 * time_limit if len(calls) == 1 else 0.0   # the first LP takes 3/4 of the budget
     monkeypatch.setattr(swn, "_residual_full", slow)
-    r = swn.solve(g, method="lp", time_limit=8.0, cycle_choice="lp")
-    assert calls == [8.0, 2.0] and r.passes >= 2                   # the second LP gets what is left
-    # the first LP takes the whole budget: the second is refused, naming the fallback
-    monkeypatch.setattr(swn, "_residual_full", lambda gm, g_, e, tl, alg="highs-ds": real(gm, g_, e, tl, alg)[:2] + (tl,))
+    r = swn.solve(g, method="lp", options=SWNOptions(time_limit=8.0))
+    assert r.passes >= 2 and calls[0] == 8.0 and calls[1:] and all(c == 2.0 for c in calls[1:])   # what is left
+    # the first LP takes the whole budget: the second pass is refused, naming the fallback
+    monkeypatch.setattr(swn, "_residual_full",
+                        lambda gm, g_, e, tl, ends, forbid=None: real(gm, g_, e, tl, ends, forbid)[:2] + (tl,))
     with pytest.raises(ValueError, match=r"whole time_limit.*method='reduced'"):
-        swn.solve(g, method="lp", time_limit=8.0, cycle_choice="lp")
+        swn.solve(g, method="lp", options=SWNOptions(time_limit=8.0))
 
 
 def _band_and_long_loop():
@@ -222,27 +147,23 @@ def _band_and_long_loop():
     return swn, g + loop, loop != 0, R.astype(int)
 
 
-def test_cycle_choice_keeps_the_whole_loop_not_the_band_side():
-    """cycle_choice: the LP's optimum (least ε-weighted length, thesis §6.1.2) carries the class on the band's
-    side j = 10 — its gaps are shorter than the loop's — and cuts the band open. "complete" (default) solves the
-    LP again without that side's edges, finds the loop, and keeps it: 3/4 of its jump mass lies on the input
-    against 2/3 on the side."""
+def test_second_cycle_keeps_the_whole_loop_not_the_band_side(monkeypatch):
+    """The LP's optimum (least ε-weighted length, thesis §6.1.2) carries the class on the band's side j = 10 — its
+    gaps are shorter than the loop's — which would cut the band open. The solver solves the LP again without that
+    side's edges, finds the loop, and keeps it: 3/4 of its jump mass lies on the input against 2/3 on the side."""
     swn, g, loop, truth = _band_and_long_loop()
     A = swn.dec.areas
-    lp = swn.solve(g, method="lp", cycle_choice="lp")
-    assert np.abs(lp.residual[loop]).max() < 0.1                 # the LP's cycle avoids the loop ...
-    assert mislabeled(lp, truth, A) > 0.1                        # ... and cuts the band
     r = swn.solve(g, method="lp")
+    first, _, _ = swn._residual_full(r.gamma, r.chain, 1e-2, 300.0, r.endpoints)
+    assert np.abs(first[loop]).max() < 0.1                       # the LP's own cycle avoids the loop
     assert np.abs(r.residual[loop]).min() > 0.5                  # the loop carries the class
     assert not np.any(r.bounding[loop])
     assert mislabeled(r, truth, A) < 0.01
-    for alg in ("highs-ipm", "band", "network"):                 # every form of the LP chooses alike
-        assert np.array_equal(swn.solve(g, method="lp", lp_algorithm=alg).face_labels, r.face_labels)
-    with pytest.raises(ValueError, match="cycle_choice"):
-        swn.solve(g, cycle_choice="shortest")
+    monkeypatch.setattr(S, "BAND_FACES", 0)                      # the banded LP chooses alike
+    assert np.array_equal(swn.solve(g, method="lp").face_labels, r.face_labels)
 
 
-# ------------------------------------------- a broken meridian plus a broken region boundary (bench: swn-ns-runs)
+# ------------------------------------------------------------- a broken meridian plus a broken region boundary
 def _meridian_and_patch(i0, i1, j0, j1):
     """48 x 24 torus: the meridian i = 5 with three 2-edge gaps (18 of its 24 edges kept) and the boundary of the
     face patch i0 ≤ i < i1, j0 ≤ j < j1 with a quarter of its edges deleted (seeded). Returns the solver, the input
@@ -274,7 +195,7 @@ def test_broken_meridian_is_the_nonbounding_part_beside_a_broken_region():
         assert np.allclose(np.round(r.bounding) + np.where(g != 0, np.round(r.residual), 0), g)   # g = bnd + N
 
 
-@pytest.mark.xfail(strict=True, reason="known limit of the LP decomposition (bench/RESULTS.md swn-ns-runs): where "
+@pytest.mark.xfail(strict=True, reason="known limit of the LP decomposition: where "
                    "the meridian runs through the patch, parallel to two of its sides, the residual's cycle leaves "
                    "the meridian at the crossings and follows a patch side")
 def test_broken_meridian_through_a_broken_patch_known_limit():

@@ -4,6 +4,7 @@ issue 12."""
 import numpy as np
 import pytest
 
+from gsdf import SWNOptions
 from gsdf.swn._solver import SurfaceWindingNumbers, surface_winding_number
 from tests.shapes import uv_sphere
 from tests.shapes import annulus, double_torus, torus
@@ -212,9 +213,13 @@ def test_bad_input(tor):
     with pytest.raises(ValueError, match="method"):
         swn.solve([idx[5]], method="gurobi")
     with pytest.raises(ValueError, match="epsilon"):
-        swn.solve([idx[5]], epsilon=0)
+        SWNOptions(epsilon=0)
     with pytest.raises(ValueError, match="epsilon"):
-        swn.solve([idx[5]], epsilon=True)
+        SWNOptions(epsilon=True)
+    with pytest.raises(ValueError, match="time_limit"):
+        SWNOptions(time_limit=-1.0)
+    with pytest.raises(ValueError, match="options"):
+        swn.solve([idx[5]], options={"epsilon": 0.1})
     with pytest.raises(ValueError, match="curves"):
         swn.solve("0 1 2")
     with pytest.raises(ValueError, match="repeats"):
@@ -240,7 +245,7 @@ def test_bad_input(tor):
 def test_lp_time_limit_names_the_fallback(tor):
     V, F, idx, swn = tor
     with pytest.raises(ValueError, match="method='reduced'"):
-        swn.solve([idx[5, :12], idx[30, 3:15]], time_limit=1e-4)
+        swn.solve([idx[5, :12], idx[30, 3:15]], options=SWNOptions(time_limit=1e-4))
 
 
 # ------------------------------------------------------------------------------------------ files and CLI
@@ -348,8 +353,10 @@ def test_cli_swn(tmp_path):
 def test_progress_callback(tor):
     V, F, idx, swn = tor
     seen = []
-    swn.solve([idx[5, :12]], progress=lambda d, t: seen.append((d, t)))
-    assert seen[-1] == (5, 5) and all(t == 5 for _, t in seen) and [d for d, _ in seen] == sorted(d for d, _ in seen)
+    swn.solve([idx[5, :12]], progress=lambda stage, f: seen.append((stage, f)))
+    fractions = [f for _, f in seen]
+    assert seen[0] == ("jump Laplace solve", 0.0) and seen[-1] == ("done", 1.0)
+    assert fractions == sorted(fractions) and all(isinstance(s, str) for s, _ in seen)
     with pytest.raises(ValueError, match="progress"):
         swn.solve([idx[5, :12]], progress=3)
 

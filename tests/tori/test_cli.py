@@ -7,7 +7,7 @@ from gsdf.cli.render import render
 from gsdf.cli.tori import tori
 from gsdf.io import read_mesh, write_points
 from gsdf.tori import PointsAsTori
-from gsdf.view._trace import sphere_trace
+from gsdf.render._trace import sphere_trace
 
 
 def _cloud(path, n=1500, radius=0.5, normals=True):

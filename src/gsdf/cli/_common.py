@@ -31,13 +31,13 @@ from gsdf.io._geometry import Geometry, load_geometry  # noqa: F401  (the CLI co
 from gsdf.io._safe_write import atomic_output, check_output_path, same_file
 
 def progress_bar(total: int, desc: str, enabled: bool = True):
-    """A tqdm bar and an ``update(done, total)`` callback for the library's ``progress`` hooks."""
+    """A tqdm bar of ``total`` units and the library's ``progress(stage, fraction)`` callback that moves it."""
     from tqdm import tqdm
 
     bar = tqdm(total=total, desc=desc, unit="pt", unit_scale=True, disable=not enabled, leave=False)
 
-    def update(done, _total):
-        bar.update(done - bar.n)
+    def update(stage, fraction):
+        bar.update(round(fraction * total) - bar.n)
 
     return bar, update
 

@@ -93,7 +93,39 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)        #: --t-coef, --soft-wei
 NONNEGATIVE = FiniteFloatRange(min=0)                    #: --normal-radius
 NUMBER = FiniteFloat()                                   #: --level
 FLOATS = FloatList()                                     #: --offsets, --heights, --sigmas
-DIRECTION = Direction()                                  #: --view, --up
+class Up(click.ParamType):
+    """The up direction of a picture: ``auto``, an axis (``x``, ``-y``, ``z``, ...) or ``x,y,z``."""
+
+    name = "auto|axis|x,y,z"
+
+    def convert(self, value, param, ctx):
+        s = str(value).strip().lower()
+        if s == "auto" or s.lstrip("+-") in ("x", "y", "z"):
+            return s
+        return DIRECTION.convert(value, param, ctx)
+
+
+class Size(click.ParamType):
+    """A picture size in pixels: ``N`` (square) or ``WxH``, each 8..8192; returns (width, height)."""
+
+    name = "N|WxH"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, tuple):
+            return value
+        try:
+            parts = [int(t) for t in str(value).lower().split("x")]
+            w, h = (parts[0], parts[0]) if len(parts) == 1 else parts
+            if not (8 <= w <= 8192 and 8 <= h <= 8192):
+                raise ValueError
+        except ValueError:
+            self.fail(f"expected N or WIDTHxHEIGHT (8..8192 each), got {value!r}", param, ctx)
+        return w, h
+
+
+DIRECTION = Direction()                                  #: --view
+UP = Up()                                                #: --up
+SIZE = Size()                                            #: --size
 THREADS = ThreadCount()                                  #: --threads
 BISECTION = click.IntRange(0, 60)                        #: --bisection
 COUNT = click.IntRange(1)                                #: --n-points, --workers, ...

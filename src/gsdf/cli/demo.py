@@ -32,7 +32,7 @@ def demo(output_dir, resolution, quiet):
     from gsdf import data
     from gsdf.contour import extract_isosurface, slice_contours, write_svg
     from gsdf.io import read_mesh, read_points, write_mesh
-    from gsdf.view._png import field_to_rgb, write_field_slice_png, write_png
+    from gsdf.render._png import field_to_rgb, write_field_slice_png, write_png
     from gsdf.winding import winding_number
     from gsdf.winding._point_areas import point_areas
     from gsdf.cli.sdf import signed_distance_grid

@@ -105,7 +105,7 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
     if F.shape[1] == 4:
         F = np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])       # the PNG renders triangles
     if png:
-        from gsdf.view._raster import render_function_png
+        from gsdf.render._raster import render_function_png
 
         with output_file(png, what="--png") as tmp:
             render_function_png(tmp, V, F, phi, view=view)

@@ -18,6 +18,7 @@ from gsdf.cli.slice import slice_cmd
 from gsdf.cli.surface import surface
 from gsdf.cli.swn import swn
 from gsdf.cli.tori import tori
+from gsdf.cli.view import view
 from gsdf.cli.voxelize import voxelize
 from gsdf.cli.warmup import warmup
 from gsdf.cli.winding import winding
@@ -30,6 +31,7 @@ SECTIONS = (
     ("Signed heat method", ("heat", "heat-surface")),
     ("Curves on surfaces", ("swn",)),
     ("Point clouds", ("tori", "render", "reconstruct")),
+    ("Viewing", ("view",)),
     ("Printing", ("slice",)),
     ("Datasets", ("batch",)),
     ("Setup", ("demo", "warmup")),
@@ -119,7 +121,7 @@ def main(threads):
 
 
 for command in (batch, demo, winding, sdf, voxelize, surface, boolean, slice_cmd, heat, heat_surface, tori, render,
-                swn, reconstruct, warmup):
+                swn, reconstruct, warmup, view):
     main.add_command(command)
 
 

@@ -60,15 +60,16 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
     check_output(png, (".png",), "--png")
     P, N = read_points(cloud)
 
-    def say(stage):
-        if not quiet:
+    def say(stage, fraction):
+        if not quiet and fraction < 1:
             click.echo(f"  {stage} ...", err=True)
 
     click.echo(f"{cloud}: {len(P)} points{' with normals' if N is not None else ''}; method {method}")
     if method == "simply-connected":
-        from gsdf.recon import reconstruct_simply_connected
+        from gsdf.recon import ReconstructionOptions, reconstruct_simply_connected
         V, F, rep = reconstruct_simply_connected(P, N, outliers=outliers, clusters=clusters,
-                                                 max_iterations=max_iterations, progress=say, return_report=True)
+                                                 options=ReconstructionOptions(max_iterations=max_iterations),
+                                                 progress=say, return_report=True)
         click.echo(f"  {rep['iterations']} round(s); {int(rep['outliers'].sum())} points judged outliers; "
                    f"{rep['n_tets']} tets; {rep['timings']['total']:.2f} s")
     else:
@@ -86,7 +87,7 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
         write_mesh(tmp, V, F)
     click.echo(f"mesh -> {os.path.abspath(output)}")
     if png is not None:
-        from gsdf.view._raster import render_function_png
+        from gsdf.render._raster import render_function_png
         with output_file(png, (".png",), what="--png") as tmp:
             render_function_png(tmp, V, F, np.asarray(V)[:, 1], view=view)
         click.echo(f"preview -> {os.path.abspath(png)}")

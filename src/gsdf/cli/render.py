@@ -8,14 +8,24 @@ import click
 
 from gsdf.cli._common import check_output, output_file, report_errors
 from gsdf.cli._options import (
-    DIRECTION,
     NUMBER,
+    SIZE,
+    UP,
     common_options,
     no_clobber_option,
     normals_option,
     output_option,
     view_option,
 )
+
+
+def _up_vector(up):
+    """``--up``: an axis name or x,y,z as a vector (``auto``: y)."""
+    if isinstance(up, str):
+        from gsdf.render._scene import axis_vector
+
+        return axis_vector("y" if up == "auto" else up)
+    return up
 
 
 @click.command("render", short_help="Sphere-traced PNG of a Points as Tori level set.",
@@ -31,9 +41,9 @@ Example:
 @click.argument("points", type=click.Path(dir_okay=False))
 @output_option("Output PNG.")
 @click.option("--level", type=NUMBER, default=0.0, show_default=True, help="Level set (offset) to render.")
-@click.option("--size", type=click.IntRange(8, 4096), default=384, show_default=True, help="Image width and height.")
+@click.option("--size", type=SIZE, default="384", show_default=True, help="Picture size in pixels: N or WxH.")
 @view_option("1,0.6,1.4")
-@click.option("--up", type=DIRECTION, default="0,1,0", show_default=True, help="Up vector of the picture (x,y,z).")
+@click.option("--up", type=UP, default="y", show_default=True, help="Up direction of the picture: an axis (x, -y, ...) or x,y,z.")
 @normals_option
 @common_options
 @no_clobber_option
@@ -41,9 +51,9 @@ Example:
 def render(points, output, level, size, view, up, estimate_normals, quiet):
     import numpy as np
 
-    from gsdf.view._png import write_png
+    from gsdf.render._png import write_png
     from gsdf.tori import PointsAsTori
-    from gsdf.view._trace import sphere_trace
+    from gsdf.render._trace import sphere_trace
     from gsdf.cli.tori import _load_cloud
 
     check_output(output, (".png",))
@@ -54,7 +64,7 @@ def render(points, output, level, size, view, up, estimate_normals, quiet):
         pat = PointsAsTori(P, N)
     lo, hi = pat.P.min(0), pat.P.max(0)
     m = 0.1 * np.linalg.norm(hi - lo) + abs(level)  # the box of tori.render_png: cloud + 10 % of its diagonal
-    img = sphere_trace(pat, lo - m, hi + m, size, size, level, view=view, up=up)
+    img = sphere_trace(pat, lo - m, hi + m, size[0], size[1], level, view=view, up=_up_vector(up))
     with output_file(output) as tmp:
         write_png(tmp, img, min_size=1)  # gsdf's one PNG writer
     click.echo(f"{len(pat.P)} tori, level {level:g} -> {os.path.abspath(output)}")

@@ -32,12 +32,8 @@ def signed_distance_grid(geo, resolution: int, pad: float, sign: str = "winding"
     kw = dict(V=geo.X, F=geo.F) if geo.is_mesh else dict(V=None, points=(geo.X, geo.N))
     grid = Grid.around(geo.X, resolution, pad)
     bar, update = progress_bar(grid.size, "winding numbers", not quiet and sign == "winding")
-
-    def progress(stage, fraction):
-        update(round(fraction * grid.size), grid.size)
-
     with bar:
-        return grid_sdf(resolution=grid, sign=sign, beta=beta, progress=progress, **kw)
+        return grid_sdf(resolution=grid, sign=sign, beta=beta, progress=update, **kw)
 
 
 @click.command("sdf", short_help="Signed distance grid, sign from the winding number.",
@@ -83,7 +79,7 @@ def sdf(input, output, resolution, pad, sign, png, mesh_output, beta, estimate_n
         field.save(tmp)
     click.echo(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")
     if png:
-        from gsdf.view._png import write_field_slice_png
+        from gsdf.render._png import write_field_slice_png
 
         with output_file(png, what="--png") as tmp:
             write_field_slice_png(tmp, field)

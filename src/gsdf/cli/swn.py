@@ -80,7 +80,7 @@ Example:
 def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     from gsdf.io import read_mesh
     from gsdf.io._swn_curves import read_swn_curves
-    from gsdf.swn._solver import SurfaceWindingNumbers
+    from gsdf.swn._solver import SurfaceWindingNumbers, SWNOptions
     from gsdf.swn._insert import insert_curves
 
     check_output(output, (".ply", ".obj"))
@@ -96,7 +96,8 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     solver = SurfaceWindingNumbers(V2, F2)
     bar, update = progress_bar(5, "swn steps", enabled=not quiet)
     try:
-        res = solver.solve(list(segs), method=method, epsilon=epsilon, time_limit=time_limit, progress=update)
+        res = solver.solve(list(segs), method=method, options=SWNOptions(epsilon=epsilon, time_limit=time_limit),
+                           progress=update)
     finally:
         bar.close()
     with output_file(output, (".ply", ".obj")) as tmp:
@@ -110,7 +111,7 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
                f"method {method}: labels (area) {share}; nonbounding share of the input {nb:.2f}; "
                f"{res.timings['total']:.2f} s -> {os.path.abspath(output)}")
     if png:
-        from gsdf.view._raster import render_function_png
+        from gsdf.render._raster import render_function_png
 
         m = len(F2)
         with output_file(png, (".png",), what="--png") as tmp:

@@ -54,9 +54,7 @@ def voxelize(input, output, resolution, pad, mesh_output, beta, estimate_normals
     grid = Grid.around(geo.X[np.unique(geo.F)] if geo.is_mesh else geo.X, resolution, pad)  # as gsdf.voxelize
     bar, update = progress_bar(grid.size, "voxelizing", not quiet)
     with bar:
-        def progress(stage, fraction):
-            update(round(fraction * grid.size), grid.size)
-        occ, lo, hi = run(resolution=grid, beta=beta, progress=progress, **kw)
+        occ, lo, hi = run(resolution=grid, beta=beta, progress=update, **kw)
     with output_file(output, (".npz",)) as tmp:
         save_voxels(tmp, occ, lo, hi)
     click.echo(f"{geo.describe()}\n{int(occ.sum())} of {occ.size} voxels inside, grid {occ.shape} -> "

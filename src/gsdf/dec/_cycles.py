@@ -12,8 +12,8 @@ closed 1-form (d1 ω = 0) is known up to an exact form by its b1 periods along t
 - :meth:`TreeCotree.closed_form` builds the closed form that is 0 on tree edges, the given periods on the
   generators, and on cotree edges whatever keeps every face closed (a tree-shaped, square sparse system).
 
-Used by surface winding numbers (thesis ch. 6) to round the cohomology class of the harmonic part γ to the
-nearest integer class before the residual LP (see :mod:`gsdf.swn._solver`).
+The periods give the integer homology class of a closed edge loop (pair it with the closed forms of unit periods),
+e.g. to tell nonbounding loops on a surface of genus > 0 (thesis §2.3, §6.1) apart from bounding ones.
 
 Example
 -------

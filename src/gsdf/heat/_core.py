@@ -71,19 +71,6 @@ __all__ = ["SignedHeatCore", "FactorizedPoisson", "LEVEL_SETS", "unique_rows", "
 LEVEL_SETS = ("zero", "multiple", "none")
 
 
-def reporter(progress):
-    """The ``progress(stage, fraction)`` callback to call: a no-op for None; ValueError when not callable."""
-    if progress is None:
-        return _quiet
-    if not callable(progress):
-        raise ValueError(f"progress: expected a callable progress(stage, fraction) or None, got {progress!r}")
-    return progress
-
-
-def _quiet(stage: str, fraction: float) -> None:
-    pass
-
-
 def hash_key(*arrays) -> str:
     """A cache key for constraint sets: sha1 over shapes and bytes."""
     h = hashlib.sha1()
@@ -422,7 +409,7 @@ class SignedHeatCore:
         """Validate, assemble and solve (Alg. 1 with §7.1); returns φ (n,) on the domain's nodes."""
         mode = _checks.choice(level_set_constraint, "level_set_constraint", LEVEL_SETS)
         lam = None if soft_weight is None else _checks.positive(soft_weight, "soft_weight")
-        report = reporter(progress)
+        report = _checks.progress_callback(progress)
         report("sources", 0.0)
         # repeated calls with the same curves reuse the validated, assembled sources (domains whose sources do
         # not depend on a changing state declare ``cache_sources``)
@@ -437,7 +424,7 @@ class SignedHeatCore:
 
     def solve(self, S: Sources, mode: str = "zero", lam=None, report=None) -> np.ndarray:
         """Steps I–III for assembled sources; ``mode`` a level-set constraint, ``lam`` the soft weight or None."""
-        report = report or _quiet
+        report = report or _checks.progress_callback(None)
         if S.X0 is not None and not np.any(S.X0):
             raise ValueError("curves: the sources have zero total length / weight")
         with blas_region():               # one BLAS limit for all factorizations and solves of the call

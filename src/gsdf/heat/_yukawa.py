@@ -242,7 +242,8 @@ class YukawaTree:
     def __call__(self, Q, dref=None, slack: float = 0.0, chunk: int = 1 << 16, progress=None) -> np.ndarray:
         """Scaled X at queries ``Q`` (q, 3) → (q, 3).
 
-        ``dref`` (q,) is an estimate of the nearest source distance with ``|dref − d*| ≤ slack`` (computed
+        ``progress(stage, fraction)`` is called after each chunk when given. ``dref`` (q,) is an estimate of the
+        nearest source distance with ``|dref − d*| ≤ slack`` (computed
         exactly with a k-d tree when omitted); :func:`grid_nearest_distance` gives one for grids.
         """
         Q = np.ascontiguousarray(Q, dtype=np.float64)
@@ -257,7 +258,7 @@ class YukawaTree:
             _tree_kernel(q, d, self._B, self._W, self._D, self._erho, t.lo, t.hi, t.right, t.skip, t.start, t.end,
                          self.lam, self.theta, band, self._rmin, out[s:s + chunk])
             if progress is not None:
-                progress(len(q))
+                progress("Yukawa sums", (s + len(q)) / len(Q))
         return out
 
     def direct(self, Q) -> np.ndarray:

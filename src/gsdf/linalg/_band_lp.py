@@ -3,8 +3,7 @@
 The program of :func:`gsdf.linalg._dual_l1.dual_graph_l1`, ``min Σ w |J|`` with ``J = d + x_A − x_B`` and bounds on J, has
 sparse optimal jumps when d is closed (the sum of d around every vertex loop of the dual graph vanishes, as for the
 residual of surface winding numbers, thesis §6.1.2): J lives near the input curves and the paths that close their
-gaps. Solving it on all cells costs simplex pivots that only route the dual flow through the far field
-(bench/RESULTS.md "swn-lp-band"). Here:
+gaps. Solving it on all cells costs simplex pivots that only route the dual flow through the far field. Here:
 
 1. **band**: the seed cells (e.g. the faces along the curves and along the reduced LP's completion paths, §6.3)
    grown by ``rings`` rings of neighbours; outside it, J = 0 is imposed: every connected piece of the outside is
@@ -23,8 +22,8 @@ gaps. Solving it on all cells costs simplex pivots that only route the dual flow
    are scaled by S ≈ 10⁹ / (total fixed flow) and rounded inwards; a deficit up to 10⁻⁶ of the fixed flow is
    accepted, and jumps below 10⁻⁶ (relative to max |d|) count as 0, so the flow is a certificate up to these
    resolutions). Found: the result is the full optimum (same objective). Not
-   found: the band is doubled and steps 1–3 repeat, at most ``max_rounds`` times, then the full program is
-   solved (``fallback``).
+   found: the band is grown and steps 1–3 repeat, at most ``max_rounds`` times, then the full program is
+   solved (HiGHS interior point, :func:`gsdf.linalg._dual_l1.dual_graph_l1`).
 
 Example
 -------
@@ -126,11 +125,10 @@ def certify(n, P, J, w, lo, hi, tol=1e-9):
 
 
 def banded_l1(n_cells: int, pairs, offsets, weights, bounds=None, seeds=None, rings: int = 4, max_rounds: int = 6,
-              time_limit: float = 300.0, fallback: str = "network", gauge: str = "component",
-              _info: dict | None = None) -> DualL1Result:
-    """The program of :func:`gsdf.linalg._dual_l1.dual_graph_l1`, solved on a band around ``seeds`` and proven optimal for
-    all cells (module docstring); the full program (``fallback`` algorithm of ``dual_graph_l1``) if no band of
-    ``max_rounds`` tries can be proven.
+              time_limit: float = 300.0, gauge: str = "component", _info: dict | None = None) -> DualL1Result:
+    """The program of :func:`gsdf.linalg._dual_l1.dual_graph_l1`, solved on a band around ``seeds`` and proven optimal
+    for all cells (module docstring); the full program (HiGHS interior point) if no band of ``max_rounds`` tries
+    can be proven.
 
     Parameters
     ----------
@@ -140,7 +138,6 @@ def banded_l1(n_cells: int, pairs, offsets, weights, bounds=None, seeds=None, ri
     rings : int ≥ 0, neighbour rings added to the seeds; after a failed proof the band grows by ``rings`` rings
         around the links of the certificate's minimum cut (where the better shifts jump) and one ring everywhere
     max_rounds : int ≥ 1
-    fallback : "network", "highs", "highs-ds" or "highs-ipm"
 
     Returns
     -------
@@ -159,8 +156,6 @@ def banded_l1(n_cells: int, pairs, offsets, weights, bounds=None, seeds=None, ri
         raise ValueError(f"rings: expected an integer >= 0, got {rings!r}")
     if isinstance(max_rounds, bool) or not isinstance(max_rounds, (int, np.integer)) or max_rounds < 1:
         raise ValueError(f"max_rounds: expected an integer >= 1, got {max_rounds!r}")
-    if fallback not in ("network", "highs", "highs-ds", "highs-ipm"):
-        raise ValueError(f"fallback: expected 'network', 'highs', 'highs-ds' or 'highs-ipm', got {fallback!r}")
     k = len(P)
     A, B = P[:, 0], P[:, 1]
     band = np.zeros(n, dtype=bool)
@@ -256,5 +251,5 @@ def banded_l1(n_cells: int, pairs, offsets, weights, bounds=None, seeds=None, ri
         raise ValueError(f"linear program: band solve hit its time limit (time_limit={time_limit})")
     info["fallback"] = True
     r = dual_graph_l1(n, P, d, w, bounds=np.column_stack([lo, hi]), time_limit=left, gauge=gauge,
-                      algorithm=fallback)
+                      algorithm="highs-ipm")
     return DualL1Result(r.shifts, r.jumps, r.objective, time.perf_counter() - t_start)

@@ -17,7 +17,8 @@ a network matrix with two nonzeros per column block. Bounds on J become bounds o
 ``lo ≥ 0`` the negative part is fixed at 0 and ``s⁺ ∈ [lo, hi]``; mirrored for ``hi ≤ 0``; otherwise
 ``s⁺ ≤ hi`` and ``s⁻ ≤ -lo``. One shift per connected component of the dual graph is fixed at 0 (the gauge),
 so the answer is deterministic up to LP ties. HiGHS failure, infeasibility or its time limit raise ValueError.
-``algorithm="network"`` solves the LP dual instead, a pure min-cost circulation (:mod:`gsdf.linalg._netflow`).
+The same program is also solved through its LP dual, a pure min-cost circulation (:mod:`gsdf.linalg._netflow`),
+and on a proven band of cells (:mod:`gsdf.linalg._band_lp`).
 
 Example
 -------
@@ -39,7 +40,7 @@ from gsdf.linalg._l1_terms import DualL1Result, _checked_terms
 
 __all__ = ["DualL1Result", "dual_graph_l1", "ALGORITHMS"]
 
-ALGORITHMS = ("highs", "highs-ds", "highs-ipm", "network")
+ALGORITHMS = ("highs", "highs-ds", "highs-ipm")
 
 
 def solve_highs(cost, A_eq, b_eq, bounds, algorithm: str, time_limit: float):
@@ -83,8 +84,7 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
         Seconds HiGHS may use; reaching it raises ValueError.
     gauge : "component" | "none"
         Fix one shift per connected component of the dual graph at 0 (default), or leave all free.
-    algorithm : "highs" (HiGHS picks), "highs-ds" (dual simplex), "highs-ipm" (interior point + crossover) or
-        "network" (the dual min-cost circulation by a network simplex, :mod:`gsdf.linalg._netflow`; same optimum)
+    algorithm : "highs" (HiGHS picks), "highs-ds" (dual simplex) or "highs-ipm" (interior point + crossover)
 
     Returns
     -------
@@ -98,11 +98,6 @@ def dual_graph_l1(n_cells: int, pairs, offsets, weights, bounds=None, time_limit
     """
     if algorithm not in ALGORITHMS:
         raise ValueError(f"algorithm: expected one of {ALGORITHMS}, got {algorithm!r}")
-    if algorithm == "network":
-        from gsdf.linalg._netflow import dual_graph_l1_network
-
-        return dual_graph_l1_network(n_cells, pairs, offsets, weights, bounds=bounds, time_limit=time_limit,
-                                     gauge=gauge)
     n, P, d, w, lo, hi, first, _ = _checked_terms(n_cells, pairs, offsets, weights, bounds, time_limit, gauge)
     k = len(P)
     # bounds of s+ and s-

@@ -1,11 +1,11 @@
 """Primal network simplex for min-cost circulations with real capacities and costs (numba), and the L1 dual-graph
-program solved through it.
+program solved through it (the restricted solves of :mod:`gsdf.linalg._band_lp`).
 
-Why: the L1 program of :func:`gsdf.linalg._dual_l1.dual_graph_l1` (least weighted L1 jump ``Σ w |d + x_A − x_B|`` over
-per-cell shifts x, with bounds on the jumps) is the LP dual of a *pure* minimum-cost circulation on the dual graph:
-the shifts x are the node potentials of the flow problem. Pure network LPs are solved by the network simplex,
-whose bases are spanning trees — no factorization, one tree path per pivot. HiGHS sees only a general sparse LP
-(presolve removes nothing on it; simplex and crossover grew to 320 s at 134k faces, bench/RESULTS.md).
+The L1 program of :func:`gsdf.linalg._dual_l1.dual_graph_l1` (least weighted L1 jump ``Σ w |d + x_A − x_B|`` over
+per-cell shifts x, with bounds on the jumps; the residual of surface winding numbers, thesis §6.1.2) is the LP
+dual of a *pure* minimum-cost circulation on the dual graph: the shifts x are the node potentials of the flow
+problem. Pure network LPs are solved by the network simplex, whose bases are spanning trees — no factorization,
+one tree path per pivot.
 
 The dual, derived (Lagrangian of ``J = d + x_A − x_B`` with multiplier f per dual edge):
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_normals, as_points, choice, positive
+from gsdf._checks import as_mesh, as_normals, as_points, choice, positive, progress_callback
 
 __all__ = ["signed_distance_grid"]
 
@@ -76,7 +76,7 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
     choice(sign, "sign", ("winding", "pseudonormal"))
     if not isinstance(return_closest, (bool, np.bool_)):
         raise ValueError(f"return_closest: expected True or False, got {return_closest!r}")
-    report = _progress(progress)
+    report = progress_callback(progress)
     if points is not None:
         if V is not None or F is not None:
             raise ValueError("points: give either a mesh (V, F) or points=(P, N), not both")
@@ -140,13 +140,6 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
 
 #: Queries per winding-number call (the chunk of gsdf.winding's own query loop: the same calls, the same numbers).
 CHUNK = 1 << 20
-
-
-def _progress(progress):
-    """``progress`` validated: a callable ``progress(stage, fraction)`` or None."""
-    if progress is not None and not callable(progress):
-        raise ValueError("progress: expected a callable progress(stage, fraction) or None")
-    return progress
 
 
 def _chunked(winding, Q, progress, stage: str = "winding numbers") -> np.ndarray:

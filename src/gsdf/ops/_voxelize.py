@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_normals, as_points, as_weights, positive
+from gsdf._checks import as_mesh, as_normals, as_points, as_weights, positive, progress_callback
 from gsdf._memory import check_bytes, grid_bytes
 from gsdf.mesh._topology import manifold_report, split_nonmanifold_vertices
 
@@ -115,8 +115,7 @@ def winding_grid(mesh=None, points=None, resolution=100, beta=None, progress=Non
     from gsdf.grid import as_grid
 
     wn, X = _winding_object(mesh, points, beta)
-    if progress is not None and not callable(progress):
-        raise ValueError("progress: expected a callable progress(stage, fraction) or None")
+    progress = progress_callback(progress)
     grid = as_grid(resolution, X=X)
     shape = grid.shape
     # the grid (8 B/node, +1 B for voxelize's occupancy) plus one chunk of centres, indices and values
@@ -127,8 +126,7 @@ def winding_grid(mesh=None, points=None, resolution=100, beta=None, progress=Non
     for s in range(0, total, CHUNK):
         e = min(total, s + CHUNK)
         W[s:e] = np.asarray(wn(grid.points(np.arange(s, e, dtype=np.int64))), dtype=np.float64).reshape(-1)
-        if progress is not None:
-            progress("winding numbers", e / total)
+        progress("winding numbers", e / total)
     return GridField(W.reshape(shape), *grid.box)
 
 

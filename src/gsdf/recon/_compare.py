@@ -39,8 +39,8 @@ def oriented_normals(P, N=None) -> np.ndarray:
         N = as_normals(N, len(P), "N")
         return N / np.maximum(np.linalg.norm(N, axis=1), 1e-300)[:, None]
     from gsdf.recon._orient import orient_normals
-    from gsdf.recon._pipeline import _pca_normals
-    return orient_normals(P, _pca_normals(P))
+    from gsdf.recon._cloud import pca_normals
+    return orient_normals(P, pca_normals(P))
 
 
 def _box(P, pad=0.1):

@@ -1,13 +1,13 @@
 """Global fit of a closed mesh onto its samples: sparse least squares over ALL vertex positions (geometry only).
 
-The guarantee layer (:mod:`.grow`) returns the boundary of a tet region; the local relocation
-(:mod:`.relocate`) moves vertices one by one and refuses any move that flips a face, so the pleats of that
+The guarantee layer (:mod:`gsdf.recon._grow`) returns the boundary of a tet region; the local relocation
+(:mod:`gsdf.recon._relocate`) moves vertices one by one and refuses any move that flips a face, so the pleats of that
 boundary — strips where the surface folds back over itself, faces facing against the true normal — stay.  This
 pass moves every vertex at once (input points too), alternating
 
 (a) data attachment: every sample s is attached to its closest point on the current mesh (a face and
     barycentric coordinates b_s, :class:`gsdf.distance.TriangleDistance`); every vertex v to its foot f_v
-    and normal n_v on the moving-least-squares quadric of its nearest samples (:func:`.relocate.local_surface`);
+    and normal n_v on the moving-least-squares quadric of its nearest samples (:func:`gsdf.recon._relocate.local_surface`);
 (b) one sparse least-squares solve for all positions x (3 unknowns per vertex):
 
         minimise   β Σ_s a_s |Σ_i b_si x_i − s|²                     samples on the surface (point-to-point)
@@ -21,7 +21,7 @@ pass moves every vertex at once (input points too), alternating
     Laplacian of the edges).  Moving the membrane's normal force to the right-hand side makes it act along
     the surface only: it spreads the vertices evenly over the surface and so unfolds pleats (on a flat patch
     the minimiser of Σ|x_i − x_j|² with the rim held is Tutte's embedding, which has no folds), without the
-    shrinking of a plain membrane (measured: CD rises by ~30 % without it).
+    shrinking of a plain membrane.
 
 The normal equations are symmetric positive definite (ε > 0); they are solved by conjugate gradients with a
 3 × 3 block-Jacobi preconditioner, warm-started at the current positions, to a relative residual of 1e-7.  They
@@ -31,9 +31,7 @@ bincount per round), so a mat-vec reads K once for all three coordinates and add
 diagonal blocks k_v I₃ + c_v n_v n_vᵀ invert in closed form (Sherman–Morrison); the CG iteration is SciPy's
 (:func:`gsdf.linalg._iterative.cg_loop`) in one numba kernel.  Vertices and samples are relabelled along the
 Z-order curve inside (the result does not depend on the labels), and the triangle tree of the attachment is
-built once and refitted in later rounds (:meth:`gsdf.distance.TriangleDistance.refit`).  Measured
-(bench/RESULTS.md section recon-fit-stages, bunny00 clouds): 3.4–7× less time than the scipy kron assembly with
-SciPy's ``cg`` that it replaces, with the same result to ~1e-11 spacings.
+built once and refitted in later rounds (:meth:`gsdf.distance.TriangleDistance.refit`).
 
 Only vertex positions change — the face list, hence the combinatorial topology (closed, edge- and
 vertex-manifold, genus 0, one component), is exactly the input's.  Faces may turn over during the fit (that
@@ -250,7 +248,7 @@ class _Clock:
 
 def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float = 5.0, surface: float = 1.0,
                    membrane: float = 0.2, prox: float = 0.01, trim: float = 3.0, k: int = 8,
-                   fit_tol: float = 0.2, normals=None, side_cos: float = 0.0, return_report: bool = False):
+                   fit_tol: float = 0.2, return_report: bool = False):
     """Move all vertices of a mesh onto its samples by alternating attachment and a global least-squares solve.
 
     See the module text for the energy.  The faces are not changed, so the topology is the input's.
@@ -266,9 +264,6 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
     trim : float > 0 — samples farther than this × ``spacing`` from the mesh get no weight in a round.
     k : int ≥ 3 — samples per local quadric; fit_tol : float > 0 — in spacings, the rms residual above which a
         vertex's quadric is not trusted (two sheets of a thin part, a crease): no surface term there.
-    normals : (s, 3) float or None — oriented (outward) sample normals: each vertex's quadric is then fitted to
-        the samples on its side only, those whose normal has cosine > ``side_cos`` with the vertex normal of the
-        current mesh (:func:`.relocate.local_surface` with normals).  None: the k nearest samples.
     return_report : bool — also return ``{"iterations", "attached" (per round), "cg_iterations" (per round),
         "mean_shift", "max_shift"}``.
 
@@ -315,11 +310,6 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
     F = rank[F]
     ps = morton_order(S)
     S = S[ps]
-    if normals is not None:
-        NS = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
-        if NS.shape != (m, 3):
-            raise ValueError(f"normals: expected ({m}, 3), got {NS.shape}")
-        NS = NS[ps]
     tree = cKDTree(S)
     P = _Pattern(F, n)
     td = None
@@ -330,16 +320,7 @@ def fit_to_samples(V, F, S, spacing: float, *, iterations: int = 4, data: float 
         td = TriangleDistance(X, F) if td is None else td.refit(X)
         d, face, _, bary = td.query_barycentric(S)
         clock("attach")
-        if normals is None:
-            foot, nrm, _, rms = local_surface(X, S, h, k=k, tree=tree, return_fit=True)
-        else:                                       # area-weighted vertex normals of the current mesh
-            Nf = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
-            Nv = np.zeros_like(X)
-            for j in range(3):
-                np.add.at(Nv, F[:, j], Nf)
-            Nv /= np.maximum(np.linalg.norm(Nv, axis=1), 1e-300)[:, None]
-            foot, nrm, _, rms = local_surface(X, S, h, k=k, tree=tree, return_fit=True, normals=NS,
-                                              query_normals=Nv, side_cos=side_cos)
+        foot, nrm, _, rms = local_surface(X, S, h, k=k, tree=tree, return_fit=True)
         nrm = np.ascontiguousarray(nrm)
         clock("surface")
         a = data * (d <= trim * h)

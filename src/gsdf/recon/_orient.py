@@ -5,8 +5,9 @@ part of the jump field.  On a Delaunay tetrahedralisation of the convex hull (a 
 zero, so A ≡ 0 and the eigenproblem is degenerate (notes 2(b).4).  This module is the working replacement
 (notes 2(b).5(a), "PCA normals plus a propagated orientation"):
 
-1. PCA normals, oriented by propagation along a minimum spanning tree of the k-nearest-neighbour graph with
-   weights ``1 - |n_i·n_j|`` (Hoppe et al. 1992), the sign of each tree fixed by its extreme point;
+1. PCA normals, signed by the top eigenvector of the k-nearest-neighbour graph's signed adjacency (Hoppe et
+   al. 1992's agreement of neighbouring normals, damped on edges that leave the tangent plane), the sign of
+   each component fixed by its convex-hull points (:func:`orient_normals`);
 2. the face chain F0 (:func:`face_chain`): faces of the Delaunay mesh in a band near the points
    across which the tangent-plane signed distance of the nearest points
    changes sign between the two adjacent tet centroids; each face gets jump +1 oriented along the normals.
@@ -23,28 +24,12 @@ Example
 
 from __future__ import annotations
 
-import numba as nb
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-__all__ = ["orient_normals", "tangent_signed_distance", "face_chain", "local_spacing"]
-
-
-def local_spacing(P: np.ndarray, k: int = 6) -> np.ndarray:
-    """(n,) mean distance of each point to its ``k`` nearest neighbours."""
-    k = min(k, len(P) - 1)
-    d, _ = cKDTree(P).query(P, k=k + 1)
-    return d[:, 1:].mean(axis=1)
-
-
-@nb.njit(cache=True)
-def _propagate(order, pred, rel, flip):
-    for i in order:
-        p = pred[i]
-        if p >= 0:
-            flip[i] = flip[p] * rel[i]
+__all__ = ["orient_normals", "tangent_signed_distance", "face_chain"]
 
 
 def _knn_links(P, k, link):
@@ -86,55 +71,29 @@ def _hull_sign(P, N, members):
     return -1.0 if np.sum(np.sign(np.einsum("ij,ij->i", N[hv], out))) < 0 else 1.0
 
 
-def orient_normals(P: np.ndarray, N: np.ndarray, k: int = 10, link: float = 6.0, method: str = "spectral",
-                   sharpness: float = 4.0, crossing: float = 0.0, weak: float = 0.25) -> np.ndarray:
+def orient_normals(P: np.ndarray, N: np.ndarray, k: int = 10, link: float = 6.0, sharpness: float = 4.0,
+                   crossing: float = 0.0, weak: float = 0.25) -> np.ndarray:
     """Consistently orient unit normals ``N`` (n, 3) of points ``P``.
 
-    Both methods work on the kNN graph (components closer than ``link`` × the median spacing linked through
-    their nearest pair); the sign of each component is a majority vote of its convex-hull points, whose
-    outward normals point away from its centroid.
-
-    * ``"spectral"`` (default): the signs s maximise Σ a_ij s_i s_j over the kNN edges, with
-      a_ij = n_i·n_j (1 − c_ij)^``sharpness`` − ``crossing`` (n_i·n_j)⁴ (n_i·d̂)(n_j·d̂), d̂ the unit edge vector
-      and c_ij = ½(|n_i·d̂| + |n_j·d̂|).  The first (sheet) term is Hoppe's agreement of neighbouring normals,
-      damped on edges that leave the tangent plane (across a thin part the two sides' normal lines are
-      parallel but their outward signs opposite, so n_i·n_j would say "flip").  The relaxation is the top
-      eigenvector of the normalised signed adjacency, then local majority votes: one bad edge cannot flip a
-      whole subtree as in a spanning tree — every sign is decided by all its edges.  On the 32 Table-2 clouds
-      (PCA normals of the pre-filtered points) it flips 2.2 % of the sample normals against the truth, the
-      spanning tree 3.7 % (camel 8K+200: 138 against 679; bench/RESULTS.md section recon-thin).
-      The second (crossing) term, off by default, is the sign relation across a thin part: for consistently
-      oriented normals of a smooth closed surface −(n_i·d̂)(n_j·d̂) ≥ 0, and it is large exactly across thin
-      parts.  On a clean flat ellipsoid 4–7 spacings thick, where both methods orient the two sides alike
-      (51 % right), ``crossing=1`` gets 96 %; but an outlier moved along the normal looks like the other side
-      of a thin part, and in the reconstruction of the Table-2 clouds the term oriented kept outliers into
-      sheets (bunny 1K+800: CD×100 0.59 → 1.33), so the pipeline does not use it.
-    * ``"mst"``: propagation along a minimum spanning tree with weights ``1 - |n_i·n_j|`` (Hoppe et al. 1992).
+    On the kNN graph (components closer than ``link`` × the median spacing linked through their nearest pair)
+    the signs s maximise Σ a_ij s_i s_j over the edges, with a_ij = n_i·n_j (1 − c_ij)^``sharpness`` −
+    ``crossing`` (n_i·n_j)⁴ (n_i·d̂)(n_j·d̂), d̂ the unit edge vector and c_ij = ½(|n_i·d̂| + |n_j·d̂|).  The
+    first (sheet) term is Hoppe et al. 1992's agreement of neighbouring normals, damped on edges that leave the
+    tangent plane (across a thin part the two sides' normal lines are parallel but their outward signs
+    opposite, so n_i·n_j would say "flip").  The relaxation is the top eigenvector of the normalised signed
+    adjacency, then local majority votes: one bad edge cannot flip a whole subtree as in a spanning tree —
+    every sign is decided by all its edges.  The second (crossing) term, off by default, is the sign relation
+    across a thin part: for consistently oriented normals of a smooth closed surface −(n_i·d̂)(n_j·d̂) ≥ 0, and
+    it is large exactly across thin parts; an outlier moved along the normal looks like the other side of a
+    thin part, so the reconstruction does not use it.  Points whose signs rest on little weight (below
+    ``weak`` × the median) take the sign of their neighbours with weight.  The sign of each component is a
+    majority vote of its convex-hull points, whose outward normals point away from its centroid.
     """
-    if method not in ("spectral", "mst"):
-        raise ValueError(f"method: expected 'spectral' or 'mst', got {method!r}")
     n = len(P)
     k = min(k, n - 1)
     rows, cols = _knn_links(P, k, link)
     dot = np.einsum("ij,ij->i", N[rows], N[cols])
     flip = np.ones(n)
-    if method == "mst":
-        wgt = 1.0 - np.abs(dot) + 1e-6
-        G = sp.csr_matrix((wgt, (rows, cols)), shape=(n, n))
-        G = G.maximum(G.T)
-        T = minimum_spanning_tree(G)
-        T = T + T.T
-        ncomp, comp = connected_components(T, directed=False)
-        for c in range(ncomp):
-            members = np.flatnonzero(comp == c)
-            order, pred = breadth_first_order(T, members[0], directed=False, return_predecessors=True)
-            pred = np.where(pred < 0, -1, pred).astype(np.int64)
-            rel = np.ones(n)
-            idx = np.flatnonzero(pred >= 0)
-            rel[idx] = np.sign(np.einsum("ij,ij->i", N[idx], N[pred[idx]]) + 1e-300)
-            _propagate(order.astype(np.int64), pred, rel, flip)
-            flip[members] *= _hull_sign(P, N * flip[:, None], members)
-        return N * flip[:, None]
     D = P[cols] - P[rows]
     D /= np.maximum(np.linalg.norm(D, axis=1), 1e-300)[:, None]
     ai, aj = np.einsum("ij,ij->i", D, N[rows]), np.einsum("ij,ij->i", D, N[cols])
@@ -206,7 +165,7 @@ def tangent_signed_distance(P: np.ndarray, N: np.ndarray, Q: np.ndarray, k: int 
     return np.einsum("qkx,qkx->qk", N[I], Q[:, None, :] - P[I]).mean(axis=1)
 
 
-def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.0, sign: str = "tangent") -> np.ndarray:
+def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.0) -> np.ndarray:
     """(nF,) int8 oriented face chain F0 on the tet complex ``K`` (canonical orientation; 0 = not in F0).
 
     Tets are labelled inside / outside by the sign of the tangent-plane distance of the nearest inlier points
@@ -219,17 +178,12 @@ def face_chain(K, P: np.ndarray, N: np.ndarray, spacing: float, band: float = 4.
     Parameters
     ----------
     K : TetComplex; P, N : (n, 3) — inlier points and their oriented unit normals; spacing : float — median
-    nearest-neighbour spacing of P; band : float; sign : {"tangent", "winding"} — inside test of the tet
-    centroids (tangent-plane distance < 0, or fast winding number of the oriented points > ½).
+    nearest-neighbour spacing of P; band : float.
     """
     ft = K.face_tets
     tree = cKDTree(P)
     cen = K.V[K.T].mean(axis=1)
-    if sign == "winding":
-        from gsdf.winding import fast_winding_number_points
-        inside = fast_winding_number_points(P, N, cen) > 0.5
-    else:
-        inside = tangent_signed_distance(P, N, cen, tree=tree) < 0
+    inside = tangent_signed_distance(P, N, cen, tree=tree) < 0
     dv, _ = tree.query(K.V)
     near = (dv <= band * spacing)[K.faces].all(axis=1)
     both = (ft >= 0).all(axis=1)

@@ -1,6 +1,6 @@
 """Vertex relocation of a reconstructed mesh onto the local surface of the samples (geometry only).
 
-The guarantee layer (:mod:`.grow`) outputs the boundary of a tet region: its vertices are sample points and
+The guarantee layer (:mod:`gsdf.recon._grow`) outputs the boundary of a tet region: its vertices are sample points and
 Steiner points, so the surface is faceted, and Steiner vertices (and kept outliers) stand off the sampled
 surface.  This module moves vertices onto the *local surface* of the samples — a moving-least-squares fit
 (Levin 2003; Alexa et al. 2003): around each vertex, the Gaussian-weighted plane of its k nearest samples,

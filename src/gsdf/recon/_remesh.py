@@ -1,11 +1,11 @@
 """Edge flips that make a closed triangle mesh follow the local surface of its samples (connectivity only).
 
-The guarantee layer (:mod:`.grow`) outputs the boundary of a tet region: its edges are Delaunay edges of the
+The guarantee layer (:mod:`gsdf.recon._grow`) outputs the boundary of a tet region: its edges are Delaunay edges of the
 samples and Steiner points, chosen for the topology, not for the fit — a face may cut across a bend of the
 sampled surface although a flip of one of its edges would follow it.  This pass flips the edge (a, b) of the
 faces (a, b, c), (b, a, d) into (c, d) when the two new faces lie closer to the samples' surface: the error
 of a face is its area × the mean offset of its centroid and edge midpoints from the moving-least-squares
-quadric (:func:`.relocate.local_surface`'s fit, with ``k`` samples) of the sample nearest to each point.
+quadric (:func:`gsdf.recon._relocate.local_surface`'s fit, with ``k`` samples) of the sample nearest to each point.
 
 The topology is kept by construction: a flip is taken only when (c, d) is not already an edge, so a closed,
 edge-manifold, oriented mesh stays one, with the same vertices, edge and face counts — hence the same Euler
@@ -67,7 +67,7 @@ def _has_edge(F, vf, off, deg, a, b):
 @nb.njit(cache=True)
 def _point_error(px, py, pz, S, cen, frame, h, coef, near, i, j, k):
     """|offset| of point p from the quadric fitted around the sample nearest to p among the nearest samples
-    of vertices i, j, k (frame rows t1, t2, n; the fit of :func:`.relocate.local_surface`)."""
+    of vertices i, j, k (frame rows t1, t2, n; the fit of :func:`gsdf.recon._relocate.local_surface`)."""
     best, bd = -1, 1e300
     for v in (i, j, k):
         q = near[v]

@@ -1,6 +1,6 @@
 """Gap labels of surface winding numbers: the faces at the gaps of broken curves rounded at the field's own level.
 
-The rule and why it is used: :meth:`gsdf.swn._solver.SurfaceWindingNumbers.gap_shift`. This module holds the
+The rule: :meth:`gsdf.swn._solver.SurfaceWindingNumbers.gap_shift`. This module holds the
 kernel — one numba pass of point-to-point Dijkstra searches over all gaps (each search stops when it settles its
 target and resets only the vertices it touched, so the pass costs about the gaps' neighbourhoods, not |gaps| × |V|)
 — and the vectorised pairing and level steps around it (no Python loop over gaps).
@@ -17,11 +17,8 @@ from scipy.sparse.csgraph import connected_components
 
 GAP_MAX_EDGES = 8   # a gap whose closing path has more edges keeps the global level: the path is the chord, and over a
                     # long gap the curve's own bend (the member of the pencil through the curves' level, exact for a
-                    # broken circle) matters more than the chord (bench_swn.py --breaking long --topology simply, 420
-                    # cases: mean 1.683 % global, 1.816 % without this limit, 1.685 % with it; 12 edges: 1.687 %;
-                    # the random-interval cases, gaps <= 5 edges, are unchanged for limits 5-12: 0.267 %)
-GAP_EPS = 0.1       # path weight ℓ / (|Δw| + GAP_EPS); bench/bench_swn_gaps.py (|dw| paths, eps 0.1): 0.267 % mean
-                    # on the 420 simply connected cases; eps 1e-3 / 1 gave 0.265 / 0.272 % on 140 of them (scratch)
+                    # broken circle) matters more than the chord
+GAP_EPS = 0.1       # path weight ℓ / (|Δw| + GAP_EPS): the floor on |Δw|
 
 
 @nb.njit(cache=True)

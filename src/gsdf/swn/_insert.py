@@ -159,172 +159,197 @@ def insert_curves(V, F, curves):
     """
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
-    n = len(V)
-    topo = MeshTopology(F, n)
+    topo = MeshTopology(F, len(V))
     topo.require_manifold("F")
     topo.require_oriented("F")
-    E = topo.edges
-    ekey = E[:, 0] * n + E[:, 1]
-
-    def edge_id(a, b):
-        lo, hi = min(a, b), max(a, b)
-        e = int(np.searchsorted(ekey, lo * n + hi))
-        return e if e < len(ekey) and ekey[e] == lo * n + hi else -1
-
     parent0 = None
     if np.any(curves.kinds == "f"):
         V, F, curves, parent0 = _split_at_face_points(V, F, curves)
-        n = len(V)
-        topo = MeshTopology(F, n)
-        E = topo.edges
-        ekey = E[:, 0] * n + E[:, 1]
-    kinds, index, params, ev = curves.kinds, curves.index, curves.params, curves.edge_vertices
-    newV = [V]
-    nv = n
-    node_vertex = np.full(len(kinds), -1, dtype=np.int64)
-    node_edge = np.full(len(kinds), -1, dtype=np.int64)
-    edge_points: dict[int, list] = {}                        # edge -> [(s along canonical lo->hi, vertex)]
-    point_key: dict = {}
-    for k in range(len(kinds)):
-        if kinds[k] == "v":
-            if not 0 <= index[k] < n:
-                raise ValueError(f"curves: node {k} names vertex {index[k]}, out of range for {n} vertices")
-            node_vertex[k] = index[k]
-            continue
-        a, b = int(ev[k, 0]), int(ev[k, 1])
-        t = float(params[k, 0])
-        if t <= SNAP:
-            node_vertex[k] = a
-            continue
-        if t >= 1 - SNAP:
-            node_vertex[k] = b
-            continue
-        e = edge_id(a, b)
-        if e < 0:
-            raise ValueError(f"curves: node {k} lies on ({a}, {b}), which is not an edge of the mesh")
-        s = t if a < b else 1 - t
-        key = (e, round(s, 12))
-        if key in point_key:
-            node_vertex[k] = point_key[key]
-        else:
-            lo, hi = E[e]
-            newV.append(((1 - s) * V[lo] + s * V[hi])[None])
-            point_key[key] = nv
-            edge_points.setdefault(e, []).append((s, nv))
-            node_vertex[k] = nv
-            nv += 1
-        node_edge[k] = e
-    X = np.concatenate(newV)
-
-    # a lone segment between two vertices sharing an edge, both ends free: split it at the midpoint
-    segs = np.asarray(curves.segments, dtype=np.int64)
-    deg = np.bincount(node_vertex[segs].ravel(), minlength=nv)
-    extra = []
-    for si, (p, q) in enumerate(segs):
-        a, b = int(node_vertex[p]), int(node_vertex[q])
-        if a < n and b < n and deg[a] == 1 and deg[b] == 1 and not topo.boundary_vertices[a] \
-                and not topo.boundary_vertices[b]:
-            e = edge_id(a, b)
-            if e >= 0:
-                lo, hi = E[e]
-                X = np.concatenate([X, (0.5 * (V[lo] + V[hi]))[None]])
-                edge_points.setdefault(e, []).append((0.5, nv))
-                extra.append((si, nv))
-                nv += 1
-    vseg = [(int(node_vertex[p]), int(node_vertex[q])) for p, q in segs]
-    for si, mid in extra[::-1]:
-        a, b = vseg[si]
-        vseg[si:si + 1] = [(a, mid), (mid, b)]
-
-    # faces around each point: a vertex's faces, or the two faces of a split edge
-    vf_ptr = np.argsort(F.ravel(), kind="stable")
-    counts = np.bincount(F.ravel(), minlength=n)
-    starts = np.concatenate([[0], np.cumsum(counts)])
-
-    def faces_of(v):
-        if v < n:
-            return set((vf_ptr[starts[v]:starts[v + 1]] // 3).tolist())
-        e = vertex_edge[v]
-        return {int(f) for f in topo.edge_faces[e] if f >= 0}
-
-    vertex_edge = {}
-    for e, pts in edge_points.items():
-        for _, v in pts:
-            vertex_edge[v] = e
-
-    def on_edge(v, e):
-        if v < n:
-            return v in (E[e, 0], E[e, 1])
-        return vertex_edge[v] == e
-
-    def along(e, a, b):
-        """Vertices from a to b along split edge e (both on it)."""
-        lo, hi = E[e]
-        pts = sorted([(0.0, int(lo)), (1.0, int(hi))] + edge_points.get(e, []))
-        ids = [v for _, v in pts]
-        i, j = ids.index(a), ids.index(b)
-        return ids[i:j + 1] if i <= j else ids[j:i + 1][::-1]
-
-    chords: dict[int, list] = {}
-    out_segs = []
-    for si, (a, b) in enumerate(vseg):
-        if a == b:
-            continue
-        # along one (possibly split) edge?
-        cand = []
-        if a < n and b < n:
-            e = edge_id(a, b)
-            if e >= 0:
-                cand = [e]
-        elif a >= n and on_edge(b, vertex_edge[a]):
-            cand = [vertex_edge[a]]
-        elif b >= n and on_edge(a, vertex_edge[b]):
-            cand = [vertex_edge[b]]
-        if cand:
-            path = along(cand[0], a, b)
-            out_segs += list(zip(path[:-1], path[1:]))
-            continue
-        common = faces_of(a) & faces_of(b)
-        if not common:
-            raise ValueError(f"curves: segment {si} joins points that share no face (vertices {a}, {b} of the cut "
-                             "mesh): the curve is not connected where it claims to be")
-        f = min(common)
-        chords.setdefault(f, []).append((a, b))
-        out_segs.append((a, b))
-
-    touched = set(chords)
-    for e in edge_points:
-        touched |= {int(f) for f in topo.edge_faces[e] if f >= 0}
-    keep = np.ones(len(F), dtype=bool)
-    newF, parent = [], []
-    for f in sorted(touched):
-        keep[f] = False
-        poly = []
-        for k in range(3):
-            a, b = int(F[f, k]), int(F[f, (k + 1) % 3])
-            e = topo.face_edges[f, k]
-            poly += along(e, a, b)[:-1]
-        polys = [poly]
-        for a, b in chords.get(f, []):
-            for pi, P in enumerate(polys):
-                if a in P and b in P:
-                    i, j = sorted((P.index(a), P.index(b)))
-                    if j - i in (1, len(P) - 1):
-                        break                                 # already a side
-                    polys[pi:pi + 1] = [P[i:j + 1], P[j:] + P[:i + 1]]
-                    break
-            else:
-                raise ValueError(f"curves: two curve segments cross inside face {f}; insert their crossing point")
-        for P in polys:
-            for tri in _ear_clip(P, X):
-                newF.append(tri)
-                parent.append(f)
-    F2 = np.concatenate([F[keep], np.array(newF, dtype=np.int64).reshape(-1, 3)])
-    par = np.concatenate([np.flatnonzero(keep), np.array(parent, dtype=np.int64)])
+        topo = MeshTopology(F, len(V))
+    cut = _Cut(V, F, topo)
+    X, node_vertex = cut.node_vertices(curves)
+    X, vseg = cut.split_lone_segments(X, node_vertex[np.asarray(curves.segments, dtype=np.int64)])
+    chords, out_segs = cut.route(vseg)
+    F2, par = cut.retriangulate(X, chords)
     if parent0 is not None:
         par = parent0[par]
     S = np.array(out_segs, dtype=np.int64).reshape(-1, 2)
     return X, F2, S, par
+
+
+class _Cut:
+    """The mesh being cut: its edges, the points inserted on them (``edge_points``: edge -> [(s along the
+    canonical lo -> hi direction, vertex)]), and the steps of :func:`insert_curves`."""
+
+    def __init__(self, V, F, topo):
+        self.V, self.F, self.topo = V, F, topo
+        self.n = len(V)
+        self.E = topo.edges
+        self.ekey = self.E[:, 0] * self.n + self.E[:, 1]
+        self.edge_points: dict[int, list] = {}
+        self.vertex_edge: dict[int, int] = {}
+
+    def edge_id(self, a, b):
+        n, ekey = self.n, self.ekey
+        lo, hi = min(a, b), max(a, b)
+        e = int(np.searchsorted(ekey, lo * n + hi))
+        return e if e < len(ekey) and ekey[e] == lo * n + hi else -1
+
+    def node_vertices(self, curves):
+        """The vertex of every node (inserting the edge points, one per distinct position): (X, (k,) int)."""
+        V, E, n = self.V, self.E, self.n
+        kinds, index, params, ev = curves.kinds, curves.index, curves.params, curves.edge_vertices
+        newV = [V]
+        nv = n
+        node_vertex = np.full(len(kinds), -1, dtype=np.int64)
+        point_key: dict = {}
+        for k in range(len(kinds)):
+            if kinds[k] == "v":
+                if not 0 <= index[k] < n:
+                    raise ValueError(f"curves: node {k} names vertex {index[k]}, out of range for {n} vertices")
+                node_vertex[k] = index[k]
+                continue
+            a, b = int(ev[k, 0]), int(ev[k, 1])
+            t = float(params[k, 0])
+            if t <= SNAP:
+                node_vertex[k] = a
+                continue
+            if t >= 1 - SNAP:
+                node_vertex[k] = b
+                continue
+            e = self.edge_id(a, b)
+            if e < 0:
+                raise ValueError(f"curves: node {k} lies on ({a}, {b}), which is not an edge of the mesh")
+            s = t if a < b else 1 - t
+            key = (e, round(s, 12))
+            if key in point_key:
+                node_vertex[k] = point_key[key]
+            else:
+                lo, hi = E[e]
+                newV.append(((1 - s) * V[lo] + s * V[hi])[None])
+                point_key[key] = nv
+                self.edge_points.setdefault(e, []).append((s, nv))
+                node_vertex[k] = nv
+                nv += 1
+        return np.concatenate(newV), node_vertex
+
+    def split_lone_segments(self, X, segs):
+        """A lone segment between two vertices sharing an edge, both ends free (interior endpoints of nothing
+        else), is split at its midpoint. ``segs`` (s, 2) vertex pairs; returns (X, vertex pairs as a list)."""
+        V, E, n, topo = self.V, self.E, self.n, self.topo
+        nv = len(X)
+        deg = np.bincount(segs.ravel(), minlength=nv)
+        extra = []
+        for si, (a, b) in enumerate(segs):
+            a, b = int(a), int(b)
+            if a < n and b < n and deg[a] == 1 and deg[b] == 1 and not topo.boundary_vertices[a] \
+                    and not topo.boundary_vertices[b]:
+                e = self.edge_id(a, b)
+                if e >= 0:
+                    lo, hi = E[e]
+                    X = np.concatenate([X, (0.5 * (V[lo] + V[hi]))[None]])
+                    self.edge_points.setdefault(e, []).append((0.5, nv))
+                    extra.append((si, nv))
+                    nv += 1
+        vseg = [(int(a), int(b)) for a, b in segs]
+        for si, mid in extra[::-1]:
+            a, b = vseg[si]
+            vseg[si:si + 1] = [(a, mid), (mid, b)]
+        for e, pts in self.edge_points.items():
+            for _, v in pts:
+                self.vertex_edge[v] = e
+        return X, vseg
+
+    def faces_of(self, v):
+        """The faces around a point: a vertex's faces, or the two faces of a split edge."""
+        if v < self.n:
+            if not hasattr(self, "_vf"):
+                F = self.F
+                self._vf = (np.argsort(F.ravel(), kind="stable"),
+                            np.concatenate([[0], np.cumsum(np.bincount(F.ravel(), minlength=self.n))]))
+            vf_ptr, starts = self._vf
+            return set((vf_ptr[starts[v]:starts[v + 1]] // 3).tolist())
+        e = self.vertex_edge[v]
+        return {int(f) for f in self.topo.edge_faces[e] if f >= 0}
+
+    def on_edge(self, v, e):
+        if v < self.n:
+            return v in (self.E[e, 0], self.E[e, 1])
+        return self.vertex_edge[v] == e
+
+    def along(self, e, a, b):
+        """Vertices from a to b along split edge e (both on it)."""
+        lo, hi = self.E[e]
+        pts = sorted([(0.0, int(lo)), (1.0, int(hi))] + self.edge_points.get(e, []))
+        ids = [v for _, v in pts]
+        i, j = ids.index(a), ids.index(b)
+        return ids[i:j + 1] if i <= j else ids[j:i + 1][::-1]
+
+    def route(self, vseg):
+        """Every segment along a (possibly split) edge, or across a face as a chord: (chords per face, the
+        output segments)."""
+        n = self.n
+        chords: dict[int, list] = {}
+        out_segs = []
+        for si, (a, b) in enumerate(vseg):
+            if a == b:
+                continue
+            cand = []
+            if a < n and b < n:
+                e = self.edge_id(a, b)
+                if e >= 0:
+                    cand = [e]
+            elif a >= n and self.on_edge(b, self.vertex_edge[a]):
+                cand = [self.vertex_edge[a]]
+            elif b >= n and self.on_edge(a, self.vertex_edge[b]):
+                cand = [self.vertex_edge[b]]
+            if cand:
+                path = self.along(cand[0], a, b)
+                out_segs += list(zip(path[:-1], path[1:]))
+                continue
+            common = self.faces_of(a) & self.faces_of(b)
+            if not common:
+                raise ValueError(f"curves: segment {si} joins points that share no face (vertices {a}, {b} of the "
+                                 "cut mesh): the curve is not connected where it claims to be")
+            f = min(common)
+            chords.setdefault(f, []).append((a, b))
+            out_segs.append((a, b))
+        return chords, out_segs
+
+    def retriangulate(self, X, chords):
+        """Every face touched (by a chord or a split edge) re-triangulated in its own plane: the polygon of its
+        corners and inserted points, split along its chords, ear-clipped. Returns (F2, parent)."""
+        F, topo = self.F, self.topo
+        touched = set(chords)
+        for e in self.edge_points:
+            touched |= {int(f) for f in topo.edge_faces[e] if f >= 0}
+        keep = np.ones(len(F), dtype=bool)
+        newF, parent = [], []
+        for f in sorted(touched):
+            keep[f] = False
+            poly = []
+            for k in range(3):
+                a, b = int(F[f, k]), int(F[f, (k + 1) % 3])
+                poly += self.along(topo.face_edges[f, k], a, b)[:-1]
+            polys = [poly]
+            for a, b in chords.get(f, []):
+                for pi, P in enumerate(polys):
+                    if a in P and b in P:
+                        i, j = sorted((P.index(a), P.index(b)))
+                        if j - i in (1, len(P) - 1):
+                            break                                 # already a side
+                        polys[pi:pi + 1] = [P[i:j + 1], P[j:] + P[:i + 1]]
+                        break
+                else:
+                    raise ValueError(f"curves: two curve segments cross inside face {f}; insert their crossing "
+                                     "point")
+            for P in polys:
+                for tri in _ear_clip(P, X):
+                    newF.append(tri)
+                    parent.append(f)
+        F2 = np.concatenate([F[keep], np.array(newF, dtype=np.int64).reshape(-1, 3)])
+        par = np.concatenate([np.flatnonzero(keep), np.array(parent, dtype=np.int64)])
+        return F2, par
 
 
 def _split_at_face_points(V, F, curves):

@@ -5,40 +5,36 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
 
 0. classify: the surface is simply connected when its first Betti number is 0 (χ ∈ {1, 2} per component);
    interior endpoints are the interior vertices where the integer edge chain g of the curves does not close;
-1. jump Laplace solve ``u`` (jump g across the curves, harmonic elsewhere; at interior endpoints a discrete
-   branch point (default on simply connected surfaces), or the endpoints excluded with projective interpolation
-   next to them (``endpoint_rule="exclude"``, the default with an LP)) — :meth:`SurfaceWindingNumbers._jump_solve`;
+1. jump Laplace solve ``u`` (thesis Eq. 6.2: jump g across the curves, harmonic elsewhere). Interior endpoints
+   are discrete branch points on simply connected surfaces (thesis §2.3.3, §6.2); on the others they are
+   excluded, with projective interpolation next to them (spec §1(b) ①) — :meth:`SurfaceWindingNumbers._jump_solve`;
 2. Darboux derivative ω = Du (du with the jumps removed);
 3. for open curves, the coexact part is removed by Hodge decomposition: γ = ω − ⋆1⁻¹d1ᵀβ (u harmonic: no exact
-   part). γ is the harmonic part that nonbounding components leave behind;
+   part). γ is the harmonic part that nonbounding components leave behind (thesis §6.1.2);
 4. residual function v: integrate γ in every face, then shift faces (|F| unknowns) so that v jumps as little as
    possible in the weighted L1 sense, jumps on the input being cheap (weight ε) and never "extra loops"
-   (0 ≤ g Jv ≤ g²) — the dual-graph LP :func:`gsdf.dec.dual_graph_l1` (HiGHS). ``method="reduced"`` is §6.3's
-   reduced LP: the curves are first completed by shortest paths between endpoints of opposite sign (Dijkstra on
-   edge lengths, the input's own edges forbidden — the demo's weights are inverted, see ``_complete_chain``),
-   faces are flood-filled across the completed chain, γ integrated along a BFS tree in each piece, and the LP
-   has one shift per piece;
-   With ``homology="integer"`` the class of γ (its periods on a tree–cotree homology basis) is first rounded
-   to the nearest integer class; a class 0 skips the LP;
-   ``cycle_choice="complete"`` (default) solves the full LP a second time with the input edges of its cycle
-   forbidden and keeps, of the two homologous cycles, the one with the larger share of its jump mass on the
-   input (a broken loop rather than a shorter, more broken side of a region round the same handle);
+   (0 ≤ g Jv ≤ g²) — the dual-graph LP :func:`gsdf.linalg._dual_l1.dual_graph_l1` (HiGHS dual simplex; from
+   ``BAND_FACES`` faces on, the same program on a band of faces proven optimal for all faces,
+   :func:`gsdf.linalg._band_lp.banded_l1`). ``method="reduced"`` is §6.3's reduced LP: the curves are first
+   completed by shortest paths between endpoints of opposite sign (Dijkstra on edge lengths, the input's own
+   edges forbidden, see ``_complete_chain``), faces are flood-filled across the completed chain, γ integrated
+   along a BFS tree in each piece, and the LP has one shift per piece. The full LP is solved a second time with
+   the input edges of its cycle forbidden, and of the two homologous cycles the one with the larger share of its
+   jump mass on the input is kept (a broken loop rather than a shorter, more broken side of a region round the
+   same handle: :meth:`SurfaceWindingNumbers._complete_cycle`);
 5. the jumps of v (Jv, the completed nonbounding part) are removed from the input: the jump Laplace equation is
-   solved again with jumps "Γ ∖ Jv" (§6.1.2) on the input's edges only — Jv off the input (where the
-   LP closed the gaps of nonbounding loops) is the completion of the nonbounding part, not a jump of w: w.
-   "Γ ∖ Jv" is read as a subset of the input (``bounding="subset"``, default): an input edge is nonbounding
-   when Jv explains at least half of its jump, the bounding part is g − round(Jv); a remainder that still
-   has a harmonic part (a broken loop the LP explained only partly) is decomposed again (steps ①–④, at
-   most ``MAX_PASSES``). ``bounding="fractional"`` keeps g − Jv (one pass).
+   solved again with jumps "Γ ∖ Jv" (§6.1.2), read as a subset of the input: an input edge is nonbounding when
+   Jv explains at least half of its jump, the bounding part is g − round(Jv); a remainder that still has a
+   harmonic part (a broken loop the LP explained only partly, thesis Fig. 6.6) is decomposed again (steps ①–④,
+   at most ``MAX_PASSES``). Jv off the input (where the LP closed the gaps of nonbounding loops) is the
+   completion of the nonbounding part, not a jump of w.
    Faces are labelled ``round(w − s)`` (w the mean of the face's corners, a corner at an interior endpoint
    filled by the mean of the other two: :meth:`SurfaceWindingNumbers.label_values`, thesis §6.1) with the
-   offset s the level of w on the input curves minus ½
-   (circular mean of the mean of the two faces of every bounding input edge; see
-   :meth:`SurfaceWindingNumbers.rounding_offset`); with ``labels="gaps"`` (the default of the LP methods) the faces at each gap of
-   the bounding curves are rounded at the level of w across that gap instead — the mean level along the
-   |Δw|-weighted shortest path that closes the gap (:meth:`SurfaceWindingNumbers.gap_shift`; one numba pass of
-   Dijkstra searches over all gaps, :mod:`gsdf.swn._gaps`). Then the labels are shifted so that the faces
-   to the right of the curves get label 0 (the thesis' "+1 crossing from the right").
+   offset s the level of w on the input curves minus ½ (:meth:`SurfaceWindingNumbers.rounding_offset`); with
+   an LP the faces at each gap of the bounding curves are rounded at the level of w across that gap instead —
+   the mean level along the |Δw|-weighted shortest path that closes the gap
+   (:meth:`SurfaceWindingNumbers.gap_shift`, :mod:`gsdf.swn._gaps`). Then the labels are shifted so that the
+   faces to the right of the curves get label 0 (the thesis' "+1 crossing from the right").
 
 Boundaries (spec §1(e).5): the jump Laplace problem has zero-Neumann conditions, so a loop around a hole bounds
 (together with the boundary) and an arc joining two boundary circles does not; curves ending on the boundary are
@@ -62,31 +58,56 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, dijkstra
 
-from gsdf.dec._cycles import TreeCotree
+from gsdf._checks import progress_callback
 from gsdf.dec._hodge import HodgeDecomposition
-from gsdf.linalg._dual_l1 import dual_graph_l1
 from gsdf.dec._triangle import TriangleDEC
+from gsdf.linalg._dual_l1 import dual_graph_l1
 from gsdf.linalg._graph import forest_potentials
 from gsdf.swn._gaps import GAP_EPS, GAP_MAX_EDGES, gap_shift as _gap_shift
 
-__all__ = ["SurfaceWindingNumbers", "SWNResult", "surface_winding_number", "bounding_segments", "METHODS"]
+__all__ = ["SurfaceWindingNumbers", "SWNOptions", "SWNResult", "surface_winding_number", "bounding_segments",
+           "METHODS"]
 
 METHODS = ("lp", "reduced", "none")
-HOMOLOGY = ("real", "integer")
-BOUNDING = ("subset", "fractional")
-MAX_PASSES = 3          # bounding="subset": decompositions of the remainder at most (bench: a third pass is rare)
-LP_ALGORITHMS = ("auto", "highs", "highs-ds", "highs-ipm", "network", "band")   # gsdf.linalg._netflow / .band_lp
-ENDPOINT_RULES = ("auto", "branch", "exclude")
-CYCLE_CHOICES = ("complete", "lp")
-LABEL_RULES = ("auto", "gaps", "global")   # face labels: rounding level per gap or one global level
-CHOICE_TOL = 0.1        # cycle_choice="complete": input edges with |Jv| above this are the LP cycle's own (bench:
-                        # 0.1 and 0.3 chose alike on 41 replayed cases; 1e-3 also forbids the loop's traces)
-IPM_FACES = 12_000      # "auto": HiGHS interior point from this many faces on, dual simplex below (torus case of
-                        # bench/bench_swn_lp.py --only speed, loaded machine: 8k faces 2.5 s vs 3.8 s, 33k faces
-                        # 75 s vs 62 s; at load ≈ 9: 1.5 vs 2.1 s and 36 vs 16 s)
-BAND_FACES = 12_000     # "auto": the banded LP (gsdf.linalg._band_lp) from this many faces on (torus case of
-                        # bench/bench_swn_lp.py --only speed, loaded machine: 33k faces 3 s vs 14-29 s HiGHS)
+MAX_PASSES = 3          # decompositions of the remainder at most (step ⑤)
+CHOICE_TOL = 0.1        # second cycle: input edges with |Jv| above this are the first LP cycle's own
+BAND_FACES = 12_000     # the full LP on a proven band of faces (gsdf.linalg._band_lp) from this many faces on
 NEXT = np.array([1, 2, 0])
+
+
+@dataclass(frozen=True)
+class SWNOptions:
+    """Settings of the residual linear program of :meth:`SurfaceWindingNumbers.solve` (step ④; used by
+    ``method="lp"`` and ``"reduced"`` on surfaces that are not simply connected).
+
+    Attributes
+    ----------
+    epsilon : float in (0, 1]
+        LP weight of jumps on the input's edges relative to gap-closing ones (thesis §6.1.2: jumps along the
+        input curves are cheap, weight ε, so the residual closes gaps rather than cutting new curves).
+    time_limit : float > 0
+        Seconds the residual LPs may take, summed over the decomposition passes; beyond it a ValueError that
+        names ``method="reduced"`` (one unknown per curve piece) as the fallback.
+
+    A ValueError names the attribute when a value is out of range.
+
+    Example
+    -------
+    >>> SWNOptions(epsilon=0.05)
+    SWNOptions(epsilon=0.05, time_limit=300.0)
+    """
+
+    epsilon: float = 1e-2
+    time_limit: float = 300.0
+
+    def __post_init__(self):
+        e, t = self.epsilon, self.time_limit
+        if isinstance(e, bool) or not isinstance(e, (int, float, np.floating)) or not (0 < float(e) <= 1):
+            raise ValueError(f"epsilon: expected a number in (0, 1], got {e!r}")
+        if isinstance(t, bool) or not isinstance(t, (int, float, np.floating)) or not float(t) > 0:
+            raise ValueError(f"time_limit: expected a positive number of seconds, got {t!r}")
+        object.__setattr__(self, "epsilon", float(e))
+        object.__setattr__(self, "time_limit", float(t))
 
 
 @dataclass
@@ -99,7 +120,6 @@ class SWNResult:
     face_labels : (m,) int64 integer winding number per face (0 to the right of the curves)
     residual : (nE,) the jump chain Jv of the residual function: ≈ the completed nonbounding part of the curves
     bounding : (nE,) the bounding part on the input's edges (0 elsewhere): ``g - round(Jv)`` over the passes
-        (``bounding="subset"``, integer) or ``g - Jv`` (``bounding="fractional"``)
     u : (m, 3) the jump-harmonic function of step ① per corner (the "naive" winding number)
     chain : (nE,) the input as an integer edge chain g
     endpoints : (n,) bool interior endpoints of the input
@@ -107,11 +127,11 @@ class SWNResult:
     offset : the rounding offset s (plus the integer shift)
     method : the method that produced ``corner_values``
     lp_objective : objective of the residual LP (nan when no LP ran; summed over the passes)
-    passes : number of decompositions (steps ①–④) run: 0 without an LP, more than 1 when ``bounding="subset"``
-        decomposed a remainder again
-    label_shift : (m,) the per-face shift of the rounding level at the gaps (``labels="gaps"``, see
-        :meth:`SurfaceWindingNumbers.gap_shift`; zeros with ``labels="global"``): ``face_labels ==
-        round(mean of corners)`` and, up to one integer shift, the global-level labels are
+    passes : number of decompositions (steps ①–④) run: 0 without an LP, more than 1 when a remainder of the
+        input was decomposed again (step ⑤)
+    label_shift : (m,) the per-face shift of the rounding level at the gaps (see
+        :meth:`SurfaceWindingNumbers.gap_shift`; zeros with ``method="none"``): ``face_labels ==
+        round(mean of corners)`` and, up to one integer shift, the labels of one global rounding level are
         ``round(corner_values.mean(1) + label_shift)``
     timings : dict of seconds per step ("lp" is the HiGHS part of "residual"; "total" the sum of the steps)
     """
@@ -174,7 +194,6 @@ class SurfaceWindingNumbers:
         self.betti_1 = self.topology.betti_1()
         self.simply_connected = self.betti_1 == 0
         self._hodge = None
-        self._cycles = None
         n = self.dec.n_vertices
         self._edge_key = self.dec.edges[:, 0] * n + self.dec.edges[:, 1]
 
@@ -244,8 +263,8 @@ class SurfaceWindingNumbers:
             if not np.isfinite(b).all() or abs(b[k] - 1.0) > 1e-9 or np.abs(np.delete(b, k)).max() > 1e-9:
                 raise ValueError(f"curves[{ci}][{q}]: point ({e}, {b.tolist()}) lies inside face {e} or on one "
                                  "of its edges; surface winding numbers need curves along mesh edges: cut the "
-                                 "mesh along the curves first (V2, F2, segments, parent = gsdf.winding."
-                                 "surface_curves.insert_surface_points(V, F, curves)) and solve list(segments) "
+                                 "mesh along the curves first (V2, F2, segments, parent = gsdf.swn._insert."
+                                 "insert_surface_points(V, F, curves)) and solve list(segments) "
                                  "on (V2, F2)")
             out.append(int(F[e, k]))
         return np.asarray(out, dtype=np.int64)
@@ -289,115 +308,44 @@ class SurfaceWindingNumbers:
             self._hodge = HodgeDecomposition(d.d0, d.d1, d.star1)
         return self._hodge
 
-    def tree_cotree(self) -> TreeCotree:
-        """The tree–cotree homology basis of the mesh (built once, lazily)."""
-        if self._cycles is None:
-            self._cycles = TreeCotree(self.dec)
-        return self._cycles
-
     # ----------------------------------------------------------------------------------------------- solve
-    def solve(self, curves, *, method: str = "lp", epsilon: float = 1e-2, time_limit: float = 300.0,
-              homology: str = "real", lp_algorithm: str = "auto", bounding: str = "subset", progress=None,
-              endpoint_rule: str = "auto", cycle_choice: str = "complete", labels: str = "auto",
-              _final: str = "curves") -> SWNResult:
-        """Surface winding numbers of ``curves``.
+    def solve(self, curves, *, method: str = "lp", options: SWNOptions | None = None,
+              progress=None) -> SWNResult:
+        """Surface winding numbers of ``curves`` (thesis ch. 6; the steps of the module docstring).
 
         Parameters
         ----------
-        curves : list of vertex polylines along mesh edges, or an integer edge chain (nE,)
-        method : "lp" (full residual LP, §6.1), "reduced" (reduced LP, §6.3) or "none" (naive rounding of u)
-        epsilon : float in (0, 1], LP weight of jumps on the input's edges relative to gap-closing ones
-        time_limit : float, seconds HiGHS may take, summed over the passes; beyond it a ValueError names
-            ``method="reduced"``
-        homology : "real" (default) or "integer" — the cohomology class of the harmonic part γ that the residual
-            must integrate. "real": γ itself, as thesis §6.1.2 writes; a broken *bounding* curve then leaves a
-            fractional class (the flux of the harmonic forms through its gaps) that the LP attributes to the
-            cheap input edges, turning parts of bounding curves partly nonbounding. "integer": γ's periods along
-            a homology basis (:class:`gsdf.dec._cycles.TreeCotree`) are rounded to the nearest integers first — the
-            input is an integer chain, so its nonbounding part is an integer class — and γ is corrected by the
-            closed form with the rounding error as periods (the LP only sees the class: exact parts are absorbed
-            by the face shifts). A class that rounds to 0 needs no LP at all; otherwise Jv is an integer chain.
-        lp_algorithm : "auto" (default: HiGHS dual simplex below ``BAND_FACES`` = 12k faces; from there "band"
-            in the face form, HiGHS interior point in the cycle form), "highs",
-            "highs-ds" or "highs-ipm" — the HiGHS algorithm of the full residual LP — or "network": the same
-            face-form program solved as its dual min-cost circulation by a network simplex
-            (:func:`gsdf.linalg._netflow.dual_graph_l1_network`; face form only) — or "band": the face-form program on
-            a band of faces around the curves and their §6.3 completion paths, proven optimal for all faces by
-            a maximum-flow certificate, grown until proven (:func:`gsdf.linalg._band_lp.banded_l1`; HiGHS interior
-            point on all faces if no band is proven; face form only)
-        bounding : "subset" (default) or "fractional" — how step ⑤ reads the bounding part "Γ ∖ Jv" (§6.1.2)
-            off the residual. "subset": as a *subset* of the input, the thesis' words ("the bounding components
-            of Γ are … the complement of the nonbounding components, taken as a subset of Γ"): an input edge
-            belongs to the nonbounding part when the residual explains at least half of its jump,
-            ``round(Jv)``, and the bounding part is the integer chain ``g − round(Jv)`` on the input. When the
-            LP explained a broken nonbounding loop only partly (Jv < ½ on some of its edges; thesis Fig. 6.6:
-            coefficients below 1 on broken loops), this remainder still holds nonbounding pieces, so it is
-            decomposed again (steps ①–④ on the remainder, at most ``MAX_PASSES`` decompositions) until the
-            residual removes no further input edge. "fractional": the bounding part is ``g − Jv`` itself
-            (fractional jumps left on partly explained loops), one decomposition — the behaviour before.
-            Simply connected surfaces and ``method="none"`` are unaffected.
-        progress : callable(done, total), optional — the package's progress signature; called after each of the
-            steps (jump solve, Darboux derivative, Hodge decomposition, residual LP, final solve)
-        endpoint_rule : "auto" (default), "branch" or "exclude" — how the jump solves (steps ① and ⑤) treat
-            interior endpoints: "branch" keeps them with a discrete branch point (an angular ramp of the corner
-            values around the endpoint, :meth:`gsdf.dec.TriangleDEC.branch_coordinates`); "exclude" drops them
-            and every halfedge touching them, with projective interpolation of their corners (the authors' rule;
-            its one-rings act as holes, see :meth:`_jump_solve`). "auto": "branch" on simply connected
-            surfaces, "exclude" otherwise — on 64 replayed not simply connected bench cases "branch" had the
-            same mean error (2.15 % vs 2.16 %) but 2 more cases over 0.5 % (73.4 % vs 76.6 % under), so the
-            surfaces with an LP keep the rule their LP was validated with
-        cycle_choice : "complete" (default) or "lp" — which of two homologous candidate cycles carries the class
-            of γ (``method="lp"`` only). "lp": the LP's optimum, the cycle of least ε-weighted length (thesis
-            §6.1.2; Fig. 6.10: the shortest nonbounding set). Between a broken nonbounding loop and a homologous
-            side of a broken region (a band round a handle) that is the one with the least *gap* length, so a
-            long, little-broken loop loses to a shorter, more broken region side and the region is cut open.
-            "complete": the LP is solved a second time with the input edges the first cycle uses
-            (``|Jv| > CHOICE_TOL``) forbidden, and of the two cycles the one with the larger share of its
-            jump mass Σ ℓ|Jv| on input edges is kept — the candidate that is more nearly a whole input curve,
-            a share that does not grow with the curve's length (derived; the gap share of a broken curve is
-            its deletion rate). One more LP per decomposition pass
-        labels : "auto" (default), "gaps" or "global" — the level at which the final w is rounded. "global": one
-            offset for the whole surface, the level of w on the curves (:meth:`rounding_offset`). "gaps": the
-            same, but the faces at each gap of the bounding curves are rounded at the level of w *across that
-            gap*, measured along the closing path between the gap's two endpoints (:meth:`gap_shift`); faces away
-            from gaps keep the global labels. "auto": "gaps" for ``method="lp"`` / ``"reduced"``, "global" for
-            ``method="none"`` (naive rounding of u stays the baseline). Bench (bench/RESULTS.md swn-simply,
-            swn-ns-5): 420 simply connected cases, mean error 0.310 % → 0.267 %, cases under 0.5 % 80.0 % →
-            86.9 %; not simply connected cases: see swn-ns-5
+        curves : list of vertex polylines along mesh edges, :class:`gsdf.Curve` objects, or an integer edge
+            chain (nE,) (see :meth:`chain`)
+        method : "lp" (full residual LP, thesis §6.1), "reduced" (reduced LP, §6.3) or "none" (naive rounding of
+            u). On simply connected surfaces no LP is needed and "lp" and "reduced" give the same result.
+        options : SWNOptions, optional — the residual LP's weight ε and time limit
+        progress : callable ``progress(stage, fraction)``, optional — called as each step starts (jump solve,
+            Darboux derivative, Hodge decomposition, residual LP, final solve) and once at the end (fraction 1)
 
         Returns
         -------
         SWNResult
+
+        Interior endpoints: a discrete branch point on simply connected surfaces (an angular ramp of the corner
+        values round the endpoint, :meth:`gsdf.dec.TriangleDEC.branch_coordinates`), excluded with projective
+        interpolation of their corners on the others (:meth:`_jump_solve`). Face labels: with ``method="lp"`` or
+        ``"reduced"`` the faces at each gap of the bounding curves are rounded at the level of w across that gap
+        (:meth:`gap_shift`); ``method="none"`` rounds at one global level (:meth:`rounding_offset`).
         """
         if method not in METHODS:
             raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
-        if isinstance(epsilon, bool) or not isinstance(epsilon, (int, float, np.floating)) or \
-                not (0 < float(epsilon) <= 1):
-            raise ValueError(f"epsilon: expected a number in (0, 1], got {epsilon!r}")
-        if lp_algorithm not in LP_ALGORITHMS:
-            raise ValueError(f"lp_algorithm: expected one of {LP_ALGORITHMS}, got {lp_algorithm!r}")
-        if homology not in HOMOLOGY:
-            raise ValueError(f"homology: expected one of {HOMOLOGY}, got {homology!r}")
-        if not isinstance(bounding, str) or bounding not in BOUNDING:
-            raise ValueError(f"bounding: expected one of {BOUNDING}, got {bounding!r}")
-        if endpoint_rule not in ENDPOINT_RULES:
-            raise ValueError(f"endpoint_rule: expected one of {ENDPOINT_RULES}, got {endpoint_rule!r}")
-        if endpoint_rule == "auto":
-            endpoint_rule = "branch" if self.simply_connected else "exclude"
-        if cycle_choice not in CYCLE_CHOICES:
-            raise ValueError(f"cycle_choice: expected one of {CYCLE_CHOICES}, got {cycle_choice!r}")
-        if not isinstance(labels, str) or labels not in LABEL_RULES:
-            raise ValueError(f"labels: expected one of {LABEL_RULES}, got {labels!r}")
-        if labels == "auto":
-            labels = "global" if method == "none" else "gaps"
-        if progress is not None and not callable(progress):
-            raise ValueError(f"progress: expected a callable(done, total), got {type(progress).__name__}")
+        if options is None:
+            options = SWNOptions()
+        elif not isinstance(options, SWNOptions):
+            raise ValueError(f"options: expected a SWNOptions, got {type(options).__name__}")
+        progress = progress_callback(progress)
+        endpoint_rule = "branch" if self.simply_connected else "exclude"
+        labels = "global" if method == "none" else "gaps"
         steps = iter(range(1, 6))
 
-        def say(_name):
-            if progress is not None:
-                k = next(steps, 5)
-                progress(k - 1, 5)
+        def say(name):
+            progress(name, (next(steps, 5) - 1) / 5)
         dec, topo = self.dec, self.topology
         T = {}
         t0 = time.perf_counter()
@@ -417,56 +365,19 @@ class SurfaceWindingNumbers:
         if method == "none" or self.simply_connected:
             om = dec.darboux(u, ends) if method != "none" else zero
             res = self._finish(u, u, g, zero, ends, om, om, method, T, labels=labels)
-            if progress is not None:
-                progress(5, 5)
+            progress("done", 1.0)
             return res
 
         say("Darboux derivative")
-        for key in ("darboux", "hodge", "lp", "residual"):
-            T[key] = 0.0
-        Jv = zero.copy()                    # the residual, summed over the passes
-        removed = zero.copy()               # input edges read as nonbounding (bounding="subset")
-        obj = 0.0
-        cur, ends_cur, u_cur = g, ends, u
-        n_pass = 1 if bounding == "fractional" else MAX_PASSES
-        for k_pass in range(n_pass):
-            if k_pass:                       # ① again on the remainder (new endpoints where pieces were removed)
-                t0 = time.perf_counter()
-                ends_cur = ends | dec.chain_endpoints(cur, tol=1e-6)
-                u_cur = self._jump_solve(cur, ends_cur, endpoint_rule)
-                T["jump_solve"] += time.perf_counter() - t0
-            left = float(time_limit) - T["lp"]     # time_limit bounds the LPs of all passes together
-            om_k, gamma_k, Jv_k, obj_k = self._decompose(u_cur, cur, ends_cur, method, homology, epsilon,
-                                                         left, lp_algorithm, T, say if k_pass == 0 else None,
-                                                         cycle_choice)
-            if k_pass == 0:
-                om, gamma = om_k, gamma_k
-            Jv = Jv + Jv_k
-            obj += obj_k
-            if bounding == "fractional":
-                break
-            # "Γ ∖ Jv" as a subset of the input: edges whose jump the residual explains by at least a half
-            cut = np.where(cur != 0, np.round(Jv_k), 0.0)
-            if not np.any(cut):
-                break
-            removed = removed + cut
-            cur = np.where(cur != 0, cur - cut, 0.0)
-            if not np.any(cur):
-                break
+        om, gamma, Jv, removed, obj, passes = self._passes(u, g, ends, method, options, endpoint_rule, T, say)
 
         say("final jump solve")
         t0 = time.perf_counter()
         Jv = np.where(np.abs(Jv) < 1e-9, 0.0, Jv)
-        # thesis §6.1.2 step ⑤: w jumps across "Γ ∖ Jv", the bounding part as a subset of the input — g − Jv on the
+        # thesis §6.1.2 step ⑤: w jumps across "Γ ∖ Jv", the bounding part as a subset of the input, on the
         # input's edges only; the completion of the nonbounding part off the input (Jv across the gaps) is not a
-        # jump of w. Vertices where the bounding part does not close become endpoints (the spec's "cleaner
-        # alternative"). _final="all" (diagnosis only) also keeps −Jv off the input.
-        if bounding == "subset":
-            bnd = np.where(g != 0, g - removed, 0.0)
-        elif _final == "all":
-            bnd = g - Jv
-        else:
-            bnd = np.where(g != 0, g - Jv, 0.0)
+        # jump of w. Vertices where the bounding part does not close become endpoints.
+        bnd = np.where(g != 0, g - removed, 0.0)
         ends2 = ends | dec.chain_endpoints(bnd, tol=1e-6)
         if np.any(bnd != g):
             w = self._jump_solve(bnd, ends2, endpoint_rule)
@@ -475,13 +386,46 @@ class SurfaceWindingNumbers:
         T["final_solve"] = time.perf_counter() - t0
         res = self._finish(w, u, g, Jv, ends, om, gamma, method, T, bnd, labels=labels)
         res.lp_objective = obj
-        res.passes = k_pass + 1
-        if progress is not None:
-            progress(5, 5)
+        res.passes = passes
+        progress("done", 1.0)
         return res
 
-    def _decompose(self, u, g, ends, method, homology, epsilon, time_limit, lp_algorithm, T, say=None,
-                   cycle_choice="lp"):
+    def _passes(self, u, g, ends, method, options, endpoint_rule, T, say):
+        """Steps ①–④ on the input and then on its remainders (step ⑤'s subset reading): after each pass the
+        input edges whose jump the residual explains by at least a half leave the input, and the remainder is
+        decomposed again while it loses edges (at most ``MAX_PASSES``). Returns (ω, γ of the first pass, Jv
+        summed over the passes, the input removed as nonbounding, LP objective, passes)."""
+        dec = self.dec
+        for key in ("darboux", "hodge", "lp", "residual"):
+            T[key] = 0.0
+        Jv = np.zeros(dec.n_edges)          # the residual, summed over the passes
+        removed = np.zeros(dec.n_edges)     # input edges read as nonbounding
+        obj = 0.0
+        cur, ends_cur, u_cur = g, ends, u
+        for k_pass in range(MAX_PASSES):
+            if k_pass:                       # ① again on the remainder (new endpoints where pieces were removed)
+                t0 = time.perf_counter()
+                ends_cur = ends | dec.chain_endpoints(cur, tol=1e-6)
+                u_cur = self._jump_solve(cur, ends_cur, endpoint_rule)
+                T["jump_solve"] += time.perf_counter() - t0
+            left = options.time_limit - T["lp"]     # time_limit bounds the LPs of all passes together
+            om_k, gamma_k, Jv_k, obj_k = self._decompose(u_cur, cur, ends_cur, method, options.epsilon, left, T,
+                                                         say if k_pass == 0 else None)
+            if k_pass == 0:
+                om, gamma = om_k, gamma_k
+            Jv = Jv + Jv_k
+            obj += obj_k
+            # "Γ ∖ Jv" as a subset of the input: edges whose jump the residual explains by at least a half
+            cut = np.where(cur != 0, np.round(Jv_k), 0.0)
+            if not np.any(cut):
+                break
+            removed = removed + cut
+            cur = np.where(cur != 0, cur - cut, 0.0)
+            if not np.any(cur):
+                break
+        return om, gamma, Jv, removed, obj, k_pass + 1
+
+    def _decompose(self, u, g, ends, method, epsilon, time_limit, T, say=None):
         """Steps ②–④ for the chain g with jump-harmonic u: (ω, γ, Jv, LP objective); adds to T's steps."""
         dec = self.dec
         say = say if say is not None else (lambda _name: None)
@@ -495,22 +439,11 @@ class SurfaceWindingNumbers:
             gamma = om - co
         else:
             gamma = om
-        integer = homology == "integer"
-        if integer:
-            # round the class of γ: periods along the tree–cotree loops to the nearest integers (docstring)
-            tc = self.tree_cotree()
-            per = tc.periods(gamma)
-            k = np.round(per)
-            gamma_lp = gamma + tc.closed_form(k - per) if np.any(k) else None
-        else:
-            gamma_lp = gamma
         T["hodge"] += time.perf_counter() - t0
 
         say(f"residual ({method} LP)")
         t0 = time.perf_counter()
-        if gamma_lp is not None and not np.abs(gamma_lp).max() > 1e-9:
-            gamma_lp = None                       # ω has no harmonic part: u is already a labeling (§6.1.1)
-        if gamma_lp is None:                      # integer class 0 / γ = 0: nothing nonbounding, no LP
+        if not np.abs(gamma).max() > 1e-9:       # ω has no harmonic part: u is already a labeling (§6.1.1)
             Jv, obj, lp_s = np.zeros(dec.n_edges), 0.0, 0.0
         else:
             try:
@@ -518,23 +451,13 @@ class SurfaceWindingNumbers:
                     raise ValueError(f"the residual LPs of the earlier passes took {T['lp']:.1f} s, the whole "
                                      f"time_limit")
                 if method == "lp":
-                    alg = lp_algorithm if lp_algorithm != "auto" else \
-                        ("highs-ipm" if self.dec.n_faces >= IPM_FACES else "highs-ds")
-                    if lp_algorithm == "auto" and self.dec.n_faces >= BAND_FACES:
-                        alg = "band"
-                    extra = (ends,) if alg == "band" else ()          # the band's seeds need the endpoints
-                    Jv, obj, lp_s = self._residual_full(gamma_lp, g, float(epsilon), time_limit, alg, *extra)
-                    if cycle_choice == "complete":
-                        Jv, obj, lp_s = self._complete_cycle(gamma_lp, g, float(epsilon), time_limit, alg, extra,
-                                                             Jv, obj, lp_s)
+                    Jv, obj, lp_s = self._residual_full(gamma, g, epsilon, time_limit, ends)
+                    Jv, obj, lp_s = self._complete_cycle(gamma, g, epsilon, time_limit, ends, Jv, obj, lp_s)
                 else:
-                    Jv, obj, lp_s = self._residual_reduced(gamma_lp, g, ends, time_limit)
+                    Jv, obj, lp_s = self._residual_reduced(gamma, g, ends, time_limit)
             except ValueError as exc:
                 hint = " — try method='reduced' (one unknown per curve piece)" if method == "lp" else ""
                 raise ValueError(f"method={method!r}: {exc}{hint}") from exc
-            if integer:                           # a network LP with an integer class: integer jumps
-                r = np.round(Jv)
-                Jv = np.where(np.abs(Jv - r) < 1e-6, r, Jv)
         T["lp"] += lp_s
         T["residual"] += time.perf_counter() - t0
         return om, gamma, Jv, obj
@@ -542,18 +465,13 @@ class SurfaceWindingNumbers:
     def _jump_solve(self, chain: np.ndarray, ends: np.ndarray, rule: str = "branch") -> np.ndarray:
         """Corner values (m, 3) of the jump Laplace solve (thesis Eq. 6.2, step ①) with jumps ``chain``.
 
-        ``rule="branch"``: interior endpoints keep their degree of freedom, with the angular ramp of a branch point
-        around them (thesis §2.3.3: the angle-valued u fails to be harmonic only at endpoints, a branch point;
-        §6.2: ω behaves like dθ there) — :meth:`gsdf.dec.TriangleDEC.branch_coordinates`. Nothing is removed
-        from the energy, and the Laplacian is the same for every curve set (one cached factorization).
-        ``rule="exclude"``: endpoints and their halfedges are dropped, their corners filled by projective
-        interpolation (spec §1(b) step ①, the authors' demo). The one-ring of an excluded endpoint is a hole
-        with zero-Neumann walls: on curves broken into runs of a few edges the holes leak (the far-field jump of
-        a broken leg loop, bench case dino:3, was 0.29 against 0.456 on the same curve on 4× and 16× refined
-        meshes, where the ramp gives 0.453), and neighbouring holes can wall a region off the solve entirely
-        (dino:37: w ≡ 0 on 7 % of the area; ramp 0.660 vs refined 0.659). Simply connected bench cases
-        (``bench/bench_swn.py --topology simply``, 420 cases): mean / max error 0.40 % / 13.5 % excluded,
-        0.32 % / 4.7 % branched.
+        ``rule="branch"`` (simply connected surfaces): interior endpoints keep their degree of freedom, with the
+        angular ramp of a branch point around them (thesis §2.3.3: the angle-valued u fails to be harmonic only at
+        endpoints, a branch point; §6.2: ω behaves like dθ there) — :meth:`gsdf.dec.TriangleDEC.branch_coordinates`.
+        Nothing is removed from the energy, and the Laplacian is the same for every curve set (one cached
+        factorization). ``rule="exclude"`` (the other surfaces): endpoints and their halfedges are dropped,
+        their corners filled by projective interpolation (spec §1(b) step ①, the authors' demo); the one-ring
+        of an excluded endpoint is then a hole with zero-Neumann walls.
         """
         dec = self.dec
         if rule == "branch":
@@ -593,11 +511,9 @@ class SurfaceWindingNumbers:
         thesis §6.1: near an endpoint the winding number is constant along rays from it) — the corner of an
         endpoint takes the mean of its face's other corners, so a face touching an endpoint is labelled by the
         value of its far edge (for a linear w that is also the side holding most of its area). A face whose
-        corners are all endpoints keeps its values. With ``endpoint_rule="exclude"`` the corners are filled
-        this way already (no change); with the branch rule the endpoint corners hold the ramp of the branch
-        point, whose values say little about the face's side of the level set: on the 420 simply connected
-        bench cases (bench/bench_swn.py --topology simply) mean / max error 0.327 % / 4.69 % with the ramp
-        corners, 0.310 % / 4.64 % with this fill; 77.6 % → 80.0 % of cases under 0.5 %."""
+        corners are all endpoints keeps its values. With the exclusion rule of :meth:`_jump_solve` the corners are
+        filled this way already (no change); with the branch rule the endpoint corners hold the ramp of the
+        branch point, whose values say little about the face's side of the level set."""
         E = ends[self.dec.F]
         if not E.any():
             return w
@@ -611,18 +527,16 @@ class SurfaceWindingNumbers:
 
     def gap_shift(self, wf, bounding, ends, s: float, eps: float = GAP_EPS,
                   max_edges: int = GAP_MAX_EDGES) -> np.ndarray:
-        """Per-face shift of the rounding level at the gaps of the curves (``labels="gaps"`` of :meth:`solve`):
-        the faces are labelled ``round(wf - s - shift)``.
+        """Per-face shift of the rounding level at the gaps of the curves (the labels of :meth:`solve` with
+        ``method="lp"`` or ``"reduced"``): the faces are labelled ``round(wf - s - shift)``.
 
-        Why: next to an interior endpoint w is a branch point — it takes every value of one unit interval on a
-        small circle round it — so every level set of w in that interval runs from one end of a gap to the
-        other, a pencil of closing curves through the gap's two ends (in the plane, for a straight curve with a
-        gap, the circular arcs through both ends: inscribed-angle theorem). Rounding at one global level picks
-        the same member of the pencil in every gap, the one through the curves' own level (the right one for a
-        broken circle, :meth:`rounding_offset`); but the level at which w crosses a gap varies from gap to gap
-        (other curves, curvature, mesh boundary), and most of the mislabeled area of the bench sits on the
-        faces of the deleted edges (bench/RESULTS.md, swn-floor). Here each gap is rounded at the field's own
-        level *across it*:
+        Next to an interior endpoint w is a branch point — it takes every value of one unit interval on a small
+        circle round it — so every level set of w in that interval runs from one end of a gap to the other, a
+        pencil of closing curves through the gap's two ends (in the plane, for a straight curve with a gap, the
+        circular arcs through both ends: inscribed-angle theorem). Rounding at one global level picks the same
+        member of the pencil in every gap, the one through the curves' own level (:meth:`rounding_offset`); but
+        the level at which w crosses a gap varies from gap to gap (other curves, curvature, mesh boundary). Here
+        each gap is rounded at the field's own level *across it*:
 
         1. pairing: the label boundary of ``round(wf - s)`` off the curves is split into connected pieces; a
            piece that touches exactly two endpoints of the bounding curves names a gap (a, b);
@@ -633,20 +547,9 @@ class SurfaceWindingNumbers:
         3. level: the mean over the path's edges of the mean of their two faces' values; the faces touching a
            vertex of the path (a and b included) are rounded at that level instead of ``s + ½`` (the mean of the
            shifts where several paths touch a face). Faces elsewhere keep ``shift = 0``, and so do the faces of
-           a gap whose path has more than ``max_edges`` edges: the path is a chord, and over a long gap the
+           a gap whose path has more than ``max_edges`` edges: the path is then a chord, and over a long gap the
            curve's own bend matters more (a circle with one gap of a quarter of it is closed along the circle by
-           the global level — inscribed-angle theorem — and would be cut along the chord); on the bench's
-           long-gap scheme (bench_swn.py --breaking long --topology simply) the unlimited rule raised the mean
-           error from 1.683 % to 1.816 %, with ``max_edges=8`` it is 1.685 %.
-
-        Measured (bench/bench_swn_gaps.py, 420 simply connected cases): mean mislabeled area 0.309 % → 0.267 %,
-        cases under 0.5 % 80.2 % → 86.9 %. Where the path is the deleted edges themselves (63 % of the gaps on
-        110 of the cases) the faces of the gap are then all right; the rest is a path that cuts a corner of the
-        deleted staircase (a 2-edge gap closed by the third edge of its triangle), whose level then separates two
-        faces that lie on the same side. Also measured and not kept (scratch runs, 110–140 of the cases): faces
-        beside the path labelled by its side instead of rounded (same error), the level of the curve edges at
-        the two ends, alone or averaged with the path's (worse), the shift shrunk toward 0 (worse), the widest
-        gap of the face values near the path level (worse), path weights squared / square-rooted (worse / same).
+           the global level — inscribed-angle theorem — and would be cut along the chord).
 
         Parameters
         ----------
@@ -687,18 +590,13 @@ class SurfaceWindingNumbers:
         part |g − Jv|, over the edges whose bounding part rounds to a nonzero jump (edges found mostly
         nonbounding should not separate labels and carry no information). Without bounding input edges:
         the area-weighted circular mean of w (w is known up to a constant; a 50/50 split leaves w ≈ ±½).
-        On generated cases (bench/bench_swn.py) this beat the area-weighted circular mean of w (mean error
-        5.4 % vs 10.9 % on 48 hard cases) and a vote over thresholds along the curves (7.0 %).
 
         Why this level (derived): in the plane the jump-harmonic w of a broken circle is the winding number of
         its arcs, the subtended angle over 2π; by the inscribed-angle theorem it is f/2 on the whole missing
         part of the circle (f the fraction present) — exactly the mean of the two sides on the arcs, (f+1)/2
-        and (f−1)/2. So rounding at the curves' level closes such gaps along the circle (tested). Also tried on
-        replayed simply connected cases of the bench, none better overall: the least dense level of w
-        (anywhere, or within ±0.1 / ±0.2 of this one; 210 cases on 5 meshes; only dino improved), the level on
-        the edges at the endpoints only (84 cases, mixed), and the level minimising the label boundary off the
-        input (16 cases, worse). Near a mesh boundary the zero-Neumann reflection
-        moves the level inside gaps away from the curves' level; not corrected here."""
+        and (f−1)/2. So rounding at the curves' level closes such gaps along the circle. Near a mesh boundary
+        the zero-Neumann reflection moves the level inside gaps away from the curves' level; not corrected
+        here."""
         dec, topo = self.dec, self.topology
         ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
         b = g[ce] - Jv[ce]
@@ -732,18 +630,26 @@ class SurfaceWindingNumbers:
         d_hi = vinit[A, (sa + 1) % 3] - vinit[B, sb]
         return 0.5 * (d_lo + d_hi)
 
-    def _complete_cycle(self, gamma, g, eps, time_limit, alg, extra, Jv, obj, lp_s):
-        """``cycle_choice="complete"`` (see :meth:`solve`): the LP again with the input edges of the first cycle
-        ``Jv`` forbidden; (Jv, objective, seconds) of the cycle with the larger share of Σ ℓ|Jv| on the input.
-        The first cycle is kept when the second LP fails: no time left, HiGHS out of time or in numerical
-        trouble, or no feasible cycle once the first cycle's input edges are forbidden."""
+    def _complete_cycle(self, gamma, g, eps, time_limit, ends, Jv, obj, lp_s):
+        """The second candidate cycle of the full LP: the LP again with the input edges of the first cycle ``Jv``
+        (``|Jv| > CHOICE_TOL``) forbidden; (Jv, objective, seconds) of the cycle with the larger share of its jump
+        mass Σ ℓ|Jv| on the input edges.
+
+        The LP's optimum is the cycle of least ε-weighted length (thesis §6.1.2; Fig. 6.10: the shortest
+        nonbounding set). Between a broken nonbounding loop and a homologous side of a broken region (a band
+        round a handle) that is the one with the least *gap* length, so a long, little-broken loop loses to a
+        shorter, more broken region side and the region is cut open. The share of the jump mass on the input is
+        the candidate that is more nearly a whole input curve, a measure that does not grow with the curve's
+        length (the gap share of a broken curve is its deletion rate). The first cycle is kept when the second
+        LP fails: no time left, HiGHS out of time or in numerical trouble, or no feasible cycle once the first
+        cycle's input edges are forbidden."""
         used = (g != 0) & (np.abs(Jv) > CHOICE_TOL)
         left = time_limit - lp_s
         if not used.any() or not left > 0:
             return Jv, obj, lp_s
         t0 = time.perf_counter()
         try:
-            J2, obj2, s2 = self._residual_full(gamma, g, eps, left, alg, *extra, forbid=used)
+            J2, obj2, s2 = self._residual_full(gamma, g, eps, left, ends, forbid=used)
         except ValueError:              # the second LP failed (see above): the LP's own cycle
             return Jv, obj, lp_s + time.perf_counter() - t0
         ell = self.dec.edge_len
@@ -774,20 +680,23 @@ class SurfaceWindingNumbers:
             hi[forbid[interior]] = 0.0
         return interior, d, w, np.column_stack([lo, hi])
 
-    def _residual_full(self, gamma, g, eps, time_limit, algorithm="highs-ds", ends=None, forbid=None):
+    def _residual_full(self, gamma, g, eps, time_limit, ends, forbid=None):
+        """The full residual LP (spec §1(b) ④) on all faces: (Jv (nE,), objective, seconds). Below ``BAND_FACES``
+        faces HiGHS' dual simplex (:func:`gsdf.linalg._dual_l1.dual_graph_l1`); from there the same program on a
+        band of faces around the curves and their §6.3 completion paths, proven optimal for all faces by a
+        maximum-flow certificate and grown until proven (:func:`gsdf.linalg._band_lp.banded_l1`)."""
         dec, topo = self.dec, self.topology
         interior, d, w, bounds = self._full_lp_terms(gamma, g, eps, forbid)
         pairs = topo.edge_faces[interior]
-        if algorithm == "band":
+        if dec.n_faces >= BAND_FACES:
             from gsdf.linalg._band_lp import banded_l1
 
             # seeds: the faces along the curves and along their shortest-path completions (§6.3)
-            path = (g != 0) | (self._complete_chain(g, ends) != 0) if ends is not None else (g != 0)
+            path = (g != 0) | (self._complete_chain(g, ends) != 0)
             seeds = np.unique(topo.edge_faces[path & (topo.edge_face_count == 2)])
-            r = banded_l1(dec.n_faces, pairs, d, w, bounds=bounds, seeds=seeds, time_limit=time_limit,
-                          fallback="highs-ipm")
+            r = banded_l1(dec.n_faces, pairs, d, w, bounds=bounds, seeds=seeds, time_limit=time_limit)
         else:
-            r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=bounds, time_limit=time_limit, algorithm=algorithm)
+            r = dual_graph_l1(dec.n_faces, pairs, d, w, bounds=bounds, time_limit=time_limit, algorithm="highs-ds")
         Jv = np.zeros(dec.n_edges)
         Jv[interior] = r.jumps
         return Jv, r.objective, r.seconds
@@ -887,19 +796,22 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
     return out
 
 
-def surface_winding_number(V, F, curves, *, method: str = "lp", epsilon: float = 1e-2,
-                           time_limit: float = 300.0, homology: str = "real",
-                           lp_algorithm: str = "auto", bounding: str = "subset",
-                           endpoint_rule: str = "auto", cycle_choice: str = "complete",
-                           labels: str = "auto") -> SWNResult:
-    """One-call surface winding numbers: ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
+def surface_winding_number(V, F, curves, *, method: str = "lp", options: SWNOptions | None = None,
+                           progress=None) -> SWNResult:
+    """One-call surface winding numbers (thesis ch. 6): ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
+
+    Parameters
+    ----------
+    V : (n, 3) float; F : (m, 3) int — a manifold, consistently oriented triangle mesh
+    curves, method, options, progress : as :meth:`SurfaceWindingNumbers.solve`
+
+    Returns
+    -------
+    SWNResult (``face_labels``, ``corner_values``, ``residual``, ``u``, ...)
 
     Examples
     --------
     >>> res = surface_winding_number(V, F, [loop])                          # doctest: +SKIP
     >>> res.face_labels                                                     # doctest: +SKIP
     """
-    return SurfaceWindingNumbers(V, F).solve(curves, method=method, epsilon=epsilon, time_limit=time_limit,
-                                             homology=homology, lp_algorithm=lp_algorithm, bounding=bounding,
-                                             endpoint_rule=endpoint_rule, cycle_choice=cycle_choice,
-                                             labels=labels)
+    return SurfaceWindingNumbers(V, F).solve(curves, method=method, options=options, progress=progress)

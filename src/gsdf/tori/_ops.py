@@ -2,7 +2,7 @@
 
 Every function takes and returns *pointwise* signed distance callables ``f(Q (q, 3)) -> (q,)`` (negative inside),
 e.g. :class:`~gsdf.tori._pat.PointsAsTori` objects, so results can be contoured
-(:func:`contour`), rendered (:func:`gsdf.view._trace.render_png`) or combined further. Booleans use min/max
+(:func:`contour`), rendered (:func:`gsdf.render._trace.render_png`) or combined further. Booleans use min/max
 (exact inside/outside, a distance bound away from the seams); erosion/dilation of a shape by r are the offsets
 φ ∓ r, and closing (dilate then erode) / opening (erode then dilate) compose offsets of the *re-distanced*
 intermediate, which we approximate by the offset field itself (exact for an exact SDF away from the medial axis).

@@ -15,7 +15,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
     """Validate ``Q`` chunk by chunk and call ``kernel(q_chunk, out_chunk)`` on each.
 
     Only one float64 copy of one chunk exists at a time, so 10^8 float32 queries need ~chunk×24 bytes of
-    scratch beyond the output. ``progress(done, total)`` is called after each chunk when given.
+    scratch beyond the output. ``progress(stage, fraction)`` is called after each chunk when given.
     ``coherent=True`` evaluates each chunk grouped by cells of a coarse Morton grid
     (:func:`gsdf.spatial._morton.cell_order`: tree walks of neighbouring queries then share cached nodes) and
     scatters the results back. ``frame`` (a :class:`gsdf._normalize.Frame`) maps each
@@ -47,7 +47,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         else:
             kernel(q, out[s:e])
         if progress is not None:
-            progress(e, n)
+            progress("winding numbers", e / n)
     return out
 
 

@@ -189,13 +189,7 @@ class GridDomain(HeatDomain):
         dref, slack = grid_nearest_distance(S.B, self.lo, self.spacing, self.shape)
         tree = YukawaTree(S.B, S.W, self.t, theta=self.theta, eps=self.eps)
         Q = grid_points(self.lo, self.hi, self.shape)
-        done = [0]
-
-        def step(k):
-            done[0] += k
-            self._progress("heat (step I)", done[0] / self.n_nodes)
-
-        return tree(Q, dref, slack, progress=step)
+        return tree(Q, dref, slack, progress=lambda stage, fraction: self._progress("heat (step I)", fraction))
 
     def gather(self, X):
         return X

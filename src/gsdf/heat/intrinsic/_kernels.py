@@ -17,7 +17,7 @@ operators identify edges by their vertex pair); in these rare cases the result i
 flips".
 
 Faces are laid out in 2D (``layout``): slot 0 along +x, the third vertex above it, z = 0, so the operators of
-:class:`~gsdf.heat.triangle._operators.TriangleMeshOperators` (which only need per-face corner positions) work
+:class:`~gsdf.mesh._triangle_ops.TriangleOperators` (which only need per-face corner positions) work
 unchanged in these per-face frames.
 """
 

@@ -10,7 +10,8 @@ import numpy as np
 from gsdf._checks import as_mesh, as_points, choice, integer, nonnegative, positive
 from gsdf._normalize import Frame
 from gsdf.grid import PAD, Grid
-from gsdf.heat._core import LEVEL_SETS, reporter
+from gsdf._checks import progress_callback
+from gsdf.heat._core import LEVEL_SETS
 from gsdf.heat._yukawa import YukawaTree
 from gsdf.heat.volume._sources import Sources, _cloud_sources, _mesh_sources, check_cloud, mesh_sources, point_sources
 
@@ -80,7 +81,7 @@ class VolumeHeatOptions:
         return dict(mode=mode, lam=lam, t_scale=choice(self.t_scale, "t_scale", {"grid", "input"}),
                     theta=nonnegative(self.theta, "theta"),
                     mesher=choice(self.mesher, "mesher", {"delaunay", "tetgen"}),
-                    max_memory=max_memory, progress=reporter(self.progress))
+                    max_memory=max_memory, progress=progress_callback(self.progress))
 
 
 def _input_positions(mesh, points):

@@ -12,7 +12,8 @@ from scipy.spatial import cKDTree
 from gsdf._memory import check_bytes
 from gsdf._normalize import Frame
 from gsdf.field import GridField, TetField
-from gsdf.heat._core import SignedHeatCore, reporter
+from gsdf._checks import progress_callback
+from gsdf.heat._core import SignedHeatCore
 from gsdf.heat.grid._domain import GridDomain
 from gsdf.heat.tet._domain import TetDomain
 from gsdf.heat._sources import Sources
@@ -39,7 +40,7 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     ``theta`` the Yukawa tree tolerance; ``progress(stage, fraction)``; ``frame``: the
     :class:`gsdf._normalize.Frame` the inputs are in (the field is returned in world units).
     """
-    report = reporter(progress)
+    report = progress_callback(progress)
     lo, hi = np.asarray(bbox_min, float), np.asarray(bbox_max, float)
     shape = tuple(int(s) for s in shape)
     n = int(np.prod(shape))
@@ -82,7 +83,7 @@ def solve_tet(src: Sources, X, faces, lo, hi, shape, t_coef: float = 1.0, t=None
     (:mod:`gsdf.heat.tet._mesh`). ``progress(stage, fraction)``; ``frame``: the :class:`gsdf._normalize.Frame`
     the inputs are in (the field is returned in world units).
     """
-    report = reporter(progress)
+    report = progress_callback(progress)
     timings = {}
     t0 = time.perf_counter()
     h = float((hi - lo).max()) / (max(shape) - 1)

@@ -166,7 +166,7 @@ def render_png(sdf, path, width: int = 256, height: int = 256, level: float = 0.
     >>> os.path.getsize(f) > 0
     True
     """
-    from gsdf.view._png import write_png
+    from gsdf.render._png import write_png
     from gsdf.io._safe_write import check_output_path
 
     check_output_path(path, extensions=(".png",))

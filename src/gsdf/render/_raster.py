@@ -41,7 +41,7 @@ def render_function_png(path, V, F, values, size: int = 800, view=(0.0, 0.0, 1.0
     -------
     >>> render_function_png("phi.png", V, F, phi)          # doctest: +SKIP
     """
-    from gsdf.view._png import field_to_rgb, write_png
+    from gsdf.render._png import field_to_rgb, write_png
 
     V = np.asarray(V, np.float64)
     F = np.asarray(F, np.int64)
