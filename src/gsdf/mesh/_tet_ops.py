@@ -36,13 +36,15 @@ True
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 import scipy.sparse as sp
 
 from gsdf.linalg._assembly import coo_to_csr
 from gsdf.mesh._triangle_ops import d0_matrix
 
-__all__ = ["TetOperators", "EDGE_PAIRS", "FACE_LOCAL", "signed_volumes", "unique_rows"]
+__all__ = ["EDGE_PAIRS", "FACE_LOCAL", "TetOperators", "signed_volumes", "unique_rows"]
 
 # local vertex pairs of the 6 edges of a tet
 EDGE_PAIRS = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
@@ -111,21 +113,19 @@ class TetOperators:
         self.V, self.T = V, T
         self.volumes = np.abs(det) / 6.0
         self.n_vertices, self.n_tets = V.shape[0], T.shape[0]
-        self._A = self._edges = self._faces = self._d0 = self._d1 = self._d2 = None
+        self._edges = self._faces = None
 
     # ------------------------------------------------------------------------------------------- geometry
-    @property
+    @cached_property
     def area_vectors(self) -> np.ndarray:
         """(m, 4, 3) outward area vectors ``A_k`` of the faces opposite each vertex (``∇λ_k = −A_k / 3|T|``)."""
-        if self._A is None:
-            V, T = self.V, self.T
-            A = np.empty((self.n_tets, 4, 3))
-            for k in range(4):
-                i, j, l = FACE_LOCAL[k]
-                p = V[T[:, i]]
-                A[:, k] = 0.5 * np.cross(V[T[:, j]] - p, V[T[:, l]] - p)
-            self._A = A
-        return self._A
+        V, T = self.V, self.T
+        A = np.empty((self.n_tets, 4, 3))
+        for k in range(4):
+            i, j, l = FACE_LOCAL[k]
+            p = V[T[:, i]]
+            A[:, k] = 0.5 * np.cross(V[T[:, j]] - p, V[T[:, l]] - p)
+        return A
 
     def edge_weights(self) -> np.ndarray:
         """(m, 6) P1 FEM edge weights of each tet, ``w_ij = −|T| ∇λ_i·∇λ_j = −A_i·A_j / (9|T|)`` =
@@ -207,34 +207,27 @@ class TetOperators:
     def n_faces(self) -> int:
         return len(self.faces)
 
-    @property
+    @cached_property
     def d0(self) -> sp.csr_matrix:
         """(nE, nV) gradient: ``(d0 u)_ab = u_b − u_a``."""
-        if self._d0 is None:
-            self._d0 = d0_matrix(self.edges, self.n_vertices)
-        return self._d0
+        return d0_matrix(self.edges, self.n_vertices)
 
-    @property
+    @cached_property
     def d1(self) -> sp.csr_matrix:
         """(nF, nE) curl: face (a, b, c) → ab + bc − ac."""
-        if self._d1 is None:
-            Fc = self.faces
-            key = self.edges[:, 0] * self.n_vertices + self.edges[:, 1]
-            cols = np.stack([np.searchsorted(key, Fc[:, a] * self.n_vertices + Fc[:, b])
-                             for a, b in ((0, 1), (1, 2), (0, 2))], axis=1)
-            vals = np.tile([1.0, 1.0, -1.0], (len(Fc), 1))
-            rows = np.repeat(np.arange(len(Fc)), 3)
-            self._d1 = sp.csr_matrix((vals.ravel(), (rows, cols.ravel())), shape=(len(Fc), self.n_edges))
-        return self._d1
+        Fc, n = self.faces, self.n_vertices
+        key = self.edges[:, 0] * n + self.edges[:, 1]
+        cols = np.stack([np.searchsorted(key, Fc[:, a] * n + Fc[:, b]) for a, b in ((0, 1), (1, 2), (0, 2))], axis=1)
+        vals = np.tile([1.0, 1.0, -1.0], (len(Fc), 1))
+        rows = np.repeat(np.arange(len(Fc)), 3)
+        return sp.csr_matrix((vals.ravel(), (rows, cols.ravel())), shape=(len(Fc), self.n_edges))
 
-    @property
+    @cached_property
     def d2(self) -> sp.csr_matrix:
         """(nT, nF) divergence: +1 where the canonical face normal points out of the tet."""
-        if self._d2 is None:
-            rows = np.repeat(np.arange(self.n_tets), 4)
-            self._d2 = sp.csr_matrix((self.tet_face_sign.ravel().astype(float), (rows, self.tet_faces.ravel())),
-                                     shape=(self.n_tets, self.n_faces))
-        return self._d2
+        rows = np.repeat(np.arange(self.n_tets), 4)
+        return sp.csr_matrix((self.tet_face_sign.ravel().astype(float), (rows, self.tet_faces.ravel())),
+                             shape=(self.n_tets, self.n_faces))
 
     # ---------------------------------------------------------------------------------------- operators
     def cotan_laplacian(self) -> sp.csr_matrix:

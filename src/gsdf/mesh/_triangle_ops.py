@@ -39,7 +39,7 @@ import scipy.sparse as sp
 from gsdf.linalg._assembly import coo_to_csr
 from gsdf.mesh._connectivity import unique_edges
 
-__all__ = ["TriangleOperators", "d0_matrix", "NEXT", "PREV"]
+__all__ = ["NEXT", "PREV", "TriangleOperators", "d0_matrix"]
 
 NEXT = np.array([1, 2, 0])
 PREV = np.array([2, 0, 1])

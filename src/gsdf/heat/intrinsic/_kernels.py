@@ -345,7 +345,7 @@ def _trace(Fv, Lay, nbr_f, nbr_s, f, b, d, tol, max_steps, out_f, out_b):
 
 def _initial_state(V, F):
     """Arrays of the flip algorithm for the input mesh: Fv, FL, FE, EF, ES, the sorted edge keys."""
-    n, m = len(V), len(F)
+    n = len(V)
     Fv = np.array(F, dtype=np.int64, copy=True)
     FL = np.linalg.norm(V[F[:, NEXT]] - V[F], axis=2)
     b = Fv[:, NEXT]
