@@ -175,6 +175,9 @@ class TriangleDEC(TriangleOperators):
         endpoint keeps its degree of freedom and every halfedge stays in the energy; nothing is excluded and
         no projective interpolation is needed (``endpoints`` of the result is all False).
 
+        Excluded endpoints would act as holes (their one-rings out of the solve); the figures are in
+        docs/decisions.md, "Surface winding numbers".
+
         Parameters
         ----------
         jump : (nE,) float
