@@ -217,7 +217,7 @@ class MeshCases:
         d = self.swn.dec
         self.dec = d
         self.topo = d.topology
-        self.area = d.face_area
+        self.area = d.areas
         self.rng = np.random.default_rng(seed)
         n, m = d.n_vertices, d.n_faces
         # eigenfunctions 2..6 of L φ = λ M φ (shift-invert near 0)
@@ -243,7 +243,7 @@ class MeshCases:
         d, topo = self.dec, self.topo
         n = d.n_vertices
         E = d.edges
-        G = sp.coo_matrix((d.edge_length, (E[:, 0], E[:, 1])), shape=(n, n)).tocsr()
+        G = sp.coo_matrix((d.edge_len, (E[:, 0], E[:, 1])), shape=(n, n)).tocsr()
         root = int(self.rng.integers(n))
         dist, pred = dijkstra(G, directed=False, indices=root, return_predecessors=True)
         child = np.flatnonzero(pred >= 0)
@@ -254,7 +254,7 @@ class MeshCases:
         cand = np.flatnonzero(~in_tree)
         Af, Bf = topo.edge_faces[cand, 0], topo.edge_faces[cand, 1]
         m = d.n_faces
-        W = sp.coo_matrix((1.0 / (1e-9 + d.edge_length[cand]), (Af, Bf)), shape=(m, m)).tocsr()
+        W = sp.coo_matrix((1.0 / (1e-9 + d.edge_len[cand]), (Af, Bf)), shape=(m, m)).tocsr()
         T = minimum_spanning_tree(W).tocoo()
         fk = np.minimum(T.row, T.col) * m + np.maximum(T.row, T.col)
         ck = np.minimum(Af, Bf) * m + np.maximum(Af, Bf)
@@ -298,7 +298,7 @@ class MeshCases:
         n, m = d.n_vertices, d.n_faces
         E = d.edges
         ok = ~forbid_e
-        w = d.edge_length * (1.0 + TOUCH_PENALTY * (forbid_v[E[:, 0]].astype(float) + forbid_v[E[:, 1]]))
+        w = d.edge_len * (1.0 + TOUCH_PENALTY * (forbid_v[E[:, 0]].astype(float) + forbid_v[E[:, 1]]))
         G = sp.coo_matrix((w[ok], (E[ok, 0], E[ok, 1])), shape=(n, n)).tocsr()
         dist, pred = dijkstra(G, directed=False, indices=int(root), return_predecessors=True)
         child = np.flatnonzero(pred >= 0)
@@ -306,7 +306,7 @@ class MeshCases:
         in_tree = np.isin(E[:, 0] * n + E[:, 1], tkey)
         cand = np.flatnonzero(~in_tree)
         Af, Bf = topo.edge_faces[cand, 0], topo.edge_faces[cand, 1]
-        wc = 1.0 / (1e-9 + d.edge_length[cand])
+        wc = 1.0 / (1e-9 + d.edge_len[cand])
         reach = np.isfinite(dist)
         low = ~ok[cand] | ~reach[E[cand, 0]] | ~reach[E[cand, 1]]
         wc[low] = 1e-6 * wc.min()                                    # into the cotree first
@@ -718,7 +718,7 @@ def scaling(time_limit, sizes):
                 line.append(f" {r.timings.get('lp', 0):.3f} s / {r.timings['total']:.2f} s |")
             except ValueError as exc:
                 line.append(f" failed ({str(exc)[:40]}) |")
-        errs = " / ".join(f"{100 * mislabeled(res[m].face_labels, truth, swn.dec.face_area):.2f} %"
+        errs = " / ".join(f"{100 * mislabeled(res[m].face_labels, truth, swn.dec.areas):.2f} %"
                           if m in res else "–" for m in ("lp", "reduced"))
         line.append(f" {errs} |")
         rows.append("".join(line))
@@ -744,7 +744,7 @@ def author_data(out_dir=None):
         swn = SurfaceWindingNumbers(V2, F2)
         r = swn.solve(list(segs), method="lp")
         rr = swn.solve(list(segs), method="reduced")
-        A = swn.dec.face_area
+        A = swn.dec.areas
         labs = np.unique(r.face_labels)
         share = ", ".join(f"{int(k)}: {100 * A[r.face_labels == k].sum() / A.sum():.1f} %" for k in labs)
         agree = 100 * (1 - mislabeled(rr.face_labels, r.face_labels, A))

@@ -75,7 +75,7 @@ def test_incidence_complex_and_orientation():
 
 def test_fem_weights_are_the_p1_stiffness():
     K = _ball(200)
-    w = K.fem_tet_weights()
+    w = K.edge_weights()
     # an independent P1 stiffness from barycentric gradients: K_ij = |T| ∇λ_i·∇λ_j, w_ij = −K_ij
     V, T = K.V, K.T
     M = np.concatenate([np.ones((len(T), 4, 1)), V[T]], axis=2)            # rows [1 x y z]
@@ -88,7 +88,7 @@ def test_fem_weights_are_the_p1_stiffness():
     R = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1.0]])
     Kr = TetComplex(R, np.array([[0, 1, 2, 3]]))
     th = np.arccos(1 / 3)
-    assert np.allclose(Kr.fem_tet_weights(), np.sqrt(8) / np.tan(th) / 6)
+    assert np.allclose(Kr.edge_weights(), np.sqrt(8) / np.tan(th) / 6)
     assert (K.star1 > 0).all() and (K.star0 > 0).all() and (K.star2 > 0).all()
 
 

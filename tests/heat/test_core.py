@@ -214,11 +214,11 @@ def test_a_new_vertex_domain_plugs_into_the_core():
     from gsdf.heat._core import SignedHeatCore
     from gsdf.heat._domain import VertexSurfaceDomain, tangent_frames
     from gsdf.data._shapes import grid_mesh
-    from gsdf.heat.triangle._operators import TriangleMeshOperators
+    from gsdf.mesh._triangle_ops import TriangleOperators
 
     class FlatVertexDomain(VertexSurfaceDomain):
         def __init__(self, V, F):
-            self.ops = TriangleMeshOperators(V, F)
+            self.ops = TriangleOperators(V, F)
             L = self.ops.cotan_laplacian()
             N = np.tile([0.0, 0, 1], (len(V), 1))
             e1, e2 = tangent_frames(N)

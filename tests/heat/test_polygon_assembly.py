@@ -12,7 +12,7 @@ from gsdf.contour import region_boundary_curves
 from gsdf.heat import PolygonMeshSignedHeatSolver, SurfaceSignedHeatSolver
 from gsdf.heat.polygon._domain import PolygonDomain, connection_laplacian, frame_transport
 from gsdf.data._shapes import sphere_mesh
-from gsdf.heat.triangle._operators import TriangleMeshOperators
+from gsdf.mesh._triangle_ops import TriangleOperators
 
 
 def _nonplanar_mixed(seed=0):
@@ -45,7 +45,7 @@ def _nonplanar_mixed(seed=0):
 def test_polygon_assembly_equals_prolonged_refined_operators():
     V, polys = _nonplanar_mixed()
     d = PolygonDomain(V, polys)
-    fine = TriangleMeshOperators(d.V_refined, d.F_refined, edges=False)
+    fine = TriangleOperators(d.V_refined, d.F_refined, edges=False)
     P = d.P
     L_ref = (P.T @ fine.cotan_laplacian() @ P).toarray()
     M_ref = P.T @ fine.vertex_mass()

@@ -9,7 +9,7 @@ import gsdf
 from gsdf.field import TetField
 from gsdf.contour._tets import locate_in_tets, marching_tetrahedra
 from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
-from gsdf.heat.tet._mesh import graded_lattice, surface_samples, tet_geometry
+from gsdf.heat.tet._mesh import graded_lattice, surface_samples, tet_quality
 
 from tests.shapes import uv_sphere
 
@@ -81,7 +81,7 @@ def test_tet_sphere_sdf_close_to_exact_and_zero_on_input(sphere, tmp_path):
     h = f.meta["h"]
     assert err.mean() < 0.08 * h and np.quantile(err, 0.99) < 0.6 * h
     tets = f.tets
-    vol, _, q = tet_geometry(f.vertices, tets)
+    q = tet_quality(f.vertices, tets)
     assert f.meta["n_dropped_tets"] == int((q < 0.02).sum())
     Vi, Fi = f.isosurface(0.0)
     assert abs(np.linalg.norm(Vi, axis=1).mean() - 0.98) < 0.02
@@ -160,7 +160,7 @@ def test_spd_solver_iterative_and_direct_agree():
     """Above ``direct_max`` the solver runs preconditioned CG; it must match the factorization."""
     import scipy.sparse as sp
 
-    from gsdf.heat.tet._mesh import SPDSolver
+    from gsdf.linalg import SPDSolver
 
     n = 40
     K1 = sp.diags([2.0 * np.ones(n), -np.ones(n - 1), -np.ones(n - 1)], [0, -1, 1])

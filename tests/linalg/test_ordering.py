@@ -9,7 +9,7 @@ from scipy.sparse.csgraph import reverse_cuthill_mckee
 from scipy.spatial import Delaunay
 
 from gsdf.data._shapes import grid_mesh
-from gsdf.heat.triangle._operators import TriangleMeshOperators
+from gsdf.mesh._triangle_ops import TriangleOperators
 from gsdf.linalg._ldl import LDLFactorization, fill_count
 from gsdf.linalg._ordering import approximate_minimum_degree, fill_reducing_ordering, nested_dissection
 
@@ -69,7 +69,7 @@ def test_amd_fill_against_nested_dissection_rcm_and_superlu_mmd():
         assert amd < 0.75 * nd and amd < 0.3 * rcm
         assert amd <= 1.05 * mmd
     V, F = grid_mesh(40)                                                        # a regular grid: ND is strong
-    A = (TriangleMeshOperators(V, F).cotan_laplacian() + sp.identity(len(V))).tocsr()
+    A = (TriangleOperators(V, F).cotan_laplacian() + sp.identity(len(V))).tocsr()
     amd = fill_count(A, approximate_minimum_degree(A))
     assert amd <= 1.05 * fill_count(A, nested_dissection(A))
     assert amd <= 1.05 * fill_count(A, _mmd_perm(A))

@@ -74,7 +74,7 @@ def test_branch_solve_is_linear_in_the_chain(sphere):
     ends = lambda g: dec.chain_endpoints(g)  # noqa: E731
     u = lambda g: swn._jump_solve(g, ends(g), "branch")  # noqa: E731
     r = u(g1 + g2) - u(g1) - u(g2)
-    A = np.repeat(dec.face_area, 3)
+    A = np.repeat(dec.areas, 3)
     r = r.ravel() - np.average(r.ravel(), weights=A)
     assert np.abs(r).max() < 1e-6
     r_old = (swn._jump_solve(g1 + g2, ends(g1 + g2), "exclude") - swn._jump_solve(g1, ends(g1), "exclude")
@@ -92,7 +92,7 @@ def test_branch_coordinates_ramp_closes_around_an_endpoint():
     g[np.flatnonzero((dec.edges == [a, b]).all(1))] = 1.0
     jc = dec.branch_coordinates(g)
     assert not jc.endpoints.any() and jc.walked[[a, b]].all()
-    ang = dec.corner_angles
+    ang = dec.angles
     for v in (a, b):
         f, k = np.nonzero(F == v)
         c = jc.c[f, k]

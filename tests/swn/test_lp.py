@@ -45,7 +45,7 @@ def test_final_solve_jumps_only_across_the_input():
     ends = r.endpoints | swn.dec.chain_endpoints(r.bounding, tol=1e-6)   # incl. where the bounding part ends
     inner = ~swn.topology.boundary_edges & ~ends[swn.dec.edges].any(1)
     assert np.abs(J[off & inner]).max() < 1e-8                 # ... but w does not jump there
-    assert mislabeled(r, truth, swn.dec.face_area) < 0.01
+    assert mislabeled(r, truth, swn.dec.areas) < 0.01
 
 
 def test_band_solver_agrees_with_highs(monkeypatch):
@@ -86,7 +86,7 @@ def test_bounding_part_is_a_subset_of_the_input():
     assert not np.any(r.bounding[mer])                           # ... and still read as nonbounding
     assert np.array_equal(r.bounding[~mer], r.chain[~mer])      # the patch boundary stays whole
     assert np.ptp(r.corner_values[~R]) < 1e-6 and np.ptp(r.corner_values[R]) < 1e-6
-    assert mislabeled(r, truth, swn.dec.face_area) == 0.0
+    assert mislabeled(r, truth, swn.dec.areas) == 0.0
 
 
 def test_subset_reading_stops_when_nothing_is_left_to_remove():
@@ -96,7 +96,7 @@ def test_subset_reading_stops_when_nothing_is_left_to_remove():
     g = g + swn.chain([[5 * 24 + 23, 5 * 24]])                  # the closing edge: a whole meridian
     r = swn.solve(g, method="lp")
     assert r.passes == 2 and np.allclose(r.residual[mer], r.chain[mer], atol=1e-6)
-    assert not np.any(r.bounding[mer]) and mislabeled(r, R.astype(int), swn.dec.face_area) == 0.0
+    assert not np.any(r.bounding[mer]) and mislabeled(r, R.astype(int), swn.dec.areas) == 0.0
 
 
 def test_time_limit_bounds_the_lps_of_all_passes(monkeypatch):
@@ -152,7 +152,7 @@ def test_second_cycle_keeps_the_whole_loop_not_the_band_side(monkeypatch):
     gaps are shorter than the loop's — which would cut the band open. The solver solves the LP again without that
     side's edges, finds the loop, and keeps it: 3/4 of its jump mass lies on the input against 2/3 on the side."""
     swn, g, loop, truth = _band_and_long_loop()
-    A = swn.dec.face_area
+    A = swn.dec.areas
     r = swn.solve(g, method="lp")
     first, _, _ = swn._residual_full(r.gamma, r.chain, 1e-2, 300.0, r.endpoints)
     assert np.abs(first[loop]).max() < 0.1                       # the LP's own cycle avoids the loop
@@ -191,7 +191,7 @@ def test_broken_meridian_is_the_nonbounding_part_beside_a_broken_region():
         r = swn.solve(g, method="lp")
         assert not np.any(np.round(r.bounding[mer]))
         assert np.array_equal(np.round(r.bounding[~mer]), g[~mer])
-        assert mislabeled(r, truth, swn.dec.face_area) < 0.002
+        assert mislabeled(r, truth, swn.dec.areas) < 0.002
         assert np.allclose(np.round(r.bounding) + np.where(g != 0, np.round(r.residual), 0), g)   # g = bnd + N
 
 

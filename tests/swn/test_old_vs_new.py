@@ -1,5 +1,7 @@
-"""Old-vs-new: ``gsdf.surface_winding_number`` with its defaults gives bit-identical results to the code before the
-options were folded into :class:`gsdf.SWNOptions` (the previous checkout, ``GSDF_OLD_SRC``, set it to a checkout's src folder, run in a subprocess). Skipped unless GSDF_OLD_SRC is set."""
+"""Old-vs-new: ``gsdf.surface_winding_number`` with its defaults gives the results of the code before the options
+were folded into :class:`gsdf.SWNOptions` and the DEC operators into the shared triangle operator set (the previous
+checkout: set ``GSDF_OLD_SRC`` to its src folder; run in a subprocess): identical labels, values up to rounding.
+Skipped unless GSDF_OLD_SRC is set."""
 
 import os
 import pathlib
@@ -81,13 +83,28 @@ def _run(src, path, cases):
     return dict(np.load(path))
 
 
-def test_defaults_bit_identical_to_the_previous_code(tmp_path):
+def test_defaults_agree_with_the_previous_code(tmp_path):
+    """Labels and bounding parts are bit-identical. The DEC operators now come from the shared triangle operator
+    set (gsdf.mesh._triangle_ops: Eq. 5 cotangents, arccos angles, edge lengths from the face slots), which moves
+    ⋆1 and the weights by a few ulps (tests/mesh/test_triangle_ops.py); downstream, measured on these cases:
+    corner values ≤ 1.9e-14; u by a constant ≤ 3.5e-9 (the jump solve's 1e-8 regularization fixes the constant
+    only to ~ulp / 1e-8), ≤ 3.5e-14 after removing it; the residual (the LP's solution) ≤ 1.2e-9, within HiGHS'
+    tolerances."""
     old = _run(OLD_SRC, tmp_path / "old.npz", CASES)
     new = _run(NEW_SRC, tmp_path / "new.npz", CASES)
     assert sorted(old) == sorted(new)
     for k in old:
-        assert old[k].shape == new[k].shape, k
-        assert np.array_equal(old[k], new[k]), k
+        a, b = old[k], new[k]
+        assert a.shape == b.shape, k
+        kind = k.rsplit(":", 1)[1]
+        if kind in ("face_labels", "bounding"):
+            assert np.array_equal(a, b), k
+        elif kind == "u":
+            assert np.abs(a - b).max() < 1e-7 and np.ptp(a - b) < 1e-12, k
+        elif kind == "residual":
+            assert np.abs(a - b).max() < 1e-8, k
+        else:
+            assert np.abs(a - b).max() < 1e-12, k
 
 
 _INSERT_SCRIPT = r'''

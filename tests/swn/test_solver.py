@@ -46,7 +46,7 @@ def test_sphere_closed_latitude_loop(sphere):
     res = swn.solve([np.r_[ring, ring[0]]])
     assert swn.simply_connected and "lp" not in res.timings
     truth = (V[F].mean(1)[:, 2] > V[ring[0], 2]).astype(int)
-    area = swn.dec.face_area
+    area = swn.dec.areas
     assert mislabeled(res, truth, area) == 0.0
     assert np.abs(res.omega).max() < 1e-6
     # the ring runs counter-clockwise seen from +z: the cap above it is on its left, label 1
@@ -72,13 +72,13 @@ def test_sphere_broken_loop(sphere):
     assert 0.25 <= 1 - keep.mean() <= 0.35
     res = swn.solve(pieces)
     assert res.endpoints.sum() >= 4
-    assert mislabeled(res, truth, swn.dec.face_area) <= 0.05
+    assert mislabeled(res, truth, swn.dec.areas) <= 0.05
 
 
 def test_torus_meridian(tor):
     V, F, idx, swn = tor
     mer = np.r_[idx[5], idx[5, 0]]
-    area = swn.dec.face_area
+    area = swn.dec.areas
     naive = swn.solve([mer], method="none")
     uf = naive.u.mean(1)
     assert np.ptp(uf) > 0.9                                   # u ramps once around the torus (Fig. 6.1)
@@ -105,13 +105,13 @@ def test_torus_broken_meridian_gap_closes(tor):
         on = r.chain != 0
         gap = (~on) & (np.abs(r.residual) > 0.1)       # (a ~1e-3 circulation along a longitude aside)
         assert gap.any()                                       # the gap closes ...
-        gl = swn.dec.edge_length[gap].sum()
-        assert gl < 1.3 * (24 - keep + 1) * swn.dec.edge_length[on].mean()   # ... by the short arc
+        gl = swn.dec.edge_len[gap].sum()
+        assert gl < 1.3 * (24 - keep + 1) * swn.dec.edge_len[on].mean()   # ... by the short arc
         jv.append(np.median(np.abs(r.residual[on])))
         # spec §1(f): the LP optimum is at most ε·(nonbounding input length) + gap length (closing by Jv = 1)
-        el = swn.dec.edge_length
+        el = swn.dec.edge_len
         assert r.lp_objective <= 1e-2 * el[on].sum() + (24 - keep + 1) * el[on].mean() * 1.001
-        assert mislabeled(r, np.zeros(len(F), int), swn.dec.face_area) == 0.0
+        assert mislabeled(r, np.zeros(len(F), int), swn.dec.areas) == 0.0
     assert jv[0] < jv[1] <= 1.0 + 1e-9 and jv[1] > 0.85         # Jv -> 1 as the breakage shrinks (Fig. 6.6)
 
 
@@ -125,10 +125,10 @@ def test_torus_opposite_meridians_bound_a_band(tor):
     # loop a runs along +j at i = 5: the face holding (5, j) -> (5, j+1) has i = 4, so the left of the curves
     # (winding number 1) is the outside of the band
     truth = (~band).astype(int)
-    assert mislabeled(res, truth, swn.dec.face_area) == 0.0
+    assert mislabeled(res, truth, swn.dec.areas) == 0.0
     assert set(np.unique(res.face_labels[band])) == {0} and set(np.unique(res.face_labels[~band])) == {1}
     for m in ("reduced", "none"):
-        assert mislabeled(swn.solve([a, b], method=m), truth, swn.dec.face_area) == 0.0
+        assert mislabeled(swn.solve([a, b], method=m), truth, swn.dec.areas) == 0.0
 
 
 def test_torus_three_meridians_either_optimum(tor):
@@ -145,7 +145,7 @@ def test_torus_three_meridians_either_optimum(tor):
     # on the left of each loop: i < 4 / i < 20 for the + loops, i ≥ 36 for the reversed one
     t1 = (band != 2).astype(int)                               # loop 4 nonbounding: 1 outside [20, 36)
     t2 = (band == 0).astype(int)                               # loop 20 nonbounding: 1 on [36, 48) ∪ [0, 4)
-    area = swn.dec.face_area
+    area = swn.dec.areas
     assert min(mislabeled(res, t1, area), mislabeled(res, t2, area)) == 0.0
     assert np.isclose(np.abs(res.residual).sum(), np.abs(res.chain).sum() / 3, rtol=0.05)
 
@@ -166,9 +166,9 @@ def test_double_torus_waist_and_handle():
     assert np.allclose(res.residual[on_a1], a1[on_a1], atol=1e-6)          # Jv = a1
     assert np.abs(res.residual[~on_a1]).max() < 1e-6
     truth = (cen[:, 0] < 0).astype(int)
-    assert mislabeled(res, truth, swn.dec.face_area) == 0.0
+    assert mislabeled(res, truth, swn.dec.areas) == 0.0
     naive = swn.solve(waist + a1, method="none")
-    assert mislabeled(naive, truth, swn.dec.face_area) > 0.0
+    assert mislabeled(naive, truth, swn.dec.areas) > 0.0
     assert np.ptp(naive.u.mean(1)[truth == 1]) > 0.5            # naive u ramps around the handle
 
 
@@ -180,7 +180,7 @@ def test_annulus_circle_and_radial_arc():
     r_face = np.linalg.norm(V[F].mean(1), axis=1)
     inner = r_face < np.linalg.norm(V[idx[3, 0]])
     assert np.abs(res.residual).max() < 1e-6
-    assert mislabeled(res, inner.astype(int), swn.dec.face_area) == 0.0
+    assert mislabeled(res, inner.astype(int), swn.dec.areas) == 0.0
     assert set(np.unique(res.face_labels[inner])) == {1}
     arc = swn.solve([idx[:, 0]])
     assert arc.endpoints.sum() == 0                           # endpoints on the boundary: closed
@@ -404,7 +404,7 @@ def test_flat_circle_one_big_gap_offset_is_the_curve_level(gap):
     g[ang < 2 * np.pi * gap] = 0                                     # one gap, `gap` of the circle's edges
     res = swn.solve(g)
     assert res.endpoints.sum() == 2
-    A = swn.dec.face_area
+    A = swn.dec.areas
     err = mislabeled(res, truth, A) * A.sum() / A[disk].sum()        # relative to the disk's area
     assert err < 0.06
     # the level on the arc ≈ the level on the missing part of the circle (inscribed-angle theorem)

@@ -102,7 +102,7 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
         bar.close()
     with output_file(output, (".ply", ".obj")) as tmp:
         (write_swn_ply if ext == ".ply" else write_swn_obj)(tmp, V2, F2, res.corner_values, res.face_labels)
-    A = solver.dec.face_area
+    A = solver.dec.areas
     labs = np.unique(res.face_labels)
     share = ", ".join(f"{int(k)}: {100 * A[res.face_labels == k].sum() / A.sum():.1f}%" for k in labs)
     nb = float(np.abs(res.residual[res.chain != 0]).sum() / max(np.abs(res.chain).sum(), 1))

@@ -1,7 +1,8 @@
 """Discrete exterior calculus on triangle and tet meshes.
 
-``_triangle``: d0, d1, diagonal Hodge stars (cotan, clamped), jump ("reduced") coordinates of an integer edge chain,
-the jump Laplace solve, the Darboux derivative. ``_tet``: the same on tet complexes. ``_hodge``: Hodge
+``_triangle``: diagonal Hodge stars (cotan, clamped), jump ("reduced") coordinates of an integer edge chain, the
+jump Laplace solve, the Darboux derivative. ``_tet``: the same on tet complexes. Both build on the operator sets
+of :mod:`gsdf.mesh` (geometry, connectivity, d0/d1/d2, cotan and P1 weights). ``_hodge``: Hodge
 decomposition of a 1-form on any cell complex given d0, d1 and positive diagonal stars (exact, coexact, harmonic
 parts) and a harmonic basis (dimension = first Betti number). ``_cycles``: tree–cotree homology bases.
 

@@ -1,22 +1,15 @@
-"""Discrete exterior calculus on tetrahedral meshes: the tet complex, its operators, and jump fields.
+"""Discrete exterior calculus on tetrahedral meshes: Hodge stars, the jump Laplace solve and jump fields.
 
-Owns: unique edges / faces with a canonical orientation (increasing vertex index), the incidence matrices
-d0 (edges × vertices), d1 (faces × edges), d2 (tets × faces); the P1 FEM ("cotan") edge weights of each tet and
-positive diagonal Hodge stars; per-corner jump coordinates of an oriented face chain, its Darboux derivative,
-and the jump Laplace solve of Chen, Li & Huang 2026 (seed 003, §4.1–4.2, Eqs. 2–6 and 10) with the fixes of
-the implementation notes (wave2 §2(b).1, .3): c is per corner (a walk in each vertex star), weights are FEM
-weights clamped positive.
+Owns: positive diagonal Hodge stars (the P1 FEM edge weights clamped positive, barycentric dual volumes, dual
+edge over face area); per-corner jump coordinates of an oriented face chain, its Darboux derivative, and the jump
+Laplace solve of Chen, Li & Huang 2026 (seed 003, §4.1–4.2, Eqs. 2–6 and 10) with the fixes of the implementation
+notes (wave2 §2(b).1, .3): c is per corner (a walk in each vertex star), weights are FEM weights clamped positive.
+The geometry, connectivity, d0/d1/d2 and the FEM weights come from :class:`gsdf.mesh._tet_ops.TetOperators`
+(its module docs give the orientation conventions).
 
-Orientation conventions
------------------------
-* Edge ``e = (a, b)`` with ``a < b`` points from ``a`` to ``b``: ``(d0 u)_e = u_b - u_a``.
-* Face ``(a, b, c)`` with ``a < b < c`` has the right-hand normal ``(b - a) x (c - a)``; its boundary is
-  ``ab + bc - ac``.
-* Tets are stored positively oriented (``det[v1-v0, v2-v0, v3-v0] > 0``; input tets are reordered if needed);
-  ``d2[t, f] = +1`` when the canonical normal of ``f`` points out of ``t``.
-* An oriented face chain ``G`` (one integer per face) carries the jump of the winding field: crossing face
-  ``f`` along its canonical normal, the value drops by ``G[f]`` (inside = 1, outside = 0 for a chain whose
-  normals point out of the shape).
+An oriented face chain ``G`` (one integer per face) carries the jump of the winding field: crossing face ``f``
+along its canonical normal, the value drops by ``G[f]`` (inside = 1, outside = 0 for a chain whose normals point
+out of the shape).
 
 Example
 -------
@@ -37,13 +30,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from gsdf._checks import as_points
+from gsdf.mesh._tet_ops import EDGE_PAIRS, TetOperators
 
 __all__ = ["TetComplex", "chain_boundary_vertices", "correction_chain"]
-
-# local vertex pairs of the 6 edges of a tet and, for each, the opposite pair
-_EDGE_PAIRS = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
-# outward-oriented faces of a positively oriented tet, face k opposite local vertex k (from ∂[v0v1v2v3])
-_FACE_LOCAL = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 
 
 def _as_tets(T, n_vertices: int) -> np.ndarray:
@@ -62,35 +51,7 @@ def _as_tets(T, n_vertices: int) -> np.ndarray:
     return A
 
 
-def _perm_sign(A: np.ndarray) -> np.ndarray:
-    """Sign of the permutation sorting each row of ``A`` (rows of 3 distinct values)."""
-    inv = (A[:, 0] > A[:, 1]).astype(np.int64) + (A[:, 0] > A[:, 2]) + (A[:, 1] > A[:, 2])
-    return 1 - 2 * (inv % 2)
-
-
-def _unique_rows(R: np.ndarray, n: int):
-    """``np.unique(R, axis=0, return_inverse=True)`` for rows of k ≤ 3 vertex ids < ``n``, same result.
-
-    Each row is packed into one int64 (base ``n`` digits), whose numeric order is the rows' lexicographic
-    order, so a 1-D unique gives the same rows, order and inverse — ~10× faster than the row-wise unique
-    (a structured-view sort) on millions of rows.  Falls back to it when the key would overflow.
-    """
-    k = R.shape[1]
-    if n ** k >= 2 ** 63:
-        u, inv = np.unique(R, axis=0, return_inverse=True)
-        return u, inv.ravel()
-    key = np.zeros(len(R), dtype=np.int64)
-    for j in range(k):
-        key = key * n + R[:, j].astype(np.int64)
-    uk, inv = np.unique(key, return_inverse=True)
-    u = np.empty((len(uk), k), dtype=R.dtype)
-    for j in range(k - 1, -1, -1):
-        u[:, j] = uk % n
-        uk = uk // n
-    return u, inv.ravel()
-
-
-class TetComplex:
+class TetComplex(TetOperators):
     """A tetrahedral mesh as a cell complex with DEC operators.
 
     Parameters
@@ -98,104 +59,22 @@ class TetComplex:
     V : (n, 3) float array
         Vertex positions.
     T : (m, 4) int array
-        Tets; reordered in place of a copy so that every tet is positively oriented.  Tets of zero volume are
-        allowed (Qhull slivers); their FEM weights are zero and the clamp of :attr:`star1` keeps stars positive.
+        Tets; reordered in a copy so that every tet is positively oriented.  Tets of zero volume are allowed
+        (Qhull slivers); their FEM weights are zero and the clamp of :attr:`star1` keeps stars positive.
 
     Attributes
     ----------
-    V, T : arrays; ``T`` positively oriented.
-    edges : (nE, 2) int64, ``edges[:, 0] < edges[:, 1]``.
-    faces : (nF, 3) int64, increasing per row.
-    tet_edges : (m, 6) int64 edge ids in the order of ``_EDGE_PAIRS``.
-    tet_faces : (m, 4) int64 face ids, face k opposite local vertex k; ``tet_face_sign`` (m, 4) ±1.
-    face_tets : (nF, 2) int64, the tet on the negative side of the canonical normal (the face points out of it)
-        and the tet on the positive side; -1 on the hull.
-    volumes : (m,) float64.
+    Those of :class:`~gsdf.mesh._tet_ops.TetOperators` (``V``, ``T`` positively oriented, ``volumes``, ``edges``,
+    ``faces``, ``tet_edges``, ``tet_faces``, ``tet_face_sign``, ``face_tets``, ``d0``, ``d1``, ``d2``,
+    :meth:`~gsdf.mesh._tet_ops.TetOperators.edge_weights`), built at once; ``star0``, ``star1``, ``star2``.
     """
 
     def __init__(self, V, T):
         V = as_points(V, "V")
-        T = _as_tets(T, V.shape[0]).copy()
-        a, b, c, d = (V[T[:, k]] for k in range(4))
-        det = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a)
-        neg = det < 0
-        T[neg, 2], T[neg, 3] = T[neg, 3].copy(), T[neg, 2].copy()
-        self.V, self.T = V, T
-        self.volumes = np.abs(det) / 6.0
-        m = T.shape[0]
-        # edges
-        Eall = np.sort(T[:, _EDGE_PAIRS].reshape(-1, 2), axis=1)
-        self.edges, inv = _unique_rows(Eall, V.shape[0])
-        self.tet_edges = inv.reshape(m, 6).astype(np.int64)
-        # faces
-        Floc = T[:, _FACE_LOCAL].reshape(-1, 3)
-        sign = _perm_sign(Floc)
-        self.faces, finv = _unique_rows(np.sort(Floc, axis=1), V.shape[0])
-        self.tet_faces = finv.reshape(m, 4).astype(np.int64)
-        self.tet_face_sign = sign.reshape(m, 4).astype(np.int64)
-        nF = self.faces.shape[0]
-        ft = -np.ones((nF, 2), dtype=np.int64)
-        tid = np.repeat(np.arange(m), 4)
-        side = (sign < 0).astype(np.int64)  # 0: face points out of this tet
-        if (np.bincount(finv * 2 + side, minlength=2 * nF) > 1).any():
-            raise ValueError("T: a face is shared by two tets on the same side (overlapping or inconsistent tets)")
-        ft[finv, side] = tid
-        self.face_tets = ft
-        self.n_vertices, self.n_edges, self.n_faces, self.n_tets = V.shape[0], len(self.edges), nF, m
+        super().__init__(V, _as_tets(T, V.shape[0]))
+        self._build_edges()
+        self._build_faces()                                     # checks that no two tets overlap at a face
         self._star1 = None
-
-    # ------------------------------------------------------------------ incidence
-    @property
-    def d0(self) -> sp.csr_matrix:
-        """(nE, nV) gradient: ``(d0 u)_ab = u_b - u_a``."""
-        nE = self.n_edges
-        r = np.repeat(np.arange(nE), 2)
-        v = np.tile([-1.0, 1.0], nE)
-        return sp.csr_matrix((v, (r, self.edges.ravel())), shape=(nE, self.n_vertices))
-
-    @property
-    def d1(self) -> sp.csr_matrix:
-        """(nF, nE) curl: face (a, b, c) → ab + bc − ac."""
-        Fc = self.faces
-        keys = [np.sort(Fc[:, [0, 1]], 1), np.sort(Fc[:, [1, 2]], 1), np.sort(Fc[:, [0, 2]], 1)]
-        cols = np.stack([self._edge_id(k) for k in keys], axis=1)
-        vals = np.tile([1.0, 1.0, -1.0], (len(Fc), 1))
-        rows = np.repeat(np.arange(len(Fc)), 3)
-        return sp.csr_matrix((vals.ravel(), (rows, cols.ravel())), shape=(len(Fc), self.n_edges))
-
-    @property
-    def d2(self) -> sp.csr_matrix:
-        """(nT, nF) divergence: +1 where the canonical face normal points out of the tet."""
-        rows = np.repeat(np.arange(self.n_tets), 4)
-        return sp.csr_matrix((self.tet_face_sign.ravel().astype(float), (rows, self.tet_faces.ravel())),
-                             shape=(self.n_tets, self.n_faces))
-
-    def _edge_id(self, pairs: np.ndarray) -> np.ndarray:
-        key = self.edges[:, 0] * self.n_vertices + self.edges[:, 1]
-        q = pairs[:, 0] * self.n_vertices + pairs[:, 1]
-        i = np.searchsorted(key, q)
-        return i
-
-    # ------------------------------------------------------------------ metric
-    def fem_tet_weights(self) -> np.ndarray:
-        """(m, 6) P1 FEM edge weights of each tet, ``w_ij = -∫_T ∇λ_i·∇λ_j`` = ``|e_kl| cot θ_kl / 6``.
-
-        ``θ_kl`` is the dihedral angle at the edge opposite ``ij``.  Computed from outward area vectors
-        ``a_i`` of the faces opposite each vertex (``∇λ_i = -a_i / 3|T|``): ``w_ij = -a_i·a_j / (9|T|)``.
-        These are the cotangent weights, not App. C's (notes 2(b).3); they can be negative.
-        """
-        V, T = self.V, self.T
-        A = np.empty((self.n_tets, 4, 3))
-        for k in range(4):
-            i, j, l = _FACE_LOCAL[k]
-            p = V[T[:, i]]
-            A[:, k] = 0.5 * np.cross(V[T[:, j]] - p, V[T[:, l]] - p)
-        dots = np.einsum("tkx,tkx->tk", A[:, _EDGE_PAIRS[:, 0]], A[:, _EDGE_PAIRS[:, 1]])
-        vol = self.volumes
-        out = np.zeros_like(dots)
-        ok = vol > 1e-300
-        out[ok] = -dots[ok] / (9.0 * vol[ok, None])
-        return out
 
     @property
     def star1(self) -> np.ndarray:
@@ -206,7 +85,7 @@ class TetComplex:
         positive diagonal keeps the Hodge decomposition exact.
         """
         if self._star1 is None:
-            w = np.bincount(self.tet_edges.ravel(), self.fem_tet_weights().ravel(), minlength=self.n_edges)
+            w = np.bincount(self.tet_edges.ravel(), self.edge_weights().ravel(), minlength=self.n_edges)
             pos = w[w > 0]
             med = np.median(pos) if pos.size else 1.0
             self._star1 = np.clip(w, 1e-3 * med, 1e3 * med)
@@ -215,7 +94,7 @@ class TetComplex:
     @property
     def star0(self) -> np.ndarray:
         """(nV,) barycentric dual volumes (a quarter of each incident tet); isolated vertices get a tiny floor."""
-        s = np.bincount(self.T.ravel(), np.repeat(self.volumes / 4.0, 4), minlength=self.n_vertices)
+        s = self.vertex_mass()
         pos = s[s > 0]
         return np.maximum(s, 1e-12 * (pos.mean() if pos.size else 1.0))
 
@@ -223,8 +102,7 @@ class TetComplex:
     def star2(self) -> np.ndarray:
         """(nF,) positive ⋆2 = |dual edge| / |face|, dual edge through the centroids of the adjacent tets."""
         Fc = self.faces
-        area = 0.5 * np.linalg.norm(np.cross(self.V[Fc[:, 1]] - self.V[Fc[:, 0]],
-                                             self.V[Fc[:, 2]] - self.V[Fc[:, 0]]), axis=1)
+        area = self.face_areas()
         cen_t = self.V[self.T].mean(axis=1)
         cen_f = self.V[Fc].mean(axis=1)
         L = np.zeros(len(Fc))
@@ -278,7 +156,7 @@ class TetComplex:
 
     def darboux_derivative(self, c: np.ndarray) -> np.ndarray:
         """(nE,) ω_ab = mean over the tets around edge ab of ``c[t, b] - c[t, a]`` (seed 003 Eq. 4, sign fixed)."""
-        i, j = _EDGE_PAIRS[:, 0], _EDGE_PAIRS[:, 1]
+        i, j = EDGE_PAIRS[:, 0], EDGE_PAIRS[:, 1]
         # orient each tet-edge difference along the canonical edge (lower index → higher)
         Ti, Tj = self.T[:, i], self.T[:, j]
         diff = c[:, j] - c[:, i]
@@ -324,11 +202,6 @@ class TetComplex:
         """A :class:`gsdf.dec._hodge.HodgeDecomposition` of 1-forms on this complex (⋆1 = clamped FEM weights)."""
         from gsdf.dec._hodge import HodgeDecomposition
         return HodgeDecomposition(self.d0, self.d1, self.star1, self.star0, self.star2)
-
-    def face_areas(self) -> np.ndarray:
-        """(nF,) triangle areas."""
-        V, Fc = self.V, self.faces
-        return 0.5 * np.linalg.norm(np.cross(V[Fc[:, 1]] - V[Fc[:, 0]], V[Fc[:, 2]] - V[Fc[:, 0]]), axis=1)
 
 
 def correction_chain(K: TetComplex, gamma, eps_start: float = 1.0, eps_end: float = 1e-2, eps_factor: float = 4.0,

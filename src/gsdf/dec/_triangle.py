@@ -1,10 +1,11 @@
 """Discrete exterior calculus on a manifold, consistently oriented triangle mesh.
 
-Owns: the coboundaries d0 (edges × vertices) and d1 (faces × edges) for the canonical edge orientation of
-:mod:`gsdf.mesh._connectivity`; diagonal Hodge stars ⋆0 (lumped barycentric area), ⋆1 (cotan weights, clamped),
-⋆2 (inverse face area); jump ("reduced") coordinates of an edge chain; the jump Laplace solve; the Darboux
-derivative. The formulas follow the thesis (seed 000) §2.2–2.3 and §6.1 as worked out in the spec notes
-(``wave2-swn-recon-voxel.md`` §1(b), steps ① and ②).
+Owns: the diagonal Hodge stars ⋆0 (lumped barycentric area), ⋆1 (cotan weights, clamped), ⋆2 (inverse face
+area) of the thesis (seed 000) §2.2; jump ("reduced") coordinates of an edge chain; the jump Laplace solve; the
+Darboux derivative (§2.3.3, §6.1), as worked out in the spec notes (``wave2-swn-recon-voxel.md`` §1(b), steps ①
+and ②). Geometry, d0, d1 and the cotan Laplacian come from :class:`gsdf.mesh._triangle_ops.TriangleOperators`
+(its cotangents are those of Feng & Crane 2024, Eq. 5), the connectivity from
+:class:`gsdf.mesh._connectivity.MeshTopology`.
 
 Conventions
 -----------
@@ -13,8 +14,8 @@ Conventions
 - a jump chain ``J`` (per edge, along the canonical direction lo -> hi) means: corner values in the left face of
   the edge (the face containing lo -> hi) exceed those in the right face by ``J_e`` ("+1 crossing from the
   right", thesis §2.3.3);
-- "Mollify" (spec §1(b), as the authors' demo does): halfedge cotans are clamped to [1e-3, 1e3], NaN or inf
-  become 1, so every ⋆1 entry is positive even on needle triangles.
+- "Mollify" (spec §1(b), as the authors' demo does): cotans are clamped to [1e-3, 1e3], NaN or inf become 1, so
+  every ⋆1 entry is positive even on needle triangles.
 
 Example
 -------
@@ -35,14 +36,13 @@ import scipy.sparse as sp
 from gsdf._checks import as_mesh
 from gsdf.linalg import Factorization, cached_factorization
 from gsdf.mesh._connectivity import MeshTopology
+from gsdf.mesh._triangle_ops import NEXT, PREV, TriangleOperators
 from gsdf.linalg._graph import forest_potentials
 
 __all__ = ["TriangleDEC", "JumpCoordinates", "COT_CLAMP"]
 
 COT_CLAMP = (1e-3, 1e3)
 REG = 1e-8          # diagonal added to the Laplacians before factorization (spec §1(b) "Mollify")
-NEXT = np.array([1, 2, 0])
-PREV = np.array([2, 0, 1])
 
 
 @dataclass
@@ -62,7 +62,7 @@ class JumpCoordinates:
     walked: np.ndarray
 
 
-class TriangleDEC:
+class TriangleDEC(TriangleOperators):
     """DEC operators of a manifold, consistently oriented triangle mesh (built once).
 
     Parameters
@@ -73,14 +73,12 @@ class TriangleDEC:
 
     Attributes
     ----------
+    Those of :class:`~gsdf.mesh._triangle_ops.TriangleOperators` (``areas``, ``edge_len``, ``cot``, ``angles``,
+    ``edges``, ``face_edges``, ``face_edge_signs``, ``d0``, ``d1``, …), and
     topology : MeshTopology
-    edges : (nE, 2); face_edges, face_edge_signs : (m, 3)
-    d0 : (nE, n) csr, ``(d0 u)_e = u_hi - u_lo``
-    d1 : (m, nE) csr, ``(d1 ω)_f = Σ_k sign_fk ω_{e_fk}``
-    cot : (m, 3) clamped cotan of the angle opposite each slot; halfedge weight ``0.5 * cot``
-    star0 : (n,) lumped (barycentric) vertex areas; star1 : (nE,) cotan edge weights; star2 : (m,) 1/area
-    face_area : (m,) float
-    edge_length : (nE,) float
+    cot_clamped : (m, 3) per-corner cotangents clamped to ``COT_CLAMP`` (non-finite ones set to 1)
+    halfedge_weight : (m, 3) ``½ cot_clamped`` of the angle opposite every slot
+    star0 : (n,) lumped (barycentric) vertex areas; star1 : (nE,) clamped cotan edge weights; star2 : (m,) 1/area
 
     Example
     -------
@@ -93,54 +91,25 @@ class TriangleDEC:
 
     def __init__(self, V, F, topology: MeshTopology | None = None):
         V, F = as_mesh(V, F)
-        self.V, self.F = V, F
         topo = topology if topology is not None else MeshTopology(F, len(V))
         topo.require_manifold("F")
         topo.require_oriented("F")
-        self.topology = topo
-        n, m, nE = len(V), len(F), topo.n_edges
-        self.n_vertices, self.n_faces, self.n_edges = n, m, nE
-        self.edges, self.face_edges, self.face_edge_signs = topo.edges, topo.face_edges, topo.face_edge_signs
-        P = V[F]
-        Evec = P[:, NEXT] - P                               # slot vectors v_k -> v_{k+1}
-        cr = np.cross(Evec[:, 0], -Evec[:, 2])
-        area2 = np.linalg.norm(cr, axis=1)
-        self.face_area = 0.5 * area2
-        # angle opposite slot k sits at corner k+2, between -E[k+1] and E[k+2]
-        u, w = -Evec[:, NEXT], Evec[:, PREV]
-        dot = np.einsum("fkj,fkj->fk", u, w)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            cot = dot / area2[:, None]
-        cot = np.where(np.isfinite(cot), cot, 1.0)
-        self.cot = np.clip(cot, *COT_CLAMP)
-        self.halfedge_weight = 0.5 * self.cot
-        fe = self.face_edges.ravel()
-        self.star1 = np.bincount(fe, weights=self.halfedge_weight.ravel(), minlength=nE)
-        self.star0 = np.bincount(F.ravel(), weights=np.repeat(self.face_area / 3.0, 3), minlength=n)
+        super().__init__(V, F, topology=topo)
+        cot = np.where(np.isfinite(self.cot), self.cot, 1.0)
+        self.cot_clamped = np.clip(cot, *COT_CLAMP)
+        self.halfedge_weight = 0.5 * self.cot_clamped[:, PREV]   # slot k is opposite corner k+2
+        self.star1 = np.bincount(self.face_edges.ravel(), weights=self.halfedge_weight.ravel(),
+                                 minlength=self.n_edges)
+        self.star0 = self.vertex_mass()
         with np.errstate(divide="ignore"):
-            self.star2 = np.where(self.face_area > 0, 1.0 / np.maximum(self.face_area, 1e-300), 1.0)
-        self.edge_length = np.linalg.norm(V[self.edges[:, 1]] - V[self.edges[:, 0]], axis=1)
-        r = np.arange(nE)
-        self.d0 = sp.csr_matrix((np.concatenate([-np.ones(nE), np.ones(nE)]),
-                                 (np.concatenate([r, r]), self.edges.T.ravel())), shape=(nE, n))
-        self.d1 = sp.csr_matrix((self.face_edge_signs.ravel().astype(np.float64),
-                                 (np.repeat(np.arange(m), 3), fe)), shape=(m, nE))
+            self.star2 = np.where(self.areas > 0, 1.0 / np.maximum(self.areas, 1e-300), 1.0)
         self._fact_cache: dict = {}
 
     # ------------------------------------------------------------------------------------------- operators
     def laplacian(self, exclude: np.ndarray | None = None) -> sp.csr_matrix:
-        """Cotan Laplacian L (n × n, positive semidefinite) from the clamped halfedge weights, optionally without
-        the halfedges touching the vertices where ``exclude`` (n,) bool is set (their rows are then empty)."""
-        F, w = self.F, self.halfedge_weight
-        i, j = F.ravel(), F[:, NEXT].ravel()
-        w = w.ravel()
-        if exclude is not None and exclude.any():
-            keep = ~(exclude[i] | exclude[j])
-            i, j, w = i[keep], j[keep], w[keep]
-        n = self.n_vertices
-        L = sp.coo_matrix((np.concatenate([-w, -w, w, w]),
-                           (np.concatenate([i, j, i, j]), np.concatenate([j, i, i, j]))), shape=(n, n))
-        return L.tocsr()
+        """Cotan Laplacian L (n × n, positive semidefinite) from the clamped cotangents, optionally without the
+        halfedges touching the vertices where ``exclude`` (n,) bool is set (their rows are then empty)."""
+        return self.cotan_laplacian(self.cot_clamped, exclude)
 
     def _factor(self, exclude: np.ndarray):
         key = np.flatnonzero(exclude).tobytes()
@@ -244,15 +213,6 @@ class TriangleDEC:
             ends = ends.astype(bool)
         return J, ends
 
-    @property
-    def corner_angles(self) -> np.ndarray:
-        """(m, 3) interior angle of every corner (radians), computed once."""
-        if getattr(self, "_corner_angles", None) is None:
-            from gsdf.mesh._pseudonormals import corner_angles
-
-            self._corner_angles = corner_angles(self.V, self.F)
-        return self._corner_angles
-
     def _corner_offsets(self, J, ends, branch: bool) -> JumpCoordinates:
         topo = self.topology
         n, m = self.n_vertices, self.n_faces
@@ -291,7 +251,7 @@ class TriangleDEC:
             vert = F[fi[a], ki[a]]
             sigma = np.bincount(vert[ccw], weights=d[ccw], minlength=n)       # total jump around each vertex
             sigma = np.where(ends, sigma, 0.0)
-            ang = self.corner_angles
+            ang = self.angles
             big_theta = np.bincount(F.ravel(), weights=ang.ravel(), minlength=n)
             ang = np.where(big_theta[F] > 0, ang, 1.0)           # all-degenerate fan: spread by face count
             big_theta = np.bincount(F.ravel(), weights=ang.ravel(), minlength=n)

@@ -36,7 +36,7 @@ tests/heat/test_core.py runs it against the exact distance to a circle)::
 
     class FlatVertexDomain(VertexSurfaceDomain):
         def __init__(self, V, F):
-            self.ops = TriangleMeshOperators(V, F)
+            self.ops = TriangleOperators(V, F)
             L = self.ops.cotan_laplacian()
             N = np.tile([0.0, 0, 1], (len(V), 1))
             e1, e2 = tangent_frames(N)

@@ -1,7 +1,7 @@
 """Combinatorial topology of triangle meshes: unique edges, adjacency, components, Euler characteristic, checks.
 
 This module is the one place in gsdf that extracts unique edges from a face array. Conventions (shared with
-``heat/surface/operators.py`` and ``gsdf.dec``):
+the operators of :mod:`gsdf.mesh._triangle_ops` and with :mod:`gsdf.dec`):
 
 - face slot ``k`` of face ``f`` is the halfedge ``F[f, k] -> F[f, (k + 1) % 3]`` (the corner opposite it is
   ``(k + 2) % 3``);

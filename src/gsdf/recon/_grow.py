@@ -33,11 +33,13 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from gsdf.mesh._tet_ops import EDGE_PAIRS
+
 __all__ = ["grow_regions", "carve_regions", "region_boundary"]
 
-# local vertex pair of each tet edge, same order as dec.tet._EDGE_PAIRS
+# local edge index of each pair of local tet vertices (gsdf.mesh._tet_ops.EDGE_PAIRS)
 _PAIR_TO_EDGE = np.full((4, 4), -1, dtype=np.int64)
-for _k, (_a, _b) in enumerate([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]):
+for _k, (_a, _b) in enumerate(EDGE_PAIRS.tolist()):
     _PAIR_TO_EDGE[_a, _b] = _PAIR_TO_EDGE[_b, _a] = _k
 
 

@@ -57,6 +57,7 @@ from scipy.spatial import Delaunay, QhullError, cKDTree
 
 from gsdf._checks import choice, integer, progress_callback
 from gsdf.dec._tet import TetComplex
+from gsdf.mesh._tet_ops import signed_volumes
 from gsdf.recon._cloud import dense_points, on_side, on_surface, pca_normals, prefilter, prepare_cloud
 from gsdf.recon._grow import carve_regions, grow_regions, region_boundary
 from gsdf.recon._orient import face_chain, orient_normals
@@ -288,8 +289,7 @@ def _tetrahedralise(Xi):
     try:
         K = TetComplex(Vall, Tt)
     except ValueError:  # pragma: no cover - remaining flat tets: drop them (their faces become a slit)
-        a, b, c, d = (Vall[Tt[:, k]] for k in range(4))
-        vol = np.abs(np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a))
+        vol = np.abs(signed_volumes(Vall, Tt))
         K = TetComplex(Vall, Tt[vol > 1e-10 * np.median(vol)])
     return K, S, spacing
 

@@ -139,7 +139,7 @@ def gap_shift(dec, wf, curve, ends, s, eps=GAP_EPS, max_edges=GAP_MAX_EDGES):
         return shift, 0, 0
     # the graph of the edges off the curves, weighted ℓ / (|Δw| + eps): cheap where w changes fast
     dw = np.where(inter, np.abs(wf[A] - wf[B]), 0.0)
-    wt = dec.edge_length / (dw + eps)
+    wt = dec.edge_len / (dw + eps)
     free = np.flatnonzero(~curve)
     r = np.concatenate([E[free, 0], E[free, 1]])
     c = np.concatenate([E[free, 1], E[free, 0]])

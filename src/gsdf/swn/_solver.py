@@ -497,7 +497,7 @@ class SurfaceWindingNumbers:
         if len(ce):
             right = np.where(g[ce] > 0, topo.edge_faces[ce, 1], topo.edge_faces[ce, 0])
             labs, inv = np.unique(W[right], return_inverse=True)
-            k = labs[np.argmax(np.bincount(inv, weights=dec.edge_length[ce]))]
+            k = labs[np.argmax(np.bincount(inv, weights=dec.edge_len[ce]))]
         else:
             k = 0.0
         W = (W - k).astype(np.int64)
@@ -601,13 +601,13 @@ class SurfaceWindingNumbers:
         dec, topo = self.dec, self.topology
         ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
         b = g[ce] - Jv[ce]
-        wt = dec.edge_length[ce] * np.abs(b) * (np.round(b) != 0)      # edges whose labels should jump
-        if len(ce) and wt.sum() > 1e-9 * dec.edge_length[ce].sum():
+        wt = dec.edge_len[ce] * np.abs(b) * (np.round(b) != 0)      # edges whose labels should jump
+        if len(ce) and wt.sum() > 1e-9 * dec.edge_len[ce].sum():
             mid = 0.5 * (wf[topo.edge_faces[ce, 0]] + wf[topo.edge_faces[ce, 1]])
             c = circular_mean(mid, wt)
             if c is not None:
                 return c - 0.5
-        c = circular_mean(wf, dec.face_area)
+        c = circular_mean(wf, dec.areas)
         return 0.0 if c is None else c
 
     # ------------------------------------------------------------------------------------------ residuals
@@ -653,7 +653,7 @@ class SurfaceWindingNumbers:
             J2, obj2, s2 = self._residual_full(gamma, g, eps, left, ends, forbid=used)
         except ValueError:              # the second LP failed (see above): the LP's own cycle
             return Jv, obj, lp_s + time.perf_counter() - t0
-        ell = self.dec.edge_length
+        ell = self.dec.edge_len
         on = g != 0
 
         def share(J):
@@ -672,7 +672,7 @@ class SurfaceWindingNumbers:
         d = self._edge_offsets(vinit, interior)
         gi = g[interior]
         on = gi != 0
-        w = dec.edge_length[interior] * np.where(on, eps, 1.0)
+        w = dec.edge_len[interior] * np.where(on, eps, 1.0)
         # "no extra loops": 0 ≤ g·Jv ≤ g² on the input's edges
         lo = np.where(on, np.minimum(0.0, gi), -np.inf)
         hi = np.where(on, np.maximum(0.0, gi), np.inf)
@@ -717,7 +717,7 @@ class SurfaceWindingNumbers:
         E, n = dec.edges, dec.n_vertices
         free = (g == 0)
         # endpoints of other curves may be passed through; the input's own edges may not
-        Gm = sp.coo_matrix((dec.edge_length[free], (E[free, 0], E[free, 1])), shape=(n, n)).tocsr()
+        Gm = sp.coo_matrix((dec.edge_len[free], (E[free, 0], E[free, 1])), shape=(n, n)).tocsr()
         D, pred = dijkstra(Gm, directed=False, indices=pos, return_predecessors=True)
         need_p = np.rint(div[pos]).astype(np.int64)
         need_n = np.rint(-div[neg]).astype(np.int64)
@@ -766,11 +766,11 @@ class SurfaceWindingNumbers:
         inter = ca != cb
         Jv = np.zeros(dec.n_edges)
         Jv[ce] = d                                              # intra-piece cut edges: fixed jumps
-        obj = float(np.dot(dec.edge_length[ce][~inter], np.abs(d[~inter])))
+        obj = float(np.dot(dec.edge_len[ce][~inter], np.abs(d[~inter])))
         lp_s = 0.0
         if inter.any():
             r = dual_graph_l1(int(ncomp), np.stack([ca[inter], cb[inter]], 1), d[inter],
-                              dec.edge_length[ce][inter], time_limit=time_limit)
+                              dec.edge_len[ce][inter], time_limit=time_limit)
             Jv[ce[inter]] = r.jumps
             obj += r.objective
             lp_s = r.seconds

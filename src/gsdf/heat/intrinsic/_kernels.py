@@ -17,7 +17,7 @@ operators identify edges by their vertex pair); in these rare cases the result i
 flips".
 
 Faces are laid out in 2D (``layout``): slot 0 along +x, the third vertex above it, z = 0, so the operators of
-:class:`~gsdf.heat.triangle._operators.TriangleMeshOperators` (which only need per-face corner positions) work
+:class:`~gsdf.mesh._triangle_ops.TriangleOperators` (which only need per-face corner positions) work
 unchanged in these per-face frames.
 """
 
@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from gsdf.heat.triangle._operators import NEXT
+from gsdf.mesh._connectivity import unique_edges
+from gsdf.mesh._triangle_ops import NEXT
 
 
 @njit(cache=True)
@@ -344,14 +345,14 @@ def _trace(Fv, Lay, nbr_f, nbr_s, f, b, d, tol, max_steps, out_f, out_b):
 
 def _initial_state(V, F):
     """Arrays of the flip algorithm for the input mesh: Fv, FL, FE, EF, ES, the sorted edge keys."""
-    n, m = len(V), len(F)
+    n = len(V)
     Fv = np.array(F, dtype=np.int64, copy=True)
     FL = np.linalg.norm(V[F[:, NEXT]] - V[F], axis=2)
-    a, b = Fv, Fv[:, NEXT]
-    key = (np.minimum(a, b) * n + np.maximum(a, b)).ravel()
-    uniq, inv = np.unique(key, return_inverse=True)
+    b = Fv[:, NEXT]
+    edges, FE, _ = unique_edges(Fv, n)
+    uniq = edges[:, 0] * n + edges[:, 1]                   # sorted edge keys lo * n + hi
+    inv = FE.ravel()
     nE = len(uniq)
-    FE = inv.reshape(m, 3).astype(np.int64)
     cnt = np.bincount(inv, minlength=nE)
     order = np.argsort(inv, kind="stable")
     start = np.concatenate([[0], np.cumsum(cnt)])

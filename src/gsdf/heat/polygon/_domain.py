@@ -43,7 +43,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from gsdf import _checks
-from gsdf.heat.triangle._operators import TriangleMeshOperators
+from gsdf.mesh._triangle_ops import TriangleOperators
 from gsdf.heat.polygon._kernels import (
     connection_values,
     fine_divergence,
@@ -300,11 +300,11 @@ class PolygonDomain(VertexSurfaceDomain):
         super().__init__(V, L, self.M, Lconn, N, e1, e2, t_coef * self.mean_edge ** 2)
 
     @property
-    def fine_ops(self) -> TriangleMeshOperators:
+    def fine_ops(self) -> TriangleOperators:
         """Vertex operators of the refined triangle mesh (built on first access; the solves use the kernel's
         normals and divergence weights of the same triangles)."""
         if self._fine_ops is None:
-            self._fine_ops = TriangleMeshOperators(self.V_refined, self.F_refined, edges=False)
+            self._fine_ops = TriangleOperators(self.V_refined, self.F_refined, edges=False)
         return self._fine_ops
 
     def gather(self, X) -> np.ndarray:

@@ -331,7 +331,7 @@ def polygon_assembly(Vr, start, corners, vid, wflat, n, thresh):
     :func:`polygon_csr_pattern`); mass : (n,); An : (n, 3) area-weighted normal sums;
     good : (k,) bool, the fine triangles (triangles, then the fans polygon by polygon) that are kept;
     fn : (k, 3) their unit normals; fG : (k, 3, 3) ``|f| ∇λ_c = ½ n × (v_{c+2} − v_{c+1})`` per corner c
-    (the divergence weights of :meth:`TriangleMeshOperators.divergence`).
+    (the divergence weights of :meth:`gsdf.mesh._triangle_ops.TriangleOperators.divergence`).
     """
     m = len(start) - 1
     tot = 0

@@ -1,5 +1,5 @@
-"""Tetrahedral meshes as a signed-heat domain (Feng & Crane 2024, §8.1, App. B); meshing and operators in
-:mod:`gsdf.heat.tet._mesh`.
+"""Tetrahedral meshes as a signed-heat domain (Feng & Crane 2024, §8.1, App. B); meshing in
+:mod:`gsdf.heat.tet._mesh`, operators from :class:`gsdf.mesh._tet_ops.TetOperators`.
 
 Step I    per kept tet: the Yukawa sum at its barycenter (:class:`~gsdf.heat._yukawa.YukawaTree`), the closed
           form of the short-time heat flow in R³ that the authors' implementation also uses on tets.
@@ -26,7 +26,7 @@ import scipy.sparse as sp
 from gsdf.linalg import SPDSolver
 from gsdf.heat._core import FactorizedPoisson
 from gsdf.heat._sources import Sources
-from gsdf.heat.tet._mesh import p1_laplacian, weak_divergence
+from gsdf.mesh._tet_ops import TetOperators
 from gsdf.heat._domain import HeatDomain
 
 __all__ = ["TetDomain", "tet_interpolation_rows"]
@@ -68,18 +68,19 @@ class TetDomain(HeatDomain):
     Parameters
     ----------
     P, T, D : vertices (n, 3), tets (m, 4), the scipy Delaunay locator (or None);
-    keep : (m,) bool, tets used by the operators (quality ≥ min_quality); vol, G : volumes and barycentric
-    gradients of all tets; n_input : number of input points (the first vertices); comp : (n_input,) their
-    connected components; t : diffusion time; theta : Yukawa tree tolerance.
+    keep : (m,) bool, tets used by the operators (:func:`~gsdf.heat.tet._mesh.tet_quality` above the front-end's
+    threshold); n_input : number of input points (the first vertices); comp : (n_input,) their connected
+    components; t : diffusion time; theta : Yukawa tree tolerance.
     """
 
     heat_form = "direct"
     difference_order = "first"
     shift_hard_zero = False
 
-    def __init__(self, P, T, D, keep, vol, G, n_input, comp, t, theta=1.5):
-        self.P, self.T, self.D, self.keep, self.vol, self.G = P, T, D, keep, vol, G
-        self.Tk, self.volk, self.Gk = T[keep], vol[keep], G[keep]
+    def __init__(self, P, T, D, keep, n_input, comp, t, theta=1.5):
+        self.P, self.T, self.D, self.keep = P, T, D, keep
+        self.Tk = T[keep]
+        self.ops = TetOperators(P, self.Tk)
         self.n_nodes = len(P)
         self.n_input, self.comp = int(n_input), np.asarray(comp)
         self.t, self.theta = float(t), theta
@@ -113,15 +114,15 @@ class TetDomain(HeatDomain):
         return X
 
     def divergence(self, Y):
-        return weak_divergence(self.Tk, self.volk, self.Gk, Y, self.n_nodes)
+        return self.ops.divergence(Y)
 
     def laplacian(self):
         if self._K is None:
-            self._K = p1_laplacian(self.Tk, self.volk, self.Gk, self.n_nodes)
+            self._K = self.ops.cotan_laplacian()
         return self._K
 
     def mass(self):
-        M = np.bincount(self.Tk.ravel(), weights=np.repeat(self.volk / 4.0, 4), minlength=self.n_nodes)
+        M = self.ops.vertex_mass()
         return np.where(M > 0, M, M[M > 0].mean() if (M > 0).any() else 1.0)
 
     def poisson_solver(self):

@@ -1,5 +1,8 @@
-"""Meshing and operators of the tetrahedral signed-heat domain (Feng & Crane 2024, §8.1 and App. B). The steps
-run in :mod:`gsdf.heat._core` over :class:`gsdf.heat.tet._domain.TetDomain`; ``solve_tet`` is in :mod:`.solve`.
+"""The tet meshes of the tetrahedral signed-heat domain (Feng & Crane 2024, §8.1 and App. B): graded Delaunay or
+TetGen meshes of the box around the input, and the quality that decides which tets the operators use. The
+operators (P1 stiffness, weak divergence, lumped masses) are :class:`gsdf.mesh._tet_ops.TetOperators`; the steps
+run in :mod:`gsdf.heat._core` over :class:`gsdf.heat.tet._domain.TetDomain`, the front-end is
+:func:`gsdf.heat.volume._solve.solve_tet`.
 
 Mesh (``mesher="delaunay"``, default, no extra dependency). The vertex set is
 
@@ -8,36 +11,15 @@ Mesh (``mesher="delaunay"``, default, no extra dependency). The vertex set is
   exactly at vertices of the tet mesh and holds along the whole input, not only at its corners;
 * an adaptive background lattice, graded like an octree: body-centred cubic (BCC) points of spacing h within
   2h of Z, 2h up to 4h, 4h up to 8h, … (the distance to Z by a k-d tree), the coarsest of ``levels`` levels
-  filling the box; lattice points closer than 0.35 h to Z are dropped. h is the grid spacing the resolution
-  gives. ``levels=2`` (spacing ≤ 2h) is the default: coarser far fields cost accuracy wherever the field is
-  evaluated (mean |error| at the 32³ grid nodes of a sphere: 0.0028 with 2 levels, 0.0061 with 3, 0.0111
-  with 8; uniform h: 0.0019 at 2.5× the vertices);
+  filling the box (the front-end uses 2: spacing ≤ 2h); lattice points closer than 0.35 h to Z are dropped.
+  h is the grid spacing the resolution gives;
 * the box corners;
 
 tetrahedralized by Delaunay (scipy/Qhull). Delaunay of a dense surface sample creates flat tets whose four
-vertices lie (almost) on the input, and Qhull leaves zero-volume tets on the box faces; tets of quality
-(6√2 |T| / l_rms³, 1 for the regular tet) below ``min_quality`` are left out of the operators (with the
-"zero" constraint such tets only touch fixed vertices anyway). ``mesher="tetgen"`` uses the optional
-``tetgen`` package (AGPL, not a dependency: ``pip install tetgen``) for a conforming constrained Delaunay
-mesh of the input inside the box.
-
-Step I   ``step1="yukawa"`` (default): X per tet = Σ_f |f| N_f G_t(c_T, b_f) at the tet barycenters c_T, the
-         closed form of the short-time heat flow in R³ that the authors' implementation also uses on tets,
-         summed by the tree of :mod:`.yukawa`. ``step1="heat"``: the seed's Crouzeix–Raviart solve
-         (M + tL) X_t = X⁰ on the faces, M Eq. 23, L Eq. 21 (assembled as 9 |T| ∇λ_a·∇λ_b, equal to the
-         cotangent form), sources by point quadrature in the containing tet (exactly the seed's
-         X⁰ = Σ |ijk| N_ijk ψ_ijk when the source point is a barycenter of a tet face), X per tet = mean of its
-         four face values (App. B.2).
-Step II  Y = X / |X| per tet.
-Step III φ on vertices: the P1 (cotangent) Laplacian against the divergence of Eq. 22 in weak form,
-         b_i = Σ_T |T| ∇λ_i · Y_T, natural Neumann boundary on the box.
-Level set ("zero", default): φ = 0 exactly on every input point (Dirichlet rows, the seed's §8.1 choice);
-         "multiple": φ constant on each connected component of the input (one unknown per component), then
-         shifted so its area-weighted mean over the sources is 0; "none": only that shift.
-
-Linear algebra: the Step III matrix is symmetric positive definite after the constraint (or one pinned
-vertex) and is factorized once by CHOLMOD (``cholespy``, when installed) or SuperLU; the CR system of
-``step1="heat"`` likewise, with three right-hand sides (pyamg-preconditioned CG above ``amg_above`` faces).
+vertices lie (almost) on the input, and Qhull leaves zero-volume tets on the box faces; tets of low quality
+(:func:`tet_quality`, 1 for the regular tet) are left out of the operators (with the "zero" constraint such tets
+only touch fixed vertices anyway). ``mesher="tetgen"`` uses the optional ``tetgen`` package (AGPL, not a
+dependency: ``pip install tetgen``) for a conforming constrained Delaunay mesh of the input inside the box.
 """
 
 from __future__ import annotations
@@ -46,7 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import Delaunay, cKDTree
 
-from gsdf.linalg import SPDSolver
+from gsdf.mesh._tet_ops import EDGE_PAIRS, signed_volumes
 
 BYTES_PER_TET_VERTEX = 3000  # ~6.5 tets per vertex, sparse P1 matrix and its Cholesky factor
 
@@ -178,56 +160,15 @@ def input_points(kind: str, X, F, h: float, surface_spacing: float = 0.5):
     return Zu, cu.ravel()
 
 
-# ----------------------------------------------------------------------------------------------- operators
-def tet_geometry(P, T):
-    """Signed-volume-free geometry: volumes (m,), barycentric gradients ∇λ (m, 4, 3), qualities (m,)."""
-    A = P[T[:, 1:]] - P[T[:, :1]]  # (m, 3, 3) rows = edges from vertex 0
-    det = np.linalg.det(A)
-    vol = np.abs(det) / 6.0
-    e = np.concatenate([A, P[T[:, [2, 3, 3]]] - P[T[:, [1, 1, 2]]]], axis=1)
-    lrms = np.sqrt((e ** 2).sum(axis=2).mean(axis=1))
-    q = 6.0 * np.sqrt(2.0) * vol / np.maximum(lrms, 1e-300) ** 3
-    ok = vol > 1e-14 * np.maximum(lrms, 1e-300) ** 3
-    G = np.zeros((len(T), 4, 3))
-    inv = np.linalg.inv(A[ok])  # columns are gradients of λ1..λ3
-    G[ok, 1:] = np.transpose(inv, (0, 2, 1))
-    G[ok, 0] = -G[ok, 1:].sum(axis=1)
-    vol[~ok] = 0.0
-    q[~ok] = 0.0
-    return vol, G, q
-
-
-def _assemble(T_dofs, local, n):
-    m = T_dofs.shape[1]
-    rows = np.repeat(T_dofs, m, axis=1).ravel()
-    cols = np.tile(T_dofs, (1, m)).ravel()
-    return sp.csr_matrix((local.ravel(), (rows, cols)), shape=(n, n))
-
-
-def p1_laplacian(T, vol, G, n):
-    """P1 (cotangent) stiffness K_ij = Σ_T |T| ∇λ_i · ∇λ_j (positive semidefinite)."""
-    return _assemble(T, np.einsum("tai,tbi->tab", G, G) * vol[:, None, None], n)
-
-
-def cr_operators(T, vol, G):
-    """Crouzeix–Raviart faces, tet→face map (face a opposite vertex a), Laplacian (Eq. 21), mass (Eq. 23)."""
-    opp = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
-    Fall = np.sort(T[:, opp], axis=2).reshape(-1, 3)
-    faces, finv = np.unique(Fall, axis=0, return_inverse=True)
-    TF = finv.reshape(-1, 4)
-    nF = len(faces)
-    GG = np.einsum("tai,tbi->tab", G, G) * vol[:, None, None]
-    Lcr = _assemble(TF, 9.0 * GG, nF)  # ψ_a = 1 − 3λ_a: ∇ψ_a·∇ψ_b = 9 ∇λ_a·∇λ_b
-    Mloc = np.full((4, 4), -1.0 / 20.0) + np.eye(4) * (2.0 / 5.0 + 1.0 / 20.0)
-    Mcr = _assemble(TF, vol[:, None, None] * Mloc[None], nF)
-    return faces, TF, Lcr, Mcr
-
-
-def weak_divergence(T, vol, G, Y, n):
-    """b_i = Σ_T |T| ∇λ_i · Y_T (Eq. 22 integrated against the hat functions)."""
-    b = np.zeros(n)
-    np.add.at(b, T.ravel(), (vol[:, None] * np.einsum("tai,ti->ta", G, Y)).ravel())
-    return b
+# ----------------------------------------------------------------------------------------------- quality
+def tet_quality(P, T) -> np.ndarray:
+    """Quality ``6√2 |T| / l_rms³`` of every tet (1 for the regular tet, 0 for flat ones), shape (m,); tets whose
+    volume is below 1e-14 l_rms³ get 0."""
+    vol = np.abs(signed_volumes(P, T)) / 6.0
+    e = P[T[:, EDGE_PAIRS[:, 1]]] - P[T[:, EDGE_PAIRS[:, 0]]]              # (m, 6, 3)
+    lrms = np.maximum(np.sqrt((e ** 2).sum(axis=2).mean(axis=1)), 1e-300)
+    q = 6.0 * np.sqrt(2.0) * vol / lrms ** 3
+    return np.where(vol > 1e-14 * lrms ** 3, q, 0.0)
 
 
 # ----------------------------------------------------------------------------------------------- meshing
@@ -285,30 +226,3 @@ def tetgen_mesh(Z, F_in, lo, hi, h, quality: float = 1.5):
         raise ValueError("tetgen did not preserve the input points (self-intersecting input?); "
                          'use mesher="delaunay"')
     return nodes, np.asarray(elem, np.int64)[:, :4], None
-
-
-def cr_heat(src, P, T, D, keep, vol, G, tt, amg_above):
-    """Step I of the seed on Crouzeix–Raviart faces; returns X per kept tet (mean of its face values)."""
-    ok = keep  # the same tets as Step III (slivers make M + tL numerically indefinite)
-    faces, TF, Lcr, Mcr = cr_operators(T[ok], vol[ok], G[ok])
-    nF = len(faces)
-    okidx = np.flatnonzero(ok)
-    pos = np.full(len(T), -1)
-    pos[okidx] = np.arange(len(okidx))
-    s = D.find_simplex(src.B) if D is not None else np.full(len(src.B), -1)  # tetgen: nearest centroid
-    bad = (s < 0) | (pos[np.maximum(s, 0)] < 0)
-    if bad.any():  # outside / in a degenerate tet: the kept tet with the nearest centroid
-        s[bad] = okidx[cKDTree(P[T[okidx]].mean(axis=1)).query(src.B[bad])[1]]
-    si = pos[s]
-    A = P[T[s, 1:]] - P[T[s, :1]]
-    b3 = np.linalg.solve(np.transpose(A, (0, 2, 1)), (src.B - P[T[s, 0]])[:, :, None])[:, :, 0]
-    lam = np.column_stack([1.0 - b3.sum(axis=1), b3])
-    theta = 1.0 - 3.0 * lam  # CR basis values at the source point
-    X0 = np.zeros((nF, 3))
-    for a in range(4):
-        np.add.at(X0, TF[si, a], theta[:, a, None] * src.W)
-    A1 = (Mcr + tt * Lcr).tocsr()
-    Xf = SPDSolver(A1, direct_max=amg_above).solve(X0)  # factorized up to amg_above faces, CG above
-    XT = np.zeros((len(T), 3))
-    XT[okidx] = Xf[TF].mean(axis=1)
-    return XT[keep]

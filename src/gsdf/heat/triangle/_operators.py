@@ -1,8 +1,7 @@
-"""Discrete operators of the signed heat method on triangle meshes (Feng & Crane 2024, §5).
-
-Everything is assembled per face with vectorized numpy and summed into scipy.sparse matrices, so the operators
-are oblivious to nonmanifold edges/vertices and to boundary (§9.4): an edge shared by k faces simply receives k
-contributions.
+"""The Crouzeix–Raviart vector heat operators of the signed heat method on triangle meshes (Feng & Crane 2024,
+§5.2–5.4): the complex edge bases, the CR connection Laplacian (Eqs. 8–9), the vector heat matrix (Eq. 12), and
+the maps between edge vectors and face vectors. Geometry, connectivity, the cotan Laplacian, masses and the
+divergence come from :class:`gsdf.mesh._triangle_ops.TriangleOperators`.
 
 Conventions
 -----------
@@ -26,14 +25,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from gsdf.linalg._assembly import coo_to_csr
-from gsdf.mesh._connectivity import unique_edges
+from gsdf.mesh._triangle_ops import NEXT, TriangleOperators
 
-NEXT = np.array([1, 2, 0])
-PREV = np.array([2, 0, 1])
+__all__ = ["TriangleMeshOperators"]
 
 
-class TriangleMeshOperators:
-    """Topology, geometry and sparse operators of a triangle mesh, built once.
+class TriangleMeshOperators(TriangleOperators):
+    """:class:`~gsdf.mesh._triangle_ops.TriangleOperators` with the Crouzeix–Raviart vector heat operators.
 
     ``point_weight`` (class default 1.0) is the length a vertex point source (App. A.1, Eq. 19: unit
     vectors, no length) weighs against the length-weighted curve sources, in these operators' units: the
@@ -41,22 +39,15 @@ class TriangleMeshOperators:
 
     Parameters
     ----------
-    V : (n, 3) float64
-    F : (m, 3) int64, validated, no degenerate faces
-    P : (m, 3, 3) float64, optional
-        Per-face corner positions to use instead of ``V[F]`` (planar layouts of an intrinsic triangulation,
-        :mod:`gsdf.heat.intrinsic._kernels`); then only vertex-based sources are meaningful.
-    edges : bool
-        False: only the vertex operators (``cotan_laplacian``, ``vertex_mass``, ``divergence``, ``areas``,
-        ``normals``, ``cot``) — no edge topology, angles or Crouzeix–Raviart operators (polygon fine meshes).
+    V, F, P, edges : as for :class:`~gsdf.mesh._triangle_ops.TriangleOperators` (``F`` validated, no degenerate
+        faces; ``edges=False``: the vertex operators only, no CR operators).
 
     Attributes
     ----------
-    edges : (nE, 2) canonical edges (sorted vertex pairs); face_edges : (m, 3) edge index of every face slot;
-    slot_sign : (m, 3) +1 where the slot runs along the canonical edge direction, else -1;
-    areas : (m,); normals : (m, 3) unit; cot : (m, 3) cotangent of the corner angle at vertex ``F[:, k]``;
-    angles : (m, 3) corner angles; edge_len : (nE,); h : mean spacing of edge midpoints (half the mean edge
-    length, §6).
+    slot_sign : (m, 3) float ±1 (``face_edge_signs``); h : mean spacing of edge midpoints (half the mean edge
+    length, §6); slot_u, slot_w : (m, 3, 3) unit canonical direction of every slot's edge and ``n × u``;
+    slot_rho : (m, 3) complex direction of ``u`` in the face frame; edge_ref_slot : (nE,) flat slot of every
+    edge's reference face; slot_sigma : (m, 3) ±1; consistent : bool (every ``slot_sigma`` is +1)
 
     Example
     -------
@@ -70,36 +61,12 @@ class TriangleMeshOperators:
     point_weight = 1.0
 
     def __init__(self, V: np.ndarray, F: np.ndarray, P: np.ndarray | None = None, edges: bool = True):
-        self.V, self.F = V, F
-        # intrinsic triangulations (§9.4) pass per-face planar layouts P instead of using V[F]; the operators
-        # below only need per-face corner positions, so they run unchanged in these face frames
-        self.intrinsic = P is not None
-        n, m = len(V), len(F)
-        self.n_vertices, self.n_faces = n, m
-        P = V[F] if P is None else P                           # (m, 3, 3) corner positions
-        self.P = P
-        E = P[:, NEXT] - P                                     # slot vectors v_a -> v_{a+1}
-        cr = np.cross(E[:, 0], -E[:, 2])                       # (v1-v0) x (v2-v0)
-        dbl = np.linalg.norm(cr, axis=1)
-        self.areas = 0.5 * dbl
-        self.normals = cr / dbl[:, None]
-        L2 = np.einsum("fij,fij->fi", E, E)
-        self.slot_len = np.sqrt(L2)
-        # cot of the angle at vertex k (opposite slot k+1), Eq. 5: (|ki|^2 + |ij|^2 - |jk|^2) / (4 area)
-        self.cot = (L2[:, PREV] + L2 - L2[:, NEXT]) / (4.0 * self.areas[:, None])
-        self._vf = None
+        super().__init__(V, F, P=P, edges=edges)
         if not edges:
-            # vertex operators only (cotan Laplacian, mass, divergence): the fine meshes of polygon Laplacians
             return
-        # slot a: edge (v_a, v_{a+1}); unique edges lower -> higher index, as everywhere (gsdf.mesh._connectivity)
-        self.edges, self.face_edges, signs = unique_edges(F, n)
-        self.edge_keys = self.edges[:, 0] * n + self.edges[:, 1]
-        self.n_edges = len(self.edges)
-        self.slot_sign = signs.astype(np.float64)
-        cosang = np.einsum("fij,fij->fi", E, -E[:, PREV]) / (self.slot_len * self.slot_len[:, PREV])
-        self.angles = np.arccos(np.clip(cosang, -1.0, 1.0))
-        self.edge_len = np.zeros(self.n_edges)
-        self.edge_len[self.face_edges.ravel()] = self.slot_len.ravel()
+        m = self.n_faces
+        E = self.P[:, NEXT] - self.P
+        self.slot_sign = self.face_edge_signs.astype(np.float64)
         self.h = 0.5 * float(self.edge_len.mean())
         # per slot: unit canonical edge direction u, in-face perpendicular w = n x u, and the complex direction
         # rho of u in a face frame (x = slot-0 direction, y = n x x), used for the rotations of Eq. 8
@@ -121,11 +88,6 @@ class TriangleMeshOperators:
         self.consistent = bool((self.slot_sigma > 0).all())
 
     # ------------------------------------------------------------------ Crouzeix–Raviart operators (§5.3–5.4)
-    def cr_mass(self) -> sp.csr_matrix:
-        """Diagonal CR mass matrix, Eq. 7: one third of the area of the faces around every edge."""
-        d = np.bincount(self.face_edges.ravel(), weights=np.repeat(self.areas / 3.0, 3), minlength=self.n_edges)
-        return sp.diags(d).tocsr()
-
     def cr_connection_laplacian(self) -> sp.csr_matrix:
         """Complex Hermitian PSD CR connection Laplacian, Eqs. 8–9 (Alg. 5).
 
@@ -142,7 +104,7 @@ class TriangleMeshOperators:
         rows, cols, vals = self._cr_connection_triplets()
         nE = self.n_edges
         d = np.arange(nE)
-        mass = np.bincount(self.face_edges.ravel(), weights=np.repeat(self.areas / 3.0, 3), minlength=nE)
+        mass = self.cr_mass_diagonal()
         return coo_to_csr(np.concatenate([d, rows]), np.concatenate([d, cols]),
                           np.concatenate([mass.astype(np.complex128), t * vals]), (nE, nE))
 
@@ -189,35 +151,7 @@ class TriangleMeshOperators:
         n2 = 2 * self.n_edges
         return sp.csr_matrix((vals, (rows, cols)), shape=(n2, n2))
 
-    # ------------------------------------------------------------------ vertex operators (§5.5)
-    def cotan_laplacian(self) -> sp.csr_matrix:
-        """Positive semidefinite cotan Laplacian C (Eq. 10): C_ij = -½ Σ cot θ_k, C_ii = -Σ_j C_ij."""
-        F = self.F
-        i, j = F[:, NEXT].ravel(), F[:, PREV].ravel()          # slot opposite corner k: (v_{k+1}, v_{k+2})
-        w = 0.5 * self.cot.ravel()
-        rows = np.concatenate([i, j, i, j])
-        cols = np.concatenate([j, i, i, j])
-        vals = np.concatenate([-w, -w, w, w])
-        n = self.n_vertices
-        return coo_to_csr(rows, cols, vals, (n, n))
-
-    def vertex_mass(self) -> np.ndarray:
-        """Barycentric vertex areas A_i = ⅓ Σ |ijk| (§9.1), shape (n,)."""
-        return np.bincount(self.F.ravel(), weights=np.repeat(self.areas / 3.0, 3), minlength=self.n_vertices)
-
-    def divergence(self, Y: np.ndarray) -> np.ndarray:
-        """Integrated divergence b_i = Σ_f |f| ∇λ_i · Y_f of a face vector field Y (m, 3) (§5.5, the weak form of
-        Eq. 3; the boundary term n·Y is omitted as in the paper). With the PSD cotan Laplacian C, ``C φ = b``
-        is the least-squares fit ∇φ ≈ Y of Eq. 2."""
-        F = self.F
-        G = getattr(self, "_div_G", None)
-        if G is None:                                           # per mesh, kept for repeated solves
-            E = self.P[:, NEXT] - self.P                        # slot vectors
-            # |f| ∇λ_k = ½ n × (v_{k+2} - v_{k+1}) = ½ n × E[:, k+1]
-            G = self._div_G = 0.5 * np.cross(self.normals[:, None, :], E[:, NEXT])
-        contrib = np.einsum("fkj,fj->fk", G, Y)
-        return np.bincount(F.ravel(), weights=contrib.ravel(), minlength=self.n_vertices)
-
+    # ------------------------------------------------------------------ edge vectors <-> face vectors
     def edge_to_face_vectors(self, X: np.ndarray) -> np.ndarray:
         """Sum over the three edges of each face of the edge vectors X (complex, edge basis) as 3D vectors
         (face averaging of §6 up to the factor ⅓, Alg. 3), shape (m, 3)."""
@@ -234,30 +168,3 @@ class TriangleMeshOperators:
         if not self.consistent:
             z = np.where(self.slot_sigma[faces] > 0, z, np.conj(z))   # to the edges' reference bases
         return self.face_edges[faces], z
-
-    def edge_lookup(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-        """Edge index of vertex pairs (i, j), or -1 where there is no such edge."""
-        i, j = np.asarray(i, np.int64), np.asarray(j, np.int64)
-        key = np.minimum(i, j) * self.n_vertices + np.maximum(i, j)
-        pos = np.searchsorted(self.edge_keys, key)
-        pos = np.clip(pos, 0, self.n_edges - 1)
-        return np.where(self.edge_keys[pos] == key, pos, -1)
-
-    def vertex_faces(self) -> sp.csr_matrix:
-        """Sparse incidence (n, m): row i lists the faces containing vertex i (value = slot + 1)."""
-        if self._vf is None:
-            m = self.n_faces
-            rows = self.F.ravel()
-            cols = np.repeat(np.arange(m), 3)
-            vals = np.tile(np.arange(1, 4), m)
-            self._vf = sp.csr_matrix((vals, (rows, cols)), shape=(self.n_vertices, m))
-        return self._vf
-
-    def mesh_components(self) -> np.ndarray:
-        """Connected component label of every vertex (via faces)."""
-        from scipy.sparse.csgraph import connected_components
-
-        F, n = self.F, self.n_vertices
-        A = sp.csr_matrix((np.ones(2 * len(F)), (np.concatenate([F[:, 0], F[:, 1]]),
-                                                 np.concatenate([F[:, 1], F[:, 2]]))), shape=(n, n))
-        return connected_components(A, directed=False)[1]

@@ -10,19 +10,6 @@ iteration is two sparse products, no linear solve.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
-
-
-def gradient_operator(ops) -> sp.csr_matrix:
-    """Per-face gradient of vertex functions, (3m, n): rows 3f..3f+2 give ∇φ on face f."""
-    F, V = ops.F, ops.V
-    E = ops.P[:, [1, 2, 0]] - ops.P                            # slot vectors (per-face layouts if intrinsic)
-    # ∇λ_k = n × (v_{k+2} - v_{k+1}) / (2 area) = n × E[:, k+1] / (2 area)
-    G = np.cross(ops.normals[:, None, :], E[:, [1, 2, 0]]) / (2 * ops.areas[:, None, None])
-    m = len(F)
-    rows = (3 * np.arange(m)[:, None, None] + np.arange(3)[None, None, :]).repeat(3, axis=1)  # (m, k, d)
-    cols = np.broadcast_to(F[:, :, None], (m, 3, 3))
-    return sp.csr_matrix((G.ravel(), (rows.ravel(), cols.ravel())), shape=(3 * m, len(V)))
 
 
 def sharpen(ops, phi0: np.ndarray, fixed: np.ndarray, fixed_values=None, iterations: int = 3000,
@@ -34,7 +21,7 @@ def sharpen(ops, phi0: np.ndarray, fixed: np.ndarray, fixed_values=None, iterati
     -------
     >>> phi = sharpen(solver.ops, phi0, fixed)[0]           # doctest: +SKIP
     """
-    K = gradient_operator(ops)
+    K = ops.gradient()
     n, m = ops.n_vertices, ops.n_faces
     c = ops.vertex_mass() * np.sign(phi0)
     absK = abs(K)

@@ -30,7 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from gsdf.heat._sources import Sources
-from gsdf.heat.triangle._operators import NEXT, TriangleMeshOperators
+from gsdf.heat.triangle._operators import TriangleMeshOperators
+from gsdf.mesh._triangle_ops import NEXT
 
 BARY_TOL = 1e-6
 

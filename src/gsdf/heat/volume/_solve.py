@@ -18,7 +18,7 @@ from gsdf.heat.grid._domain import GridDomain
 from gsdf.heat.tet._domain import TetDomain
 from gsdf.heat._sources import Sources
 from gsdf.heat.volume._sources import source_components
-from gsdf.heat.tet._mesh import BYTES_PER_TET_VERTEX, delaunay_mesh, input_points, tet_geometry, tetgen_mesh
+from gsdf.heat.tet._mesh import BYTES_PER_TET_VERTEX, delaunay_mesh, input_points, tet_quality, tetgen_mesh
 
 __all__ = ["solve_grid", "solve_tet", "BYTES_PER_NODE"]
 
@@ -105,14 +105,13 @@ def solve_tet(src: Sources, X, faces, lo, hi, shape, t_coef: float = 1.0, t=None
         P, T, D = delaunay_mesh(Z, lo, hi, h, levels=TET_LEVELS, grading=TET_GRADING)
     nV = len(P)
     check_bytes(nV * BYTES_PER_TET_VERTEX, f"signed_heat_volume: the tet mesh of {nV:,} vertices", max_memory)
-    vol, G, q = tet_geometry(P, T)
-    keep = q >= TET_MIN_QUALITY
+    keep = tet_quality(P, T) >= TET_MIN_QUALITY
     timings["mesh"] = time.perf_counter() - t0
     report("tet mesh", 1.0)
 
     t0 = time.perf_counter()
     tt = float(t_coef) * h * h if t is None else t
-    domain = TetDomain(P, T, D, keep, vol, G, nZ, comp, tt, theta=theta)
+    domain = TetDomain(P, T, D, keep, nZ, comp, tt, theta=theta)
     core = SignedHeatCore(domain)
     S = domain.prepare(src, shift=(mode != "zero" or lam is not None))     # hard "zero" is not shifted
     report("heat (step I)", 0.0)
