@@ -43,7 +43,7 @@ class PolygonMeshSignedHeatSolver:
     >>> V = np.array([[a, b, 0.0] for a in x for b in x])
     >>> i = np.arange(81).reshape(9, 9)
     >>> quads = np.stack([i[:-1, :-1].ravel(), i[1:, :-1].ravel(), i[1:, 1:].ravel(), i[:-1, 1:].ravel()], 1)
-    >>> loop = np.concatenate([i[2, 2:6], i[2:6, 6], i[6, 6:2:-1], i[6:1:-1, 2]])
+    >>> loop = np.concatenate([i[2:6, 2], i[6, 2:6], i[6:2:-1, 6], i[2, 6:1:-1]])   # counter-clockwise
     >>> phi = PolygonMeshSignedHeatSolver(V, quads).compute_distance([loop])
     >>> bool(phi[40] < 0)                                          # the centre is inside
     True
