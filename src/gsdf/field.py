@@ -228,13 +228,11 @@ def load_field(path) -> Field:
     """
     import os
 
-    p = os.fspath(path)
+    from gsdf._checks import readable_file
+
+    p = readable_file(path, "path")
     ext = os.path.splitext(p)[1].lower()
     if ext in (".vti", ".vtk", ".vtu", ".ply"):
-        if not os.path.exists(p):
-            raise FileNotFoundError(2, "No such file or directory", p)
-        if os.path.isdir(p):
-            raise ValueError(f"{p}: is a directory, not a field file")
         return _load_vti(p) if ext == ".vti" else _load_mesh_field(p, ext)
     if ext == ".npy":
         raise ValueError(f"{p}: a .npy file holds the values without their grid or mesh; save the field as .npz "
@@ -336,13 +334,9 @@ def _load_vti(p: str) -> GridField:
 
 def _load_npz(path, keys, what: str) -> dict:
     """The arrays ``keys`` of a gsdf ``.npz`` file; FileNotFoundError if missing, else ValueError naming the file."""
-    import os
+    from gsdf._checks import readable_file
 
-    p = os.fspath(path)
-    if not os.path.exists(p):
-        raise FileNotFoundError(2, "No such file or directory", p)
-    if os.path.isdir(p):
-        raise ValueError(f"{p}: is a directory, not a {what} file")
+    p = readable_file(path, "path")
     try:
         with np.load(p, allow_pickle=False) as d:
             missing = [k for k in keys if k not in d]

@@ -19,14 +19,14 @@ import time
 import uuid
 from dataclasses import dataclass, field
 
-from gsdf.batch._inputs import collect_inputs
+from gsdf.batch._inputs import check_output_folder, collect_inputs
 from gsdf.batch._manifest import MANIFEST_NAME, ManifestWriter, file_sha256, params_sha256, read_manifest
 from gsdf.batch._tasks import check_options, task_name
 from gsdf.batch._worker import process_item
 
 LOCK_NAME = ".gsdf-batch.lock"
 POLL = 0.5  # seconds between checks of the items in flight
-_PART = re.compile(r"^\..+\.npz\..+\.part$")
+_PART = re.compile(r"^\..+\.npz\..+\.(part|tmp\.npz)$")  # temporaries of gsdf.io._safe_write.atomic_output
 STATUSES = ("done", "failed", "skipped", "cancelled")
 
 
@@ -129,39 +129,86 @@ def _count(name, value, lo=1):
     return value
 
 
-def _prepare_output(out) -> str:
+def _check_out(out) -> str:
     if not isinstance(out, (str, os.PathLike)) or not os.fspath(out):
         raise ValueError(f"out: expected a folder path, got {out!r}")
     out = os.path.abspath(os.fspath(out))
     if os.path.exists(out) and not os.path.isdir(out):
         raise ValueError(f"out: {out} exists and is not a folder")
-    try:
-        os.makedirs(out, exist_ok=True)
-        fd, probe = tempfile.mkstemp(dir=out, prefix=".gsdf-write-test.")
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise ValueError(f"out: cannot write to the output folder {out} ({exc.strerror or exc})") from None
     return out
 
 
-def _lock(out):
-    """An exclusive lock on the output folder (two runs must not write one manifest); None where unsupported."""
+def _prepare_output(out: str) -> list:
+    """Create ``out`` (and missing parents) and check it is writable; returns the folders this created (deepest
+    first), which :func:`_cleanup_output` removes again when the run leaves them empty."""
+    created = []
+    probe = out
+    while not os.path.exists(probe):
+        created.append(probe)
+        probe = os.path.dirname(probe)
     try:
-        import fcntl
-    except ImportError:  # pragma: no cover - Windows
-        return None
-    fh = open(os.path.join(out, LOCK_NAME), "a")
-    try:
-        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        fh.close()
-        raise ValueError(f"out: another gsdf batch is writing to {out}") from None
-    return fh
+        os.makedirs(out, exist_ok=True)
+        fd, test = tempfile.mkstemp(dir=out, prefix=".gsdf-write-test.")
+        os.close(fd)
+        os.unlink(test)
+    except OSError as exc:
+        _cleanup_output(created)
+        raise ValueError(f"out: cannot write to the output folder {out} ({exc.strerror or exc})") from None
+    return created
+
+
+def _cleanup_output(created) -> None:
+    """Remove the folders this run created if nothing was written into them (a refused or failed start)."""
+    for d in created:
+        try:
+            os.rmdir(d)
+        except OSError:
+            return  # not empty (or gone): keep it and its parents
+
+
+class _Lock:
+    """An exclusive lock on the output folder (two runs must not write one manifest): ``LOCK_NAME`` held with
+    ``flock``, unlinked by :meth:`release` on every exit path (a kill -9 leaves the file, never the lock: the
+    next run takes it over). Without ``fcntl`` (Windows) no lock is taken."""
+
+    def __init__(self, out: str):
+        self.path = os.path.join(out, LOCK_NAME)
+        self.fh = None
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - Windows
+            return
+        while True:
+            try:
+                fh = open(self.path, "a")
+            except OSError as exc:
+                raise ValueError(f"out: cannot create the lock file {self.path} ({exc.strerror or exc})") from None
+            try:
+                fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                fh.close()
+                raise ValueError(f"out: another gsdf batch is writing to {out}") from None
+            try:  # the file we locked may have been unlinked by the run that held it: lock the current one
+                same = os.path.samestat(os.fstat(fh.fileno()), os.stat(self.path))
+            except OSError:
+                same = False
+            if same:
+                self.fh = fh
+                return
+            fh.close()
+
+    def release(self) -> None:
+        if self.fh is not None:
+            try:
+                os.unlink(self.path)  # while still holding it: a waiting run then re-opens a fresh file
+            except OSError:
+                pass
+            self.fh.close()
+            self.fh = None
 
 
 def _remove_stale_parts(out) -> None:
-    """Temporary ``.NAME.npz.*.part`` files of workers killed mid-write (we hold the folder's lock)."""
+    """Temporary ``.NAME.npz.*.tmp.npz`` files of workers killed mid-write (we hold the folder's lock)."""
     for base, _, files in os.walk(out):
         for f in files:
             if _PART.match(f):
@@ -263,8 +310,15 @@ def run_batch(inputs, task, out, options=None, *, workers=None, executor=None, p
         rec["status"], sum(counts[s] for s in STATUSES) / max(1, counts["total"])))
     items = collect_inputs(inputs)
     jobs_options = [check_options(task, {**user_options, **it.options}, it.path) for it in items]
-    out = _prepare_output(out)
-    lock = _lock(out)
+    out = _check_out(out)
+    check_output_folder(inputs, items, out)
+    created = _prepare_output(out)
+    try:
+        lock = _Lock(out)
+    except BaseException:
+        _cleanup_output(created)
+        raise
+    ok = False
     try:
         _remove_stale_parts(out)
         manifest = os.path.join(out, MANIFEST_NAME)
@@ -297,12 +351,14 @@ def run_batch(inputs, task, out, options=None, *, workers=None, executor=None, p
                 if own:
                     ex.close(cancel=result.interrupted)
         result.seconds = time.perf_counter() - t0
+        ok = True
         if result.interrupted:
             raise BatchInterrupted(result)
         return result
     finally:
-        if lock is not None:
-            lock.close()
+        lock.release()
+        if not ok:
+            _cleanup_output(created)
 
 
 def _reusable(prev, job, out, retry_failed) -> bool:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 import socket
-import tempfile
 import time
 import traceback
 
@@ -21,30 +20,23 @@ from gsdf.batch._tasks import load_geometry, run_task
 
 
 def write_npz_atomic(path, arrays: dict) -> None:
-    """Write ``arrays`` to ``path`` (.npz) atomically: a temporary file in the target folder, fsync'ed, then
-    ``os.replace`` onto the final name. An interruption at any point leaves no file under ``path`` (a hidden
-    ``.NAME.*.part`` file may remain after a hard kill; it never counts as an output).
+    """Write ``arrays`` to ``path`` (.npz) atomically through :func:`gsdf.io._safe_write.atomic_output` (a
+    temporary file in the target folder, fsync'ed, then renamed onto the final name, with the mode every gsdf
+    output gets: ``0666 & ~umask``). An interruption at any point leaves no file under ``path`` (a hidden
+    ``.NAME.*.tmp.npz`` file may remain after a hard kill; it never counts as an output and the next run on the
+    folder removes it).
 
     Example
     -------
     >>> write_npz_atomic("out/a.npz", {"sdf": np.zeros(3)})      # doctest: +SKIP
     """
-    path = os.fspath(path)
-    folder, name = os.path.split(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, "wb") as fh:
+    from gsdf.io._safe_write import atomic_output
+
+    with atomic_output(path, extensions=(".npz",), make_parents=True) as tmp:
+        with open(tmp, "wb") as fh:
             np.savez(fh, **arrays)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def worker_threads(requested, by_worker=None) -> int:

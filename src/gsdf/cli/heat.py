@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, load_geometry, output_file, report_errors
+from gsdf.cli._common import announce, check_output, load_geometry, output_file, report_errors
 from gsdf.cli._options import (
     common_options,
     level_set_option,
@@ -104,7 +104,7 @@ def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, lev
     with output_file(output) as tmp:
         field.save(tmp)
     where = f"a {len(field.vertices)}-node tet mesh" if tet else f"{field.shape} grid nodes"
-    click.echo(f"{geo.describe()}\nsigned heat field on {where} -> {os.path.abspath(output)}")
+    announce(f"{geo.describe()}\nsigned heat field on {where} -> {os.path.abspath(output)}")
     if levels:
         from gsdf.io import write_mesh
 
@@ -115,4 +115,4 @@ def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, lev
                 else field.isosurface(v * scale)
             with output_file(path, what="--offsets") as tmp:
                 write_mesh(tmp, Vs, Fs)
-            click.echo(f"level {v * scale:.6g}: {len(Fs)} triangles -> {os.path.abspath(path)}")
+            announce(f"level {v * scale:.6g}: {len(Fs)} triangles -> {os.path.abspath(path)}")

@@ -74,8 +74,9 @@ def read_curves(path: str, F=None) -> CurveSources:
     edges = first = None
     import os
 
-    if os.path.isdir(path):
-        raise ValueError(f"{path}: is a directory, not a curve file")
+    from gsdf._checks import readable_file
+
+    path = readable_file(path, "path")
     with open(path, "rb") as fb:
         raw = fb.read()
     try:

@@ -19,14 +19,13 @@ Conventions shared by every reader:
 from __future__ import annotations
 
 import codecs
-import errno
 import io
 import os
 import re
 
 import numpy as np
 
-from gsdf._checks import as_faces, as_points
+from gsdf._checks import as_faces, as_points, readable_file
 from gsdf.io._external import MESHIO_FORMATS, TRIMESH_FORMATS, read_external
 from gsdf.io._safe_write import atomic_output
 
@@ -56,10 +55,10 @@ def _extension(path, supported, what: str) -> tuple[str, str]:
 
 
 def _check_file(p: str) -> None:
-    """Raise FileNotFoundError for a missing path, ValueError for an empty file."""
-    if not os.path.exists(p):
-        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), p)
-    if os.path.isfile(p) and os.path.getsize(p) == 0:
+    """Raise FileNotFoundError for a missing path, ValueError for anything but a readable regular file of a size
+    that fits in memory (:func:`gsdf._checks.readable_file`) and for an empty file."""
+    readable_file(p)
+    if os.path.getsize(p) == 0:
         raise ValueError(f"{p}: file is empty")
 
 

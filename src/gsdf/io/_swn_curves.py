@@ -94,9 +94,9 @@ def read_swn_curves(path, F) -> SWNCurves:
     """
     from gsdf.io._curves import gc_edges
 
-    p = os.fspath(path)
-    if not os.path.isfile(p):
-        raise ValueError(f"{p}: no such curve file")
+    from gsdf._checks import readable_file
+
+    p = readable_file(path, "path")
     F = np.asarray(F, dtype=np.int64)
     n = int(F.max()) + 1 if F.size else 0
     m = len(F)

@@ -213,6 +213,9 @@ def save_voxels(path, occ, bbox_min, bbox_max) -> None:
 
 def load_voxels(path):
     """Read a file written by :func:`save_voxels`; returns ``(occupancy, bbox_min, bbox_max)``."""
+    from gsdf._checks import readable_file
+
+    path = readable_file(path, "path")
     try:
         with np.load(path) as d:
             return _occupancy(d["occupancy"]), *_bbox(d["bbox_min"], d["bbox_max"])

@@ -340,6 +340,9 @@ class PointsAsTori:
     def load(cls, path) -> "PointsAsTori":
         """Read a file written by :meth:`save`; every array is checked against the points (shape, length,
         finiteness) before any kernel reads it."""
+        from gsdf._checks import readable_file
+
+        path = readable_file(path, "path")
         try:
             z = np.load(path, allow_pickle=False)
             files = set(z.files)
