@@ -93,6 +93,32 @@ def as_values(x, name: str = "values", shape=None, *, finite: bool = True, allow
     return A
 
 
+def as_occupancy(x, name: str = "occupancy") -> np.ndarray:
+    """Validate a voxel grid: a 3-D boolean array (0/1 numbers accepted) with no empty axis; returns it as a
+    C-contiguous bool array. Its size is checked first (the callers' padded copies and masks: a few bytes per
+    voxel, :func:`gsdf._memory.check_bytes`; one pass per voxel, :func:`gsdf._memory.check_work`), so that a
+    10^12-voxel grid is refused at once."""
+    A = _array(x, name)
+    if A.ndim != 3:
+        raise ValueError(f"{name}: expected a 3-D boolean array, got {A.ndim} dimensions (shape {A.shape})")
+    if min(A.shape) < 1:
+        raise ValueError(f"{name}: has an empty axis, shape {A.shape}")
+    from gsdf._memory import SECONDS_PER_CELL, check_bytes, check_work, size_of
+
+    n = size_of(A)
+    what = f"{name}: a {A.shape[0]}x{A.shape[1]}x{A.shape[2]} voxel grid ({n:,} voxels)"
+    check_bytes(4 * n, what)
+    check_work(n, SECONDS_PER_CELL, what)
+    if A.dtype != bool:
+        if A.dtype.kind not in _REAL_KINDS:
+            raise ValueError(f"{name}: expected a boolean array, got {_dtype_words(A)}")
+        if not np.isin(A, (0, 1)).all():
+            raise ValueError(f"{name}: expected a boolean array (or 0/1 values), got dtype {A.dtype} with other "
+                             "values")
+        A = A.astype(bool)
+    return np.ascontiguousarray(A)
+
+
 def flag(x, name: str) -> bool:
     """Validate a switch: ``True``/``False`` (or numpy's bool); strings such as ``"no"``, numbers and None are
     refused (``"no"`` is truthy: accepting it would do the opposite of what was asked)."""
@@ -225,6 +251,11 @@ def finite(x, name: str) -> float:
     return v
 
 
+#: Largest diffusion-time coefficient of the heat methods (t = t_coef · h², h a mesh or grid spacing): beyond it
+#: the heat spreads over thousands of spacings — far past any domain gsdf meshes or grids — and the field loses
+#: every feature (at 1e308, t overflows).
+T_COEF_MAX = 1e6
+
 #: Largest integer option accepted (beyond 2**53 floats cannot hold it, and numba kernels take int64).
 MAX_INT = 2 ** 53
 
@@ -242,6 +273,18 @@ def integer(x, name: str, lo: int = 1, hi: int = MAX_INT) -> int:
     if v > hi:
         raise ValueError(f"{name}: expected an integer <= {hi}, got {x!r}")
     return v
+
+
+def neighbours(k, n: int, name: str = "k", lo: int = 1, default: int = 0) -> int:
+    """Validate a neighbour count ``k`` for a cloud of ``n`` points: an integer >= ``lo`` and at most ``n - 1``
+    (a point has no more neighbours). Up to ``default`` (the function's default k) is accepted on smaller
+    clouds, which then use all ``n - 1`` other points (the callers' documented clamp); beyond both it is refused.
+    Returns ``k`` unchanged."""
+    hi = max(n - 1, int(default), lo)
+    if not isinstance(k, (bool, np.bool_)) and np.ndim(k) == 0 and isinstance(k, (int, np.integer)) and k > hi:
+        raise ValueError(f"{name}: {k} neighbours asked for, but the cloud has {n} points (at most {n - 1} "
+                         "neighbours each)")
+    return integer(k, name, lo, hi=hi)
 
 
 def choice(x, name: str, options) -> str:

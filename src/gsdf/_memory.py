@@ -137,8 +137,21 @@ WORK_LIMIT = 300.0
 SECONDS_PER_QUERY = 1e-6         #: a tree query: fast winding number, distance, nearest neighbours, PAT
 SECONDS_PER_NODE = 2e-7          #: a node of a grid solve, a field evaluation, an isosurface or voxel pass
 SECONDS_PER_PAIR = 2e-9          #: one query × element term of a direct sum (exact winding numbers)
+SECONDS_PER_CELL = 1e-9          #: one voxel of an elementwise pass over a boolean grid
 
 _TIME_SUFFIX = {"": 1.0, "S": 1.0, "M": 60.0, "H": 3600.0, "D": 86400.0}
+
+
+def seconds_per_point(func, default: float = SECONDS_PER_NODE) -> float:
+    """Single-thread seconds of one evaluation of the field ``func`` at one point: its ``_seconds_per_point``
+    attribute (gsdf's evaluators — fast winding numbers, distances, Points as Tori — carry one), else
+    ``default`` (a lower bound for any Python function on arrays)."""
+    v = getattr(func, "_seconds_per_point", default)
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return default
+    return v if math.isfinite(v) and v >= 0 else default
 
 
 def work_limit() -> float:

@@ -488,8 +488,13 @@ def test_cli_batch(dataset, tmp_path):
     out = tmp_path / "cli"
     res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "-o", str(out),
                                "--normalize", "cube", "-q"])
-    assert res.exit_code == 0, res.output
+    assert res.exit_code == 3, res.output  # an item failed: scripts and CI must see it
     assert "done" in res.output and "failed" in res.output and "corrupt.obj" in res.output
+    assert "1 of 5 item(s) failed" in res.output and "--allow-failures" in res.output
+    res = runner.invoke(main, ["batch", str(dataset), "--task", "sdf-grid", "--resolution", "12", "-o", str(out),
+                               "--normalize", "cube", "-q", "--retry-failed", "--allow-failures"])
+    assert res.exit_code == 0, res.output  # the failure again, allowed
+    assert "corrupt.obj" in res.output
     z = np.load(out / "a" / "cube.npz")
     assert z["sdf"].shape == (12, 12, 12) and z["scale"] == pytest.approx(0.5)
     assert -1.0 <= z["sdf"].min() <= -0.85  # the centre is 1 frame unit from every face

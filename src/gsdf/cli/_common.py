@@ -59,6 +59,8 @@ def counting(func, desc: str, enabled: bool = True):
         bar.update(len(Q))
         return out
 
+    if hasattr(func, "_seconds_per_point"):  # the cost of one evaluation, for the size guard
+        wrapped._seconds_per_point = func._seconds_per_point
     return bar, wrapped
 
 

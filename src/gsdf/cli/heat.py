@@ -109,7 +109,9 @@ def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, lev
         from gsdf.io import write_mesh
 
         X = geo.X
-        scale = float(np.linalg.norm(X.max(axis=0) - X.min(axis=0))) if relative else 1.0
+        from gsdf.grid import diagonal
+
+        scale = diagonal(X.min(axis=0), X.max(axis=0)) if relative else 1.0
         for v, path in zip(levels, surface_paths):
             Vs, Fs = field.isosurface(v * scale, close=True) if hasattr(field, "spacing") \
                 else field.isosurface(v * scale)

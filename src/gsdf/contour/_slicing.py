@@ -15,6 +15,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from gsdf._checks import as_points, choice, integer
+from gsdf._memory import check_bytes, check_work, seconds_per_point
 from gsdf.contour._isosurface import (CHUNK, _check_bbox, _check_func, _edges_of_vertices, _evaluate, _finite,
                                       refine_on_edges)
 
@@ -200,6 +201,12 @@ def slice_contours(
     choice(inside, "inside", {"above", "below"})
 
     nu, nv = grid.shape[ua], grid.shape[va]
+    ns = Z.size
+    what = f"slice_contours: {ns:,} heights × a {nu}x{nv} grid ({ns * nu * nv:,} nodes)"
+    # values (8 B) and inside/outside masks (2 B) per node of every slice; per plane node: its position (24 B),
+    # meshgrid copies (16 B) and one chunk of queries; per slice: a padded copy for marching squares
+    check_bytes(10 * ns * nu * nv + 64 * nu * nv + 48 * min(CHUNK, ns * nu * nv), what)
+    check_work(ns * nu * nv, seconds_per_point(func), what)
     ax = grid.axes()
     gu, gv = ax[ua], ax[va]
     h = grid.spacing[[ua, va]]
@@ -210,7 +217,6 @@ def slice_contours(
     plane[:, va] = W.ravel()
 
     # --- field values on all slices (batched so each func call gets up to `chunk` points) ---
-    ns = Z.size
     values = np.empty((ns, nu * nv))
     per_call = max(1, chunk // (nu * nv))
     for s in range(0, ns, per_call):

@@ -25,7 +25,7 @@ import re
 
 import numpy as np
 
-from gsdf._checks import as_faces, as_points, readable_file
+from gsdf._checks import as_faces, as_points, as_values, flag, readable_file
 from gsdf.io._external import MESHIO_FORMATS, TRIMESH_FORMATS, read_external
 from gsdf.io._safe_write import atomic_output
 
@@ -622,6 +622,7 @@ def read_mesh(path, triangulate: bool = True):
     >>> V, polys = read_mesh("quads.obj", triangulate=False)         # doctest: +SKIP
     """
     p, ext = _extension(path, MESH_READ_FORMATS, "mesh")
+    triangulate = flag(triangulate, "triangulate")
     if ext not in MESH_FORMATS:
         _check_file(p)
         if os.path.isdir(p):
@@ -723,7 +724,7 @@ def _vertex_data(vertex_data, n: int) -> dict:
         if a.shape != (n,) or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool):
             raise ValueError(f"vertex_data[{name!r}]: expected a numeric array of shape ({n},), "
                              f"got {a.dtype} {a.shape}")
-        out[name] = a.astype(np.float64)
+        out[name] = as_values(a.astype(np.uint8) if a.dtype == bool else a, f"vertex_data[{name!r}]")
     return out
 
 
@@ -782,7 +783,8 @@ def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
         STL stores triangles only, so polygons are fan-triangulated for it.
     vertex_data : dict of str -> (n,) float array, optional
         Extra per-vertex scalars (e.g. a distance field) written as PLY vertex properties
-        (doubles), or VTK/VTU point data.  Other formats raise ValueError.
+        (doubles), or VTK/VTU point data.  Other formats raise ValueError, and so do NaN, infinite or
+        complex values (a reader could not tell them from data: fill them explicitly).
     binary : bool, default True
         PLY only: binary little-endian (default) or ASCII.
 

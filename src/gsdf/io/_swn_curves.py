@@ -142,6 +142,7 @@ def read_swn_curves(path, F) -> SWNCurves:
                     index.append(i)
                     params.append((0.0, 0.0, 0.0))
                 segs += [(base + k, base + k + 1) for k in range(len(idx) - 1)]
+                continue
             if key not in _OBJ_KEYS:
                 raise ValueError(f"{p}: line {ln_no}: unknown directive {key!r}")
             continue                                           # other OBJ statements (v x y z, f, vn, ...)

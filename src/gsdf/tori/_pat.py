@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_points, choice, finite, integer, nonnegative, positive
+from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.grid import PAD, Grid, padded_box
 from gsdf.threads import apply_env
@@ -283,7 +284,7 @@ class PointsAsTori:
     def _eval(self, Q, want_grad):
         b = self._blend
         fr = self._frame
-        Q = as_points(Q, "Q")
+        Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
         Qf, excess = fr.queries(Q, want_excess=True)
 
         def fn(q, d, i, out):

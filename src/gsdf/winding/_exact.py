@@ -15,6 +15,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_faces, as_mesh, as_normals, as_points, as_weights
+from gsdf._memory import SECONDS_PER_PAIR
 from gsdf._normalize import Frame
 from gsdf.winding._query import map_queries
 from gsdf.winding._solid_angle import solid_angle_w
@@ -115,7 +116,7 @@ def winding_number(V, F, Q, method: str = "auto") -> np.ndarray:
         return ExactWindingNumber(V, F)(Q)
     frame = Frame.of_mesh(V, F)  # scale invariance: kernels run on O(1) coordinates (gsdf._normalize)
     T = triangle_corners(frame.geometry(V), F)
-    return map_queries(lambda q, out: _wn_triangles(T, q, out), Q, frame=frame)
+    return map_queries(lambda q, out: _wn_triangles(T, q, out), Q, frame=frame, cost=len(F) * SECONDS_PER_PAIR)
 
 
 def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
@@ -140,7 +141,7 @@ def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
     True
     """
     frame, P, NA = oriented_area_normals(P, N, areas)
-    return map_queries(lambda q, out: _wn_points(P, NA, q, out), Q, frame=frame)
+    return map_queries(lambda q, out: _wn_points(P, NA, q, out), Q, frame=frame, cost=len(P) * SECONDS_PER_PAIR)
 
 
 def winding_number_2d(V, E, Q) -> np.ndarray:
@@ -158,7 +159,8 @@ def winding_number_2d(V, E, Q) -> np.ndarray:
     E = as_faces(E, V.shape[0], "E", corners=2)
     frame = Frame.of_mesh(V, E)
     S = np.ascontiguousarray(frame.geometry(V)[E].reshape(-1, 4))
-    return map_queries(lambda q, out: _wn_polyline(S, q, out), Q, dim=2, frame=frame)
+    return map_queries(lambda q, out: _wn_polyline(S, q, out), Q, dim=2, frame=frame,
+                       cost=len(S) * SECONDS_PER_PAIR)
 
 
 def oriented_area_normals(P, N, areas=None):

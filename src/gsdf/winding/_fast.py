@@ -51,6 +51,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_mesh, integer
+from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.spatial._bvh import BVH, build_bvh, build_volume_bvh
 from gsdf.spatial._wide import widen
@@ -781,6 +782,7 @@ def _single_thread(serial: bool):
 
 class _FastWindingBase:
     tree: BVH
+    _seconds_per_point = SECONDS_PER_QUERY  # cost of one query, for the size guard of contouring callers
 
     def __call__(self, Q, progress=None) -> np.ndarray:
         """Winding numbers at query points ``Q`` (q, 3); evaluated in parallel chunks."""

@@ -82,7 +82,7 @@ class SurfaceSignedHeatSolver:
         # distances are mapped back on output (gsdf._normalize)
         self.frame = Frame.of_mesh(V, F) if len(F) else Frame.of(V)
         self.V_world, V = V, self.frame.geometry(V)
-        self.t_coef = _checks.positive(t_coef, "t_coef")
+        self.t_coef = _checks.positive(t_coef, "t_coef", most=_checks.T_COEF_MAX)
         rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
         if rep.any():
             raise ValueError(f"F: face {int(np.flatnonzero(rep)[0])} repeats a vertex ({int(rep.sum())} "
