@@ -229,7 +229,7 @@ def test_binary_ply_written_by_plyfile(tmp_path, order):
 
 
 def test_ply_vertex_data(tmp_path):
-    d = np.array([0.5, -1.0, np.inf, 2.0])
+    d = np.array([0.5, -1.0, 1e300, 2.0])
     p = tmp_path / "m.ply"
     write_mesh(p, TET_V, TET_F, vertex_data={"distance": d, "winding": np.arange(4)})
     ply = plyfile.PlyData.read(str(p))
@@ -243,6 +243,10 @@ def test_ply_vertex_data(tmp_path):
         write_mesh(p, TET_V, TET_F, vertex_data={"distance": d[:3]})
     with pytest.raises(ValueError, match="name"):
         write_mesh(p, TET_V, TET_F, vertex_data={"x": d})
+    for bad, why in ((np.inf, "NaN or infinite"), (np.nan, "NaN or infinite"), (1j, "complex")):
+        with pytest.raises(ValueError, match=why):  # refused, not written: a reader cannot tell them from data
+            write_mesh(tmp_path / "bad.ply", TET_V, TET_F, vertex_data={"distance": d + bad})
+    assert not (tmp_path / "bad.ply").exists()
 
 
 def test_ascii_stl_merges_vertices(tmp_path):

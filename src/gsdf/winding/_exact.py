@@ -17,7 +17,7 @@ from numba import njit, prange
 from gsdf._checks import as_faces, as_mesh, as_normals, as_points, as_weights
 from gsdf._memory import SECONDS_PER_PAIR
 from gsdf._normalize import Frame
-from gsdf.winding._query import map_queries
+from gsdf.winding._query import map_queries, query_array
 from gsdf.winding._solid_angle import solid_angle_w
 
 INV_4PI = 1.0 / (4.0 * np.pi)
@@ -109,6 +109,7 @@ def winding_number(V, F, Q, method: str = "auto") -> np.ndarray:
     if method not in ("auto", "direct", "hierarchical"):
         raise ValueError(f"method: must be 'auto', 'direct' or 'hierarchical', got {method!r}")
     V, F = as_mesh(V, F)
+    query_array(Q)  # the size guard before any tree is built
     n_queries = np.shape(Q)[0] if np.ndim(Q) == 2 else 1
     if method == "hierarchical" or (method == "auto" and n_queries > 64 and F.shape[0] > 64):
         from gsdf.winding._hierarchical import ExactWindingNumber

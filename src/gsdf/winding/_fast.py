@@ -56,7 +56,7 @@ from gsdf._normalize import Frame
 from gsdf.spatial._bvh import BVH, build_bvh, build_volume_bvh
 from gsdf.spatial._wide import widen
 from gsdf.threads import run_ranges, run_tasks
-from gsdf.winding._query import map_queries
+from gsdf.winding._query import map_queries, query_array
 from gsdf.winding._exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w
 
 # layout of the per-node coefficient row
@@ -911,6 +911,7 @@ def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarra
     >>> (np.round(w, 6) + 0.0).tolist()
     [1.0, 0.0]
     """
+    query_array(Q)  # the size guard before the tree is built
     return FastWindingNumber(V, F, beta=beta, order=order)(Q)
 
 
@@ -928,4 +929,5 @@ def fast_winding_number_points(P, N, Q, areas=None, beta: float = 2.3, order: in
     >>> bool(abs(w[0] - 1) < 0.05 and abs(w[1]) < 0.05)
     True
     """
+    query_array(Q)  # the size guard before the tree is built
     return FastWindingNumberPoints(P, N, areas=areas, beta=beta, order=order)(Q)

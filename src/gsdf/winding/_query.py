@@ -26,17 +26,8 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
     memory checked by :func:`gsdf._memory.check_bytes`) run before the first pass over ``Q``.
     """
     apply_env()  # GSDF_NUM_THREADS
-    A = _array(Q, "Q")
-    if A.ndim == 1 and A.shape[0] == dim:
-        A = A.reshape(1, dim)
-    if A.ndim != 2 or A.shape[1] != dim:
-        raise ValueError(f"Q: expected shape (q, {dim}), got {A.shape}")
-    if A.dtype.kind not in "fiu":
-        raise ValueError(f"Q: expected numeric coordinates, got {_dtype_words(A)}")
+    A = query_array(Q, dim, cost, chunk)
     n = A.shape[0]
-    if n > 1000:
-        check_bytes(8 * n + 48 * min(n, chunk), f"Q: winding numbers at {n:,} query points")
-        check_work(n, cost, f"Q: winding numbers at {n:,} query points")
     out = np.empty(n, dtype=np.float64)
     for s in range(0, n, chunk):
         e = min(n, s + chunk)
@@ -56,6 +47,25 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         if progress is not None:
             progress("winding numbers", e / n)
     return out
+
+
+def query_array(Q, dim: int = 3, cost: float = SECONDS_PER_QUERY, chunk: int = CHUNK) -> np.ndarray:
+    """``Q`` as an (q, dim) numeric array (not yet copied or checked for finiteness), after the size guard: the
+    output's memory (:func:`gsdf._memory.check_bytes`) and ``q × cost`` seconds of work
+    (:func:`gsdf._memory.check_work`). One-call functions run it before building their tree, so that 10^9
+    queries are refused at once."""
+    A = _array(Q, "Q")
+    if A.ndim == 1 and A.shape[0] == dim:
+        A = A.reshape(1, dim)
+    if A.ndim != 2 or A.shape[1] != dim:
+        raise ValueError(f"Q: expected shape (q, {dim}), got {A.shape}")
+    if A.dtype.kind not in "fiu":
+        raise ValueError(f"Q: expected numeric coordinates, got {_dtype_words(A)}")
+    n = A.shape[0]
+    if n > 1000:
+        check_bytes(8 * n + 48 * min(n, chunk), f"Q: winding numbers at {n:,} query points")
+        check_work(n, cost, f"Q: winding numbers at {n:,} query points")
+    return A
 
 
 def _already_coherent(q: np.ndarray) -> bool:
