@@ -26,7 +26,7 @@ from gsdf.batch._worker import process_item
 
 LOCK_NAME = ".gsdf-batch.lock"
 POLL = 0.5  # seconds between checks of the items in flight
-_PART = re.compile(r"^\..+\.npz\..+\.(part|tmp\.npz)$")  # temporaries of gsdf.io._safe_write.atomic_output
+_PART = re.compile(r"^\..+\.npz\..+\.part$")
 STATUSES = ("done", "failed", "skipped", "cancelled")
 
 
@@ -208,7 +208,7 @@ class _Lock:
 
 
 def _remove_stale_parts(out) -> None:
-    """Temporary ``.NAME.npz.*.tmp.npz`` files of workers killed mid-write (we hold the folder's lock)."""
+    """Temporary ``.NAME.npz.*.part`` files of workers killed mid-write (we hold the folder's lock)."""
     for base, _, files in os.walk(out):
         for f in files:
             if _PART.match(f):
