@@ -763,3 +763,36 @@ def test_binary_ply_mixed_polygons_fast_path(tmp_path, byte_order, layout):
     p.write_bytes(data[:-5])
     with pytest.raises(ValueError, match=errmsg(p) + ".*ends early"):
         read_mesh(p)
+
+
+@pytest.mark.parametrize("bad", ["yes", "no", 0, None, [1]])
+def test_read_mesh_triangulate_is_a_switch(tmp_path, bad):
+    p = tmp_path / "t.off"
+    write_mesh(p, TET_V, TET_F)
+    with pytest.raises(ValueError, match="triangulate: expected True or False"):
+        read_mesh(p, triangulate=bad)
+
+
+@pytest.mark.parametrize("kind", ["fifo", "dir", "dev"])
+@pytest.mark.parametrize("ext", [".off", ".obj", ".ply", ".stl", ".xyz", ".npy"])
+def test_readers_take_regular_files_only(tmp_path, kind, ext):
+    """A FIFO blocked the reader forever, a link to /dev/zero read until memory ran out, a folder leaked
+    IsADirectoryError."""
+    import os
+
+    from gsdf.io import read_points
+
+    p = tmp_path / f"x{ext}"
+    if kind == "fifo":
+        os.mkfifo(p)
+    elif kind == "dir":
+        p.mkdir()
+    elif os.path.exists("/dev/zero"):
+        p.symlink_to("/dev/zero")
+    else:
+        pytest.skip("no /dev/zero")
+    why = {"fifo": "is a FIFO", "dir": "is a directory", "dev": "is a device"}[kind]
+    readers = ([read_points] if ext != ".stl" else []) + ([read_mesh] if ext not in (".xyz", ".npy") else [])
+    for reader in readers:
+        with pytest.raises(ValueError, match=why):
+            reader(p)

@@ -124,3 +124,26 @@ def test_estimate_normals_sphere():
     assert np.max(1.0 - np.einsum("ij,ij->i", No, U)) < 1e-2
     # estimated normals give the same areas as exact ones
     assert point_areas(P, No).sum() == pytest.approx(point_areas(P, U).sum(), rel=1e-3)
+
+
+def test_k_bounded_by_the_cloud():
+    """k = 10^9 was clamped silently; the default k on a small cloud keeps its documented clamp."""
+    rng = np.random.default_rng(0)
+    P = rng.normal(size=(200, 3))
+    for fn in (lambda k: estimate_normals(P, k=k), lambda k: point_areas(P, P, k=k)):
+        with pytest.raises(ValueError, match="k: 1000000000 neighbours asked for, but the cloud has 200 points"):
+            fn(10 ** 9)
+        with pytest.raises(ValueError, match="k: 200 neighbours"):
+            fn(200)
+        assert len(fn(199)) == 200
+    assert len(point_areas(P[:10], P[:10])) == 10  # default k = 20 > 9 neighbours: all of them (documented)
+
+
+def test_winding_areas_must_be_real():
+    import gsdf
+
+    rng = np.random.default_rng(0)
+    P = rng.normal(size=(50, 3))
+    for fn in (gsdf.fast_winding_number_points, gsdf.winding_number_points):
+        with pytest.raises(ValueError, match="areas: expected real numbers, got complex"):
+            fn(P, P, P[:3], areas=np.ones(50) + 1j)
