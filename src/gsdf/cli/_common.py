@@ -48,6 +48,23 @@ def progress_bar(total: int, desc: str, enabled: bool = True):
     return bar, update
 
 
+class LazyWinding:
+    """The fast winding number of a loaded input, its tree built on the first evaluation: a contouring call's
+    size guard (which reads ``_seconds_per_point``, the cost of a tree query) refuses a too large grid before any
+    tree is built."""
+
+    def __init__(self, geo, beta=None):
+        from gsdf._memory import SECONDS_PER_QUERY
+
+        self._geo, self._beta, self._fn = geo, beta, None
+        self._seconds_per_point = SECONDS_PER_QUERY
+
+    def __call__(self, Q):
+        if self._fn is None:
+            self._fn = self._geo.winding(self._beta)
+        return self._fn(Q)
+
+
 def counting(func, desc: str, enabled: bool = True):
     """Wrap a field ``func(Q)`` so that a progress bar counts the evaluated points (total unknown up front)."""
     from tqdm import tqdm

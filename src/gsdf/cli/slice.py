@@ -11,6 +11,7 @@ from gsdf.cli._common import (
     announce,
     bbox_of,
     check_output,
+    LazyWinding,
     counting,
     load_geometry,
     output_file,
@@ -62,7 +63,7 @@ def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, es
     if zs is None:
         n = layers or 10
         zs = list(lo[ax] + (hi[ax] - lo[ax]) * (np.arange(n) + 0.5) / n)
-    bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
+    bar, func = counting(LazyWinding(geo, beta), "winding numbers", not quiet)
     with bar:
         contours = slice_contours(func, zs, lo, hi, resolution=resolution, axis=ax)
     with output_file(output) as tmp:

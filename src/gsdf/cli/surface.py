@@ -10,6 +10,7 @@ from gsdf.cli._common import (
     announce,
     bbox_of,
     check_output,
+    LazyWinding,
     counting,
     load_geometry,
     output_file,
@@ -59,7 +60,7 @@ def surface(input, output, resolution, level, bisection, pad, beta, estimate_nor
     check_output(output, MESH_WRITE_FORMATS)
     geo = load_geometry(input, estimate_normals)
     lo, hi = bbox_of(geo.X, pad)
-    bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
+    bar, func = counting(LazyWinding(geo, beta), "winding numbers", not quiet)
     with bar:
         V, F = extract_isosurface(func, lo, hi, resolution=resolution, level=level, bisection_steps=bisection)
     with output_file(output) as tmp:
