@@ -40,7 +40,7 @@ import os
 
 import numpy as np
 
-from gsdf._checks import choice, integer, positive
+from gsdf._checks import _real, choice, integer, positive
 from gsdf._memory import SECONDS_PER_QUERY, check_bytes, check_work
 from gsdf.grid import Grid
 from gsdf.io._geometry import Geometry, load_geometry
@@ -445,9 +445,11 @@ def locals_without_source(values: dict) -> dict:
 def _float(x, name) -> float:
     if isinstance(x, (bool, np.bool_)):
         raise ValueError(f"{name}: expected a number, got the bool {x!r}")
+    if not isinstance(x, str):  # a CSV cell is parsed; anything else is the one real-number check
+        return _real(x, name)
     try:
         return float(x)
-    except (TypeError, ValueError):
+    except ValueError:
         raise ValueError(f"{name}: expected a number, got {x!r}") from None
 
 

@@ -33,7 +33,7 @@ import dataclasses
 
 import numpy as np
 
-from gsdf._checks import as_mesh, choice, positive
+from gsdf._checks import as_mesh, choice, integer, positive
 
 __all__ = ["mesh_boolean", "trim_mesh", "BooleanOptions"]
 
@@ -238,15 +238,7 @@ def trim_mesh(V, F, winding, keep="outside", bisection_steps=12):
 
 
 def _steps(bisection_steps):
-    try:
-        if isinstance(bisection_steps, (bool, np.bool_, str)) or np.ndim(bisection_steps) != 0:
-            raise TypeError
-        s = int(bisection_steps)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise ValueError(f"bisection_steps: expected a non-negative integer, got {bisection_steps!r}") from exc
-    if s != bisection_steps or s < 0 or s > 60:
-        raise ValueError(f"bisection_steps: expected an integer in [0, 60], got {bisection_steps!r}")
-    return s
+    return integer(bisection_steps, "bisection_steps", 0, hi=60)
 
 
 def _compact(V, F):

@@ -50,7 +50,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_mesh, integer
+from gsdf._checks import as_mesh, integer, positive
 from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.spatial._bvh import BVH, build_bvh, build_volume_bvh
@@ -742,15 +742,8 @@ def _eval_points(Q, P, NA, N, C, beta2, order, out):
 
 
 def _check_params(beta, order):
-    if isinstance(beta, (bool, np.bool_)) or np.ndim(beta) != 0:
-        raise ValueError(f"beta: expected a number, got {beta!r}")
-    try:
-        beta = float(beta)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise ValueError(f"beta: expected a number, got {beta!r}") from exc
     # β² multiplies node radii² in the walk: beyond 1e150 it overflows (every node would be opened anyway)
-    if not np.isfinite(beta) or beta <= 0 or beta > 1e150:
-        raise ValueError(f"beta: must be a finite positive number <= 1e150, got {beta!r}")
+    beta = positive(beta, "beta", most=1e150)
     if isinstance(order, (bool, np.bool_)) or np.ndim(order) != 0 or order not in (0, 1, 2):
         raise ValueError(f"order: must be 0, 1 or 2, got {order!r}")
     return beta, int(order)

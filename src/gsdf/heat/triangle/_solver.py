@@ -94,7 +94,7 @@ class SurfaceSignedHeatSolver:
             raise ValueError(f"F: face {int(np.flatnonzero(bad)[0])} has zero area ({int(bad.sum())} degenerate "
                              "faces); remove degenerate triangles first")
         self.V, self.F = self.V_world, F
-        self.intrinsic_delaunay = bool(intrinsic_delaunay)
+        self.intrinsic_delaunay = _checks.flag(intrinsic_delaunay, "intrinsic_delaunay")
         self.input_ops = TriangleMeshOperators(V, F)
         # a vertex point source weighs one input unit against the curves (its old meaning at every scale)
         self.input_ops.point_weight = float(self.frame.inverse_length(1.0))

@@ -140,14 +140,7 @@ class VoxelSurfaceDomain(VertexSurfaceDomain):
         occ = as_occupancy(occupancy)
         s = as_spacing(spacing)
         self.connection = _checks.choice(connection, "connection", CONNECTIONS)
-        if isinstance(normal_radius, (bool, np.bool_)):
-            raise ValueError(f"normal_radius: expected a non-negative number, got {normal_radius!r}")
-        try:
-            r = float(normal_radius)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"normal_radius: expected a non-negative number, got {normal_radius!r}") from exc
-        if not np.isfinite(r) or r < 0:
-            raise ValueError(f"normal_radius: must be finite and >= 0, got {normal_radius!r}")
+        r = _checks.nonnegative(normal_radius, "normal_radius")
         self.occupancy, self.spacing, self.normal_radius = occ, s, r
         S = digital_surface(occ, s)
         self.surface = S
