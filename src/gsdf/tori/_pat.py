@@ -343,9 +343,8 @@ class PointsAsTori:
         finiteness) before any kernel reads it."""
         from gsdf._checks import readable_file
 
-        path = readable_file(path, "path")
         try:
-            z = np.load(path, allow_pickle=False)
+            z = np.load(readable_file(path, "path"), allow_pickle=False)
             files = set(z.files)
         except Exception as exc:
             raise ValueError(f"{path}: not a saved PointsAsTori file ({type(exc).__name__}: {exc})") from exc
