@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import _dtype_words, as_points, choice, finite, integer
+from gsdf._checks import _dtype_words, as_points, as_values, choice, finite, integer
 from gsdf._memory import check_bytes, check_work, grid_bytes, seconds_per_point
 
 #: More bisection steps than this cannot improve a float64 root (the bracket reaches one ulp well before).
@@ -169,13 +169,8 @@ def refine_on_edges(func, A, B, fa, fb, level: float = 0.5, steps: int = 10, chu
     level = _finite(level, "level")
     steps = integer(steps, "steps", 0, hi=MAX_BISECTION)
     chunk = integer(chunk, "chunk", 1)
-    fa = np.asarray(fa, dtype=np.float64).copy()
-    fb = np.asarray(fb, dtype=np.float64).copy()
-    for name, f in (("fa", fa), ("fb", fb)):
-        if f.shape != (k,):
-            raise ValueError(f"{name}: expected shape ({k},), got {f.shape}")
-        if not np.isfinite(f).all():
-            raise ValueError(f"{name}: contains NaN or infinite values")
+    fa = as_values(fa, "fa", (k,), allow_empty=True).copy()
+    fb = as_values(fb, "fb", (k,), allow_empty=True).copy()
     if np.any((fa - level) * (fb - level) > 0):
         bad = int(np.argmax((fa - level) * (fb - level) > 0))
         raise ValueError(

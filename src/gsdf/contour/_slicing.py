@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from gsdf._checks import as_points, choice, integer
+from gsdf._checks import as_points, as_values, choice, integer
 from gsdf._memory import check_bytes, check_work, seconds_per_point
 from gsdf.contour._isosurface import (CHUNK, _check_bbox, _check_func, _edges_of_vertices, _evaluate, _finite,
                                       refine_on_edges)
@@ -189,10 +189,9 @@ def slice_contours(
         raise ValueError(f"axis: must be 0, 1 or 2, got {axis}")
     ua, va = (axis + 1) % 3, (axis + 2) % 3
     grid = _plane_grid(bbox_min, bbox_max, resolution, axis)
-    Z = np.atleast_1d(np.asarray(z_values))
-    if Z.ndim != 1 or Z.size == 0 or not np.issubdtype(Z.dtype, np.number):
+    Z = np.atleast_1d(as_values(z_values, "z_values", finite=False, allow_empty=True))
+    if Z.ndim != 1 or Z.size == 0:
         raise ValueError(f"z_values: expected a number or a non-empty 1D array of numbers, got shape {Z.shape}")
-    Z = Z.astype(np.float64)
     if not np.isfinite(Z).all():
         raise ValueError("z_values: contains NaN or infinite values")
     level = _finite(level, "level")
@@ -426,7 +425,7 @@ def write_svg(
     if ns == 0:
         raise ValueError("contours_per_slice: is empty (no slices)")
     if z_values is not None:
-        Z = np.atleast_1d(np.asarray(z_values, dtype=np.float64))
+        Z = np.atleast_1d(as_values(z_values, "z_values", finite=False, allow_empty=True))
         if Z.shape != (ns,):
             raise ValueError(f"z_values: expected shape ({ns},), got {Z.shape}")
         if not np.isfinite(Z).all():
@@ -538,5 +537,5 @@ def write_slices_svg(path, func, z_values, bbox_min=None, bbox_max=None, svg_opt
     lo, hi = grid.box
     opts = dict(svg_options or {})
     opts.setdefault("bbox", [[lo[ua], lo[va]], [hi[ua], hi[va]]])
-    write_svg(path, C, z_values=np.atleast_1d(np.asarray(z_values, dtype=np.float64)), **opts)
+    write_svg(path, C, z_values=np.atleast_1d(as_values(z_values, "z_values")), **opts)
     return C

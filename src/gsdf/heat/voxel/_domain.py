@@ -79,12 +79,7 @@ def as_occupancy(occupancy) -> np.ndarray:
 
 def as_spacing(spacing) -> np.ndarray:
     """Validate a voxel size: a positive finite scalar or 3-vector; returns (3,) float64."""
-    if isinstance(spacing, (bool, np.bool_)):
-        raise ValueError(f"spacing: expected a positive number or 3 positive numbers, got {spacing!r}")
-    try:
-        s = np.asarray(spacing, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"spacing: expected a positive number or 3 positive numbers, got {spacing!r}") from exc
+    s = _checks.as_values(spacing, "spacing", finite=False)
     if s.ndim == 0:
         s = np.full(3, float(s))
     if s.shape != (3,):
