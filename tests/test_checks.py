@@ -118,3 +118,32 @@ def test_readable_file_size_guard(tmp_path, monkeypatch):
     monkeypatch.setenv("GSDF_MEMORY_LIMIT", "64M")
     with pytest.raises(ValueError, match="big.xyz: reading a file of 32.0 MB: needs about 256.0 MB"):
         readable_file(f)
+
+
+def test_options_dataclasses_refuse_bad_values_at_construction():
+    """The fuzz found options objects that took anything until used (or never)."""
+    import gsdf
+
+    for cls, kw in ((gsdf.BooleanOptions, {"exact": "no"}), (gsdf.BooleanOptions, {"bisection_steps": "x"}),
+                    (gsdf.PointsAsToriOptions, {"ridge": np.inf}), (gsdf.PointsAsToriOptions, {"k_fallback": np.nan}),
+                    (gsdf.PointsAsToriOptions, {"curvature_cap": "x"}), (gsdf.VolumeHeatOptions, {"mesher": "bogus"}),
+                    (gsdf.VolumeHeatOptions, {"soft_weight": b"x"}), (gsdf.BatchOptions, {"resume": 2}),
+                    (gsdf.BatchOptions, {"scheduler_timeout": -np.inf}), (gsdf.BatchOptions, {"scheduler_timeout": 1j}),
+                    (gsdf.SdfSamplesOptions, {"margin": -1}), (gsdf.SWNOptions, {"time_limit": 0})):
+        with pytest.raises(ValueError, match=next(iter(kw))):
+            cls(**kw)
+    for cls in (gsdf.BooleanOptions, gsdf.PointsAsToriOptions, gsdf.VolumeHeatOptions, gsdf.BatchOptions,
+                gsdf.SdfSamplesOptions, gsdf.SWNOptions):
+        cls()  # the defaults are valid
+
+
+def test_switches_and_callbacks_of_entry_points():
+    import gsdf
+
+    with pytest.raises(ValueError, match="report: expected True or False"):
+        gsdf.voxels_to_mesh(np.ones((1, 1, 1), bool), [0] * 3, [1] * 3, report="yes")
+    with pytest.raises(ValueError, match="progress: expected a callable"):
+        gsdf.run_batch("nowhere", "occupancy", "out", progress=float("nan"))
+    with pytest.raises(ValueError, match="sdf: did not return real numbers"):
+        gsdf.render_png(lambda q: np.linalg.norm(q, axis=1) - 0.5 + 1j, "x.png", 8, 8, bbox_min=[-1] * 3,
+                        bbox_max=[1] * 3)

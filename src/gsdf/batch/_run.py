@@ -19,6 +19,7 @@ import time
 import uuid
 from dataclasses import dataclass, field
 
+from gsdf._checks import flag, integer, positive, progress_callback
 from gsdf.batch._inputs import check_output_folder, collect_inputs
 from gsdf.batch._manifest import MANIFEST_NAME, ManifestWriter, file_sha256, params_sha256, read_manifest
 from gsdf.batch._tasks import check_options, task_name
@@ -69,6 +70,14 @@ class BatchOptions:
     max_retries: int = 2
     threads: int | None = None
     scheduler_timeout: float = 10.0
+
+    def __post_init__(self):  # a ValueError naming the attribute, at construction
+        flag(self.resume, "resume")
+        flag(self.retry_failed, "retry_failed")
+        integer(self.max_retries, "max_retries", lo=0)
+        if self.threads is not None:
+            integer(self.threads, "threads", lo=1)
+        positive(self.scheduler_timeout, "scheduler_timeout")
 
 
 @dataclass
@@ -306,6 +315,7 @@ def run_batch(inputs, task, out, options=None, *, workers=None, executor=None, p
     kind = _executor_spec(workers, executor)
     _count("threads", bo.threads)
     _count("max_retries", bo.max_retries, lo=0)
+    progress = None if progress is None else progress_callback(progress)
     report = None if progress is None else (lambda rec, counts: progress(
         rec["status"], sum(counts[s] for s in STATUSES) / max(1, counts["total"])))
     items = collect_inputs(inputs)

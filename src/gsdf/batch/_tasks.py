@@ -185,6 +185,9 @@ class SdfSamplesOptions:
     beta: float | None = None
     estimate_normals: bool = False
 
+    def __post_init__(self):
+        _check_fields(self)
+
 
 @dataclasses.dataclass(frozen=True)
 class OccupancyOptions:
@@ -213,6 +216,17 @@ class OccupancyOptions:
     margin: float = 0.1
     beta: float | None = None
     estimate_normals: bool = False
+
+    def __post_init__(self):
+        _check_fields(self)
+
+
+def _check_fields(opts) -> None:
+    """A ValueError naming the attribute of an options dataclass, at construction (the checks of the flags)."""
+    for f in dataclasses.fields(opts):
+        v = getattr(opts, f.name)
+        if v is not None or f.name != "beta":
+            _CHECKS[f.name](v, f.name)
 
 
 def _task_options(task, values: dict) -> dict:

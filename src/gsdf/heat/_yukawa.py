@@ -37,7 +37,7 @@ import numpy as np
 from numba import njit, prange
 from scipy.spatial import cKDTree
 
-from gsdf._checks import as_points, as_values, nonnegative, positive
+from gsdf._checks import as_points, as_values, integer, nonnegative, positive
 from gsdf._memory import SECONDS_PER_PAIR, SECONDS_PER_QUERY
 from gsdf.spatial._bvh import build_bvh
 
@@ -253,6 +253,7 @@ class YukawaTree:
         if dref is not None:
             dref = as_values(dref, "dref", (len(Q),), allow_empty=True)
         slack = nonnegative(slack, "slack")
+        chunk = integer(chunk, "chunk", 1)
         out = np.empty((len(Q), 3))
         t = self.tree
         band = self.tau / self.lam + 2.0 * float(slack)

@@ -33,7 +33,7 @@ import dataclasses
 
 import numpy as np
 
-from gsdf._checks import as_mesh, choice, integer, positive
+from gsdf._checks import as_mesh, choice, flag, integer, positive
 
 __all__ = ["mesh_boolean", "trim_mesh", "BooleanOptions"]
 
@@ -70,6 +70,12 @@ class BooleanOptions:
     exact: bool = False
     bisection_steps: int = 12
     stitch: bool = True
+
+    def __post_init__(self):  # a ValueError naming the attribute, at construction
+        positive(self.beta, "beta", most=1e150)
+        flag(self.exact, "exact")
+        _steps(self.bisection_steps)
+        flag(self.stitch, "stitch")
 
 _OPS = ("union", "intersection", "difference")
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_normals, as_occupancy, as_points, as_weights, positive, progress_callback
+from gsdf._checks import as_mesh, as_normals, as_occupancy, as_points, as_weights, flag, positive, progress_callback
 from gsdf._memory import SECONDS_PER_QUERY, check_bytes, check_work, grid_bytes
 from gsdf.mesh._topology import manifold_report, split_nonmanifold_vertices
 
@@ -254,6 +254,7 @@ def voxels_to_mesh(occ, bbox_min, bbox_max, report: bool = False):
     """
     A = _occupancy(occ)
     lo, hi = _bbox(bbox_min, bbox_max)
+    report = flag(report, "report")
     # padded copy and masks (~4 B/cell), plus ~300 B per exposed cell face (at most 6 per occupied cell:
     # indices, quads, triangles, the unique of the node ids)
     check_bytes(grid_bytes(np.array(A.shape) + 2, 4) + 300 * 6 * int(np.count_nonzero(A)),

@@ -169,6 +169,14 @@ class PointsAsToriOptions:
     curvature_cap: float = 4.0
     kd_eps: float = 0.0
 
+    def __post_init__(self):  # a ValueError naming the attribute, at construction (as PointsAsTori checks them)
+        integer(self.k_eval, "k_eval", lo=1)
+        integer(self.k_fallback, "k_fallback", lo=1)
+        nonnegative(self.normal_weight, "normal_weight")
+        nonnegative(self.ridge, "ridge")
+        positive(self.curvature_cap, "curvature_cap")
+        nonnegative(self.kd_eps, "kd_eps", most=1e3)
+
 
 class PointsAsTori:
     """Generalized signed distance of an oriented point cloud, evaluated pointwise (thesis ch. 5).

@@ -69,6 +69,9 @@ class VolumeHeatOptions:
     max_memory: int | None = None
     progress: Callable[[str, float], None] | None = None
 
+    def __post_init__(self):  # a ValueError naming the attribute, at construction ("auto" is resolved per domain)
+        self._checked("grid")
+
     def _checked(self, domain: str) -> dict:
         """The options validated for ``domain`` (ValueError naming the option): a dict with ``mode`` and ``lam``
         (the soft weight, or None for the hard constraint) in place of the two constraint fields."""
