@@ -322,7 +322,7 @@ def test_bad_input():
         VoxelSurfaceSignedHeatSolver(np.ones((4, 4), bool))
     with pytest.raises(ValueError, match="occupancy.*boolean"):
         VoxelSurfaceSignedHeatSolver(occ * 2.5)
-    with pytest.raises(ValueError, match="occupancy.*dtype"):
+    with pytest.raises(ValueError, match="occupancy: expected a boolean array, got strings"):
         VoxelSurfaceSignedHeatSolver(np.full((3, 3, 3), "a"))
     for bad in (np.nan, -1.0, 0.0, [1, 1], [1, np.inf, 1], True, "x"):
         with pytest.raises(ValueError, match="spacing"):
