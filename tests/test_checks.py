@@ -147,3 +147,8 @@ def test_switches_and_callbacks_of_entry_points():
     with pytest.raises(ValueError, match="sdf: did not return real numbers"):
         gsdf.render_png(lambda q: np.linalg.norm(q, axis=1) - 0.5 + 1j, "x.png", 8, 8, bbox_min=[-1] * 3,
                         bbox_max=[1] * 3)
+
+
+def test_as_values_keeps_scalars_scalar():
+    assert as_values(2, "s").shape == () and as_values(np.float32(2), "s").shape == ()
+    assert as_values([[1, 2]], "s").flags.c_contiguous

@@ -86,7 +86,7 @@ def as_values(x, name: str = "values", shape=None, *, finite: bool = True, allow
         _work_guard(size_of(A), seconds_per_item, name)
     if A.dtype != np.float64 or not A.flags.c_contiguous:
         _copy_guard(A, name)
-    A = np.ascontiguousarray(A, dtype=np.float64)
+    A = np.asarray(A, dtype=np.float64, order="C")  # (ascontiguousarray would make a scalar 1-d)
     if finite and not np.isfinite(A).all():
         bad = int(np.argmax(~np.isfinite(A.ravel())))
         raise ValueError(f"{name}: contains NaN or infinite values (first at flat index {bad})")
