@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import gsdf
-from gsdf.field import GridField, SurfaceField, TetField
+from gsdf.field import GridField, SurfaceField, TetField, load_field
 from gsdf.io._safe_write import atomic_output, check_output_path
 
 from tests.shapes import cube, uv_sphere
@@ -363,3 +363,68 @@ def test_load_field_reads_every_saved_form_back(tmp_path):
         gsdf.load_field(tmp_path / "bad.vti")
     with pytest.raises(FileNotFoundError):
         gsdf.load_field(tmp_path / "missing.vti")
+
+
+# ----------------------------------------------------------------- values are real numbers; saved fields checked
+
+
+@pytest.mark.parametrize("bad, why", [(1j, "complex numbers"), ("a", "strings"), (True, "booleans")])
+def test_field_values_must_be_real(bad, why):
+    T = np.eye(4, 3)
+    V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.]])
+    cases = [lambda v: GridField(np.full((3, 3, 3), v), [0, 0, 0], [1, 1, 1]),
+             lambda v: TetField(T, [[0, 1, 2, 3]], np.full(4, v)),
+             lambda v: SurfaceField(V, [[0, 1, 2], [0, 2, 3]], np.full(4, v))]
+    for make in cases:
+        with pytest.raises(ValueError, match=f"values: expected real numbers, got {why}"):
+            make(bad)
+
+
+def test_tet_field_checks_its_tets():
+    T = np.eye(4, 3)
+    for tets, why in (([[0, 1, 2, 4]], "vertex index 4 out of range"), ([[0, 1, 2, -1]], "negative vertex index"),
+                      ([[0, 1, 2]], r"expected shape \(m, 4\)"), ([[0, 1, 2, 3.5]], "integers")):
+        with pytest.raises(ValueError, match=why):
+            TetField(T, tets, np.zeros(4))
+
+
+def test_surface_field_takes_lists_and_empty_queries():
+    V = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    F = [[0, 1, 2], [0, 2, 3]]
+    f = SurfaceField(V, F, [0, 1, 1, 0])
+    assert len(f.isolines(0.5)) == 1
+    assert f.at([0, 1], [[1, 0, 0], [0, 1, 0]]).tolist() == [0.0, 1.0]
+    assert f.at([], []).shape == (0,)
+    assert f([[0.5, 0.5, 0]]).shape == (1,) and f(np.zeros((0, 3))).shape == (0,)
+    with pytest.raises(ValueError, match="face: expected a 1-d integer array"):
+        f.at([0.5], [[1, 0, 0]])
+    with pytest.raises(ValueError, match="bary: contains NaN"):
+        f.at([0], [[np.nan, 0, 0]])
+    with pytest.raises(ValueError, match="level: must be a finite number"):
+        f.isolines(np.nan)
+
+
+@pytest.mark.parametrize("tamper, why", [
+    ({"values": lambda z: z["values"] + 1j}, "values: expected real numbers, got complex numbers"),
+    ({"values": lambda z: z["values"].astype(str)}, "values: expected real numbers, got strings"),
+    ({"kind": lambda z: np.array("bogus")}, "its 'kind' is 'bogus', expected 'grid'"),
+    ({"kind": lambda z: np.array(5)}, "its 'kind' is 5, expected 'grid'"),
+])
+def test_load_field_refuses_tampered_files(tmp_path, tamper, why):
+    p = tmp_path / "g.npz"
+    GridField(np.zeros((3, 3, 3)), [0, 0, 0], [1, 1, 1]).save(p)
+    z = dict(np.load(p))
+    z.update({k: f(z) for k, f in tamper.items()})
+    np.savez(tmp_path / "t.npz", **z)
+    with pytest.raises(ValueError, match=why) as e:
+        load_field(tmp_path / "t.npz")
+    assert str(e.value).startswith(str(tmp_path / "t.npz"))
+
+
+def test_load_field_of_a_folder_or_fifo(tmp_path):
+    (tmp_path / "d.npz").mkdir()
+    with pytest.raises(ValueError, match="is a directory"):
+        load_field(tmp_path / "d.npz")
+    os.mkfifo(tmp_path / "p.vti")
+    with pytest.raises(ValueError, match="is a FIFO"):
+        load_field(tmp_path / "p.vti")

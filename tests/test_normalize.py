@@ -153,9 +153,9 @@ def test_bad_options_are_refused():
     P2 = fibonacci_sphere(200)
     Q1 = np.zeros((1, 3))
     bad = [
-        (lambda: estimate_normals(P2, k=2 ** 70), "k: expected an integer <="),
+        (lambda: estimate_normals(P2, k=2 ** 70), "k: 1180591620717411303424 neighbours asked for"),
         (lambda: gsdf.fast_winding_number(V, F, Q1, beta=1e200), "beta: must be a finite positive number"),
-        (lambda: gsdf.fast_winding_number(V, F, Q1, beta=True), "beta: expected a number"),
+        (lambda: gsdf.fast_winding_number(V, F, Q1, beta=True), "beta: expected a real number"),
         (lambda: gsdf.FastWindingNumber(V, F, leaf_size="x"), "leaf_size"),
         (lambda: gsdf.ExactWindingNumber(V, F, leaf_size=1e300), "leaf_size"),
         (lambda: gsdf.distance.TriangleDistance(V, F, leaf_size=2 ** 64), "leaf_size"),
@@ -169,7 +169,7 @@ def test_bad_options_are_refused():
         (lambda: gsdf.ops.voxelize(mesh=(V, F), resolution=np.inf), "resolution"),
         (lambda: gsdf.contour.extract_isosurface(lambda q: q[:, 0], [-1] * 3, [1] * 3, 8, level=0.0,
                                                  bisection_steps=10 ** 9), "bisection_steps"),
-        (lambda: gsdf.tori.offset(lambda q: q[:, 0], [1, 2]), "r: expected a number"),
+        (lambda: gsdf.tori.offset(lambda q: q[:, 0], [1, 2]), "r: expected a real number"),
         (lambda: gsdf.ops.mesh_boolean(V, F, V + 0.3, F, "union",
                                        options=gsdf.BooleanOptions(beta=np.inf)), "beta"),
     ]

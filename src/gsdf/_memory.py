@@ -1,11 +1,21 @@
-"""Memory guard: estimate the bytes of a large allocation before making it, refuse with numbers.
+"""Size guard: estimate the memory AND the work of a size-driven request before starting it, refuse with numbers.
 
-Every allocation proportional to a grid (voxel and winding grids, sampled signed-distance grids,
-isosurface extraction) or to queries × neighbours calls :func:`check_bytes` first. The limit is what the
-machine can give now: ``MemAvailable`` of ``/proc/meminfo`` (Linux), else ``os.sysconf`` physical pages;
-the environment variable ``GSDF_MEMORY_LIMIT`` (bytes, or with a K/M/G/T suffix, e.g. ``2G``) overrides it.
-A refused request is a ``ValueError`` naming what was asked, its estimated size and the limit, instead of a
-numpy ``MemoryError`` traceback (or the machine swapping).
+Every entry point whose cost grows with a size it is given (query points, grid or voxel counts, slice heights ×
+resolution, sample counts, neighbour counts k) calls the two checks of this module before its first pass over
+the data, so that an absurd size is a ``ValueError`` in well under a second instead of a ``MemoryError``
+traceback, a swapping machine or a run that never ends:
+
+* :func:`check_bytes` — the bytes the request will allocate, against what the machine can give now:
+  ``MemAvailable`` of ``/proc/meminfo`` (Linux), else ``os.sysconf`` physical pages, and never more than the
+  address space left under ``RLIMIT_AS`` (``ulimit -v``); the environment variable ``GSDF_MEMORY_LIMIT`` (bytes,
+  or with a K/M/G/T suffix, e.g. ``2G``) overrides it.
+* :func:`check_work` — the wall time the request will take, estimated as items × the optimistic single-thread
+  seconds per item (the ``SECONDS_PER_*`` constants below) divided by gsdf's thread count, against
+  ``GSDF_WORK_LIMIT`` (seconds, or with an s/m/h/d suffix, e.g. ``2h``; ``none`` disables the check; default
+  5 minutes, :data:`WORK_LIMIT`). The estimates are lower bounds: what is refused would take at least that long.
+
+A refused request is a ``ValueError`` naming what was asked (the size), its estimate and the limit, and the
+variable that changes the limit.
 
 Example
 -------
@@ -25,6 +35,7 @@ import math
 import os
 
 ENV = "GSDF_MEMORY_LIMIT"
+WORK_ENV = "GSDF_WORK_LIMIT"
 _SUFFIX = {"": 1, "B": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
 
 
@@ -51,6 +62,10 @@ def available_bytes() -> int:
     env = os.environ.get(ENV)
     if env:
         return _parse(env)
+    return min(_machine_bytes(), _address_space_left())
+
+
+def _machine_bytes() -> int:
     try:
         with open("/proc/meminfo") as f:
             for line in f:
@@ -62,6 +77,25 @@ def available_bytes() -> int:
         return int(SHARE * int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES")))
     except (ValueError, OSError, AttributeError):
         return 1 << 62
+
+
+def _address_space_left() -> int:
+    """Bytes of address space this process may still map under ``RLIMIT_AS`` (2**62 without a limit)."""
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    except (ImportError, OSError, ValueError, AttributeError):  # pragma: no cover - not POSIX
+        return 1 << 62
+    if soft == resource.RLIM_INFINITY or soft <= 0:
+        return 1 << 62
+    used = 0
+    try:
+        with open("/proc/self/statm") as f:
+            used = int(f.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        pass
+    return max(0, int(SHARE * (soft - used)))
 
 
 def human(n: float) -> str:
@@ -91,6 +125,119 @@ def check_bytes(nbytes: float, what: str, limit: int | None = None) -> None:
     if nbytes > limit:
         raise ValueError(f"{what}: needs about {human(nbytes)}, more than the {human(limit)} allowed; "
                          f"lower the resolution/size, or set {ENV} (bytes) to change the limit")
+
+
+#: Default of ``GSDF_WORK_LIMIT``: the estimated wall time (seconds) above which a request is refused.
+WORK_LIMIT = 300.0
+
+#: Optimistic single-thread seconds per item of the kinds of work gsdf does (what is refused would take at
+#: least items × this / threads). Measured on the sphere of the tests and a 40k-triangle mesh, one thread: the
+#: fast winding number took 1.1–2.0 µs per query, the triangle distance 1.5–4 µs, ``gsdf slice`` 1.3 µs per
+#: slice node (see docs/decisions.md, "Size guard").
+SECONDS_PER_QUERY = 1e-6         #: a tree query: fast winding number, distance, nearest neighbours, PAT
+SECONDS_PER_NODE = 2e-7          #: a node of a grid solve, a field evaluation, an isosurface or voxel pass
+SECONDS_PER_PAIR = 2e-9          #: one query × element term of a direct sum (exact winding numbers)
+SECONDS_PER_CELL = 1e-9          #: one voxel of an elementwise pass over a boolean grid
+
+_TIME_SUFFIX = {"": 1.0, "S": 1.0, "M": 60.0, "H": 3600.0, "D": 86400.0}
+
+
+def seconds_per_point(func, default: float = SECONDS_PER_NODE) -> float:
+    """Single-thread seconds of one evaluation of the field ``func`` at one point: its ``_seconds_per_point``
+    attribute (gsdf's evaluators — fast winding numbers, distances, Points as Tori — carry one), else
+    ``default`` (a lower bound for any Python function on arrays)."""
+    v = getattr(func, "_seconds_per_point", default)
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return default
+    return v if math.isfinite(v) and v >= 0 else default
+
+
+def work_limit() -> float:
+    """Seconds of estimated wall time a request may take: ``GSDF_WORK_LIMIT`` (seconds, or ``30m``, ``2h``,
+    ``1d``; ``none``/``inf`` for no limit), else :data:`WORK_LIMIT`."""
+    text = os.environ.get(WORK_ENV)
+    if not text or not text.strip():
+        return WORK_LIMIT
+    t = text.strip().upper()
+    if t in ("NONE", "INF", "OFF", "UNLIMITED"):
+        return math.inf
+    unit = t[-1:] if t[-1:] in _TIME_SUFFIX else ""
+    try:
+        v = float(t[: len(t) - len(unit)] if unit else t) * _TIME_SUFFIX[unit]
+    except ValueError:
+        raise ValueError(f"{WORK_ENV}: expected seconds like 600, 30m, 2h or none, got {text!r}") from None
+    if not v > 0 or math.isnan(v):
+        raise ValueError(f"{WORK_ENV}: expected a positive time or none, got {text!r}")
+    return v
+
+
+def _threads() -> int:
+    try:
+        from gsdf.threads import get_num_threads
+
+        return max(1, int(get_num_threads()))
+    except Exception:  # pragma: no cover - thread setting unreadable: assume one
+        return 1
+
+
+def human_time(s: float) -> str:
+    """``45 s`` / ``12 min`` / ``3.2 h`` / ``5.1 days`` style duration."""
+    if s < 120:
+        return f"{s:.0f} s"
+    if s < 7200:
+        return f"{s / 60:.0f} min"
+    if s < 172800:
+        return f"{s / 3600:.1f} h"
+    return f"{s / 86400:.3g} days"
+
+
+def check_work(items: float, seconds_per_item: float, what: str, limit: float | None = None,
+               parallel: bool = True) -> None:
+    """Raise ``ValueError`` when ``items`` × ``seconds_per_item`` (one thread; divided by gsdf's thread count
+    when ``parallel``) exceeds ``limit`` seconds (default :func:`work_limit`).
+
+    ``what`` names the request and its size (e.g. ``"fast_winding_number: 1,000,000,000 queries"``).
+
+    Example
+    -------
+    >>> try:
+    ...     check_work(10**12, SECONDS_PER_QUERY, "10^12 queries", limit=60, parallel=False)
+    ... except ValueError as e:
+    ...     print(str(e).split(";")[0])
+    10^12 queries: would take at least 11.6 days (estimated), more than the 60 s allowed
+    """
+    limit = work_limit() if limit is None else float(limit)
+    if not math.isfinite(limit):
+        return
+    est = float(items) * float(seconds_per_item) / (_threads() if parallel else 1)
+    if est > limit:
+        raise ValueError(f"{what}: would take at least {human_time(est)} (estimated), more than the "
+                         f"{human_time(limit)} allowed; lower the size, or set {WORK_ENV} (seconds, e.g. 2h; none "
+                         "for no limit) to change the limit")
+
+
+def rows(x) -> int:
+    """Number of rows (length of the first axis) of an array-like, without copying it (0 for a scalar)."""
+    shape = getattr(x, "shape", None)
+    if shape is None:
+        try:
+            return len(x)
+        except TypeError:
+            return 0
+    return int(shape[0]) if len(shape) else 0
+
+
+def size_of(x) -> int:
+    """Number of elements of an array-like, without copying an ndarray (Python integers: no overflow)."""
+    shape = getattr(x, "shape", None)
+    if shape is None:
+        return 0
+    n = 1
+    for s in shape:
+        n *= int(s)
+    return n
 
 
 def chunk_rows(bytes_per_row: float, total: int, budget: float | None = None) -> int:

@@ -41,10 +41,12 @@ def _surface_point(item, name: str, expected: str):
         raise ValueError(f"{name}: expected {expected}, got {item!r}") from exc
     if not _is_index_scalar(e):
         raise ValueError(f"{name}: element index must be an integer, got {e!r}")
+    from gsdf._checks import as_values
+
     try:
-        b = np.asarray(b, dtype=np.float64).ravel()
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: barycentric coordinates must be numbers, got {b!r}") from exc
+        b = as_values(b, name, finite=False, allow_empty=True).ravel()
+    except ValueError as exc:
+        raise ValueError(f"{name}: barycentric coordinates must be real numbers ({exc})") from None
     return int(e), b
 
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_points, query_shaped
+from gsdf._checks import _array, as_faces, as_points, as_values, finite, query_shaped
+from gsdf._memory import SECONDS_PER_NODE
 from gsdf.contour._tets import locate_in_tets, marching_tetrahedra
 from gsdf.grid import Grid
 
@@ -76,7 +77,7 @@ class GridField(Field):
     """
 
     def __init__(self, values, bbox_min, bbox_max):
-        values = np.asarray(values, dtype=np.float64)
+        values = as_values(values, "values", finite=False, allow_empty=True)
         if values.ndim != 3 or min(values.shape) < 2:
             raise ValueError(f"values: expected a 3D grid with at least 2 nodes per axis, got shape {values.shape}")
         if not np.isfinite(values).all():
@@ -110,7 +111,7 @@ class GridField(Field):
     @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         """Trilinear interpolation at query points ``Q`` (q, 3); points outside are clamped to the box."""
-        Q = as_points(Q, "Q", allow_empty=True)
+        Q = as_points(Q, "Q", allow_empty=True, seconds_per_row=SECONDS_PER_NODE)
         n = np.array(self.values.shape)
         t = (Q - self.bbox_min) / self.spacing
         t = np.clip(t, 0.0, n - 1.0)
@@ -173,7 +174,7 @@ class GridField(Field):
 
     def isosurfaces(self, levels, close: bool = False):
         """Several level sets at once: a list of ``(V, F)``, one per level (e.g. offsets ±1 %, ±3 %)."""
-        return [self.isosurface(float(v), close=close) for v in np.atleast_1d(np.asarray(levels, dtype=float))]
+        return [self.isosurface(float(v), close=close) for v in np.atleast_1d(as_values(levels, "levels"))]
 
     SAVE_EXTENSIONS = (".npz", ".npy", ".vtk", ".vti", ".vtu")
 
@@ -206,8 +207,8 @@ class GridField(Field):
     @classmethod
     def load(cls, path) -> "GridField":
         """Read a field written by :meth:`save` to ``.npz`` (the only form that stores the box)."""
-        d = _load_npz(path, ("values", "bbox_min", "bbox_max"), "grid field")
-        return cls(d["values"], d["bbox_min"], d["bbox_max"])
+        d = _load_npz(path, ("values", "bbox_min", "bbox_max"), "grid field", "grid")
+        return _build(path, cls, d["values"], d["bbox_min"], d["bbox_max"])
 
 
 def load_field(path) -> Field:
@@ -229,13 +230,11 @@ def load_field(path) -> Field:
     """
     import os
 
-    p = os.fspath(path)
+    from gsdf._checks import readable_file
+
+    p = readable_file(path, "path")
     ext = os.path.splitext(p)[1].lower()
     if ext in (".vti", ".vtk", ".vtu", ".ply"):
-        if not os.path.exists(p):
-            raise FileNotFoundError(2, "No such file or directory", p)
-        if os.path.isdir(p):
-            raise ValueError(f"{p}: is a directory, not a field file")
         return _load_vti(p) if ext == ".vti" else _load_mesh_field(p, ext)
     if ext == ".npy":
         raise ValueError(f"{p}: a .npy file holds the values without their grid or mesh; save the field as .npz "
@@ -335,24 +334,33 @@ def _load_vti(p: str) -> GridField:
     return GridField(values, lo, lo + spacing * (np.array(shape) - 1))
 
 
-def _load_npz(path, keys, what: str) -> dict:
-    """The arrays ``keys`` of a gsdf ``.npz`` file; FileNotFoundError if missing, else ValueError naming the file."""
-    import os
+def _load_npz(path, keys, what: str, kind: str | None = None) -> dict:
+    """The arrays ``keys`` of a gsdf ``.npz`` file; FileNotFoundError if missing, else ValueError naming the file.
+    With ``kind``: the file's ``kind`` entry, when it has one, must be that string (what ``save`` writes)."""
+    from gsdf._checks import readable_file
 
-    p = os.fspath(path)
-    if not os.path.exists(p):
-        raise FileNotFoundError(2, "No such file or directory", p)
-    if os.path.isdir(p):
-        raise ValueError(f"{p}: is a directory, not a {what} file")
+    p = readable_file(path, "path")
     try:
         with np.load(p, allow_pickle=False) as d:
             missing = [k for k in keys if k not in d]
             if missing:
                 raise ValueError(f"missing arrays {', '.join(missing)}")
-            return {"__files__": list(d.files), **{k: d[k] for k in keys}}
+            out = {"__files__": list(d.files), **{k: d[k] for k in keys}}
+            stored = d["kind"] if kind is not None and "kind" in d.files else None
     except Exception as exc:  # numpy/zipfile raise ValueError, EOFError, BadZipFile, zlib.error, TokenError,
         # NotImplementedError ... for broken headers, archives and compressed data: all mean a malformed file
         raise ValueError(f"{p}: not a gsdf {what} .npz file ({exc})") from exc
+    if stored is not None and not (stored.dtype.kind == "U" and stored.shape == () and str(stored) == kind):
+        raise ValueError(f"{p}: not a gsdf {what} .npz file (its 'kind' is {stored.tolist()!r}, expected {kind!r})")
+    return out
+
+
+def _build(path, cls, *arrays):
+    """``cls(*arrays)`` of arrays read from ``path``; a refusal names the file."""
+    try:
+        return cls(*arrays)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
 
 
 def _write_vtk_structured_points(path, values, origin, spacing) -> None:
@@ -421,16 +429,8 @@ class TetField(Field):
 
     def __init__(self, vertices, tets, values, delaunay=None):
         self.vertices = as_points(vertices, "vertices")
-        T = np.asarray(tets)
-        if T.ndim != 2 or T.shape[1] != 4 or len(T) == 0:
-            raise ValueError(f"tets: expected shape (m, 4) with m > 0, got {T.shape}")
-        if not np.issubdtype(T.dtype, np.integer) or T.min() < 0 or T.max() >= len(self.vertices):
-            raise ValueError("tets: expected integer vertex indices within range")
-        self.tets = np.ascontiguousarray(T, dtype=np.int64)
-        v = np.asarray(values, dtype=np.float64).ravel()
-        if v.shape[0] != len(self.vertices) or not np.isfinite(v).all():
-            raise ValueError(f"values: expected {len(self.vertices)} finite values, got shape {np.shape(values)}")
-        self.values = v
+        self.tets = as_faces(tets, len(self.vertices), "tets", corners=4)
+        self.values = as_values(values, "values", (len(self.vertices),))
         self._delaunay = delaunay
         self.meta: dict = {}
 
@@ -445,7 +445,7 @@ class TetField(Field):
     @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         """Barycentric (piecewise linear) interpolation at ``Q`` (q, 3); outside the mesh: nearest vertex."""
-        Q = as_points(Q, "Q", allow_empty=True)
+        Q = as_points(Q, "Q", allow_empty=True, seconds_per_row=SECONDS_PER_NODE)
         out = np.empty(len(Q))
         if self._delaunay is not None:
             D = self._delaunay
@@ -473,7 +473,7 @@ class TetField(Field):
         return marching_tetrahedra(self.vertices, self.tets, self.values, level, report=report)
 
     def isosurfaces(self, levels):
-        return [self.isosurface(float(v)) for v in np.atleast_1d(np.asarray(levels, dtype=float))]
+        return [self.isosurface(float(v)) for v in np.atleast_1d(as_values(levels, "levels"))]
 
     SAVE_EXTENSIONS = (".npz", ".npy", ".vtk", ".vtu")
 
@@ -494,8 +494,8 @@ class TetField(Field):
     @classmethod
     def load(cls, path) -> "TetField":
         """Read a field written by :meth:`save` to ``.npz``."""
-        d = _load_npz(path, ("vertices", "tets", "values"), "tet field")
-        return cls(d["vertices"], d["tets"], d["values"])
+        d = _load_npz(path, ("vertices", "tets", "values"), "tet field", "tet")
+        return _build(path, cls, d["vertices"], d["tets"], d["values"])
 
 
 class SurfaceField(Field):
@@ -528,33 +528,28 @@ class SurfaceField(Field):
         from gsdf._checks import as_mesh
 
         self.vertices, self.faces = as_mesh(vertices, faces)
-        v = np.asarray(values)
-        if v.dtype == bool or not (np.issubdtype(v.dtype, np.number)) or v.shape != (len(self.vertices),):
-            raise ValueError(f"values: expected {len(self.vertices)} numbers (one per vertex), got "
-                             f"{v.dtype} {v.shape}")
-        v = v.astype(np.float64)
-        if not np.isfinite(v).all():
-            raise ValueError("values: contains NaN or infinite entries")
-        self.values = v
+        self.values = as_values(values, "values", (len(self.vertices),))
         self._distance = None
         self.meta: dict = {}
 
     def at(self, face, bary) -> np.ndarray:
         """Values at surface points given as a face index (q,) and barycentric coordinates (q, 3)."""
-        face = np.asarray(face)
-        bary = np.asarray(bary, dtype=np.float64)
-        if face.dtype == bool or not np.issubdtype(face.dtype, np.integer) or face.ndim != 1:
+        face = _array(face, "face")
+        if face.size == 0:  # [] is a float array: no face of any dtype is fine
+            face = np.zeros(0, dtype=np.int64)
+        if face.dtype.kind not in "iu" or face.ndim != 1:
             raise ValueError(f"face: expected a 1-d integer array, got {face.dtype} {face.shape}")
         if len(face) and (face.min() < 0 or face.max() >= len(self.faces)):
             raise ValueError(f"face: indices must be in [0, {len(self.faces)})")
-        if bary.shape != (len(face), 3) or not np.isfinite(bary).all():
-            raise ValueError(f"bary: expected finite shape ({len(face)}, 3), got {bary.shape}")
+        if len(face) == 0 and np.size(bary) == 0:
+            return np.zeros(0)
+        bary = as_values(bary, "bary", (len(face), 3))
         return (bary * self.values[self.faces[face]]).sum(axis=1)
 
     @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         """Values at the points of the surface closest to ``Q`` (q, 3) (on the surface: at ``Q`` itself)."""
-        Q = as_points(Q, "Q", allow_empty=True)
+        Q = as_points(Q, "Q", allow_empty=True, seconds_per_row=SECONDS_PER_NODE)
         if len(Q) == 0:
             return np.zeros(0)
         if self._distance is None:
@@ -582,9 +577,7 @@ class SurfaceField(Field):
             One per curve; a closed curve repeats its first point at the end. Empty when ``level`` is not
             crossed.
         """
-        level = float(level)
-        if not np.isfinite(level):
-            raise ValueError(f"level: expected a finite number, got {level}")
+        level = finite(level, "level")
         F = self.faces
         s = self.values - level
         pos = s[F] > 0
@@ -630,8 +623,8 @@ class SurfaceField(Field):
     @classmethod
     def load(cls, path) -> "SurfaceField":
         """Read a field written by :meth:`save` to ``.npz``."""
-        d = _load_npz(path, ("vertices", "faces", "values"), "surface field")
-        return cls(d["vertices"], d["faces"], d["values"])
+        d = _load_npz(path, ("vertices", "faces", "values"), "surface field", "surface")
+        return _build(path, cls, d["vertices"], d["faces"], d["values"])
 
 
 def _chain_segments(u: np.ndarray, v: np.ndarray, n: int) -> list:

@@ -27,6 +27,8 @@ Example
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from gsdf._checks import as_points, integer, nonnegative, positive
@@ -70,8 +72,18 @@ def padded_box(X, pad: float = PAD) -> tuple[np.ndarray, np.ndarray]:
     X = as_points(X, "X")
     pad = nonnegative(pad, "pad", most=1e6)
     lo, hi = X.min(axis=0), X.max(axis=0)
-    d = float(np.linalg.norm(hi - lo)) or 1.0
+    d = diagonal(lo, hi) or 1.0
     return lo - pad * d, hi + pad * d
+
+
+def diagonal(lo, hi) -> float:
+    """``|hi - lo|`` without underflow or overflow of the squares (scaled by the largest component first): the
+    diagonal of a box at 1e-300 or 1e300 is exact, where ``np.linalg.norm`` gives 0 or inf."""
+    half = 0.5 * np.asarray(hi, dtype=np.float64) - 0.5 * np.asarray(lo, dtype=np.float64)  # no overflow
+    m = float(np.abs(half).max())
+    if m == 0.0 or not np.isfinite(m):
+        return 2.0 * m
+    return 2.0 * m * float(np.linalg.norm(half / m))
 
 
 class Grid:
@@ -145,7 +157,7 @@ class Grid:
     @property
     def size(self) -> int:
         """Number of nodes."""
-        return int(np.prod(self.shape))
+        return math.prod(int(s) for s in self.shape)
 
     def axes(self) -> list:
         """The node coordinates along each axis: three 1-D arrays (``np.linspace`` of the box)."""

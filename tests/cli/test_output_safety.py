@@ -263,3 +263,120 @@ def test_bad_view_is_a_usage_error_before_any_work(name, view, inputs, tmp_path)
     r = invoke(args_for(name, inputs, out) + ["--png", str(tmp_path / "p.png"), "--view", view])
     assert r.exit_code == 2 and "--view" in r.output and "Traceback" not in r.output
     assert not out.exists()
+
+
+# ------------------------------------------------------------------------------------ outputs as one set
+
+
+def test_two_outputs_with_one_name_refused_before_any_work(inputs, tmp_path):
+    r = invoke(["sdf", inputs["mesh"], "--resolution", "6", "-q", "--mesh-output", tmp_path / "x.vtk",
+                "-o", tmp_path / "x.vtk"])
+    assert "named by both -o and --mesh-output" in assert_clean_failure(r)
+    (tmp_path / "a.vtk").write_bytes(b"old")
+    os.link(tmp_path / "a.vtk", tmp_path / "b.vtk")  # two names, one file
+    r = invoke(["sdf", inputs["mesh"], "--resolution", "6", "-q", "--mesh-output", tmp_path / "a.vtk",
+                "-o", tmp_path / "b.vtk"])
+    assert "named by both -o and --mesh-output" in assert_clean_failure(r)
+    assert sorted(os.listdir(tmp_path)) == ["a.vtk", "b.vtk"] and (tmp_path / "a.vtk").read_bytes() == b"old"
+    r = invoke(["sdf", inputs["mesh"], "--resolution", "6", "-q", "--png", tmp_path / "p.png",
+                "--mesh-output", tmp_path / "z.ply", "-o", tmp_path / "g.npz"])
+    assert r.exit_code == 0, r.output
+    assert sorted(os.listdir(tmp_path)) == ["a.vtk", "b.vtk", "g.npz", "p.png", "z.ply"]
+
+
+def test_a_late_failure_leaves_no_output(inputs, tmp_path):
+    """The grid and the picture are computed, then the surface fails (no zero level set in an open triangle):
+    nothing appears, the folder made for the outputs is removed, an existing file keeps its content."""
+    tri = tmp_path / "tri.off"
+    tri.write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    (tmp_path / "s.png").write_bytes(b"old picture")
+    r = invoke(["sdf", tri, "--resolution", "8", "-q", "--mesh-output", tmp_path / "s.ply", "--png",
+                tmp_path / "s.png", "-o", tmp_path / "new" / "g.npz"])
+    err = assert_clean_failure(r, contains="outside the field's range")
+    assert "->" not in r.output.replace(err, "")  # no '-> path' line claims a file that was not left
+    assert sorted(os.listdir(tmp_path)) == ["s.png", "tri.off"]
+    assert (tmp_path / "s.png").read_bytes() == b"old picture"
+
+
+def test_heat_offset_outside_the_field_leaves_no_field(inputs, tmp_path):
+    r = invoke(["heat", inputs["mesh"], "--resolution", "6", "-q", "--offsets", "5", "-o", tmp_path / "h.npz"])
+    assert_clean_failure(r, contains="outside the field's range")
+    assert os.listdir(tmp_path) == []
+    for bad in ("nan", "inf", ",", "1e308x"):
+        r = invoke(["heat", inputs["mesh"], "--resolution", "6", "-q", "--offsets", bad, "-o", tmp_path / "h.npz"])
+        assert r.exit_code == 2 and os.listdir(tmp_path) == [], r.output  # a usage error before any work
+
+
+def test_heat_t_coef_beyond_any_domain_refused(inputs, tmp_path):
+    r = invoke(["heat", inputs["mesh"], "--resolution", "6", "-q", "--t-coef", "1e308", "-o", tmp_path / "h.npz"])
+    assert_clean_failure(r, contains="t_coef: must be a finite positive number <= 1e+06")
+    assert os.listdir(tmp_path) == []
+
+
+def test_outputs_set_commits_all_or_restores(tmp_path, monkeypatch):
+    """A rename failing half way through the commit puts the replaced file back and removes the new ones."""
+    from gsdf.cli import _common
+
+    (tmp_path / "b.txt").write_text("old b")
+    real = os.replace
+    calls = []
+
+    def flaky(src, dst):
+        calls.append(dst)
+        if str(dst).endswith("c.txt"):
+            raise OSError(28, "No space left on device")
+        return real(src, dst)
+
+    monkeypatch.setattr(_common.os, "replace", flaky)
+    with pytest.raises(ValueError, match="cannot write the outputs .No space left on device.; nothing was written"):
+        with _common.outputs():
+            for name in ("a.txt", "b.txt", "c.txt"):
+                with _common.output_file(tmp_path / name) as tmp:
+                    open(tmp, "w").write("new " + name)
+    assert sorted(os.listdir(tmp_path)) == ["b.txt"] and (tmp_path / "b.txt").read_text() == "old b"
+
+
+def test_memory_error_is_one_line(inputs, tmp_path, monkeypatch):
+    import gsdf.ops._distance_grid as dg
+
+    def boom(*a, **k):
+        raise MemoryError("Unable to allocate 5.00 GiB for an array")
+
+    monkeypatch.setattr(dg, "signed_distance_grid", boom)
+    r = invoke(["sdf", inputs["mesh"], "--resolution", "6", "-q", "-o", tmp_path / "g.npz"])
+    assert "out of memory (Unable to allocate 5.00 GiB" in assert_clean_failure(r)
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("kind", ["fifo", "dir", "dev"])
+def test_inputs_that_are_not_regular_files(inputs, tmp_path, kind):
+    p = tmp_path / "in.off"
+    if kind == "fifo":
+        os.mkfifo(p)
+    elif kind == "dir":
+        p.mkdir()
+    elif os.path.exists("/dev/zero"):
+        p.symlink_to("/dev/zero")
+    else:
+        pytest.skip("no /dev/zero")
+    r = invoke(["sdf", p, "--resolution", "6", "-q", "-o", tmp_path / "g.npz"])
+    assert_clean_failure(r)
+    assert not (tmp_path / "g.npz").exists()
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0, reason="mounting a small tmpfs needs root")
+def test_disk_full_leaves_nothing(inputs, tmp_path):
+    import subprocess
+
+    full = tmp_path / "full"
+    full.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=16k", "tmpfs", str(full)]).returncode:
+        pytest.skip("mount -t tmpfs refused (no CAP_SYS_ADMIN in this container)")
+    try:
+        r = invoke(["sdf", inputs["mesh"], "--resolution", "24", "-q", "--png", full / "p.png",
+                    "-o", full / "sub" / "g.npz"])
+        left = os.listdir(full)
+    finally:
+        subprocess.run(["umount", str(full)])
+    assert_clean_failure(r, contains="no space left on device")
+    assert left == []

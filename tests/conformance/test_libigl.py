@@ -12,7 +12,6 @@ Each test names its origin as ``file::TEST_CASE``; the assertions and tolerances
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest

@@ -123,3 +123,20 @@ def test_point_sources_candidates():
         point_sources(P, P, candidates=0)
     with pytest.raises(ValueError, match="candidates"):
         point_sources(P, P, candidates=True)
+
+
+def test_yukawa_tree_validates_sources_weights_and_queries():
+    """NaN weights gave NaN fields; a (m, 2) W was accepted; NaN sources/queries leaked SciPy's text."""
+    B = np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    W = np.array([[0, 0, 1.0], [0, 0, 1.0]])
+    for args, why in (((B, W * np.nan), "W: contains NaN"), ((B * np.nan, W), "B: contains NaN"),
+                      ((B, W[:, :2]), r"W: expected shape \(n, 3\)"), ((B, W[:1]), "W: has 1 rows but there are 2"),
+                      ((B, W + 1j), "W: expected numeric coordinates, got complex")):
+        with pytest.raises(ValueError, match=why):
+            YukawaTree(*args, t=0.01)
+    tree = YukawaTree(B, W, t=0.01)
+    with pytest.raises(ValueError, match="Q: contains NaN"):
+        tree([[np.nan, 0, 0.2]])
+    with pytest.raises(ValueError, match=r"dref: expected shape \(1,\)"):
+        tree([[0.5, 0, 0.2]], dref=[1.0, 2.0])
+    assert np.isfinite(tree([[0.5, 0, 0.2]])).all()

@@ -158,7 +158,7 @@ def test_input_spacing_and_t_scale_input():
 
 
 @pytest.mark.parametrize("kwargs, msg", [
-    (dict(mesh=cube(), options=VolumeHeatOptions(t_scale="mesh")), "t_scale"),
+    (dict(mesh=cube(), options=dict(t_scale="mesh")), "t_scale"),
     (dict(mesh=(np.zeros((0, 3)), np.zeros((0, 3), int))), "empty"),
     (dict(mesh=(np.zeros((3, 3)), np.array([[0, 1, 2]]))), "zero area"),
     (dict(points=(np.eye(3), np.zeros((3, 3)))), "all normals are zero"),
@@ -167,18 +167,21 @@ def test_input_spacing_and_t_scale_input():
     (dict(mesh=cube(), resolution=1), "resolution"),
     (dict(mesh=cube(), resolution=10**6), "absurd"),
     (dict(mesh=cube(), resolution=2000), "allowed"),
-    (dict(mesh=cube(), resolution=64, options=VolumeHeatOptions(max_memory=10**6)), "allowed"),
-    (dict(mesh=cube(), options=VolumeHeatOptions(max_memory=0)), "max_memory"),
-    (dict(mesh=cube(), options=VolumeHeatOptions(progress=3)), "progress"),
+    (dict(mesh=cube(), resolution=64, options=dict(max_memory=10**6)), "allowed"),
+    (dict(mesh=cube(), options=dict(max_memory=0)), "max_memory"),
+    (dict(mesh=cube(), options=dict(progress=3)), "progress"),
     (dict(mesh=cube(), bbox_min=[0, 0, 0], bbox_max=[1, 1, 1]), "does not contain"),
     (dict(mesh=cube(), bbox_min=[1, 1, 1], bbox_max=[0, 0, 0]), "must exceed"),
     (dict(mesh=cube(), domain="octree"), "domain"),
     (dict(mesh=cube(), t_coef=-1), "t_coef"),
-    (dict(mesh=cube(), options=VolumeHeatOptions(level_set_constraint="two")), "level_set_constraint"),
+    (dict(mesh=cube(), options=dict(level_set_constraint="two")), "level_set_constraint"),
     (dict(mesh=cube(), resolution=2.5), "resolution"),
 ])
 def test_bad_input(kwargs, msg):
+    """Bad options are refused by VolumeHeatOptions itself (at construction) or by signed_heat_volume."""
     with pytest.raises(ValueError, match=msg):
+        if "options" in kwargs:
+            kwargs = {**kwargs, "options": VolumeHeatOptions(**kwargs["options"])}
         signed_heat_volume(**kwargs)
 
 

@@ -322,7 +322,7 @@ def test_bad_input():
         VoxelSurfaceSignedHeatSolver(np.ones((4, 4), bool))
     with pytest.raises(ValueError, match="occupancy.*boolean"):
         VoxelSurfaceSignedHeatSolver(occ * 2.5)
-    with pytest.raises(ValueError, match="occupancy.*dtype"):
+    with pytest.raises(ValueError, match="occupancy: expected a boolean array, got strings"):
         VoxelSurfaceSignedHeatSolver(np.full((3, 3, 3), "a"))
     for bad in (np.nan, -1.0, 0.0, [1, 1], [1, np.inf, 1], True, "x"):
         with pytest.raises(ValueError, match="spacing"):
@@ -420,3 +420,30 @@ def test_typed_curves_edge_sets(sphere32):
     assert np.allclose(s.compute_distance([Curve(E)]), s.compute_distance(ring))             # chained edges
     assert np.allclose(s.compute_distance([Curve(ring[0], signed=False)]),
                        s.compute_distance(ring, curve_signs=[False]))
+
+
+def test_t_coef_bounded_for_every_solver():
+    """t = t_coef h² overflowed at t_coef = 1e308 and gave a field uncorrelated with t_coef = 1."""
+    from tests.shapes import fibonacci_sphere, uv_sphere
+
+    V, F = uv_sphere(6, 12)
+    P = fibonacci_sphere(60)
+    occ = np.zeros((6, 6, 6), bool)
+    occ[2:4, 2:4, 2:4] = True
+    for make in (lambda t: gsdf.SurfaceSignedHeatSolver(V, F, t_coef=t),
+                 lambda t: gsdf.PointCloudSignedHeatSolver(P, P, t_coef=t),
+                 lambda t: gsdf.PolygonMeshSignedHeatSolver(V, F, t_coef=t),
+                 lambda t: gsdf.VoxelSurfaceSignedHeatSolver(occ, t_coef=t),
+                 lambda t: gsdf.signed_heat_volume(mesh=(V, F), resolution=8, t_coef=t)):
+        for t in (1e308, np.inf, np.nan, 0, -1, 1j, "1"):
+            with pytest.raises(ValueError, match="t_coef"):
+                make(t)
+
+
+def test_point_cloud_k_bounded_by_the_cloud():
+    from tests.shapes import fibonacci_sphere
+
+    P = fibonacci_sphere(60)
+    with pytest.raises(ValueError, match="k: 1000000000 neighbours asked for, but the cloud has 60 points"):
+        gsdf.PointCloudSignedHeatSolver(P, P, k=10 ** 9)
+    assert gsdf.PointCloudSignedHeatSolver(fibonacci_sphere(20), fibonacci_sphere(20)).P.shape == (20, 3)

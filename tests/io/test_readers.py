@@ -229,7 +229,7 @@ def test_binary_ply_written_by_plyfile(tmp_path, order):
 
 
 def test_ply_vertex_data(tmp_path):
-    d = np.array([0.5, -1.0, np.inf, 2.0])
+    d = np.array([0.5, -1.0, 1e300, 2.0])
     p = tmp_path / "m.ply"
     write_mesh(p, TET_V, TET_F, vertex_data={"distance": d, "winding": np.arange(4)})
     ply = plyfile.PlyData.read(str(p))
@@ -243,6 +243,10 @@ def test_ply_vertex_data(tmp_path):
         write_mesh(p, TET_V, TET_F, vertex_data={"distance": d[:3]})
     with pytest.raises(ValueError, match="name"):
         write_mesh(p, TET_V, TET_F, vertex_data={"x": d})
+    for bad, why in ((np.inf, "NaN or infinite"), (np.nan, "NaN or infinite"), (1j, "complex")):
+        with pytest.raises(ValueError, match=why):  # refused, not written: a reader cannot tell them from data
+            write_mesh(tmp_path / "bad.ply", TET_V, TET_F, vertex_data={"distance": d + bad})
+    assert not (tmp_path / "bad.ply").exists()
 
 
 def test_ascii_stl_merges_vertices(tmp_path):
@@ -800,3 +804,36 @@ def test_off_faces_continuing_on_the_next_lines(tmp_path):
     p = write(tmp_path / "short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n")
     with pytest.raises(ValueError, match="line 6: face announces 4 vertices"):
         read_mesh(p)
+
+
+@pytest.mark.parametrize("bad", ["yes", "no", 0, None, [1]])
+def test_read_mesh_triangulate_is_a_switch(tmp_path, bad):
+    p = tmp_path / "t.off"
+    write_mesh(p, TET_V, TET_F)
+    with pytest.raises(ValueError, match="triangulate: expected True or False"):
+        read_mesh(p, triangulate=bad)
+
+
+@pytest.mark.parametrize("kind", ["fifo", "dir", "dev"])
+@pytest.mark.parametrize("ext", [".off", ".obj", ".ply", ".stl", ".xyz", ".npy"])
+def test_readers_take_regular_files_only(tmp_path, kind, ext):
+    """A FIFO blocked the reader forever, a link to /dev/zero read until memory ran out, a folder leaked
+    IsADirectoryError."""
+    import os
+
+    from gsdf.io import read_points
+
+    p = tmp_path / f"x{ext}"
+    if kind == "fifo":
+        os.mkfifo(p)
+    elif kind == "dir":
+        p.mkdir()
+    elif os.path.exists("/dev/zero"):
+        p.symlink_to("/dev/zero")
+    else:
+        pytest.skip("no /dev/zero")
+    why = {"fifo": "is a FIFO", "dir": "is a directory", "dev": "is a device"}[kind]
+    readers = ([read_points] if ext != ".stl" else []) + ([read_mesh] if ext not in (".xyz", ".npy") else [])
+    for reader in readers:
+        with pytest.raises(ValueError, match=why):
+            reader(p)

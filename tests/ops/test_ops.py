@@ -426,3 +426,37 @@ def test_boolean_bad_input():
         mesh_boolean(VA, FA, VB, FA, "union", winding_b=3)
     with pytest.raises(ValueError, match="winding_b"):
         mesh_boolean(VA, FA, VB, FA, "union", winding_b=lambda Q: np.full(len(Q), np.nan))
+
+
+def test_signed_distance_grid_of_points_without_v():
+    """The documented call `signed_distance_grid(points=(P, N))` (V omitted) raised a TypeError."""
+    import gsdf
+    from tests.shapes import fibonacci_sphere
+
+    P = fibonacci_sphere(200)
+    S = gsdf.signed_distance_grid(points=(P, P), resolution=8)
+    assert S.shape == (8, 8, 8) and S([[0, 0, 0]])[0] < 0
+    with pytest.raises(ValueError, match="beta: must be a finite positive number"):
+        gsdf.signed_distance_grid(points=(P, P), resolution=8, beta=np.nan)
+
+
+@pytest.mark.parametrize("s", [1e-300, 1e-150, 1e150, 1e300])
+def test_voxelize_points_at_extreme_scales(s):
+    """The box's diagonal underflowed to 0 at 1e-300 (no cell inside) and overflowed at 1e300 (a refusal)."""
+    from tests.shapes import fibonacci_sphere
+
+    P = fibonacci_sphere(300)
+    ref, lo1, hi1 = voxelize(points=(P, P), resolution=16)
+    occ, lo, hi = voxelize(points=(P * s, P), resolution=16)
+    assert np.array_equal(occ, ref)
+    np.testing.assert_allclose(lo / s, lo1, rtol=1e-12)
+
+
+def test_box_diagonal_without_under_or_overflow():
+    from gsdf.grid import diagonal, padded_box
+
+    for s in (1e-300, 1.0, 1e300):
+        assert diagonal([0, 0, 0], [3 * s, 4 * s, 0]) == pytest.approx(5 * s, rel=1e-15)
+        lo, hi = padded_box([[0, 0, 0], [3 * s, 4 * s, 0]], pad=0.1)
+        np.testing.assert_allclose(lo / s, [-0.5, -0.5, -0.5], rtol=1e-12)
+    assert diagonal([1, 1, 1], [1, 1, 1]) == 0.0

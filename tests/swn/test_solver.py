@@ -413,3 +413,13 @@ def test_flat_circle_one_big_gap_offset_is_the_curve_level(gap):
     th = np.mod(np.arctan2(C[:, 1], C[:, 0]), 2 * np.pi)
     missing = ring & (th > 2 * np.pi * 0.03) & (th < 2 * np.pi * (gap - 0.03))
     assert abs(np.median(w[missing]) - 0.5) < 0.03                  # labels round(w): the level sits at ½
+
+
+@pytest.mark.parametrize("t", [0, -5, float("nan"), float("inf"), "x", True, 1j])
+def test_time_limit_must_be_finite_positive(t):
+    from gsdf import SWNOptions
+
+    with pytest.raises(ValueError, match="time_limit: "):
+        SWNOptions(time_limit=t)
+    with pytest.raises(ValueError, match="epsilon: "):
+        SWNOptions(epsilon=2.0)

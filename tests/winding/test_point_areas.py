@@ -142,3 +142,26 @@ def test_no_cell_far_off_on_random_sphere_points():
     # cells the hull did not cut are the plain k = 20 cells: the square clip gives the same
     sq = gsdf.point_areas(P, P, boundary="square")
     assert (a == sq).sum() >= 9500
+
+
+def test_k_bounded_by_the_cloud():
+    """k = 10^9 was clamped silently; the default k on a small cloud keeps its documented clamp."""
+    rng = np.random.default_rng(0)
+    P = rng.normal(size=(200, 3))
+    for fn in (lambda k: estimate_normals(P, k=k), lambda k: point_areas(P, P, k=k)):
+        with pytest.raises(ValueError, match="k: 1000000000 neighbours asked for, but the cloud has 200 points"):
+            fn(10 ** 9)
+        with pytest.raises(ValueError, match="k: 200 neighbours"):
+            fn(200)
+        assert len(fn(199)) == 200
+    assert len(point_areas(P[:10], P[:10])) == 10  # default k = 20 > 9 neighbours: all of them (documented)
+
+
+def test_winding_areas_must_be_real():
+    import gsdf
+
+    rng = np.random.default_rng(0)
+    P = rng.normal(size=(50, 3))
+    for fn in (gsdf.fast_winding_number_points, gsdf.winding_number_points):
+        with pytest.raises(ValueError, match="areas: expected real numbers, got complex"):
+            fn(P, P, P[:3], areas=np.ones(50) + 1j)

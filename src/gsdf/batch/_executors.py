@@ -5,7 +5,8 @@ ones), ``is_worker_death(exc)``, ``recover()``, ``close(cancel)``: the same subm
 path for both executors.
 
 - :class:`LocalExecutor` — a ``concurrent.futures.ProcessPoolExecutor`` (spawned processes, Ctrl-C ignored in
-  the workers so only the driver handles it). A worker's death breaks the whole pool: every item in flight
+  the workers so only the driver handles it; each worker dies with the driver, even when the driver is killed
+  with SIGKILL). A worker's death breaks the whole pool: every item in flight
   fails with ``BrokenProcessPool``; ``recover()`` builds a new pool and the driver resubmits those items.
 - :class:`DaskExecutor` — a ``dask.distributed.Client`` on a ``LocalCluster`` it starts (``--dask-local N``) or
   on an existing scheduler (``--scheduler ADDR``: a plain cluster, dask-jobqueue, Kubernetes — anything with a
@@ -20,13 +21,42 @@ import concurrent.futures as cf
 import multiprocessing
 import os
 import signal
+import sys
+import threading
 import time
 
 from gsdf.batch import _threads
 
 
-def _init_local_worker(threads: int) -> None:
+def _die_with_parent(parent: int) -> None:
+    """End this worker when the driver process ``parent`` dies (even by kill -9), so that no orphan finishes
+    items and writes outputs the manifest never records: on Linux the kernel sends SIGKILL at the parent's death
+    (``prctl(PR_SET_PDEATHSIG)``); everywhere a daemon thread checks once a second that the parent is still ours
+    (``os.getppid()``; it needs the GIL, which a long native kernel may hold: the prctl is the sure way)."""
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+        except (OSError, AttributeError):  # pragma: no cover - no libc prctl: the thread below remains
+            pass
+    if os.getppid() != parent:  # the parent died before the prctl took effect
+        os._exit(1)
+
+    def watch():
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="gsdf-parent-watch", daemon=True).start()
+
+
+def _init_local_worker(threads: int, parent: int | None = None) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the driver's: it cancels and shuts us down
+    if parent is not None:
+        _die_with_parent(parent)
     _threads.set_environment(threads)
 
 
@@ -48,7 +78,7 @@ class LocalExecutor:
 
     def _new_pool(self):
         return cf.ProcessPoolExecutor(max_workers=self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                      initializer=_init_local_worker, initargs=(self.threads,))
+                                      initializer=_init_local_worker, initargs=(self.threads, os.getpid()))
 
     @property
     def n_slots(self) -> int:

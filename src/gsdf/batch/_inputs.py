@@ -51,7 +51,8 @@ def _input_files(folder: str) -> list[str]:
     for base, dirs, files in os.walk(folder):
         dirs[:] = sorted(d for d in dirs if not d.startswith("."))
         found += [os.path.join(base, f) for f in sorted(files)
-                  if not f.startswith(".") and os.path.splitext(f)[1].lower() in INPUT_EXTENSIONS]
+                  if not f.startswith(".") and os.path.splitext(f)[1].lower() in INPUT_EXTENSIONS
+                  and os.path.isfile(os.path.join(base, f))]  # regular files only (no FIFO / device / socket)
     return found
 
 
@@ -133,6 +134,30 @@ def _outputs(paths: list[str], root: str) -> list[str]:
         dup = next(o for o in outs if outs.count(o) > 1)
         raise ValueError(f"INPUTS: the same input is listed twice (output {dup!r})")
     return outs
+
+
+def _inside(path: str, folder: str) -> bool:
+    """``path`` is ``folder`` or lies below it (real paths: symlinks resolved)."""
+    p, f = os.path.realpath(path), os.path.realpath(folder)
+    return p == f or p.startswith(f.rstrip(os.sep) + os.sep)
+
+
+def check_output_folder(inputs, items: list[Item], out) -> None:
+    """Refuse an output folder that would feed a batch its own outputs: ``out`` equal to or inside the folder
+    (or a glob's fixed root folder) that INPUTS searches — the ``.npz`` outputs are readable inputs, so the next
+    run would take them as items — and any listed input that lies inside ``out``."""
+    if isinstance(inputs, (str, os.PathLike)):
+        text = os.fspath(inputs)
+        root = text if os.path.isdir(text) else _glob_root(text) if _is_glob(text) and not os.path.isfile(text) \
+            else None
+        if root is not None and _inside(out, root):
+            where = "is" if os.path.realpath(out) == os.path.realpath(root) else "is inside"
+            raise ValueError(f"out: the output folder {out} {where} the input folder {root}: its outputs would be "
+                             "read as inputs by the next run; choose an output folder outside the inputs")
+    for it in items:
+        if _inside(it.path, out):
+            raise ValueError(f"INPUTS: {it.path} lies inside the output folder {out}; choose an output folder "
+                             "that holds no inputs")
 
 
 def collect_inputs(inputs) -> list[Item]:

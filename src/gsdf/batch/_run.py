@@ -19,7 +19,8 @@ import time
 import uuid
 from dataclasses import dataclass, field
 
-from gsdf.batch._inputs import collect_inputs
+from gsdf._checks import flag, integer, positive, progress_callback
+from gsdf.batch._inputs import check_output_folder, collect_inputs
 from gsdf.batch._manifest import MANIFEST_NAME, ManifestWriter, file_sha256, params_sha256, read_manifest
 from gsdf.batch._tasks import check_options, task_name
 from gsdf.batch._worker import process_item
@@ -69,6 +70,14 @@ class BatchOptions:
     max_retries: int = 2
     threads: int | None = None
     scheduler_timeout: float = 10.0
+
+    def __post_init__(self):  # a ValueError naming the attribute, at construction
+        flag(self.resume, "resume")
+        flag(self.retry_failed, "retry_failed")
+        integer(self.max_retries, "max_retries", lo=0)
+        if self.threads is not None:
+            integer(self.threads, "threads", lo=1)
+        positive(self.scheduler_timeout, "scheduler_timeout")
 
 
 @dataclass
@@ -129,35 +138,82 @@ def _count(name, value, lo=1):
     return value
 
 
-def _prepare_output(out) -> str:
+def _check_out(out) -> str:
     if not isinstance(out, (str, os.PathLike)) or not os.fspath(out):
         raise ValueError(f"out: expected a folder path, got {out!r}")
     out = os.path.abspath(os.fspath(out))
     if os.path.exists(out) and not os.path.isdir(out):
         raise ValueError(f"out: {out} exists and is not a folder")
-    try:
-        os.makedirs(out, exist_ok=True)
-        fd, probe = tempfile.mkstemp(dir=out, prefix=".gsdf-write-test.")
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise ValueError(f"out: cannot write to the output folder {out} ({exc.strerror or exc})") from None
     return out
 
 
-def _lock(out):
-    """An exclusive lock on the output folder (two runs must not write one manifest); None where unsupported."""
+def _prepare_output(out: str) -> list:
+    """Create ``out`` (and missing parents) and check it is writable; returns the folders this created (deepest
+    first), which :func:`_cleanup_output` removes again when the run leaves them empty."""
+    created = []
+    probe = out
+    while not os.path.exists(probe):
+        created.append(probe)
+        probe = os.path.dirname(probe)
     try:
-        import fcntl
-    except ImportError:  # pragma: no cover - Windows
-        return None
-    fh = open(os.path.join(out, LOCK_NAME), "a")
-    try:
-        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        fh.close()
-        raise ValueError(f"out: another gsdf batch is writing to {out}") from None
-    return fh
+        os.makedirs(out, exist_ok=True)
+        fd, test = tempfile.mkstemp(dir=out, prefix=".gsdf-write-test.")
+        os.close(fd)
+        os.unlink(test)
+    except OSError as exc:
+        _cleanup_output(created)
+        raise ValueError(f"out: cannot write to the output folder {out} ({exc.strerror or exc})") from None
+    return created
+
+
+def _cleanup_output(created) -> None:
+    """Remove the folders this run created if nothing was written into them (a refused or failed start)."""
+    for d in created:
+        try:
+            os.rmdir(d)
+        except OSError:
+            return  # not empty (or gone): keep it and its parents
+
+
+class _Lock:
+    """An exclusive lock on the output folder (two runs must not write one manifest): ``LOCK_NAME`` held with
+    ``flock``, unlinked by :meth:`release` on every exit path (a kill -9 leaves the file, never the lock: the
+    next run takes it over). Without ``fcntl`` (Windows) no lock is taken."""
+
+    def __init__(self, out: str):
+        self.path = os.path.join(out, LOCK_NAME)
+        self.fh = None
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - Windows
+            return
+        while True:
+            try:
+                fh = open(self.path, "a")
+            except OSError as exc:
+                raise ValueError(f"out: cannot create the lock file {self.path} ({exc.strerror or exc})") from None
+            try:
+                fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                fh.close()
+                raise ValueError(f"out: another gsdf batch is writing to {out}") from None
+            try:  # the file we locked may have been unlinked by the run that held it: lock the current one
+                same = os.path.samestat(os.fstat(fh.fileno()), os.stat(self.path))
+            except OSError:
+                same = False
+            if same:
+                self.fh = fh
+                return
+            fh.close()
+
+    def release(self) -> None:
+        if self.fh is not None:
+            try:
+                os.unlink(self.path)  # while still holding it: a waiting run then re-opens a fresh file
+            except OSError:
+                pass
+            self.fh.close()
+            self.fh = None
 
 
 def _remove_stale_parts(out) -> None:
@@ -259,12 +315,20 @@ def run_batch(inputs, task, out, options=None, *, workers=None, executor=None, p
     kind = _executor_spec(workers, executor)
     _count("threads", bo.threads)
     _count("max_retries", bo.max_retries, lo=0)
+    progress = None if progress is None else progress_callback(progress)
     report = None if progress is None else (lambda rec, counts: progress(
         rec["status"], sum(counts[s] for s in STATUSES) / max(1, counts["total"])))
     items = collect_inputs(inputs)
     jobs_options = [check_options(task, {**user_options, **it.options}, it.path) for it in items]
-    out = _prepare_output(out)
-    lock = _lock(out)
+    out = _check_out(out)
+    check_output_folder(inputs, items, out)
+    created = _prepare_output(out)
+    try:
+        lock = _Lock(out)
+    except BaseException:
+        _cleanup_output(created)
+        raise
+    ok = False
     try:
         _remove_stale_parts(out)
         manifest = os.path.join(out, MANIFEST_NAME)
@@ -297,12 +361,14 @@ def run_batch(inputs, task, out, options=None, *, workers=None, executor=None, p
                 if own:
                     ex.close(cancel=result.interrupted)
         result.seconds = time.perf_counter() - t0
+        ok = True
         if result.interrupted:
             raise BatchInterrupted(result)
         return result
     finally:
-        if lock is not None:
-            lock.close()
+        lock.release()
+        if not ok:
+            _cleanup_output(created)
 
 
 def _reusable(prev, job, out, retry_failed) -> bool:

@@ -40,7 +40,8 @@ import os
 
 import numpy as np
 
-from gsdf._checks import choice, integer, positive
+from gsdf._checks import _real, choice, integer, positive
+from gsdf._memory import SECONDS_PER_QUERY, check_bytes, check_work
 from gsdf.grid import Grid
 from gsdf.io._geometry import Geometry, load_geometry
 
@@ -184,6 +185,9 @@ class SdfSamplesOptions:
     beta: float | None = None
     estimate_normals: bool = False
 
+    def __post_init__(self):
+        _check_fields(self)
+
 
 @dataclasses.dataclass(frozen=True)
 class OccupancyOptions:
@@ -212,6 +216,17 @@ class OccupancyOptions:
     margin: float = 0.1
     beta: float | None = None
     estimate_normals: bool = False
+
+    def __post_init__(self):
+        _check_fields(self)
+
+
+def _check_fields(opts) -> None:
+    """A ValueError naming the attribute of an options dataclass, at construction (the checks of the flags)."""
+    for f in dataclasses.fields(opts):
+        v = getattr(opts, f.name)
+        if v is not None or f.name != "beta":
+            _CHECKS[f.name](v, f.name)
 
 
 def _task_options(task, values: dict) -> dict:
@@ -267,6 +282,7 @@ def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normali
     ((10000, 3), dtype('float32'))
     """
     o = _task_options("sdf-samples", locals())
+    check_samples_size(o["n_samples"], "n_samples")
     geo = _geometry(source, o["estimate_normals"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
     centre, half = cube(geo.X, o["normalize"], o["margin"])
@@ -304,6 +320,7 @@ def occupancy(source, n_points: int = 100_000, normalize: str = "none", seed: in
     0.21
     """
     o = _task_options("occupancy", locals())
+    check_samples_size(o["n_points"], "n_points")
     geo = _geometry(source, o["estimate_normals"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
     centre, half = cube(geo.X, o["normalize"], o["margin"])
@@ -316,20 +333,25 @@ def occupancy(source, n_points: int = 100_000, normalize: str = "none", seed: in
 
 
 GRID_BYTES_PER_NODE = 96  # node positions (24), distance + winding + sign (24), outputs and temporaries
+SAMPLE_BYTES = 160        # a sample's position (24), offsets and choices (48), distance, winding, sign (24), outputs
 
 
-def check_grid_memory(resolution: int, max_memory=None) -> None:
-    """Refuse a dense grid whose estimated working memory (``GRID_BYTES_PER_NODE`` × R³) exceeds ``max_memory``
-    (default 80 % of the available memory), before allocating anything: a clear per-item error, not an OOM kill."""
-    need = GRID_BYTES_PER_NODE * int(resolution) ** 3
-    if max_memory is None:
-        try:
-            max_memory = 0.8 * os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-        except (ValueError, OSError, AttributeError):  # pragma: no cover - platforms without sysconf
-            return
-    if need > max_memory:
-        raise ValueError(f"resolution: a {resolution}^3 grid needs about {need / 2**30:.1f} GiB, more than the "
-                         f"{max_memory / 2**30:.1f} GiB available (out-of-memory estimate)")
+def check_grid_size(resolution: int) -> None:
+    """Refuse a dense R³ grid whose working memory (``GRID_BYTES_PER_NODE`` × R³, :func:`gsdf._memory.check_bytes`)
+    or work (R³ queries, :func:`gsdf._memory.check_work`) is beyond the limits, before the input is read or
+    anything allocated: a clear per-item error, not an out-of-memory kill."""
+    n = int(resolution) ** 3
+    what = f"resolution: a {resolution}^3 grid ({n:,} nodes)"
+    check_bytes(GRID_BYTES_PER_NODE * n, what)
+    check_work(n, SECONDS_PER_QUERY, what)
+
+
+def check_samples_size(n: int, name: str) -> None:
+    """Refuse ``n`` samples whose memory (``SAMPLE_BYTES`` each) or work (a distance and a winding number query
+    each) is beyond the limits, before the input is read."""
+    what = f"{name}: {n:,} samples"
+    check_bytes(SAMPLE_BYTES * n, what)
+    check_work(n, 2 * SECONDS_PER_QUERY, what)
 
 
 def task_grid(X, resolution: int, normalize: str = "none", margin: float = 0.05) -> Grid:
@@ -362,11 +384,11 @@ def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str
     (64, 64, 64)
     """
     o = check_options("sdf-grid", locals_without_source(locals()))
+    check_grid_size(o["resolution"])
     geo = _geometry(source, o["estimate_normals"])
     if o["method"] == "pat" and geo.is_mesh:
         raise ValueError('method "pat" (Points as Tori) needs an oriented point cloud, not a mesh; '
                          'use "fast" or "heat"')
-    check_grid_memory(o["resolution"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
     grid = task_grid(geo.X, o["resolution"], o["normalize"], o["margin"])
     if o["method"] == "heat":
@@ -407,8 +429,8 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
     3
     """
     o = check_options("surface", locals_without_source(locals()))
+    check_grid_size(o["resolution"])
     geo = _geometry(source, o["estimate_normals"])
-    check_grid_memory(o["resolution"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
     grid = task_grid(geo.X, o["resolution"], o["normalize"], o["margin"])
     if o["method"] == "heat":
@@ -437,9 +459,11 @@ def locals_without_source(values: dict) -> dict:
 def _float(x, name) -> float:
     if isinstance(x, (bool, np.bool_)):
         raise ValueError(f"{name}: expected a number, got the bool {x!r}")
+    if not isinstance(x, str):  # a CSV cell is parsed; anything else is the one real-number check
+        return _real(x, name)
     try:
         return float(x)
-    except (TypeError, ValueError):
+    except ValueError:
         raise ValueError(f"{name}: expected a number, got {x!r}") from None
 
 

@@ -21,29 +21,50 @@ from gsdf.batch._tasks import load_geometry, run_task
 
 
 def write_npz_atomic(path, arrays: dict) -> None:
-    """Write ``arrays`` to ``path`` (.npz) atomically: a temporary file in the target folder, fsync'ed, then
-    ``os.replace`` onto the final name. An interruption at any point leaves no file under ``path`` (a hidden
-    ``.NAME.*.part`` file may remain after a hard kill; it never counts as an output).
+    """Write ``arrays`` to ``path`` (.npz) atomically: a temporary file in the target folder, fsync'ed, given the
+    mode every gsdf output gets (``0666 & ~umask``, :mod:`gsdf.io._safe_write`; ``mkstemp`` alone gives 0600),
+    then ``os.replace`` onto the final name. An interruption at any point leaves no file under ``path`` (a hidden
+    ``.NAME.*.part`` file may remain after a hard kill; it never counts as an output and the next run on the
+    folder removes it).
 
     Example
     -------
     >>> write_npz_atomic("out/a.npz", {"sdf": np.zeros(3)})      # doctest: +SKIP
     """
+    from gsdf.io._safe_write import _FILE_MODE
+
     path = os.fspath(path)
     folder, name = os.path.split(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{name}.", suffix=".part")
+    created = []  # folders of the mirrored layout made for this file: removed again if it is not written
+    probe = folder
+    while not os.path.exists(probe):
+        created.append(probe)
+        probe = os.path.dirname(probe)
+    for attempt in range(3):  # another worker's failed write may remove a folder it just made
+        try:
+            os.makedirs(folder, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{name}.", suffix=".part")
+            break
+        except FileNotFoundError:
+            if attempt == 2:
+                raise
     try:
         with os.fdopen(fd, "wb") as fh:
             np.savez(fh, **arrays)
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, _FILE_MODE)
         os.replace(tmp, path)
     except BaseException:
         try:
             os.unlink(tmp)
         except OSError:
             pass
+        for d in created:  # deepest first; stops at the first folder another item uses
+            try:
+                os.rmdir(d)
+            except OSError:
+                break
         raise
 
 

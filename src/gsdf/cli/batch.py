@@ -20,6 +20,9 @@ from gsdf.cli._options import (
     resolution_option,
 )
 
+#: Exit status of a run in which some items failed (1: the run itself failed; 2: a usage error; 130: Ctrl-C).
+FAILED_EXIT = 3
+
 #: The task options of the command line -> the library's option name, per task (None: the same name).
 #: ``--n-points`` is the number of query points of either sampling task; ``--resolution`` is the grid of
 #: sdf-grid / surface and the signed heat grid of sdf-samples (--sign heat).
@@ -53,7 +56,8 @@ manifest.jsonl there.
 INPUTS is a folder (searched recursively), a quoted glob ("data/**/*.off"), a list file (one path per line),
 or a CSV / JSON manifest with a 'path' column / field and per-item task options. Outputs mirror the inputs'
 folder layout. A rerun skips items whose output exists and whose input hash and options match; failing items
-are recorded in the manifest and the run goes on; Ctrl-C stops cleanly.
+are recorded in the manifest and the run goes on; the exit status is then 3 (--allow-failures: 0); Ctrl-C stops
+cleanly. The output folder may not be, or lie inside, the folder of the inputs.
 
 \b
 Tasks and their arrays (float32 unless --dtype float64; all carry center (3,), scale):
@@ -106,10 +110,12 @@ Examples:
 @click.option("--retry-failed", is_flag=True, help="Run items that failed before again.")
 @click.option("--max-retries", type=click.IntRange(0), default=2, show_default=True,
               help="Resubmissions of an item whose worker died.")
+@click.option("--allow-failures", is_flag=True,
+              help="Exit 0 even when items failed (default: exit 3 when any item failed; the manifest says why).")
 @common_options
 @report_errors
 def batch(inputs, task, output_dir, workers, dask_local, scheduler, scheduler_timeout, resume, retry_failed,
-          max_retries, quiet, **task_options):
+          max_retries, allow_failures, quiet, **task_options):
     from gsdf.batch import BatchInterrupted, BatchOptions, run_batch
 
     chosen = [f"--{n}" for n, v in (("workers", workers), ("dask-local", dask_local), ("scheduler", scheduler))
@@ -152,3 +158,8 @@ def batch(inputs, task, output_dir, workers, dask_local, scheduler, scheduler_ti
     if bar is not None:
         bar.close()
     click.echo(result.summary())
+    failed = result.counts.get("failed", 0)
+    if failed and not allow_failures:
+        click.echo(f"Error: {failed} of {len(result.records)} item(s) failed (see {result.manifest}; "
+                   "--allow-failures to exit 0 anyway)", err=True)
+        sys.exit(FAILED_EXIT)

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, output_file, report_errors
 from gsdf.cli._options import (
     beta_option,
     common_options,
@@ -46,4 +46,4 @@ def boolean(a, b, op, output, exact, beta, quiet):
     V, F = mesh_boolean(VA, FA, VB, FB, op, options=BooleanOptions(beta=2.0 if beta is None else beta, exact=exact))
     with output_file(output) as tmp:
         write_mesh(tmp, V, F)
-    click.echo(f"{op}: {len(FA)} + {len(FB)} triangles -> {len(F)} triangles -> {os.path.abspath(output)}")
+    announce(f"{op}: {len(FA)} + {len(FB)} triangles -> {len(F)} triangles -> {os.path.abspath(output)}")

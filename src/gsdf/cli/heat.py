@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, load_geometry, output_file, report_errors
+from gsdf.cli._common import announce, check_output, load_geometry, output_file, report_errors
 from gsdf.cli._options import (
     common_options,
     level_set_option,
@@ -75,7 +75,6 @@ Example:
 @report_errors
 def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, level_set, soft_weight, surface_format,
          estimate_normals, quiet):
-    import numpy as np
 
     from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
 
@@ -104,15 +103,17 @@ def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, lev
     with output_file(output) as tmp:
         field.save(tmp)
     where = f"a {len(field.vertices)}-node tet mesh" if tet else f"{field.shape} grid nodes"
-    click.echo(f"{geo.describe()}\nsigned heat field on {where} -> {os.path.abspath(output)}")
+    announce(f"{geo.describe()}\nsigned heat field on {where} -> {os.path.abspath(output)}")
     if levels:
         from gsdf.io import write_mesh
 
         X = geo.X
-        scale = float(np.linalg.norm(X.max(axis=0) - X.min(axis=0))) if relative else 1.0
+        from gsdf.grid import diagonal
+
+        scale = diagonal(X.min(axis=0), X.max(axis=0)) if relative else 1.0
         for v, path in zip(levels, surface_paths):
             Vs, Fs = field.isosurface(v * scale, close=True) if hasattr(field, "spacing") \
                 else field.isosurface(v * scale)
             with output_file(path, what="--offsets") as tmp:
                 write_mesh(tmp, Vs, Fs)
-            click.echo(f"level {v * scale:.6g}: {len(Fs)} triangles -> {os.path.abspath(path)}")
+            announce(f"level {v * scale:.6g}: {len(Fs)} triangles -> {os.path.abspath(path)}")

@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, output_file, report_errors
 from gsdf.cli._options import (
     NONNEGATIVE,
     common_options,
@@ -101,7 +101,7 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
         what = f"{len(V)} vertices, {len(F)} triangles; {len(src.curves)} curves, {len(src.points)} points"
     with output_file(output) as tmp:
         write_mesh(tmp, V, F, vertex_data={"distance": phi})
-    click.echo(f"{mesh}: {what}\ndistance in [{phi.min():.6g}, {phi.max():.6g}] -> {os.path.abspath(output)}")
+    announce(f"{mesh}: {what}\ndistance in [{phi.min():.6g}, {phi.max():.6g}] -> {os.path.abspath(output)}")
     if F.shape[1] == 4:
         F = np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])       # the PNG renders triangles
     if png:
@@ -109,7 +109,7 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
 
         with output_file(png, what="--png") as tmp:
             render_function_png(tmp, V, F, phi, view=view)
-        click.echo(f"image -> {os.path.abspath(png)}")
+        announce(f"image -> {os.path.abspath(png)}")
 
 
 def _heat_voxels(path, curves_path, spacing, normal_radius, cut, level_set, t_coef, soft_weight):
@@ -127,6 +127,9 @@ def _heat_voxels(path, curves_path, spacing, normal_radius, cut, level_set, t_co
         occ, lo, hi = load_voxels(path)
         origin, size = lo, (hi - lo) / np.array(occ.shape)
     else:
+        from gsdf._checks import readable_file
+
+        readable_file(path)
         try:
             occ = np.load(path, allow_pickle=False)
         except (OSError, ValueError) as exc:

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, output_file, report_errors
 from gsdf.cli._options import (
     common_options,
     no_clobber_option,
@@ -85,9 +85,9 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
                f"{'closed manifold' if manifold else 'NOT a closed manifold'}")
     with output_file(output, (".ply", ".obj", ".off", ".stl")) as tmp:
         write_mesh(tmp, V, F)
-    click.echo(f"mesh -> {os.path.abspath(output)}")
+    announce(f"mesh -> {os.path.abspath(output)}")
     if png is not None:
         from gsdf.render._raster import render_function_png
         with output_file(png, (".png",), what="--png") as tmp:
             render_function_png(tmp, V, F, np.asarray(V)[:, 1], view=view)
-        click.echo(f"preview -> {os.path.abspath(png)}")
+        announce(f"preview -> {os.path.abspath(png)}")

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, output_file, report_errors
 from gsdf.cli._options import (
     NUMBER,
     SIZE,
@@ -67,4 +67,4 @@ def render(points, output, level, size, view, up, estimate_normals, quiet):
     img = sphere_trace(pat, lo - m, hi + m, size[0], size[1], level, view=view, up=_up_vector(up))
     with output_file(output) as tmp:
         write_png(tmp, img, min_size=1)  # gsdf's one PNG writer
-    click.echo(f"{len(pat.P)} tori, level {level:g} -> {os.path.abspath(output)}")
+    announce(f"{len(pat.P)} tori, level {level:g} -> {os.path.abspath(output)}")

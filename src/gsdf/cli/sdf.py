@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, load_geometry, output_file, progress_bar, report_errors
+from gsdf.cli._common import announce, check_output, load_geometry, output_file, progress_bar, report_errors
 from gsdf.cli._options import (
     beta_option,
     common_options,
@@ -77,17 +77,17 @@ def sdf(input, output, resolution, pad, sign, png, mesh_output, beta, estimate_n
         field = signed_distance_grid(geo, resolution, pad, sign, beta, quiet)
     with output_file(output) as tmp:
         field.save(tmp)
-    click.echo(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")
+    announce(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")
     if png:
         from gsdf.render._png import write_field_slice_png
 
         with output_file(png, what="--png") as tmp:
             write_field_slice_png(tmp, field)
-        click.echo(f"slice image -> {os.path.abspath(png)}")
+        announce(f"slice image -> {os.path.abspath(png)}")
     if mesh_output:
         from gsdf.io import write_mesh
 
         Vs, Fs = field.isosurface(0.0)
         with output_file(mesh_output, what="--mesh-output") as tmp:
             write_mesh(tmp, Vs, Fs)
-        click.echo(f"zero level set ({len(Fs)} triangles) -> {os.path.abspath(mesh_output)}")
+        announce(f"zero level set ({len(Fs)} triangles) -> {os.path.abspath(mesh_output)}")

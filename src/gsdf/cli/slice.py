@@ -7,7 +7,16 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import bbox_of, check_output, counting, load_geometry, output_file, report_errors
+from gsdf.cli._common import (
+    announce,
+    bbox_of,
+    check_output,
+    LazyWinding,
+    counting,
+    load_geometry,
+    output_file,
+    report_errors,
+)
 from gsdf.cli._options import (
     FLOATS,
     beta_option,
@@ -54,12 +63,12 @@ def slice_cmd(input, output, layers, heights, axis, resolution, layout, beta, es
     if zs is None:
         n = layers or 10
         zs = list(lo[ax] + (hi[ax] - lo[ax]) * (np.arange(n) + 0.5) / n)
-    bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
+    bar, func = counting(LazyWinding(geo, beta), "winding numbers", not quiet)
     with bar:
         contours = slice_contours(func, zs, lo, hi, resolution=resolution, axis=ax)
     with output_file(output) as tmp:
         write_svg(tmp, contours, z_values=zs, layout=layout)
     n_loops = sum(len(c) for c in contours)
-    click.echo(f"{geo.describe()}\n{len(zs)} slices along {axis}, {n_loops} closed contours -> "
+    announce(f"{geo.describe()}\n{len(zs)} slices along {axis}, {n_loops} closed contours -> "
                f"{os.path.abspath(output)}")
 slice_cmd.name = "slice"

@@ -6,7 +6,16 @@ import os
 
 import click
 
-from gsdf.cli._common import bbox_of, check_output, counting, load_geometry, output_file, report_errors
+from gsdf.cli._common import (
+    announce,
+    bbox_of,
+    check_output,
+    LazyWinding,
+    counting,
+    load_geometry,
+    output_file,
+    report_errors,
+)
 from gsdf.cli._options import (
     NUMBER,
     beta_option,
@@ -51,9 +60,9 @@ def surface(input, output, resolution, level, bisection, pad, beta, estimate_nor
     check_output(output, MESH_WRITE_FORMATS)
     geo = load_geometry(input, estimate_normals)
     lo, hi = bbox_of(geo.X, pad)
-    bar, func = counting(geo.winding(beta), "winding numbers", not quiet)
+    bar, func = counting(LazyWinding(geo, beta), "winding numbers", not quiet)
     with bar:
         V, F = extract_isosurface(func, lo, hi, resolution=resolution, level=level, bisection_steps=bisection)
     with output_file(output) as tmp:
         write_mesh(tmp, V, F)
-    click.echo(f"{geo.describe()}\nsurface: {len(V)} vertices, {len(F)} triangles -> {os.path.abspath(output)}")
+    announce(f"{geo.describe()}\nsurface: {len(V)} vertices, {len(F)} triangles -> {os.path.abspath(output)}")

@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import check_output, output_file, progress_bar, report_errors
+from gsdf.cli._common import announce, check_output, output_file, progress_bar, report_errors
 from gsdf.cli._options import (
     POSITIVE,
     common_options,
@@ -106,7 +106,7 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
     labs = np.unique(res.face_labels)
     share = ", ".join(f"{int(k)}: {100 * A[res.face_labels == k].sum() / A.sum():.1f}%" for k in labs)
     nb = float(np.abs(res.residual[res.chain != 0]).sum() / max(np.abs(res.chain).sum(), 1))
-    click.echo(f"{mesh}: {len(V2)} vertices, {len(F2)} triangles after inserting the curves (+{len(V2) - len(V)}); "
+    announce(f"{mesh}: {len(V2)} vertices, {len(F2)} triangles after inserting the curves (+{len(V2) - len(V)}); "
                f"b1 = {solver.betti_1}, {int(res.endpoints.sum())} endpoints\n"
                f"method {method}: labels (area) {share}; nonbounding share of the input {nb:.2f}; "
                f"{res.timings['total']:.2f} s -> {os.path.abspath(output)}")
@@ -117,4 +117,4 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
         with output_file(png, (".png",), what="--png") as tmp:
             render_function_png(tmp, V2[F2].reshape(-1, 3), np.arange(3 * m).reshape(m, 3),
                                 res.corner_values.ravel() - 0.5, view=view)
-        click.echo(f"image -> {os.path.abspath(png)}")
+        announce(f"image -> {os.path.abspath(png)}")

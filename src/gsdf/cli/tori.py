@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, output_file, report_errors
 from gsdf.cli._options import (
     common_options,
     no_clobber_option,
@@ -80,7 +80,7 @@ def tori(points, output, estimator, resolution, offsets, pad, k, estimate_normal
     if ext == ".npz" and resolution is None:
         with output_file(output) as tmp:
             pat.save(tmp)
-        click.echo(f"fitted tori -> {os.path.abspath(output)}")
+        announce(f"fitted tori -> {os.path.abspath(output)}")
         return
     from gsdf.tori._pat import level_grid
 
@@ -91,7 +91,7 @@ def tori(points, output, estimator, resolution, offsets, pad, k, estimate_normal
         field = GridField(pat.signed_distance(g.points()).reshape(g.shape), *g.box)
         with output_file(output) as tmp:
             field.save(tmp)
-        click.echo(f"signed distance grid {field.shape} -> {os.path.abspath(output)}")
+        announce(f"signed distance grid {field.shape} -> {os.path.abspath(output)}")
         return
     from gsdf.contour import extract_isosurface
     from gsdf.io import write_mesh
@@ -100,4 +100,4 @@ def tori(points, output, estimator, resolution, offsets, pad, k, estimate_normal
         V, F = extract_isosurface(pat.signed_distance, resolution=g, level=v, inside="below")
         with output_file(path) as tmp:
             write_mesh(tmp, V, F)
-        click.echo(f"level {v:g}: {len(F)} triangles -> {os.path.abspath(path)}")
+        announce(f"level {v:g}: {len(F)} triangles -> {os.path.abspath(path)}")

@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, output_file, report_errors
 from gsdf.cli._options import NUMBER, SIZE, UP, common_options, no_clobber_option
 
 _CLOUD_EXTENSIONS = (".xyz", ".pwn", ".pc", ".npy")
@@ -84,7 +84,7 @@ def view(files, output, size, up, azimuth, elevation, level, slice_, field_name,
     except (RuntimeError, ImportError) as exc:          # no display, no polyscope, no EGL: say what to do
         raise click.ClickException(str(exc)) from exc
     if not quiet:
-        click.echo(f"{len(files)} file(s), {img.shape[1]}x{img.shape[0]} in {time.perf_counter() - t:.1f} s -> "
+        announce(f"{len(files)} file(s), {img.shape[1]}x{img.shape[0]} in {time.perf_counter() - t:.1f} s -> "
                    f"{os.path.abspath(output)}")
 
 

@@ -6,7 +6,14 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, load_geometry, output_file, progress_bar, report_errors
+from gsdf.cli._common import (
+    announce,
+    check_output,
+    load_geometry,
+    output_file,
+    progress_bar,
+    report_errors,
+)
 from gsdf.cli._options import (
     beta_option,
     common_options,
@@ -57,7 +64,7 @@ def voxelize(input, output, resolution, pad, mesh_output, beta, estimate_normals
         occ, lo, hi = run(resolution=grid, beta=beta, progress=update, **kw)
     with output_file(output, (".npz",)) as tmp:
         save_voxels(tmp, occ, lo, hi)
-    click.echo(f"{geo.describe()}\n{int(occ.sum())} of {occ.size} voxels inside, grid {occ.shape} -> "
+    announce(f"{geo.describe()}\n{int(occ.sum())} of {occ.size} voxels inside, grid {occ.shape} -> "
                f"{os.path.abspath(output)}")
     if mesh_output:
         from gsdf.io import write_mesh
@@ -65,4 +72,4 @@ def voxelize(input, output, resolution, pad, mesh_output, beta, estimate_normals
         Vv, Fv = voxels_to_mesh(occ, lo, hi)
         with output_file(mesh_output, what="--mesh-output") as tmp:
             write_mesh(tmp, Vv, Fv)
-        click.echo(f"voxel boundary mesh -> {os.path.abspath(mesh_output)}")
+        announce(f"voxel boundary mesh -> {os.path.abspath(mesh_output)}")

@@ -7,7 +7,14 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import check_output, load_geometry, output_file, progress_bar, report_errors
+from gsdf.cli._common import (
+    announce,
+    check_output,
+    load_geometry,
+    output_file,
+    progress_bar,
+    report_errors,
+)
 from gsdf.cli._options import (
     beta_option,
     common_options,
@@ -22,12 +29,11 @@ VALUE_EXTENSIONS = (".npy", ".txt", ".csv")
 
 def read_queries(path: str) -> np.ndarray:
     """Query points (q, 3), q > 0, finite: an .npy array or any point file :func:`gsdf.read_points` reads."""
-    from gsdf._checks import as_points
+    from gsdf._checks import as_points, readable_file
     from gsdf.io import read_points
 
     if path.lower().endswith(".npy"):
-        if not os.path.exists(path):
-            raise FileNotFoundError(2, "No such file or directory", path)
+        readable_file(path, "QUERIES")
         try:
             Q = np.load(path, allow_pickle=False)
         except Exception as exc:  # numpy raises ValueError, EOFError, TokenError ... for a broken .npy
@@ -87,5 +93,5 @@ def winding(input, queries, output, exact, order, beta, estimate_normals, quiet)
         with bar:
             w = fwn(Q, progress=update)
     write_values(output, w)
-    click.echo(f"{geo.describe()}\n{len(Q)} winding numbers (min {w.min():.4g}, max {w.max():.4g}) -> "
+    announce(f"{geo.describe()}\n{len(Q)} winding numbers (min {w.min():.4g}, max {w.max():.4g}) -> "
                f"{os.path.abspath(output)}")

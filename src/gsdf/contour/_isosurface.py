@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_points, choice, finite, integer
-from gsdf._memory import check_bytes, grid_bytes
+from gsdf._checks import _dtype_words, as_points, as_values, choice, finite, integer
+from gsdf._memory import check_bytes, check_work, grid_bytes, seconds_per_point
 
 #: More bisection steps than this cannot improve a float64 root (the bracket reaches one ulp well before).
 MAX_BISECTION = 200
@@ -72,10 +72,14 @@ def _evaluate(func, Q: np.ndarray, chunk: int) -> np.ndarray:
     out = np.empty(q)
     for s in range(0, q, chunk):
         part = Q[s : s + chunk]
+        r = func(part)
         try:
-            f = np.asarray(func(part), dtype=np.float64)
+            f = np.asarray(r)
         except (TypeError, ValueError) as exc:
-            raise ValueError(f"func: returned something that is not a numeric array ({exc})") from exc
+            raise ValueError("func: returned something that is not a numeric array") from exc
+        if f.dtype.kind not in "fiu":
+            raise ValueError(f"func: expected real values, got {_dtype_words(f)}")
+        f = f.astype(np.float64, copy=False)
         if f.shape != (part.shape[0],):
             raise ValueError(
                 f"func: returned shape {f.shape} for {part.shape[0]} query points; expected ({part.shape[0]},)"
@@ -165,13 +169,8 @@ def refine_on_edges(func, A, B, fa, fb, level: float = 0.5, steps: int = 10, chu
     level = _finite(level, "level")
     steps = integer(steps, "steps", 0, hi=MAX_BISECTION)
     chunk = integer(chunk, "chunk", 1)
-    fa = np.asarray(fa, dtype=np.float64).copy()
-    fb = np.asarray(fb, dtype=np.float64).copy()
-    for name, f in (("fa", fa), ("fb", fb)):
-        if f.shape != (k,):
-            raise ValueError(f"{name}: expected shape ({k},), got {f.shape}")
-        if not np.isfinite(f).all():
-            raise ValueError(f"{name}: contains NaN or infinite values")
+    fa = as_values(fa, "fa", (k,), allow_empty=True).copy()
+    fb = as_values(fb, "fb", (k,), allow_empty=True).copy()
     if np.any((fa - level) * (fb - level) > 0):
         bad = int(np.argmax((fa - level) * (fb - level) > 0))
         raise ValueError(
@@ -273,8 +272,9 @@ def extract_isosurface(
     shape = grid.shape
     # values (8 B/node) and scikit-image's marching cubes (a float32 copy, edge caches: ~24 B/node measured
     # loosely), plus one chunk of query points
-    check_bytes(grid_bytes(shape, 32) + 48 * min(chunk, grid_bytes(shape, 1)),
-                f"extract_isosurface: resolution={resolution} gives a {shape[0]}x{shape[1]}x{shape[2]} grid")
+    what = f"extract_isosurface: resolution={resolution} gives a {shape[0]}x{shape[1]}x{shape[2]} grid"
+    check_bytes(grid_bytes(shape, 32) + 48 * min(chunk, grid_bytes(shape, 1)), what)
+    check_work(grid_bytes(shape, 1), seconds_per_point(func), what)
     lo, spacing = grid.bbox_min, grid.spacing
     total = grid.size
     values = np.empty(total)

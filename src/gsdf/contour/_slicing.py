@@ -14,7 +14,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from gsdf._checks import as_points, choice, integer
+from gsdf._checks import as_points, as_values, choice, integer
+from gsdf._memory import check_bytes, check_work, seconds_per_point
 from gsdf.contour._isosurface import (CHUNK, _check_bbox, _check_func, _edges_of_vertices, _evaluate, _finite,
                                       refine_on_edges)
 
@@ -188,10 +189,9 @@ def slice_contours(
         raise ValueError(f"axis: must be 0, 1 or 2, got {axis}")
     ua, va = (axis + 1) % 3, (axis + 2) % 3
     grid = _plane_grid(bbox_min, bbox_max, resolution, axis)
-    Z = np.atleast_1d(np.asarray(z_values))
-    if Z.ndim != 1 or Z.size == 0 or not np.issubdtype(Z.dtype, np.number):
+    Z = np.atleast_1d(as_values(z_values, "z_values", finite=False, allow_empty=True))
+    if Z.ndim != 1 or Z.size == 0:
         raise ValueError(f"z_values: expected a number or a non-empty 1D array of numbers, got shape {Z.shape}")
-    Z = Z.astype(np.float64)
     if not np.isfinite(Z).all():
         raise ValueError("z_values: contains NaN or infinite values")
     level = _finite(level, "level")
@@ -200,6 +200,12 @@ def slice_contours(
     choice(inside, "inside", {"above", "below"})
 
     nu, nv = grid.shape[ua], grid.shape[va]
+    ns = Z.size
+    what = f"slice_contours: {ns:,} heights × a {nu}x{nv} grid ({ns * nu * nv:,} nodes)"
+    # values (8 B) and inside/outside masks (2 B) per node of every slice; per plane node: its position (24 B),
+    # meshgrid copies (16 B) and one chunk of queries; per slice: a padded copy for marching squares
+    check_bytes(10 * ns * nu * nv + 64 * nu * nv + 48 * min(CHUNK, ns * nu * nv), what)
+    check_work(ns * nu * nv, seconds_per_point(func), what)
     ax = grid.axes()
     gu, gv = ax[ua], ax[va]
     h = grid.spacing[[ua, va]]
@@ -210,7 +216,6 @@ def slice_contours(
     plane[:, va] = W.ravel()
 
     # --- field values on all slices (batched so each func call gets up to `chunk` points) ---
-    ns = Z.size
     values = np.empty((ns, nu * nv))
     per_call = max(1, chunk // (nu * nv))
     for s in range(0, ns, per_call):
@@ -420,7 +425,7 @@ def write_svg(
     if ns == 0:
         raise ValueError("contours_per_slice: is empty (no slices)")
     if z_values is not None:
-        Z = np.atleast_1d(np.asarray(z_values, dtype=np.float64))
+        Z = np.atleast_1d(as_values(z_values, "z_values", finite=False, allow_empty=True))
         if Z.shape != (ns,):
             raise ValueError(f"z_values: expected shape ({ns},), got {Z.shape}")
         if not np.isfinite(Z).all():
@@ -532,5 +537,5 @@ def write_slices_svg(path, func, z_values, bbox_min=None, bbox_max=None, svg_opt
     lo, hi = grid.box
     opts = dict(svg_options or {})
     opts.setdefault("bbox", [[lo[ua], lo[va]], [hi[ua], hi[va]]])
-    write_svg(path, C, z_values=np.atleast_1d(np.asarray(z_values, dtype=np.float64)), **opts)
+    write_svg(path, C, z_values=np.atleast_1d(as_values(z_values, "z_values")), **opts)
     return C

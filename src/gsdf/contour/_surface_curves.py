@@ -32,10 +32,8 @@ def level_set_curves(V, F, f, value: float = 0.0) -> list:
     1
     """
     V, F = _checks.as_mesh(V, F)
-    g = np.asarray(f, dtype=np.float64).ravel()
-    if g.shape[0] != len(V) or not np.isfinite(g).all():
-        raise ValueError(f"f: expected {len(V)} finite values, got shape {np.shape(f)}")
-    g = g - value
+    g = _checks.as_values(f, "f", (len(V),))
+    g = g - _checks.finite(value, "value")
     scale = max(float(np.abs(g).max()), 1e-300)
     g = np.where(g == 0, 1e-12 * scale, g)                    # no vertex exactly on the level set
     G = g[F]

@@ -74,11 +74,12 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     >>> V.shape, F.shape, np.allclose(V[:, 0], 0.5)
     ((3, 3), (1, 3), True)
     """
-    from gsdf._checks import finite
+    from gsdf._checks import as_faces, as_points, as_values, finite, flag
 
-    X = np.asarray(X, float)
-    T = np.asarray(T, np.int64)
-    s = np.asarray(values, float) - finite(level, "level")
+    X = as_points(X, "X")
+    T = as_faces(T, len(X), "T", corners=4)
+    report = flag(report, "report")
+    s = as_values(values, "values", (len(X),)) - finite(level, "level")
     if not (s.min() < 0 < s.max()):
         raise ValueError(f"level {level} is outside the field's range [{s.min() + level:.6g}, {s.max() + level:.6g}]: no surface")
     # values within round-off of the level are put exactly on it, and a node on the level counts as below it:
@@ -127,7 +128,7 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     up[ok] = np.linalg.solve(M[ok], ds[ok][:, :, None])[:, :, 0]
     flip = (n * up).sum(axis=1) < 0
     F[flip] = F[flip][:, [0, 2, 1]]
-    from gsdf.mesh._topology import manifold_report, split_nonmanifold_vertices, weld
+    from gsdf.mesh._topology import manifold_report, weld
 
     V, F = weld(V, F.astype(np.int64))
     F = _cancel_opposite_pairs(F)

@@ -9,6 +9,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from gsdf._checks import as_points, query_shaped
+from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 
 __all__ = ["PointCloudDistance", "point_cloud_distance"]
@@ -34,7 +35,7 @@ class PointCloudDistance:
     @query_shaped()
     def query(self, Q):
         """Returns ``(d (q,), index (q,) int64, closest (q, 3))`` for the query points ``Q`` (q, 3)."""
-        Q = as_points(Q, "Q")
+        Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
         Qf, excess = self._frame.queries(Q, want_excess=True)
         d, idx = self.tree.query(Qf, k=1, workers=-1)
         idx = np.asarray(idx, dtype=np.int64)

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from gsdf._checks import as_mesh, as_normals, as_points, as_weights, choice, positive, query_shaped
+from gsdf._memory import SECONDS_PER_QUERY
 from gsdf.mesh._pseudonormals import pseudonormals
 from gsdf.distance._points import point_cloud_distance
 from gsdf.distance._triangles import TriangleDistance
@@ -107,7 +108,7 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0, return_cl
     ([3], [[0.333, 0.333, 0.333]])
     """
     V, F = as_mesh(V, F)
-    Q = as_points(Q, "Q")
+    Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
     choice(sign, "sign", SIGN_MODES)
     beta = positive(beta, "beta")
     if not isinstance(return_closest, (bool, np.bool_)):
@@ -180,7 +181,7 @@ def signed_distance_points(P, N, Q, areas=None, beta: float = 2.3):
     """
     P = as_points(P, "P")
     N = as_normals(N, P.shape[0], "N")
-    Q = as_points(Q, "Q")
+    Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
     if areas is not None:
         areas = as_weights(areas, P.shape[0], "areas")
     beta = positive(beta, "beta")

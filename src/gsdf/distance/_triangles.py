@@ -30,6 +30,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_mesh, as_points, integer, query_shaped
+from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.spatial._morton import morton_order
 from gsdf.spatial._bvh import build_triangle_bvh
@@ -558,7 +559,7 @@ class TriangleDistance:
         closest : (q, 3) float64
             The closest point on that triangle.
         """
-        Q = as_points(Q, "Q")
+        Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
         d, face, closest, _ = self._query(Q, want_bary=False)
         return d, face, closest
 
@@ -566,7 +567,7 @@ class TriangleDistance:
     def query_barycentric(self, Q):
         """Like :meth:`query` but also returns the barycentric coordinates (q, 3) of the closest point in
         its triangle ``F[face]`` (exact zeros on edges, exact one at vertices)."""
-        Q = as_points(Q, "Q")
+        Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
         return self._query(Q)
 
 
@@ -587,7 +588,7 @@ def unsigned_distance(V, F, Q, return_closest: bool = False):
     [0.5, 0.5]
     """
     V, F = as_mesh(V, F)
-    Q = as_points(Q, "Q")
+    Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
     d, face, closest = TriangleDistance(V, F).query(Q)
     if return_closest:
         return d, face, closest
@@ -614,7 +615,7 @@ def _brute_kernel(Q, T, out_d2, out_face):
 def brute_force_distance(V, F, Q):
     """O(q m) reference: distance from every query to every triangle. Returns ``(d, face)``. For testing."""
     V, F = as_mesh(V, F)
-    Q = as_points(Q, "Q")
+    Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
     frame = Frame.of_mesh(V, F)
     T = np.ascontiguousarray(frame.geometry(V)[F].reshape(-1, 9))
     Q, excess = frame.queries(Q, want_excess=True)

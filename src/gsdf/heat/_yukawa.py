@@ -37,7 +37,8 @@ import numpy as np
 from numba import njit, prange
 from scipy.spatial import cKDTree
 
-from gsdf._checks import nonnegative, positive
+from gsdf._checks import as_points, as_values, integer, nonnegative, positive
+from gsdf._memory import SECONDS_PER_PAIR, SECONDS_PER_QUERY
 from gsdf.spatial._bvh import build_bvh
 
 INV_4PI = 1.0 / (4.0 * np.pi)
@@ -216,8 +217,10 @@ class YukawaTree:
     """
 
     def __init__(self, B, W, t: float, theta: float = 0.5, eps: float = 1e-6, leaf_size: int = 8):
-        B = np.ascontiguousarray(B, dtype=np.float64)
-        W = np.ascontiguousarray(W, dtype=np.float64)
+        B = as_points(B, "B")
+        W = as_points(W, "W")
+        if len(W) != len(B):
+            raise ValueError(f"W: has {len(W)} rows but there are {len(B)} source points B")
         self.m = len(B)
         self.lam = 1.0 / np.sqrt(positive(t, "t"))
         self.theta = nonnegative(theta, "theta")
@@ -246,9 +249,11 @@ class YukawaTree:
         nearest source distance with ``|dref − d*| ≤ slack`` (computed
         exactly with a k-d tree when omitted); :func:`grid_nearest_distance` gives one for grids.
         """
-        Q = np.ascontiguousarray(Q, dtype=np.float64)
+        Q = as_points(Q, "Q", allow_empty=True, seconds_per_row=SECONDS_PER_QUERY)
         if dref is not None:
-            dref = np.ascontiguousarray(dref, dtype=np.float64)
+            dref = as_values(dref, "dref", (len(Q),), allow_empty=True)
+        slack = nonnegative(slack, "slack")
+        chunk = integer(chunk, "chunk", 1)
         out = np.empty((len(Q), 3))
         t = self.tree
         band = self.tau / self.lam + 2.0 * float(slack)
@@ -263,7 +268,7 @@ class YukawaTree:
 
     def direct(self, Q) -> np.ndarray:
         """The O(q × m) direct sum with the same scaling (signedheat3d's Step I), for testing."""
-        Q = np.ascontiguousarray(Q, dtype=np.float64)
+        Q = as_points(Q, "Q", allow_empty=True, seconds_per_row=self.m * SECONDS_PER_PAIR)
         out = np.empty((len(Q), 3))
         _direct_kernel(Q, self.nearest_distance(Q), self._B, self._W, self.lam, self._rmin, out)
         return out

@@ -106,11 +106,38 @@ def gc_edges(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([a[first], b[first]], axis=1), first
 
 
-def _text(path: str) -> str:
-    if os.path.isdir(path):
-        raise ValueError(f"{path}: is a directory, not a curve file")
-    if not os.path.isfile(path):
-        raise ValueError(f"{path}: no such curve file")
+#: Tolerance of barycentric coordinates (as the surface solver's): each >= -BARY_TOL, their sum within BARY_TOL of 1.
+BARY_TOL = 1e-6
+
+
+def _check_vertex(i: int, n_vertices) -> int:
+    if i < 0:
+        raise ValueError(f"negative vertex index {i}")
+    if n_vertices is not None and i >= n_vertices:
+        raise ValueError(f"vertex index {i} out of range for a mesh of {n_vertices} vertices")
+    return i
+
+
+def _check_face_point(f: int, b: np.ndarray, n_faces) -> tuple:
+    """A node ``f a b c``: face index in range, three finite barycentric coordinates of a point in the face."""
+    if f < 0:
+        raise ValueError(f"negative face index {f}")
+    if n_faces is not None and f >= n_faces:
+        raise ValueError(f"face index {f} out of range for {n_faces} faces")
+    if b.size != 3:
+        raise ValueError(f"a face node needs 3 barycentric coordinates, got {b.size}")
+    if not np.isfinite(b).all():
+        raise ValueError(f"barycentric coordinates are not finite: {b.tolist()}")
+    if b.min() < -BARY_TOL or abs(b.sum() - 1.0) > BARY_TOL:
+        raise ValueError(f"barycentric coordinates {b.tolist()} are not those of a point in the face (each >= 0, "
+                         "sum 1)")
+    return f, b
+
+
+def _text(path) -> str:
+    from gsdf._checks import readable_file
+
+    path = readable_file(path, "path")
     with open(path, "rb") as fb:
         raw = fb.read()
     try:
@@ -236,7 +263,10 @@ def _parse(path, F):
                 if key in ("signed_curve", "unsigned_curve"):
                     curves.append([])
                     signs.append(key == "signed_curve")
-                    flips.append(bool(int(args[0])) if args else False)
+                    flip = _int(args[0], where, "flip") if args else 0
+                    if flip not in (0, 1):
+                        raise ValueError(f"flip: expected 0 or 1, got {args[0]!r}")
+                    flips.append(bool(flip))
                     mode = "curve"
                 elif key in ("unsigned_point", "signed_point"):
                     mode = "points"
@@ -379,6 +409,12 @@ def write_curves(path: str, curves, curve_signs=None, points=()) -> None:
     """Write sources in the demo format (vertex-index curves as ``v`` nodes, surface points as ``f`` nodes) to a
     ``.txt`` file (atomically, :mod:`gsdf.io._safe_write`).
 
+    ``curves``, ``curve_signs`` and ``points`` are what ``compute_distance`` takes (:func:`gsdf.curves.as_curves`,
+    :func:`gsdf.curves.as_point_sources`), checked as :func:`read_curves` checks a file: integer indices >= 0
+    (no bools, no fractions), one sign per curve, barycentric coordinates of a point in the face; edge-set
+    curves are written as their chained vertex polylines. A ValueError names the first bad entry, before the
+    file is touched.
+
     Examples
     --------
     >>> import os, tempfile, gsdf
@@ -391,23 +427,37 @@ def write_curves(path: str, curves, curve_signs=None, points=()) -> None:
     v 2
     v 0
     """
-    signs = [True] * len(curves) if curve_signs is None else list(curve_signs)
-    from gsdf.io._safe_write import atomic_output
+    from gsdf.curves import as_curves, as_point_sources
+    from gsdf.io._safe_write import atomic_output, check_output_path
 
+    check_output_path(path, extensions=(".txt",))
+    blocks = []                                           # (header, node lines)
+    for k, c in enumerate(as_curves(curves, curve_signs)):
+        head = "signed_curve\n" if c.signed else "unsigned_curve\n"
+        if c.kind == "points":
+            blocks.append((head, [_node_line(e, b, f"curves[{k}][{q}]") for q, (e, b) in enumerate(c.nodes)]))
+        else:
+            for poly in (c.polylines() if c.kind == "edges" else [c.nodes]):
+                blocks.append((head, [_node_line(int(v), (), f"curves[{k}]") for v in poly]))
+    pts = []
+    for q, p in enumerate(as_point_sources(points)):
+        pts.append(_node_line(p, (), f"points[{q}]") if isinstance(p, int) else _node_line(*p, f"points[{q}]"))
     with atomic_output(path, extensions=(".txt",)) as tmp, open(tmp, "w") as fh:
-        for c, s in zip(curves, signs):
-            fh.write("signed_curve\n" if s else "unsigned_curve\n")
-            if isinstance(c, np.ndarray) or all(np.isscalar(x) for x in c):
-                fh.writelines(f"v {int(v)}\n" for v in c)
-            else:
-                for f, b in c:
-                    b = np.asarray(b, float)
-                    fh.write(f"v {int(f)}\n" if b.size == 0 else f"f {int(f)} {b[0]:.17g} {b[1]:.17g} {b[2]:.17g}\n")
-        if len(points):
+        for head, lines in blocks:
+            fh.write(head)
+            fh.writelines(lines)
+        if pts:
             fh.write("unsigned_point\n")
-            for p in points:
-                if np.isscalar(p):
-                    fh.write(f"v {int(p)}\n")
-                else:
-                    b = np.asarray(p[1], float)
-                    fh.write(f"f {int(p[0])} {b[0]:.17g} {b[1]:.17g} {b[2]:.17g}\n")
+            fh.writelines(pts)
+
+
+def _node_line(e: int, b, name: str) -> str:
+    """One node of a curve file: ``v i`` (a vertex: ``b`` empty) or ``f i a b c``, checked."""
+    b = np.asarray(b, dtype=np.float64).ravel()
+    try:
+        if b.size == 0:
+            return f"v {_check_vertex(e, None)}\n"
+        f, b = _check_face_point(e, b, None)
+    except ValueError as exc:
+        raise ValueError(f"{name}: {exc}") from None
+    return f"f {f} {b[0]:.17g} {b[1]:.17g} {b[2]:.17g}\n"

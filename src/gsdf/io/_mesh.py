@@ -19,14 +19,13 @@ Conventions shared by every reader:
 from __future__ import annotations
 
 import codecs
-import errno
 import io
 import os
 import re
 
 import numpy as np
 
-from gsdf._checks import as_faces, as_points
+from gsdf._checks import as_faces, as_points, as_values, flag, readable_file
 from gsdf.io._external import MESHIO_FORMATS, TRIMESH_FORMATS, read_external
 from gsdf.io._safe_write import atomic_output
 
@@ -56,10 +55,10 @@ def _extension(path, supported, what: str) -> tuple[str, str]:
 
 
 def _check_file(p: str) -> None:
-    """Raise FileNotFoundError for a missing path, ValueError for an empty file."""
-    if not os.path.exists(p):
-        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), p)
-    if os.path.isfile(p) and os.path.getsize(p) == 0:
+    """Raise FileNotFoundError for a missing path, ValueError for anything but a readable regular file of a size
+    that fits in memory (:func:`gsdf._checks.readable_file`) and for an empty file."""
+    readable_file(p)
+    if os.path.getsize(p) == 0:
         raise ValueError(f"{p}: file is empty")
 
 
@@ -649,6 +648,7 @@ def read_mesh(path, triangulate: bool = True):
     >>> V, polys = read_mesh("quads.obj", triangulate=False)         # doctest: +SKIP
     """
     p, ext = _extension(path, MESH_READ_FORMATS, "mesh")
+    triangulate = flag(triangulate, "triangulate")
     if ext not in MESH_FORMATS:
         _check_file(p)
         if os.path.isdir(p):
@@ -755,7 +755,7 @@ def _vertex_data(vertex_data, n: int) -> dict:
                 or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool)):
             raise ValueError(f"vertex_data[{name!r}]: expected a numeric array of shape ({n},) or ({n}, k), "
                              f"got {a.dtype} {a.shape}")
-        out[name] = a.astype(np.float64)
+        out[name] = as_values(a.astype(np.uint8) if a.dtype == bool else a, f"vertex_data[{name!r}]")
     return out
 
 
@@ -828,7 +828,8 @@ def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
     vertex_data : dict of str -> (n,) or (n, k) float array, optional
         Extra per-vertex values (e.g. a distance field, or normals as one (n, 3) array) written as PLY vertex
         properties (doubles; an (n, k) entry ``name`` as the k properties ``name_0`` ... ``name_{k-1}``), or as
-        VTK/VTU point data (an (n, k) entry as one k-component array).  Other formats raise ValueError.
+        VTK/VTU point data (an (n, k) entry as one k-component array).  Other formats raise ValueError, and so do NaN,
+        infinite or complex values (a reader could not tell them from data: fill them explicitly).
     binary : bool, default True
         PLY only: binary little-endian (default) or ASCII.
 

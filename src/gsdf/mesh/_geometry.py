@@ -56,6 +56,8 @@ def face_normals(V: np.ndarray, F: np.ndarray) -> np.ndarray:
 
 def bounding_box(X: np.ndarray, pad: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned bounding box of points ``X``, grown by ``pad`` times its diagonal on every side."""
+    from gsdf.grid import diagonal
+
     lo, hi = X.min(axis=0), X.max(axis=0)
-    d = float(np.linalg.norm(hi - lo)) or 1.0
+    d = diagonal(lo, hi) or 1.0
     return lo - pad * d, hi + pad * d

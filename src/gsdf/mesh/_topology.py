@@ -27,6 +27,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from gsdf._checks import as_mesh
+
 __all__ = ["weld", "manifold_report", "split_nonmanifold_vertices", "mesh_topology", "is_sphere"]
 
 
@@ -153,7 +155,7 @@ def mesh_topology(V, F) -> dict:
     >>> t["closed"], t["oriented"], t["genus"]
     (True, True, [0])
     """
-    F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
+    V, F = as_mesh(V, F, allow_empty_faces=True)
     nF = len(F)
     out = {"n_faces": nF, "closed": False, "edge_manifold": False, "vertex_manifold": False, "oriented": False,
            "components": 0, "euler": 0, "genus": [], "degenerate_faces": 0}

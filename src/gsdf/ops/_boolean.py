@@ -31,7 +31,7 @@ import dataclasses
 
 import numpy as np
 
-from gsdf._checks import as_mesh, choice, positive
+from gsdf._checks import as_mesh, choice, flag, integer, positive
 
 __all__ = ["mesh_boolean", "trim_mesh", "BooleanOptions"]
 
@@ -61,6 +61,12 @@ class BooleanOptions:
     beta: float = 2.0
     exact: bool = False
 
+
+    def __post_init__(self):  # a ValueError naming the attribute, at construction
+        positive(self.beta, "beta", most=1e150)
+        flag(self.exact, "exact")
+        _steps(self.bisection_steps)
+        flag(self.stitch, "stitch")
 
 _OPS = ("union", "intersection", "difference")
 
@@ -229,15 +235,7 @@ def trim_mesh(V, F, winding, keep="outside", bisection_steps=12):
 
 
 def _steps(bisection_steps):
-    try:
-        if isinstance(bisection_steps, (bool, np.bool_, str)) or np.ndim(bisection_steps) != 0:
-            raise TypeError
-        s = int(bisection_steps)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise ValueError(f"bisection_steps: expected a non-negative integer, got {bisection_steps!r}") from exc
-    if s != bisection_steps or s < 0 or s > 60:
-        raise ValueError(f"bisection_steps: expected an integer in [0, 60], got {bisection_steps!r}")
-    return s
+    return integer(bisection_steps, "bisection_steps", 0, hi=60)
 
 
 def _compact(V, F):

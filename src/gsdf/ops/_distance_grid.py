@@ -12,11 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from gsdf._checks import as_mesh, as_normals, as_points, choice, positive, progress_callback
+from gsdf._memory import SECONDS_PER_QUERY, check_work
 
 __all__ = ["signed_distance_grid"]
 
 
-def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "winding", beta: float | None = None,
+def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: str = "winding", beta: float | None = None,
                          return_closest: bool = False, shell: float | None = None, progress=None):
     """Signed distance (negative inside) on the nodes of a regular grid around a mesh/soup or oriented cloud.
 
@@ -85,6 +86,8 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
     if shell is not None:
         shell = positive(shell, "shell")
     report = progress_callback(progress)
+    if beta is not None:
+        beta = positive(beta, "beta")
     if points is not None:
         if V is not None or F is not None:
             raise ValueError("points: give either a mesh (V, F) or points=(P, N), not both")
@@ -105,6 +108,8 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
         V, F = as_mesh(V, F)
         X = V
     grid = as_grid(resolution, X=X)
+    check_work(grid.size, 2 * SECONDS_PER_QUERY, f"signed_distance_grid: a {'x'.join(map(str, grid.shape))} grid "
+               f"({grid.size:,} nodes)")
     Q = grid.points()
 
     if points is not None:

@@ -16,7 +16,7 @@ its signed distance is computed exactly on the same grid (exact point–triangle
 from __future__ import annotations
 
 
-from gsdf._checks import positive
+from gsdf._checks import flag, positive
 from gsdf.field import GridField
 
 __all__ = ["offset_surface", "dilate_erode", "erode_dilate"]
@@ -52,6 +52,7 @@ def offset_surface(field, distance: float):
 def _reoffset(field, first: float, second: float, return_field: bool):
     from gsdf.distance import signed_distance
 
+    return_field = flag(return_field, "return_field")
     V1, F1 = field.isosurface(first)
     Q = field.grid_points()
     psi = GridField(signed_distance(V1, F1, Q).reshape(field.shape), field.bbox_min, field.bbox_max)

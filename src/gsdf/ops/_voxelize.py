@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_normals, as_points, as_weights, positive, progress_callback
-from gsdf._memory import check_bytes, grid_bytes
+from gsdf._checks import as_mesh, as_normals, as_occupancy, as_points, as_weights, flag, positive, progress_callback
+from gsdf._memory import SECONDS_PER_QUERY, check_bytes, check_work, grid_bytes
 from gsdf.mesh._topology import manifold_report, split_nonmanifold_vertices
 
 __all__ = [
@@ -119,8 +119,9 @@ def winding_grid(mesh=None, points=None, resolution=100, beta=None, progress=Non
     grid = as_grid(resolution, X=X)
     shape = grid.shape
     # the grid (8 B/node, +1 B for voxelize's occupancy) plus one chunk of centres, indices and values
-    check_bytes(grid_bytes(shape, 9) + 64 * min(CHUNK, grid_bytes(shape, 1)),
-                f"winding grid: {shape[0]}x{shape[1]}x{shape[2]} voxels")
+    what = f"winding grid: {shape[0]}x{shape[1]}x{shape[2]} voxels"
+    check_bytes(grid_bytes(shape, 9) + 64 * min(CHUNK, grid_bytes(shape, 1)), what)
+    check_work(grid_bytes(shape, 1), SECONDS_PER_QUERY, what)
     total = grid.size
     W = np.empty(total, dtype=np.float64)
     for s in range(0, total, CHUNK):
@@ -172,18 +173,7 @@ def voxelize(mesh=None, points=None, resolution=100, beta=None, progress=None):
 
 
 def _occupancy(occ) -> np.ndarray:
-    A = np.asarray(occ)
-    if A.ndim != 3:
-        raise ValueError(f"occ: expected a 3D array, got shape {A.shape}")
-    if min(A.shape) < 1:
-        raise ValueError(f"occ: has an empty axis, shape {A.shape}")
-    if A.dtype != bool:
-        if not np.issubdtype(A.dtype, np.number):
-            raise ValueError(f"occ: expected a boolean array, got dtype {A.dtype}")
-        if not np.isin(A, (0, 1)).all():
-            raise ValueError("occ: expected a boolean (0/1) array")
-        A = A.astype(bool)
-    return A
+    return as_occupancy(occ, "occ")
 
 
 def save_voxels(path, occ, bbox_min, bbox_max) -> None:
@@ -213,6 +203,9 @@ def save_voxels(path, occ, bbox_min, bbox_max) -> None:
 
 def load_voxels(path):
     """Read a file written by :func:`save_voxels`; returns ``(occupancy, bbox_min, bbox_max)``."""
+    from gsdf._checks import readable_file
+
+    path = readable_file(path, "path")
     try:
         with np.load(path) as d:
             return _occupancy(d["occupancy"]), *_bbox(d["bbox_min"], d["bbox_max"])
@@ -261,6 +254,7 @@ def voxels_to_mesh(occ, bbox_min, bbox_max, report: bool = False):
     """
     A = _occupancy(occ)
     lo, hi = _bbox(bbox_min, bbox_max)
+    report = flag(report, "report")
     # padded copy and masks (~4 B/cell), plus ~300 B per exposed cell face (at most 6 per occupied cell:
     # indices, quads, triangles, the unique of the node ids)
     check_bytes(grid_bytes(np.array(A.shape) + 2, 4) + 300 * 6 * int(np.count_nonzero(A)),

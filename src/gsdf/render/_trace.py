@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_points, finite, integer, positive
+from gsdf._checks import as_points, as_values, finite, integer, positive
 from gsdf._memory import check_bytes
 
 __all__ = ["sphere_trace", "render_png"]
@@ -52,9 +52,9 @@ def _direction(x, name):
 
 def _values(sdf, X):
     try:
-        v = np.asarray(sdf(X), dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"sdf: did not return numbers for {len(X)} points ({exc})") from exc
+        v = as_values(sdf(X), "sdf", finite=False, allow_empty=True)
+    except ValueError as exc:
+        raise ValueError(f"sdf: did not return real numbers for {len(X)} points ({exc})") from None
     if v.shape != (len(X),):
         raise ValueError(f"sdf: expected shape ({len(X)},) from {len(X)} points, got {v.shape}")
     if not np.isfinite(v).all():

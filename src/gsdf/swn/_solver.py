@@ -58,7 +58,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, dijkstra
 
-from gsdf._checks import progress_callback
+from gsdf._checks import positive, progress_callback
 from gsdf.dec._hodge import HodgeDecomposition
 from gsdf.dec._triangle import TriangleDEC
 from gsdf.linalg._dual_l1 import dual_graph_l1
@@ -85,7 +85,7 @@ class SWNOptions:
     epsilon : float in (0, 1]
         LP weight of jumps on the input's edges relative to gap-closing ones (thesis §6.1.2: jumps along the
         input curves are cheap, weight ε, so the residual closes gaps rather than cutting new curves).
-    time_limit : float > 0
+    time_limit : float > 0, finite
         Seconds the residual LPs may take, summed over the decomposition passes; beyond it a ValueError that
         names ``method="reduced"`` (one unknown per curve piece) as the fallback.
 
@@ -102,13 +102,8 @@ class SWNOptions:
     time_limit: float = 300.0
 
     def __post_init__(self):
-        e, t = self.epsilon, self.time_limit
-        if isinstance(e, bool) or not isinstance(e, (int, float, np.floating)) or not (0 < float(e) <= 1):
-            raise ValueError(f"epsilon: expected a number in (0, 1], got {e!r}")
-        if isinstance(t, bool) or not isinstance(t, (int, float, np.floating)) or not float(t) > 0:
-            raise ValueError(f"time_limit: expected a positive number of seconds, got {t!r}")
-        object.__setattr__(self, "epsilon", float(e))
-        object.__setattr__(self, "time_limit", float(t))
+        object.__setattr__(self, "epsilon", positive(self.epsilon, "epsilon", most=1.0))
+        object.__setattr__(self, "time_limit", positive(self.time_limit, "time_limit"))
 
 
 @dataclass

@@ -6,7 +6,8 @@
 * :class:`SmoothedSignedPlanarDistance` — Eq. 5.9, the self-normalized formula (Eq. 3.16) with the tangent
   plane g_i(x) = ⟨x − p_i, n_i⟩ and area weights.
 * :class:`LogSumExpDistance` — unsigned LogSumExp distance (Eq. 3.15 with h = A_i, Madan & Levin 2022):
-  d(x) = −(1/λ) log Σ A_i exp(−λ‖x − p_i‖).
+  d(x) = −(1/λ) log Σ A_i exp(−λ‖x − p_i‖), the areas A_i measured in units of the cloud's half-extent
+  (the largest half side of its bounding box; the log of an area otherwise depends on the unit of length).
 * :class:`WindingNumberPipeline` — fast winding number → marching cubes at 1/2 → signed distance to that mesh
   (the "GWN" column of §7.2).
 
@@ -14,6 +15,11 @@ All three kernels share σ_x, λ_x = C/σ_x and the neighbour selection of :mod:
 points within R_eval, at least the 32 nearest, at most ``k_eval``; exponents shifted by the nearest distance,
 which is exact). Truncating the sums is how PAT is accelerated in §5.1.3; for the baselines it changes the
 value only by weights below exp(−λ (R_eval − d_min)).
+
+Like PAT, the kernels run in the cloud's normalised frame (:class:`gsdf._normalize.Frame`; here only its scale, a
+power of two bringing the half-extent into [0.5, 1)): points, queries, areas, a fixed λ and R_eval are mapped into
+it and distances mapped back, so a cloud at 1e-150 or 1e150 gives the unit cloud's answer times the scale (the
+``(λd + 1)⟨x − p, n⟩/d³`` term of Eq. 5.8 and the areas would otherwise under- or overflow).
 """
 
 from __future__ import annotations
@@ -21,7 +27,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_points, integer, positive, query_shaped
+from gsdf._checks import as_points, as_weights, integer, positive, query_shaped
+from gsdf._memory import SECONDS_PER_QUERY
+from gsdf._normalize import Frame
 from gsdf.tori._blend import NeighbourBlend
 from gsdf.tori._pat import _clean_cloud, _sigma
 
@@ -76,34 +84,51 @@ class _Convolution:
 
     def __init__(self, P, N, areas=None, C: float = 64.0, lam=None, r_eval=None, k_eval: int = 64,
                  k_fallback: int = 32):
+        n_given = as_points(P, "P").shape[0]
         self.P, self.N = _clean_cloud(P, N, 1)
+        self.C = positive(C, "C")
+        self.lam = 0.0 if lam is None else positive(lam, "lam")
+        r_eval = None if r_eval is None else positive(r_eval, "r_eval")
+        k_eval, k_fallback = integer(k_eval, "k_eval"), integer(k_fallback, "k_fallback")
+        # scale invariance: points, areas, λ and R_eval scaled by the power of two of the cloud's normalised frame
+        # (gsdf._normalize; not centred: scaling by 2^k is exact, so at ordinary scales the sums are bitwise
+        # those of the input units, while a translation would move the truncated neighbour sums by ~1e-6)
+        e = Frame.of(self.P).exponent
+        self._frame = fr = Frame(np.zeros(3), e, e == 0)
+        self._Pf = fr.geometry(self.P, "P")
         if areas is None:
             from gsdf.winding._point_areas import point_areas
 
-            self.areas = point_areas(self.P, self.N) if len(self.P) > 20 else np.ones(len(self.P))
+            self._Af = point_areas(self._Pf, self.N) if len(self.P) > 20 else np.ones(len(self.P))
+            self.areas = fr.area(self._Af)
         else:
-            a = np.asarray(areas, dtype=np.float64)
-            if a.shape != (len(np.asarray(P)),):
-                raise ValueError(f"areas: expected shape ({len(np.asarray(P))},), got {a.shape}")
+            a = as_weights(areas, n_given, "areas")
             if len(a) != len(self.P):
                 raise ValueError("areas: cannot be combined with duplicate points or zero normals; clean the cloud first")
             self.areas = a
-        if not (np.isfinite(self.areas).all() and (self.areas >= 0).all() and (self.areas > 0).any()):
-            raise ValueError("areas: must be finite, nonnegative and not all zero")
-        self.C = positive(C, "C")
-        self.lam = 0.0 if lam is None else positive(lam, "lam")
-        self._blend = NeighbourBlend(self.P, self.C, None if r_eval is None else positive(r_eval, "r_eval"),
-                                     integer(k_eval, "k_eval"), integer(k_fallback, "k_fallback"))
+            self._Af = fr.inverse_area(a)
+            if not (np.isfinite(self._Af).all() and (self._Af > 0).any()):
+                raise ValueError("areas: too small or too large to represent relative to the cloud's size")
+        self._lam_f = 0.0 if lam is None else float(fr.length(self.lam))
+        if r_eval is not None:
+            r_eval = min(float(fr.inverse_length(r_eval)), 1e150)  # the cloud spans ~2 frame units
+            if not r_eval > 0:
+                raise ValueError("r_eval: too small to represent relative to the cloud's size")
+        self._blend = NeighbourBlend(self._Pf, self.C, r_eval, k_eval, k_fallback)
 
     @query_shaped()
     def __call__(self, Q) -> np.ndarray:
         b = self._blend
+        Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
+        Qf, excess = self._frame.queries(Q, want_excess=True)
 
         def fn(q, d, i, out):
-            _conv_kernel(q, d, i, self.P, self.N, self.areas, b.hull, self.C, self.lam, b.r_eval, b.k_fallback,
+            _conv_kernel(q, d, i, self._Pf, self.N, self._Af, b.hull, self.C, self._lam_f, b.r_eval, b.k_fallback,
                          self._mode, out)
 
-        return b.map(Q, fn)
+        out = b.map(Qf, fn)
+        # a clamped far query (gsdf._normalize.FAR) is farther by ``excess``: the distances grow by it
+        return self._frame.length(out + np.copysign(excess, out))
 
 
 class SignedHopfCole(_Convolution):
@@ -179,6 +204,12 @@ class LogSumExpDistance(_Convolution):
     def __init__(self, P, N=None, **kw):
         P = as_points(P, "P")
         super().__init__(P, np.tile([0.0, 0.0, 1.0], (len(P), 1)) if N is None else N, **kw)
+        # log Σ A_i e^{−λ d_i} depends on the unit of the areas: measure them in units of the cloud's half-extent
+        # h (the largest half side of its bounding box), so that the distance scales with the cloud; a cloud with
+        # h = 1 gets Eq. 3.15 with its areas as given
+        half = float(np.max(0.5 * self._Pf.max(axis=0) - 0.5 * self._Pf.min(axis=0)))
+        if half > 0:
+            self._Af = self._Af / (half * half)
 
     @query_shaped()
     def unsigned_distance(self, Q) -> np.ndarray:

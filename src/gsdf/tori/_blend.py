@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_points
-from gsdf._memory import check_bytes
+from gsdf._memory import SECONDS_PER_QUERY, check_bytes
 from gsdf.spatial._bvh import build_bvh
 from gsdf.spatial._radius_grid import build_radius_grid, gather_within
 
@@ -336,7 +336,7 @@ class NeighbourBlend:
         """Validate ``Q`` and call ``fn(q, d, i, out)`` chunk by chunk; ``out`` is (q,) or (q, width)."""
         from gsdf.spatial._morton import morton_order
 
-        Q = as_points(Q, name)
+        Q = as_points(Q, name, seconds_per_row=SECONDS_PER_QUERY)
         out = np.empty((len(Q), width) if width else len(Q))
         # neighbour blocks are (chunk, k_eval) distances and indices: keep one block within ~64 MB
         chunk = max(1, min(CHUNK, (64 << 20) // (16 * self.k_eval + 64)))

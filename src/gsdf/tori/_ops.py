@@ -13,12 +13,13 @@ from __future__ import annotations
 import numpy as np
 
 from gsdf._checks import as_points
+from gsdf._memory import SECONDS_PER_QUERY
 
 __all__ = ["union", "intersection", "difference", "offset", "contour"]
 
 
 def _call(f, Q):
-    return np.asarray(f(as_points(Q, "Q")), dtype=np.float64)
+    return np.asarray(f(as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)), dtype=np.float64)
 
 
 def union(*fields):

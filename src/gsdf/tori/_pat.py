@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_points, choice, finite, integer, nonnegative, positive, query_shaped
+from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.grid import PAD, Grid, padded_box
 from gsdf.threads import apply_env
@@ -168,6 +169,14 @@ class PointsAsToriOptions:
     curvature_cap: float = 4.0
     kd_eps: float = 0.0
 
+    def __post_init__(self):  # a ValueError naming the attribute, at construction (as PointsAsTori checks them)
+        integer(self.k_eval, "k_eval", lo=1)
+        integer(self.k_fallback, "k_fallback", lo=1)
+        nonnegative(self.normal_weight, "normal_weight")
+        nonnegative(self.ridge, "ridge")
+        positive(self.curvature_cap, "curvature_cap")
+        nonnegative(self.kd_eps, "kd_eps", most=1e3)
+
 
 class PointsAsTori:
     """Generalized signed distance of an oriented point cloud, evaluated pointwise (thesis ch. 5).
@@ -283,7 +292,7 @@ class PointsAsTori:
     def _eval(self, Q, want_grad):
         b = self._blend
         fr = self._frame
-        Q = as_points(Q, "Q")
+        Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
         Qf, excess = fr.queries(Q, want_excess=True)
 
         def fn(q, d, i, out):
@@ -342,8 +351,10 @@ class PointsAsTori:
     def load(cls, path) -> "PointsAsTori":
         """Read a file written by :meth:`save`; every array is checked against the points (shape, length,
         finiteness) before any kernel reads it."""
+        from gsdf._checks import readable_file
+
         try:
-            z = np.load(path, allow_pickle=False)
+            z = np.load(readable_file(path, "path"), allow_pickle=False)
             files = set(z.files)
         except Exception as exc:
             raise ValueError(f"{path}: not a saved PointsAsTori file ({type(exc).__name__}: {exc})") from exc

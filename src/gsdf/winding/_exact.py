@@ -15,8 +15,9 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_faces, as_mesh, as_normals, as_points, as_weights, query_shaped
+from gsdf._memory import SECONDS_PER_PAIR
 from gsdf._normalize import Frame
-from gsdf.winding._query import map_queries
+from gsdf.winding._query import map_queries, query_array
 from gsdf.winding._solid_angle import solid_angle_w
 
 INV_4PI = 1.0 / (4.0 * np.pi)
@@ -109,6 +110,7 @@ def winding_number(V, F, Q, method: str = "auto") -> np.ndarray:
     if method not in ("auto", "direct", "hierarchical"):
         raise ValueError(f"method: must be 'auto', 'direct' or 'hierarchical', got {method!r}")
     V, F = as_mesh(V, F)
+    query_array(Q)  # the size guard before any tree is built
     n_queries = np.shape(Q)[0] if np.ndim(Q) == 2 else 1
     if method == "hierarchical" or (method == "auto" and n_queries > 64 and F.shape[0] > 64):
         from gsdf.winding._hierarchical import ExactWindingNumber
@@ -116,7 +118,7 @@ def winding_number(V, F, Q, method: str = "auto") -> np.ndarray:
         return ExactWindingNumber(V, F)(Q)
     frame = Frame.of_mesh(V, F)  # scale invariance: kernels run on O(1) coordinates (gsdf._normalize)
     T = triangle_corners(frame.geometry(V), F)
-    return map_queries(lambda q, out: _wn_triangles(T, q, out), Q, frame=frame)
+    return map_queries(lambda q, out: _wn_triangles(T, q, out), Q, frame=frame, cost=len(F) * SECONDS_PER_PAIR)
 
 
 @query_shaped()
@@ -142,7 +144,7 @@ def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
     True
     """
     frame, P, NA = oriented_area_normals(P, N, areas)
-    return map_queries(lambda q, out: _wn_points(P, NA, q, out), Q, frame=frame)
+    return map_queries(lambda q, out: _wn_points(P, NA, q, out), Q, frame=frame, cost=len(P) * SECONDS_PER_PAIR)
 
 
 @query_shaped(2)
@@ -161,7 +163,8 @@ def winding_number_2d(V, E, Q) -> np.ndarray:
     E = as_faces(E, V.shape[0], "E", corners=2)
     frame = Frame.of_mesh(V, E)
     S = np.ascontiguousarray(frame.geometry(V)[E].reshape(-1, 4))
-    return map_queries(lambda q, out: _wn_polyline(S, q, out), Q, dim=2, frame=frame)
+    return map_queries(lambda q, out: _wn_polyline(S, q, out), Q, dim=2, frame=frame,
+                       cost=len(S) * SECONDS_PER_PAIR)
 
 
 def oriented_area_normals(P, N, areas=None):

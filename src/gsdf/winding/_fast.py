@@ -49,12 +49,13 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_mesh, integer, query_shaped
+from gsdf._checks import as_mesh, integer, positive, query_shaped
+from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.spatial._bvh import BVH, build_bvh, build_volume_bvh
 from gsdf.spatial._wide import widen
 from gsdf.threads import run_ranges, run_tasks
-from gsdf.winding._query import map_queries
+from gsdf.winding._query import map_queries, query_array
 from gsdf.winding._exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w
 
 # layout of the per-node coefficient row
@@ -738,15 +739,8 @@ def _eval_points(Q, P, NA, N, C, beta2, order, out):
 
 
 def _check_params(beta, order):
-    if isinstance(beta, (bool, np.bool_)) or np.ndim(beta) != 0:
-        raise ValueError(f"beta: expected a number, got {beta!r}")
-    try:
-        beta = float(beta)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise ValueError(f"beta: expected a number, got {beta!r}") from exc
     # β² multiplies node radii² in the walk: beyond 1e150 it overflows (every node would be opened anyway)
-    if not np.isfinite(beta) or beta <= 0 or beta > 1e150:
-        raise ValueError(f"beta: must be a finite positive number <= 1e150, got {beta!r}")
+    beta = positive(beta, "beta", most=1e150)
     if isinstance(order, (bool, np.bool_)) or np.ndim(order) != 0 or order not in (0, 1, 2):
         raise ValueError(f"order: must be 0, 1 or 2, got {order!r}")
     return beta, int(order)
@@ -777,6 +771,7 @@ def _single_thread(serial: bool):
 
 class _FastWindingBase:
     tree: BVH
+    _seconds_per_point = SECONDS_PER_QUERY  # cost of one query, for the size guard of contouring callers
 
     @query_shaped()
     def __call__(self, Q, progress=None) -> np.ndarray:
@@ -905,6 +900,7 @@ def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarra
     >>> (np.round(w, 6) + 0.0).tolist()
     [1.0, 0.0]
     """
+    query_array(Q)  # the size guard before the tree is built
     return FastWindingNumber(V, F, beta=beta, order=order)(Q)
 
 
@@ -923,4 +919,5 @@ def fast_winding_number_points(P, N, Q, areas=None, beta: float = 2.3, order: in
     >>> bool(abs(w[0] - 1) < 0.05 and abs(w[1]) < 0.05)
     True
     """
+    query_array(Q)  # the size guard before the tree is built
     return FastWindingNumberPoints(P, N, areas=areas, beta=beta, order=order)(Q)

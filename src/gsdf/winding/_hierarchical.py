@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_mesh, integer, query_shaped
+from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.spatial._bvh import build_bvh
 from gsdf.winding._query import map_queries
@@ -128,6 +129,8 @@ class ExactWindingNumber:
     >>> gsdf.ExactWindingNumber(V, F)([[0.1, 0.1, 0.1], [2, 2, 2]]).round(12)
     array([1., 0.])
     """
+
+    _seconds_per_point = SECONDS_PER_QUERY  # cost of one query, for the size guard of contouring callers
 
     def __init__(self, V, F, leaf_size: int = 8):
         V, F = as_mesh(V, F)

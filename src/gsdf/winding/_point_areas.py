@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 from scipy.spatial import cKDTree
 
-from gsdf._checks import as_normals, as_points, integer
+from gsdf._checks import as_normals, as_points, integer, neighbours
 from gsdf._normalize import Frame
 from gsdf.linalg._eig3 import jacobi_eig3
 from gsdf.spatial._knn import SelfKNN
@@ -366,8 +366,9 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     N : (n, 3) array_like
         Normals (any length; only their direction is used).  Rows that are zero get area 0.
     k : int, default 20
-        Neighbourhood size (the paper's value).  With fewer than ``k + 1`` points, all other points
-        are used (``min(k, n - 1)``).  Where the neighbours do not surround the cell (the hull clip
+        Neighbourhood size (the paper's value; its results are insensitive to it).  With fewer
+        than ``k + 1`` points, all other points are used (``min(k, n - 1)``); a ``k`` above both 20
+        and ``n - 1`` is refused.  Where the neighbours do not surround the cell (the hull clip
         below cuts it: a point on a border, or an interior point whose ``k`` nearest leave a wide
         angular gap), the cell is computed again with ``2 k``, then ``4 k`` neighbours.
     boundary : {"hull", "square"}, default "hull"
@@ -441,7 +442,7 @@ def _point_areas(P: np.ndarray, N: np.ndarray, k: int = 20, boundary: str = "hul
     """:func:`point_areas` of a validated cloud (``P`` (n, 3) float64 and ``N`` (n, 3) finite, as
     :func:`gsdf._checks.as_points` / ``as_normals`` return them)."""
     n = P.shape[0]
-    k = integer(k, "k", 1)
+    k = neighbours(k, n, "k", 1, default=20)
     if boundary not in ("hull", "square"):
         raise ValueError(f"boundary: must be one of ['hull', 'square'], got {boundary!r}")
     if n < 2:
@@ -667,7 +668,8 @@ def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) ->
     P : (n, 3) array_like
         Points, n >= 3.
     k : int, default 20
-        Neighbourhood size (clamped to ``n - 1``).
+        Neighbourhood size (clamped to ``n - 1`` when at most the default 20; a larger ``k`` than ``n - 1`` is
+        refused).
     orient_towards : None or (3,) array_like
         ``None`` (default): the sign of each normal is arbitrary — consistent orientation of an
         unoriented cloud is a global problem that is left to the user (the winding number needs
@@ -693,7 +695,7 @@ def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) ->
     """
     P = as_points(P, "P")
     n = P.shape[0]
-    k = integer(k, "k", 1)
+    k = neighbours(k, n, "k", 1, default=20)
     chunk = integer(chunk, "chunk", 1)
     if n < 3:
         raise ValueError(f"P: need at least 3 points to fit planes, got {n}")
@@ -708,10 +710,11 @@ def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) ->
     P = frame.geometry(P, "P")
     if c is not None:
         c = frame.queries(c[None, :], "orient_towards")[0]
-    from gsdf._memory import check_bytes
+    from gsdf._memory import SECONDS_PER_PAIR, check_bytes, check_work
 
-    check_bytes(8 * n * (kk + 1) + 24 * min(n, chunk) * (kk + 1) * 2,
-                f"estimate_normals: {n} points x {kk} neighbours")
+    what = f"estimate_normals: {n} points x {kk} neighbours"
+    check_bytes(8 * n * (kk + 1) + 24 * min(n, chunk) * (kk + 1) * 2, what)
+    check_work(n * (kk + 1), 10 * SECONDS_PER_PAIR, what)
     idx = _knn(P, kk)
     out = np.empty((n, 3))
     for s in range(0, n, chunk):

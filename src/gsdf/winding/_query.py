@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from gsdf._checks import _array, _dtype_words
+from gsdf._memory import SECONDS_PER_QUERY, check_bytes, check_work
 from gsdf.spatial._morton import cell_order, gather_rows
 from gsdf.threads import apply_env
 
@@ -11,7 +13,7 @@ CHUNK = 1 << 20
 
 
 def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, coherent: bool = False,
-                frame=None) -> np.ndarray:
+                frame=None, cost: float = SECONDS_PER_QUERY) -> np.ndarray:
     """Validate ``Q`` chunk by chunk and call ``kernel(q_chunk, out_chunk)`` on each.
 
     Only one float64 copy of one chunk exists at a time, so 10^8 float32 queries need ~chunk×24 bytes of
@@ -19,16 +21,12 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
     ``coherent=True`` evaluates each chunk grouped by cells of a coarse Morton grid
     (:func:`gsdf.spatial._morton.cell_order`: tree walks of neighbouring queries then share cached nodes) and
     scatters the results back. ``frame`` (a :class:`gsdf._normalize.Frame`) maps each
-    validated chunk into the geometry's normalised frame first (the kernel's geometry lives there).
+    validated chunk into the geometry's normalised frame first (the kernel's geometry lives there). ``cost``:
+    single-thread seconds per query, for the size guard (:func:`gsdf._memory.check_work`, with the output's
+    memory checked by :func:`gsdf._memory.check_bytes`) run before the first pass over ``Q``.
     """
     apply_env()  # GSDF_NUM_THREADS
-    A = np.asarray(Q)
-    if A.ndim == 1 and A.shape[0] == dim:
-        A = A.reshape(1, dim)
-    if A.ndim != 2 or A.shape[1] != dim:
-        raise ValueError(f"Q: expected shape (q, {dim}), got {A.shape}")
-    if not (np.issubdtype(A.dtype, np.floating) or np.issubdtype(A.dtype, np.integer)):
-        raise ValueError(f"Q: expected a numeric array, got dtype {A.dtype}")
+    A = query_array(Q, dim, cost, chunk)
     n = A.shape[0]
     out = np.empty(n, dtype=np.float64)
     for s in range(0, n, chunk):
@@ -49,6 +47,25 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
         if progress is not None:
             progress("winding numbers", e / n)
     return out
+
+
+def query_array(Q, dim: int = 3, cost: float = SECONDS_PER_QUERY, chunk: int = CHUNK) -> np.ndarray:
+    """``Q`` as an (q, dim) numeric array (not yet copied or checked for finiteness), after the size guard: the
+    output's memory (:func:`gsdf._memory.check_bytes`) and ``q × cost`` seconds of work
+    (:func:`gsdf._memory.check_work`). One-call functions run it before building their tree, so that 10^9
+    queries are refused at once."""
+    A = _array(Q, "Q")
+    if A.ndim == 1 and A.shape[0] == dim:
+        A = A.reshape(1, dim)
+    if A.ndim != 2 or A.shape[1] != dim:
+        raise ValueError(f"Q: expected shape (q, {dim}), got {A.shape}")
+    if A.dtype.kind not in "fiu":
+        raise ValueError(f"Q: expected numeric coordinates, got {_dtype_words(A)}")
+    n = A.shape[0]
+    if n > 1000:
+        check_bytes(8 * n + 48 * min(n, chunk), f"Q: winding numbers at {n:,} query points")
+        check_work(n, cost, f"Q: winding numbers at {n:,} query points")
+    return A
 
 
 def _already_coherent(q: np.ndarray) -> bool:

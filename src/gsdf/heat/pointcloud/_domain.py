@@ -66,8 +66,8 @@ class PointCloudDomain(VertexSurfaceDomain):
         P = _checks.as_points(P, "P")
         if len(P) < 4:
             raise ValueError(f"P: need at least 4 points, got {len(P)}")
-        k = _checks.integer(k, "k", lo=3)
-        t_coef = _checks.positive(t_coef, "t_coef")
+        k = _checks.neighbours(k, len(P), "k", lo=3, default=30)
+        t_coef = _checks.positive(t_coef, "t_coef", most=_checks.T_COEF_MAX)
         if N is None:
             from gsdf.winding._point_areas import estimate_normals
 

@@ -258,7 +258,7 @@ class PolygonDomain(VertexSurfaceDomain):
 
     def __init__(self, V, polygons, t_coef: float = 1.0):
         V = _checks.as_points(V, "V")
-        t_coef = _checks.positive(t_coef, "t_coef")
+        t_coef = _checks.positive(t_coef, "t_coef", most=_checks.T_COEF_MAX)
         self.n_vertices = n = len(V)
         self.V = V
         start, corners = _parse_polygons(polygons, n)

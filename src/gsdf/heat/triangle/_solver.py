@@ -86,7 +86,7 @@ class SurfaceSignedHeatSolver:
         # distances are mapped back on output (gsdf._normalize)
         self.frame = Frame.of_mesh(V, F) if len(F) else Frame.of(V)
         self.V_world, V = V, self.frame.geometry(V)
-        self.t_coef = _checks.positive(t_coef, "t_coef")
+        self.t_coef = _checks.positive(t_coef, "t_coef", most=_checks.T_COEF_MAX)
         rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
         self._kept = None  # input face -> kept face (-1: dropped), when faces were dropped
         if rep.any():
@@ -105,7 +105,7 @@ class SurfaceSignedHeatSolver:
             raise ValueError(f"F: face {int(np.flatnonzero(bad)[0])} has zero area ({int(bad.sum())} degenerate "
                              "faces); remove degenerate triangles first")
         self.V, self.F = self.V_world, F
-        self.intrinsic_delaunay = bool(intrinsic_delaunay)
+        self.intrinsic_delaunay = _checks.flag(intrinsic_delaunay, "intrinsic_delaunay")
         self.input_ops = TriangleMeshOperators(V, F)
         # a vertex point source weighs one input unit against the curves (its old meaning at every scale)
         self.input_ops.point_weight = float(self.frame.inverse_length(1.0))

@@ -7,7 +7,7 @@ from typing import Callable
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_points, choice, integer, nonnegative, positive
+from gsdf._checks import T_COEF_MAX, as_mesh, as_points, choice, integer, nonnegative, positive
 from gsdf._normalize import Frame
 from gsdf.grid import PAD, Grid
 from gsdf._checks import progress_callback
@@ -68,6 +68,9 @@ class VolumeHeatOptions:
     mesher: str = "delaunay"
     max_memory: int | None = None
     progress: Callable[[str, float], None] | None = None
+
+    def __post_init__(self):  # a ValueError naming the attribute, at construction ("auto" is resolved per domain)
+        self._checked("grid")
 
     def _checked(self, domain: str) -> dict:
         """The options validated for ``domain`` (ValueError naming the option): a dict with ``mode`` and ``lam``
@@ -233,7 +236,7 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
     from gsdf.threads import blas_region
 
     domain = choice(domain, "domain", {"grid", "tet"})
-    t_coef = positive(t_coef, "t_coef")
+    t_coef = positive(t_coef, "t_coef", most=T_COEF_MAX)
     if options is None:
         options = VolumeHeatOptions()
     elif not isinstance(options, VolumeHeatOptions):

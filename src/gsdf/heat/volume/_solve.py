@@ -9,10 +9,10 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from gsdf._memory import check_bytes
+from gsdf._memory import SECONDS_PER_QUERY, check_bytes, check_work
 from gsdf._normalize import Frame
 from gsdf.field import GridField, TetField
-from gsdf._checks import progress_callback
+from gsdf._checks import positive, progress_callback
 from gsdf.heat._core import SignedHeatCore
 from gsdf.heat.grid._domain import GridDomain
 from gsdf.heat.tet._domain import TetDomain
@@ -45,8 +45,9 @@ def solve_grid(src: Sources, bbox_min, bbox_max, shape, t_coef: float = 1.0, t=N
     shape = tuple(int(s) for s in shape)
     n = int(np.prod(shape))
     check_bytes(n * BYTES_PER_NODE, f"signed_heat_volume: a grid of {n:,} nodes {shape}", max_memory)
+    check_work(n, SECONDS_PER_QUERY, f"signed_heat_volume: a grid of {n:,} nodes {shape}")
     h = float(((hi - lo) / (np.array(shape) - 1)).max())
-    t = float(t_coef) * h * h if t is None else t
+    t = positive(float(t_coef) * h * h if t is None else t, "t (= t_coef h^2)")
     domain = GridDomain(lo, hi, shape, t, theta=theta, progress=report)
     core = SignedHeatCore(domain)
     S = domain.prepare(src, source_components(src) if mode == "multiple" else None)
@@ -105,12 +106,13 @@ def solve_tet(src: Sources, X, faces, lo, hi, shape, t_coef: float = 1.0, t=None
         P, T, D = delaunay_mesh(Z, lo, hi, h, levels=TET_LEVELS, grading=TET_GRADING)
     nV = len(P)
     check_bytes(nV * BYTES_PER_TET_VERTEX, f"signed_heat_volume: the tet mesh of {nV:,} vertices", max_memory)
+    check_work(nV, SECONDS_PER_QUERY, f"signed_heat_volume: the tet mesh of {nV:,} vertices")
     keep = tet_quality(P, T) >= TET_MIN_QUALITY
     timings["mesh"] = time.perf_counter() - t0
     report("tet mesh", 1.0)
 
     t0 = time.perf_counter()
-    tt = float(t_coef) * h * h if t is None else t
+    tt = positive(float(t_coef) * h * h if t is None else t, "t (= t_coef h^2)")
     domain = TetDomain(P, T, D, keep, nZ, comp, tt, theta=theta)
     core = SignedHeatCore(domain)
     S = domain.prepare(src, shift=(mode != "zero" or lam is not None))     # hard "zero" is not shifted

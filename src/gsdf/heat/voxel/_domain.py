@@ -66,38 +66,20 @@ CONNECTIONS = ("A", "B")
 
 # --------------------------------------------------------------------------------------------- validation
 def as_occupancy(occupancy) -> np.ndarray:
-    """Validate a binary volume: a 3-D bool array (0/1 integers accepted) with both occupied and empty voxels."""
-    if isinstance(occupancy, np.ndarray) and occupancy.dtype == object:
-        raise ValueError("occupancy: expected a 3-D boolean array, got dtype object")
-    try:
-        A = np.asarray(occupancy)
-    except Exception as exc:                                   # ragged nested lists
-        raise ValueError(f"occupancy: expected a 3-D boolean array ({exc})") from exc
-    if A.ndim != 3:
-        raise ValueError(f"occupancy: expected a 3-D boolean array, got {A.ndim} dimensions (shape {A.shape})")
-    if A.dtype != bool:
-        if not (np.issubdtype(A.dtype, np.integer) or np.issubdtype(A.dtype, np.floating)):
-            raise ValueError(f"occupancy: expected a boolean array, got dtype {A.dtype}")
-        if not np.isin(A, (0, 1)).all():
-            raise ValueError(f"occupancy: expected a boolean array (or 0/1 values), got dtype {A.dtype} with other "
-                             "values")
-        A = A.astype(bool)
-    if A.size == 0 or not A.any():
+    """Validate a binary volume: a 3-D bool array (0/1 integers accepted) with both occupied and empty voxels
+    (:func:`gsdf._checks.as_occupancy`, which checks its size first)."""
+    A = _checks.as_occupancy(occupancy, "occupancy")
+    if not A.any():
         raise ValueError(f"occupancy: the volume is empty (no occupied voxel, shape {A.shape}): no surface")
     if A.all():
         raise ValueError(f"occupancy: the volume is full (every voxel of shape {A.shape} occupied); pad it with "
                          "empty voxels (np.pad(occupancy, 1)) to use the box as the surface")
-    return np.ascontiguousarray(A)
+    return A
 
 
 def as_spacing(spacing) -> np.ndarray:
     """Validate a voxel size: a positive finite scalar or 3-vector; returns (3,) float64."""
-    if isinstance(spacing, (bool, np.bool_)):
-        raise ValueError(f"spacing: expected a positive number or 3 positive numbers, got {spacing!r}")
-    try:
-        s = np.asarray(spacing, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"spacing: expected a positive number or 3 positive numbers, got {spacing!r}") from exc
+    s = _checks.as_values(spacing, "spacing", finite=False)
     if s.ndim == 0:
         s = np.full(3, float(s))
     if s.shape != (3,):
@@ -149,18 +131,11 @@ class VoxelSurfaceDomain(VertexSurfaceDomain):
 
     def __init__(self, occupancy, spacing=1.0, normal_radius: float = 3.0, normals=None, connection: str = "A",
                  t_coef: float = 1.0):
-        t_coef = _checks.positive(t_coef, "t_coef")
+        t_coef = _checks.positive(t_coef, "t_coef", most=_checks.T_COEF_MAX)
         occ = as_occupancy(occupancy)
         s = as_spacing(spacing)
         self.connection = _checks.choice(connection, "connection", CONNECTIONS)
-        if isinstance(normal_radius, (bool, np.bool_)):
-            raise ValueError(f"normal_radius: expected a non-negative number, got {normal_radius!r}")
-        try:
-            r = float(normal_radius)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"normal_radius: expected a non-negative number, got {normal_radius!r}") from exc
-        if not np.isfinite(r) or r < 0:
-            raise ValueError(f"normal_radius: must be finite and >= 0, got {normal_radius!r}")
+        r = _checks.nonnegative(normal_radius, "normal_radius")
         self.occupancy, self.spacing, self.normal_radius = occ, s, r
         S = digital_surface(occ, s)
         self.surface = S
