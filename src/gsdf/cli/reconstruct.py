@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import check_output, output_file, report_errors
+from gsdf.cli._common import check_output, output_file, report_errors, write_picture
 from gsdf.cli._options import (
     common_options,
     no_clobber_option,
@@ -45,14 +45,12 @@ Examples:
               help="Alternation rounds of the outlier removal.")
 @resolution_option(128, help="Grid nodes along the longest side of the box, for the comparison methods (ignored "
                              "by simply-connected).")
-@png_option("Also write a PNG preview of the result (shaded by height).")
-@view_option("0.3,0.2,1")
+@png_option("Also write a PNG of the mesh with the input points.")
+@view_option()
 @common_options
 @no_clobber_option
 @report_errors
 def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resolution, png, view, quiet):
-    import numpy as np
-
     from gsdf.io import read_points, write_mesh
     from gsdf.mesh._topology import mesh_topology
 
@@ -76,7 +74,7 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
         from gsdf.recon import _compare as compare
         fn = {"winding": compare.reconstruct_winding, "heat": compare.reconstruct_heat,
               "pat": compare.reconstruct_pat}[method]
-        say(f"{method} level set")
+        say(f"{method} level set", 0.0)
         V, F, rep = fn(P, N, resolution=resolution, return_report=True)
         click.echo(f"  {rep['time']:.2f} s")
     top = mesh_topology(V, F)
@@ -87,7 +85,4 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
         write_mesh(tmp, V, F)
     click.echo(f"mesh -> {os.path.abspath(output)}")
     if png is not None:
-        from gsdf.render._raster import render_function_png
-        with output_file(png, (".png",), what="--png") as tmp:
-            render_function_png(tmp, V, F, np.asarray(V)[:, 1], view=view)
-        click.echo(f"preview -> {os.path.abspath(png)}")
+        write_picture(png, ("reconstruction", (V, F)), ("input points", P), view=view)

@@ -20,7 +20,8 @@ from gsdf.mesh._pseudonormals import pseudonormals
 from gsdf.distance._points import point_cloud_distance
 from gsdf.distance._triangles import TriangleDistance
 
-__all__ = ["signed_distance", "signed_distance_points", "SIGN_MODES"]
+__all__ = ["signed_distance", "signed_distance_points", "SIGN_MODES", "PseudonormalWarning",
+           "warn_pseudonormal"]
 
 #: Accepted values of ``signed_distance(..., sign=...)``.
 SIGN_MODES = ("winding", "pseudonormal")
@@ -29,6 +30,34 @@ SIGN_MODES = ("winding", "pseudonormal")
 #: on an edge or a vertex (the region-based kernel returns exact zeros there; this only absorbs rounding
 #: for points that project just inside a face, where the face and edge normals agree on the sign).
 BARY_TOL = 1e-10
+
+
+class PseudonormalWarning(UserWarning):
+    """``sign="pseudonormal"`` on a mesh that is open, non-manifold or not consistently oriented, where that sign
+    can be wrong on whole regions."""
+
+
+def warn_pseudonormal(V, F, stacklevel: int = 3) -> dict:
+    """Warn (:class:`PseudonormalWarning`) when the pseudonormal sign is unreliable on the mesh ``(V, F)``: it is
+    open, non-manifold or not consistently oriented (:func:`gsdf.mesh_topology`). Returns the topology."""
+    import warnings
+
+    from gsdf.mesh._topology import mesh_topology
+
+    t = mesh_topology(V, F)
+    problems = []
+    if not t["closed"]:
+        problems.append("open (it has boundary edges)")
+    if not (t["edge_manifold"] and t["vertex_manifold"]):
+        problems.append("non-manifold")
+    elif not t["oriented"]:
+        problems.append("not consistently oriented")
+    if problems:
+        warnings.warn(f"sign='pseudonormal' on a mesh that is {' and '.join(problems)}: the pseudonormal sign is "
+                      "exact only for closed, consistently oriented manifold meshes and can be wrong on whole "
+                      "regions here; sign='winding' is robust to holes and soups", PseudonormalWarning,
+                      stacklevel=stacklevel)
+    return t
 
 
 def _pseudonormal_sign(V, F, Q, closest, face, bary) -> np.ndarray:
@@ -91,6 +120,7 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0):
         d, _, _ = td.query(Q)
         w = np.asarray(fast_winding_number(V, F, Q, beta=beta, order=2), dtype=np.float64)
         return np.where(w > 0.5, -d, d)
+    warn_pseudonormal(V, F)
     d, face, closest, bary = td.query_barycentric(Q)
     return _pseudonormal_sign(V, F, Q, closest, face, bary) * d
 

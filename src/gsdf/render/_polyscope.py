@@ -237,17 +237,9 @@ def _register_volume(ps, vol):
 # ---------------------------------------------------------------------------------------------------------------
 
 def _font(size: int):
-    from PIL import ImageFont
+    from gsdf.render._png import font
 
-    for name in ("DejaVuSans.ttf", "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"):
-        try:
-            return ImageFont.truetype(name, size)
-        except OSError:
-            pass
-    try:
-        return ImageFont.load_default(size=size)
-    except TypeError:  # pragma: no cover - Pillow < 10.1
-        return ImageFont.load_default()
+    return font(size)
 
 
 def draw_legends(img, legends, right: bool = False):

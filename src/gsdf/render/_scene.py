@@ -34,8 +34,8 @@ import numpy as np
 #: Colours of the categorical labels (label values in increasing order cycle through them).
 PALETTE = ((0.80, 0.80, 0.82), (0.95, 0.55, 0.20), (0.25, 0.55, 0.85), (0.40, 0.75, 0.35),
            (0.85, 0.30, 0.45), (0.60, 0.45, 0.80), (0.55, 0.40, 0.30), (0.95, 0.85, 0.30))
-#: Colours of curve items, in turn.
-CURVE_COLORS = ((0.95, 0.35, 0.10), (0.10, 0.70, 0.30), (0.75, 0.15, 0.60), (0.10, 0.45, 0.85))
+#: Colours of curve items, in turn (the first, green, stands out on the coolwarm map and on the label colours).
+CURVE_COLORS = ((0.10, 0.70, 0.30), (0.95, 0.35, 0.10), (0.75, 0.15, 0.60), (0.10, 0.45, 0.85))
 MESH_COLOR = (0.75, 0.75, 0.78)
 CLOUD_COLOR = (0.35, 0.55, 0.85)
 _AXES = {"x": 0, "y": 1, "z": 2}
