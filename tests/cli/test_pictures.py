@@ -43,7 +43,7 @@ def sphere(tmp_path_factory):
 
 def _checked(png, colour_bar=True):
     img = picture.load(png)
-    assert min(img.shape[:2]) >= 400
+    assert max(img.shape[:2]) >= 800
     assert picture.problems(img, colour_bar=colour_bar) == [], png
     return img
 

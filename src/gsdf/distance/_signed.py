@@ -83,22 +83,41 @@ def _pseudonormal_sign(V, F, Q, closest, face, bary) -> np.ndarray:
 def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0):
     """Signed distance from points ``Q`` (q, 3) to the triangle mesh/soup ``(V, F)``; negative inside.
 
+    ``|d|`` is the exact distance to the nearest triangle. ``sign="winding"`` (Barill et al. 2018, §4): inside
+    where the fast winding number exceeds 1/2, robust to holes, self-intersections and soups.
+    ``sign="pseudonormal"`` (Bærentzen & Aanæs 2005): the sign of ``(q - c) . n``, ``c`` the closest point and
+    ``n`` the angle-weighted pseudonormal of its face, edge or vertex; cheaper, exact on closed, consistently
+    oriented manifold meshes, wrong on whole regions of open or broken ones (then it warns).
+
     Parameters
     ----------
-    V, F : (n, 3) float, (m, 3) int
-        Triangle mesh or soup.
+    V : (n, 3) float
+        Vertex positions, model units.
+    F : (m, 3) int
+        Triangles (a mesh or a soup).
     Q : (q, 3) float
         Query points.
-    sign : {"winding", "pseudonormal"}
-        How the inside is decided; see the module documentation. ``"pseudonormal"`` is only meaningful
-        for closed, consistently oriented manifold meshes.
-    beta : float
+    sign : {"winding", "pseudonormal"}, default "winding"
+        How the inside is decided (above).
+    beta : float, default 2.0
         Accuracy parameter of the fast winding number (``sign="winding"`` only): clusters farther than
-        ``beta`` times their radius are approximated by their expansion.
+        ``beta`` times their radius are approximated by their expansion; larger is more accurate and slower.
 
     Returns
     -------
     (q,) float64
+        Signed distance, negative inside, model units.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, face indices out of range, an unknown ``sign``, ``beta <= 0``.
+
+    Warns
+    -----
+    PseudonormalWarning
+        A ``UserWarning``: ``sign="pseudonormal"`` on a mesh that is open, non-manifold or not consistently
+        oriented.
 
     Examples
     --------
@@ -128,9 +147,32 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0):
 def signed_distance_points(P, N, Q, areas=None, beta: float = 2.3):
     """Signed distance to an oriented point cloud; negative inside.
 
-    ``|d|`` is the distance to the nearest point of ``P`` (p, 3); the sign comes from the fast winding
-    number of the oriented points (normals ``N`` (p, 3), optional per-point ``areas`` (p,)): inside where
-    it exceeds 1/2 (Barill et al. 2018).
+    ``|d|`` is the distance to the nearest point of ``P``; the sign comes from the fast winding number of the
+    oriented points: inside where it exceeds 1/2 (Barill et al. 2018, §4 and Eq. 5).
+
+    Parameters
+    ----------
+    P : (p, 3) float
+        Points, model units.
+    N : (p, 3) float
+        Outward normals (any length; normalized internally).
+    Q : (q, 3) float
+        Query points.
+    areas : (p,) float, optional
+        Point areas for the winding number (square model units); default: estimated by :func:`gsdf.point_areas`
+        with k = 20.
+    beta : float, default 2.3
+        Accuracy of the fast winding number: larger is more accurate and slower.
+
+    Returns
+    -------
+    (q,) float64
+        Signed distance, negative inside.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite values, negative areas, ``beta <= 0``.
 
     Examples
     --------

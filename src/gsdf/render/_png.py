@@ -166,8 +166,9 @@ def field_slice_image(field, axis: int = 2, at: float | None = None, zero_level:
                       title: str | None = None, vertical: int | None = None) -> np.ndarray:
     """A picture of the slice ``x[axis] = at`` (default: the middle) of a :class:`gsdf.GridField`: the other two
     axes to the right and up in increasing order (for ``axis=2``: x right, y up; ``vertical``: the axis that goes
-    up instead), square pixels, the longer side ``size`` pixels, isolines evenly spaced in value, the level
-    ``zero_level`` in black; with a colour bar titled ``title`` when given. Returns an (h, w, 3) uint8 image."""
+    up instead), square pixels, the longer side ``size`` pixels plus a white margin, isolines evenly spaced in
+    value, the level ``zero_level`` in black; with a colour bar titled ``title`` when given. Returns an
+    (h, w, 3) uint8 image."""
     from scipy.ndimage import map_coordinates
 
     vals = np.asarray(field.values, dtype=np.float64)
@@ -190,6 +191,8 @@ def field_slice_image(field, axis: int = 2, at: float | None = None, zero_level:
     img = map_coordinates(sl, [U_, V_], order=1)          # (h, w)
     scale = colour_scale(sl, zero_level)
     rgb = field_to_rgb(img, zero_level=zero_level, scale=scale)
+    m = max(10, size // 25)                              # a white margin: the slice is framed, not cut off
+    rgb = np.pad(rgb, ((m, m), (m, m), (0, 0)), constant_values=255)
     if title is not None:
         rgb = annotate(rgb, bar=(title, zero_level, scale))
     return rgb
