@@ -45,6 +45,15 @@ class Field:
         -------
         V : (n, 3) float64
         F : (m, 3) int64
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> x = np.linspace(-1, 1, 9)
+        >>> X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+        >>> V, F = gsdf.GridField(X, [-1] * 3, [1] * 3).isosurface(0.25)      # the plane x = 1/4
+        >>> bool(np.allclose(V[:, 0], 0.25))
+        True
         """
         raise NotImplementedError
 
@@ -884,6 +893,13 @@ class SurfaceField(Field):
         ------
         ValueError
             Always.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0.]])
+        >>> gsdf.SurfaceField(V, [[0, 1, 2]], V[:, 0]).isolines(0.5)[0].shape      # not isosurface
+        (2, 3)
         """
         raise ValueError("a SurfaceField has level curves, not level surfaces: use isolines(level)")
 

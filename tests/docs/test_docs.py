@@ -11,6 +11,7 @@ import os
 import re
 import subprocess
 import sys
+import warnings
 
 import pytest
 
@@ -43,6 +44,56 @@ def test_public_name_has_docstring_with_examples(name):
     examples = _section(doc, "Examples")
     assert examples, f"gsdf.{name}: the docstring has no numpy-style 'Examples' section"
     assert ">>>" in examples, f"gsdf.{name}: the Examples section has no '>>>' example"
+
+
+def _public_callables():
+    """``(name, function, bound)`` of every public name of gsdf that is a function or a class (its constructor's
+    parameters are the class's) and of every public method of the public classes (``bound``: the first
+    parameter is self / cls, not documented)."""
+    out = []
+    for name in gsdf.__all__:
+        obj = getattr(gsdf, name)
+        if inspect.isclass(obj):
+            out.append((name, obj, False))
+            for m in sorted(dir(obj)):
+                if m.startswith("_"):
+                    continue
+                raw = inspect.getattr_static(obj, m)
+                fn = raw.__func__ if isinstance(raw, (staticmethod, classmethod)) else raw
+                if inspect.isfunction(fn):
+                    out.append((f"{name}.{m}", fn, not isinstance(raw, staticmethod)))
+        elif callable(obj):
+            out.append((name, obj, False))
+    return out
+
+
+PUBLIC = _public_callables()
+
+
+@pytest.mark.skipif(importlib.util.find_spec("numpydoc") is None,
+                    reason='numpydoc is not installed (pip install -e ".[docs]")')
+@pytest.mark.parametrize("name,obj,bound", PUBLIC, ids=[p[0] for p in PUBLIC])
+def test_public_callable_documents_every_parameter(name, obj, bound):
+    """Each parameter of a public function, class or public method has an entry in its numpy-style Parameters
+    section (a class: Parameters, Other Parameters or Attributes), and each public method has an Examples
+    section; parsed with numpydoc's docscrape, as the reference pages render them."""
+    from numpydoc.docscrape import NumpyDocString
+
+    doc = inspect.getdoc(obj) or ""
+    assert doc.strip(), f"gsdf.{name}: no docstring"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")                      # numpydoc warns about sections it does not know
+        parsed = NumpyDocString(doc)
+    sections = ("Parameters", "Other Parameters") + (("Attributes",) if inspect.isclass(obj) else ())
+    documented = {n.strip().lstrip("*") for sec in sections for item in parsed[sec] for n in item.name.split(",")}
+    params = list(inspect.signature(obj).parameters.values())
+    if bound and params:
+        params = params[1:]
+    missing = [p.name for p in params if p.name not in documented]
+    assert not missing, (f"gsdf.{name}: the docstring's Parameters section does not document {missing}"
+                         + ("" if parsed["Parameters"] else " (it has no Parameters section)"))
+    if "." in name:
+        assert parsed["Examples"], f"gsdf.{name}: the docstring has no Examples section"
 
 
 def test_every_public_name_in_the_api_reference():

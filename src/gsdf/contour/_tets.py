@@ -55,8 +55,35 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     where separate sheets touch is split per fan, so the result is edge- and vertex-manifold (closed away from
     the mesh boundary). Two cases stay open, and the report says so: flat (zero-volume) tets, which a
     Delaunay of cospherical points such as a regular grid contains, and tet faces lying wholly on the level
-    (three nodes exactly at ``level``). Triangles are oriented along the gradient of ``values``. ``report=True`` returns
-    ``(V, F, report)`` with :func:`gsdf.mesh._topology.manifold_report`.
+    (three nodes exactly at ``level``). Triangles are oriented along the gradient of ``values``.
+
+    Parameters
+    ----------
+    X : (n, 3) float
+        Vertex positions of the tet mesh.
+    T : (m, 4) int
+        Tetrahedra as vertex indices.
+    values : (n,) float
+        One value per vertex, linear over each tet.
+    level : float, default 0.0
+        The level extracted; strictly between the minimum and the maximum of ``values``.
+    report : bool, default False
+        Also return the checks of the mesh: a dict with ``closed``, ``edge_manifold``, ``vertex_manifold``,
+        ``welded`` and the counts of non-manifold edges and vertices.
+
+    Returns
+    -------
+    V : (k, 3) float64
+        Crossing points, welded.
+    F : (f, 3) int64
+        Triangles, normals along the gradient of ``values`` (outward for a signed distance).
+    report : dict
+        Only with ``report=True``.
+
+    Raises
+    ------
+    ValueError
+        ``level`` not finite or outside the range of ``values`` (no surface).
 
     Examples
     --------

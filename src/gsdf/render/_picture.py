@@ -21,24 +21,56 @@ def polyscope_reason() -> str | None:
 def save_png(path, *items, view=None, size=(1200, 900), options=None, renderer: str = "auto") -> str:
     """Write a PNG picture of ``items`` (anything :func:`gsdf.view` shows) and say which renderer drew it.
 
+    With polyscope installed and able to render without a display (EGL), the picture is the screenshot of
+    :func:`gsdf.view`: a 3/4 view framing everything, a colour bar per field titled with its name (put the units
+    in it: ``("signed distance [mm]", field)``), labels with a legend. Otherwise gsdf's own renderers draw the
+    first item they can, from the same direction: a slice of a volume field, a mesh with its per-vertex,
+    per-face or per-corner values or face labels (curves drawn over it), or the zero level set of an oriented
+    cloud (sphere-traced Points as Tori), with a colour bar or legend beside it. This is the picture the
+    command line's ``--png`` writes.
+
     Parameters
     ----------
     path : str or path
         The ``.png`` to write (atomically).
     *items
-        As for :func:`gsdf.view`.
+        As for :func:`gsdf.view`: meshes ``(V, F)``, ``(V, F, values)``, fields, clouds, curves, ``(name,
+        item)``.
     view : (3,) float, optional
-        Direction from the scene towards the camera. Default: the 3/4 view of :func:`gsdf.view`.
+        Direction from the scene towards the camera. Default: the 3/4 view of :func:`gsdf.view` (y up, the
+        broad side facing the camera; a flat scene seen from above).
     size : (int, int), default (1200, 900)
-        Picture size for polyscope (gsdf's renderers size the picture to the object).
+        Picture width and height in pixels for polyscope (gsdf's renderers make the longer side about 900
+        pixels and fit the other to the object).
     options : gsdf.ViewOptions, optional
-    renderer : {"auto", "polyscope", "gsdf"}
+        Level, isolines, slice axis and position, colour map, framing (:class:`gsdf.ViewOptions`).
+    renderer : {"auto", "polyscope", "gsdf"}, default "auto"
         "auto": polyscope when it can render headless in this process, else gsdf's renderers.
 
     Returns
     -------
     str
         "polyscope" or "gsdf": the renderer used.
+
+    Raises
+    ------
+    ValueError
+        A name not ending in ``.png``, an item that cannot be shown, bad options; with gsdf's renderers, items
+        they cannot draw (bare clouds, curves alone).
+    RuntimeError
+        ``renderer="polyscope"`` where polyscope cannot start EGL.
+
+    Examples
+    --------
+    >>> import numpy as np, os, tempfile, gsdf
+    >>> x = np.linspace(-1, 1, 17)
+    >>> X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+    >>> field = gsdf.GridField(np.sqrt(X**2 + Y**2 + Z**2) - 0.5, [-1] * 3, [1] * 3)
+    >>> out = os.path.join(tempfile.mkdtemp(), "ball.png")
+    >>> gsdf.save_png(out, ("signed distance [m]", field), renderer="gsdf")
+    'gsdf'
+    >>> gsdf.save_png(out, ("signed distance [m]", field), options=gsdf.ViewOptions(slice_axis="x"))  # doctest: +SKIP
+    'polyscope'
     """
     from gsdf._checks import choice
     from gsdf.io._safe_write import check_output_path

@@ -190,7 +190,32 @@ def render_png(sdf, path, width: int = 256, height: int = 256, level: float = 0.
                bbox_max=None, **kw) -> None:
     """Sphere-trace ``sdf`` (a :class:`PointsAsTori` or any pointwise SDF) and write a PNG.
 
-    The box defaults to the cloud's bounding box (``sdf.P``) padded by 10 % of its diagonal plus ``|level|``.
+    Only pointwise queries are used (Hart 1996; thesis §5.2, Fig. 5.3): no grid, no mesh. The camera frames
+    the level set (see :func:`gsdf.render.sphere_trace`).
+
+    Parameters
+    ----------
+    sdf : PointsAsTori or callable
+        A pointwise signed distance ``sdf(Q (q, 3)) -> (q,)``, negative inside.
+    path : str or os.PathLike
+        The ``.png`` file to write (atomically).
+    width, height : int, default 256
+        Picture size in pixels.
+    level : float, default 0.0
+        The level set drawn, model units (an offset surface for level != 0).
+    bbox_min, bbox_max : (3,) float, optional
+        The box rays are traced in. Default (for a PointsAsTori): the cloud's bounding box padded by 10 % of
+        its diagonal plus ``|level|``.
+    **kw
+        ``view`` (direction towards the camera, default (1, 0.6, 1.4)), ``up`` (default (0, 1, 0)), ``fov``
+        (degrees, default 35), ``max_steps`` (default 96) and ``step_scale`` (default 0.9) of
+        :func:`gsdf.render.sphere_trace`.
+
+    Raises
+    ------
+    ValueError
+        Another extension, no box for a plain callable, a degenerate view, no ray hitting the level set, an sdf
+        returning NaN.
 
     Examples
     --------

@@ -40,8 +40,8 @@ Boundaries (spec §1(e).5): the jump Laplace problem has zero-Neumann conditions
 (together with the boundary) and an arc joining two boundary circles does not; curves ending on the boundary are
 closed.
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> from gsdf.swn._solver import SurfaceWindingNumbers
 >>> swn = SurfaceWindingNumbers(V, F)                                         # doctest: +SKIP
@@ -91,8 +91,8 @@ class SWNOptions:
 
     A ValueError names the attribute when a value is out of range.
 
-    Example
-    -------
+    Examples
+    --------
     >>> SWNOptions(epsilon=0.05)
     SWNOptions(epsilon=0.05, time_limit=300.0)
     """
@@ -888,8 +888,8 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
     distance) as oriented 2-vertex polylines: every input edge whose bounding multiplicity ``round(g − Jv)`` is
     nonzero, repeated that many times, in its direction.
 
-    Example
-    -------
+    Examples
+    --------
     >>> res = swn.solve(curves)                                               # doctest: +SKIP
     >>> segs = bounding_segments(swn, res)                                    # doctest: +SKIP
     >>> phi = SurfaceSignedHeatSolver(V, F).compute_distance(segs)            # doctest: +SKIP
@@ -907,18 +907,49 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", options: SWNOpti
                            progress=None) -> SWNResult:
     """One-call surface winding numbers (thesis ch. 6): ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
+    The integer-valued winding number of curves drawn on a surface, per face: the regions the curves bound,
+    also when they have gaps (closed by the LP) or run round handles without bounding anything.
+
     Parameters
     ----------
-    V : (n, 3) float; F : (m, 3) int — a manifold, consistently oriented triangle mesh
-    curves, method, options, progress : as :meth:`SurfaceWindingNumbers.solve`
+    V : (n, 3) float
+        Vertex positions.
+    F : (m, 3) int
+        Triangles of a manifold, consistently oriented mesh (any genus, boundary allowed).
+    curves : list or (nE,) int array
+        Vertex polylines along mesh edges, :class:`gsdf.Curve` objects or an edge chain (see
+        :meth:`SurfaceWindingNumbers.chain`); a counter-clockwise loop (seen from the normals) makes its
+        inside 1.
+    method : {"lp", "reduced", "none"}, default "lp"
+        The residual that removes the nonbounding part: the full LP (thesis §6.1), the reduced LP (§6.3), or
+        none (naive rounding).
+    options : SWNOptions, optional
+        The LP's weight ε of jumps along the input curves and its time limit (:class:`gsdf.SWNOptions`).
+    progress : callable, optional
+        ``progress(stage, fraction)`` as each step starts.
 
     Returns
     -------
-    SWNResult (``face_labels``, ``corner_values``, ``residual``, ``u``, ...)
+    SWNResult
+        ``face_labels`` (m,) int, ``corner_values`` (m, 3) float, ``residual`` (nE,) (the nonbounding part per
+        edge), ``u`` (m, 3), ``timings``.
+
+    Raises
+    ------
+    ValueError
+        A non-manifold or misoriented mesh, malformed curves, an unknown method, an LP that fails.
 
     Examples
     --------
-    >>> res = surface_winding_number(V, F, [loop])                          # doctest: +SKIP
-    >>> res.face_labels                                                     # doctest: +SKIP
+    >>> import numpy as np, gsdf
+    >>> x = np.linspace(-1, 1, 9)
+    >>> V = np.array([[a, b, 0.0] for a in x for b in x])          # vertex (i, j) = 9 i + j
+    >>> i = np.arange(81).reshape(9, 9)
+    >>> a, b, c, d = i[:-1, :-1].ravel(), i[1:, :-1].ravel(), i[1:, 1:].ravel(), i[:-1, 1:].ravel()
+    >>> F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    >>> loop = np.concatenate([i[2:6, 2], i[6, 2:6], i[6:2:-1, 6], i[2, 6:1:-1]])   # counter-clockwise
+    >>> res = gsdf.surface_winding_number(V, F, [loop])
+    >>> int(res.face_labels.sum())                                   # the 4 x 4 square inside: 32 triangles
+    32
     """
     return SurfaceWindingNumbers(V, F).solve(curves, method=method, options=options, progress=progress)
