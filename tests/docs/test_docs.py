@@ -89,6 +89,10 @@ def test_public_callable_documents_every_parameter(name, obj, bound):
     params = list(inspect.signature(obj).parameters.values())
     if bound and params:
         params = params[1:]
+    for sec in sections:                 # a paragraph inside a section is parsed as a parameter: shown as code
+        for item in parsed[sec]:
+            assert re.fullmatch(r"\*{0,2}\w+(, ?\*{0,2}\w+)*", item.name.strip()), \
+                f"gsdf.{name}: {item.name[:60]!r} under {sec} is not a parameter name (a paragraph? move it to Notes)"
     missing = [p.name for p in params if p.name not in documented]
     assert not missing, (f"gsdf.{name}: the docstring's Parameters section does not document {missing}"
                          + ("" if parsed["Parameters"] else " (it has no Parameters section)"))
@@ -127,8 +131,19 @@ def test_docs_build_without_warnings(tmp_path):
     assert r.returncode == 0, f"sphinx -W failed:\n{r.stderr[-6000:]}"
     html = (tmp_path / "html" / "index.html").read_text(encoding="utf-8")
     assert "guide/inside_outside.html" in html
+    generated = tmp_path / "html" / "api" / "generated"
     for name in gsdf.__all__:
-        assert (tmp_path / "html" / "api" / "generated" / f"gsdf.{name}.html").exists(), f"no page for gsdf.{name}"
+        assert (generated / f"gsdf.{name}.html").exists(), f"no page for gsdf.{name}"
+    # a page per public method, with its parameters
+    page = (generated / "gsdf.SurfaceSignedHeatSolver.compute_distance.html").read_text(encoding="utf-8")
+    assert "Parameters" in page and "level_set_constraint" in page and "Returns" in page and "Examples" in page
+    # no page shows markup that was not rendered (RST roles or literals left as text)
+    import html as html_lib
+
+    for f in (tmp_path / "html").rglob("*.html"):
+        text = html_lib.unescape(re.sub(r"<[^>]+>", "", f.read_text(encoding="utf-8")))
+        raw = re.findall(r":(?:func|class|meth|mod|attr|data|ref|doc):`|``[^`\n]+``|^\.\. [\w-]+::", text, re.M)
+        assert not raw, f"{f.relative_to(tmp_path / 'html')} shows raw markup: {raw[:3]}"
 
 
 @pytest.mark.parametrize("page", PAGES, ids=[os.path.basename(p) for p in PAGES])

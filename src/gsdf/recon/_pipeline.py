@@ -95,7 +95,10 @@ class ReconstructionOptions:
         (:func:`gsdf.recon._relocate.local_surface`). Vertex positions only: the faces are the same for every
         value.
 
-    A ValueError names the attribute when a value is out of range.
+    Raises
+    ------
+    ValueError
+        Naming the attribute when a value is out of range.
 
     Examples
     --------

@@ -112,7 +112,7 @@ def _fallback(path, items, view, options):
                 shape = tuple(int(max(2, round(n * e / ext.max()))) for e in ext)
                 probe = GridField(np.zeros(shape), f.bbox_min, f.bbox_max)
                 f = GridField(f(probe.grid_points()).reshape(shape), f.bbox_min, f.bbox_max)
-            kind = _scene.field_kind(f.values)
+            kind = _scene.field_kind(f.values, it.name)
             level = options.level if options.level is not None else _scene.default_level(kind) or 0.0
             if options.slice_axis is None:           # as gsdf.view: the axis across up facing the camera most
                 ax = max((i for i in range(3) if abs(upv[i]) < 0.5), key=lambda i: abs(d[i]))
@@ -134,7 +134,7 @@ def _fallback(path, items, view, options):
             level = 0.0
             if values is not None:
                 level = options.level if options.level is not None else \
-                    _scene.default_level(_scene.field_kind(values)) or 0.0
+                    _scene.default_level(_scene.field_kind(values, it.name)) or 0.0
                 if not (values.ndim == 1 and len(values) == len(V)):   # per face / corner: faces on own corners
                     corner = values if values.ndim == 2 else np.repeat(values[:, None], 3, axis=1)
                     m = len(F)

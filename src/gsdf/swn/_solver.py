@@ -89,7 +89,10 @@ class SWNOptions:
         Seconds the residual LPs may take, summed over the decomposition passes; beyond it a ValueError that
         names ``method="reduced"`` (one unknown per curve piece) as the fallback.
 
-    A ValueError names the attribute when a value is out of range.
+    Raises
+    ------
+    ValueError
+        Naming the attribute when a value is out of range.
 
     Examples
     --------

@@ -57,6 +57,8 @@ class SurfaceSignedHeatSolver:
         available; ``compute_distance_l1`` raises NotImplementedError. On a mesh that is already Delaunay no
         edge flips and the results equal those on the input triangulation.
 
+    Notes
+    -----
     Scale: the mesh is mapped once into its frame (:class:`gsdf._normalize.Frame`: centred, power-of-two
     scale) and solved there, so results are scale-covariant (φ of ``s·V`` is ``s·φ``) from 1e-150 to 1e150;
     ``ops`` and ``C`` are in frame units (``frame.length`` / ``frame.area`` map lengths and areas back);
@@ -157,9 +159,9 @@ class SurfaceSignedHeatSolver:
 
         Returns
         -------
-        (|E|,) complex128 or (2 |E|,) float64
-            The diffused vector field, one complex number per edge (the real block form on inconsistently
-            oriented meshes).
+        (nE,) complex128 or (2 nE,) float64
+            The diffused vector field, one complex number per edge (nE edges; the real block form on
+            inconsistently oriented meshes).
 
         Examples
         --------
@@ -274,7 +276,7 @@ class SurfaceSignedHeatSolver:
 
         For curves that do not bound a region (or are inconsistently oriented) the unit field cannot be
         integrated by a continuous function; this integrates it exactly in every face and puts the
-        discontinuities where the weighted L1 jump (Eq. 16) is least — a linear program on |F| unknowns solved
+        discontinuities where the weighted L1 jump (Eq. 16) is least — a linear program on ``|F|`` unknowns solved
         by HiGHS (seconds for ~10⁴ faces; it grows superlinearly). Shifted so that the length-weighted mean
         along the curves is zero.
 
