@@ -151,13 +151,43 @@ def test_guide_page_code_runs(page, tmp_path):
     r = subprocess.run([sys.executable, os.path.join(DOCS, "run_blocks.py"), page, "--cwd", str(tmp_path)],
                        capture_output=True, text=True, timeout=TIMEOUT, env=_env())
     assert r.returncode == 0, f"{os.path.relpath(page, ROOT)}:\n{r.stderr[-6000:]}"
-    # every picture the page shows is one its own code makes
+
+
+def _gallery():
+    spec = importlib.util.spec_from_file_location("make_gallery", os.path.join(DOCS, "make_gallery.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)              # defines the pictures; runs nothing
+    return mod.PICTURES
+
+
+GUIDE = sorted(glob.glob(os.path.join(DOCS, "guide", "*.md")))
+
+
+@pytest.mark.parametrize("page", GUIDE + [os.path.join(ROOT, "README.md")],
+                         ids=[os.path.basename(p) for p in GUIDE] + ["README.md"])
+def test_page_opens_with_a_gallery_picture(page):
+    """Every guide page and the README open with a picture of the task on real data, made by
+    docs/make_gallery.py (its committed output): at least 800 px wide, under 300 KB."""
+    from PIL import Image
+
     text = open(page, encoding="utf-8").read()
-    for target in re.findall(r"!\[[^\]]*\]\((img/[^)]+\.png)\)", text):
-        made = tmp_path / os.path.basename(target)
-        assert made.exists(), f"{os.path.relpath(page, ROOT)} shows {target} but its code does not write it"
-        assert made.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-        assert os.path.exists(os.path.join(os.path.dirname(page), target)), f"{target} is not committed"
+    body = [line for line in text.splitlines()[1:] if line.strip()]
+    m = re.fullmatch(r"!\[[^\]]+\]\((\S*img/(\w+)\.png)\)", body[0].strip())
+    assert m, f"{os.path.basename(page)}: does not open with a picture (first line: {body[0][:80]!r})"
+    target, name = m.groups()
+    assert name in _gallery(), f"{os.path.basename(page)} opens with {target}, which make_gallery.py does not make"
+    png = os.path.normpath(os.path.join(os.path.dirname(page), target))
+    assert os.path.isfile(png), f"{target} is not committed (python docs/make_gallery.py --only {name})"
+    with Image.open(png) as im:
+        assert im.size[0] >= 800, f"{target}: {im.size[0]} px wide"
+    assert os.path.getsize(png) < 300_000, f"{target}: {os.path.getsize(png)} bytes"
+
+
+def test_every_guide_picture_is_a_gallery_picture():
+    made = {f"{n}.png" for n in _gallery()}
+    committed = set(os.listdir(os.path.join(DOCS, "guide", "img")))
+    assert committed == made, f"not made by docs/make_gallery.py: {sorted(committed - made)}; missing: " \
+                              f"{sorted(made - committed)}"
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=[os.path.basename(p) for p in EXAMPLES])

@@ -67,7 +67,7 @@ Tasks and their arrays (float32 unless --dtype float64; all carry center (3,), s
 
 \b
 Executors (choose one): --workers N local processes (default 1), --dask-local N (a Dask LocalCluster),
---scheduler tcp://host:8786 (an existing Dask cluster: dask-jobqueue, Kubernetes, ...; needs gsdf[dask]).
+--scheduler tcp://host:8786 (an existing Dask cluster: dask-jobqueue, Kubernetes, ...; needs the dask extra).
 --threads N: threads of each item (default: the cores divided by the workers).
 
 \b

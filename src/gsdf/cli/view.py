@@ -24,7 +24,7 @@ and the isosurface), `gsdf heat-surface` meshes (the distance with isolines), `g
 number labels, with their share of the area), `gsdf voxelize` voxels, `gsdf reconstruct` meshes.
 
 The screenshot is a 3/4 view framing everything, with a colour bar titled with the field's name and units.
-Needs polyscope (pip install 'gsdf[view]'); without a display, EGL (Debian/Ubuntu: libegl1 libegl-mesa0
+Needs polyscope (the view extra: pip install -e '.[view]' in a checkout); without a display, EGL (Debian/Ubuntu: libegl1 libegl-mesa0
 libgl1-mesa-dri).
 
 \b

@@ -156,4 +156,4 @@ def _fallback(path, items, view, options):
             render_png(PointsAsTori(it.P, it.N), path, 900, 900, view=d, up=upv)
             return
     raise ValueError("save_png: gsdf's own renderers draw volume fields, meshes and oriented clouds; install "
-                     "polyscope (pip install 'gsdf[view]') for the other items")
+                     "polyscope (the view extra: pip install -e '.[view]' in a checkout) for the other items")

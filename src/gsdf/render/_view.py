@@ -132,7 +132,7 @@ def view(*items, screenshot=None, size=(1200, 900), up="auto", azimuth: float = 
     Raises
     ------
     ImportError
-        Without polyscope (``pip install 'gsdf[view]'``).
+        Without polyscope (the ``view`` extra: ``pip install -e ".[view]"`` in a checkout of gsdf).
     RuntimeError
         Without a display and no ``screenshot``; or when EGL cannot start for a screenshot.
     ValueError
