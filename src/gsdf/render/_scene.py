@@ -345,8 +345,9 @@ def round_up(a: float) -> float:
 
 
 def field_kind(v: np.ndarray, title: str | None = None) -> str:
-    """"winding" (values gather at 0 and 1: a winding number or an occupancy; or a ``title`` that says so, for
-    thin shapes whose inside is a small part of the box), "signed" (changes sign) or "plain"."""
+    """"winding" (values gather at 0 and 1: a winding number or an occupancy; with a ``title`` that says so, values
+    gathered at 0 and other integers: a thin shape, or a soup that covers some regions twice), "signed" (changes
+    sign) or "plain"."""
     v = np.asarray(v, float).ravel()
     if v.size == 0:
         return "plain"
@@ -354,9 +355,11 @@ def field_kind(v: np.ndarray, title: str | None = None) -> str:
     # the inside of a thin shape is a small part of the box: a title that names a winding number (or an
     # occupancy) needs only some values near 1
     hinted = title is not None and any(w in title.lower() for w in ("winding number", "occupancy"))
-    if (near1.mean() > 0.02 or (hinted and near1.any())) and near0.mean() > 0.02 and (near0 | near1).mean() > 0.6 \
-            and v.min() > -0.5 and v.max() < 1.5:
+    if near1.mean() > 0.02 and near0.mean() > 0.02 and (near0 | near1).mean() > 0.6 and v.min() > -0.5 \
+            and v.max() < 1.5:
         return "winding"
+    if hinted and near0.mean() > 0.02 and (np.abs(v - np.round(v)) < 0.1).mean() > 0.6 and v.max() > 0.5:
+        return "winding"        # doubly covered regions of a soup wind twice
     if v.min() < 0.0 < v.max():
         return "signed"
     return "plain"
