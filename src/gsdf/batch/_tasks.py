@@ -9,7 +9,9 @@ task               arrays (``F`` = the ``dtype`` option, float32 by default)
 ``occupancy``      ``points`` (n, 3) F, ``occupancy`` (n,) bool (inside), ``winding`` (n,) F
 ``sdf-grid``       ``sdf`` (R, R, R) F (negative inside), node (i, j, k) at ``bbox_min + (i, j, k) * spacing``;
                    ``bbox_min``, ``bbox_max`` (3,) float64, ``spacing`` (3,) float64
-``surface``        ``vertices`` (nv, 3) F, ``faces`` (nf, 3) int64 (outward oriented)
+``surface``        ``vertices`` (nv, 3) F, ``faces`` (nf, 3) int64 (outward oriented); with the option
+                   ``surface_format`` ("ply", "obj", "off", "stl") :func:`gsdf.run_batch` also writes the mesh
+                   next to the item's ``.npz``
 every task         ``center`` (3,) float64 and ``scale`` () float64: stored coordinates are
                    ``(x_input - center) / scale`` and stored distances ``d_input / scale`` (identity for
                    ``normalize="none"``)
