@@ -22,8 +22,9 @@ extensions = [
     "myst_parser",
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
-exclude_patterns = ["_build", "_generated", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["_build", "_generated", "_templates", "_static", "Thumbs.db", ".DS_Store"]
 root_doc = "index"
+templates_path = ["_templates"]  # autosummary/class.rst: a page per public method
 
 # API reference: one page per public name (docs/api/index.rst lists gsdf.__all__; test_docs checks it)
 autosummary_generate = True
@@ -41,7 +42,8 @@ suppress_warnings = ["myst.xref_missing"]
 # offline: no intersphinx inventories, no remote images or assets at build time
 intersphinx_mapping = {}
 html_theme = "alabaster"
-html_static_path = []
+html_static_path = ["_static"]
+html_css_files = ["gsdf.css"]  # code blocks scroll instead of being cut off; images fit the page
 html_theme_options = {"description": "winding numbers and signed distance for broken geometry",
                       "fixed_sidebar": True}
 

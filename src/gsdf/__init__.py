@@ -46,7 +46,7 @@ _EXPORTS = {
     "PointsAsTori": "tori", "PointsAsToriOptions": "tori", "SignedHopfCole": "tori",
     "SmoothedSignedPlanarDistance": "tori", "LogSumExpDistance": "tori", "WindingNumberPipeline": "tori",
     # pictures and the viewer (polyscope: the extra gsdf[view])
-    "view": "render", "ViewOptions": "render", "render_png": "render",
+    "view": "render", "ViewOptions": "render", "render_png": "render", "save_png": "render",
     # guaranteed simply connected reconstruction (Chen, Li & Huang 2026) and comparison reconstructions
     "reconstruct_simply_connected": "recon", "ReconstructionOptions": "recon", "mesh_topology": "mesh",
     # dataset batches

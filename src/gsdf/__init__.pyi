@@ -83,7 +83,7 @@ from gsdf.tori import (
     SmoothedSignedPlanarDistance as SmoothedSignedPlanarDistance,
     WindingNumberPipeline as WindingNumberPipeline,
 )
-from gsdf.render import ViewOptions as ViewOptions, render_png as render_png, view as view
+from gsdf.render import ViewOptions as ViewOptions, render_png as render_png, save_png as save_png, view as view
 from gsdf.winding import (
     ExactWindingNumber as ExactWindingNumber,
     FastWindingNumber as FastWindingNumber,

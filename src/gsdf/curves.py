@@ -97,19 +97,34 @@ class Curve:
         * a list of ``(face_index, barycentric (3,))`` surface points (``(vertex, ())`` also means a vertex),
           on triangle meshes;
         * ``(k, 2)`` int: a set of edges ``i → j`` (oriented when ``signed``); chained into polylines.
-    signed : bool
+    signed : bool, default True
         True: an oriented curve; the region on its left (the inside of a counter-clockwise loop seen from the
         normal side) gets negative distance. False: unsigned distance to the curve (App. A.2).
+    name : str, default "curve"
+        How error messages name the curve (e.g. ``"curves[3]"``).
 
     Attributes
     ----------
     kind : {"vertices", "points", "edges"}
-    nodes : the validated nodes (int64 array, or a list of (int, float64 array) pairs)
+        Which of the three forms ``nodes`` has.
+    nodes : (k,) int64, (k, 2) int64 or list of (int, float64 array)
+        The validated nodes.
+    signed : bool
+        As given.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 2 nodes, an empty edge list, negative or non-integer indices, malformed surface points (the
+        message starts with ``name``).
 
     Examples
     --------
-    >>> Curve([[0, 1], [1, 2], [2, 0]]).polylines()
+    >>> import gsdf
+    >>> gsdf.Curve([[0, 1], [1, 2], [2, 0]]).polylines()
     [array([0, 1, 2, 0])]
+    >>> gsdf.Curve([3, 4, 5], signed=False).kind
+    'vertices'
     """
 
     def __init__(self, nodes, signed: bool = True, name: str = "curve"):
@@ -160,9 +175,27 @@ class Curve:
         return f"Curve({self.kind}, {n} {'edges' if self.kind == 'edges' else 'nodes'}, signed={self.signed})"
 
     def polylines(self) -> list:
-        """The curve as vertex polylines (kind "vertices" or "edges"): edges are chained ``i → j → …`` into
-        maximal paths (orientation followed when signed, ignored otherwise); a path closes when it returns to
-        its start."""
+        """The curve as vertex polylines (kind "vertices" or "edges").
+
+        Edges are chained ``i → j → …`` into maximal paths (orientation followed when signed, ignored
+        otherwise); a path closes when it returns to its start.
+
+        Returns
+        -------
+        list of (k,) int64 arrays
+            One vertex path each (the nodes themselves for kind "vertices").
+
+        Raises
+        ------
+        ValueError
+            For a curve of surface points (kind "points"), which has no vertex polylines.
+
+        Examples
+        --------
+        >>> import gsdf
+        >>> gsdf.Curve([[2, 3], [0, 1], [1, 2]]).polylines()
+        [array([0, 1, 2, 3])]
+        """
         if self.kind == "vertices":
             return [self.nodes]
         if self.kind != "edges":

@@ -35,16 +35,53 @@ class Field:
         raise NotImplementedError
 
     def isosurface(self, level: float = 0.0):  # pragma: no cover - interface
+        """The level set ``field = level`` as a triangle mesh ``(V, F)`` (volume fields; see the subclasses).
+
+        Parameters
+        ----------
+        level : float, default 0.0
+            The value whose level set is extracted, in the field's units.
+
+        Returns
+        -------
+        V : (n, 3) float64
+        F : (m, 3) int64
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> x = np.linspace(-1, 1, 9)
+        >>> X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+        >>> V, F = gsdf.GridField(X, [-1] * 3, [1] * 3).isosurface(0.25)      # the plane x = 1/4
+        >>> bool(np.allclose(V[:, 0], 0.25))
+        True
+        """
         raise NotImplementedError
 
     def save(self, path) -> None:
         """Write the field to ``path``; the format follows the extension (see ``SAVE_EXTENSIONS``).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write, replaced atomically if it exists. Its extension picks the format: one of the
+            class's ``SAVE_EXTENSIONS`` (``.npz`` keeps the domain and reads back with :func:`gsdf.load_field`;
+            ``.npy`` holds the values alone; ``.vtk``, ``.vti``, ``.vtu``, ``.ply`` open in ParaView).
 
         Raises
         ------
         ValueError
             For an extension outside ``SAVE_EXTENSIONS`` (the message lists them), a directory, a parent that is
             not a folder, or a failed write.
+
+        Examples
+        --------
+        >>> import numpy as np, os, tempfile, gsdf
+        >>> f = gsdf.GridField(np.zeros((2, 2, 2)), [0, 0, 0], [1, 1, 1])
+        >>> p = os.path.join(tempfile.mkdtemp(), "f.vti")
+        >>> f.save(p)
+        >>> gsdf.load_field(p).shape
+        (2, 2, 2)
         """
         from gsdf.io._safe_write import atomic_output, extension_of
 
@@ -61,9 +98,33 @@ class GridField(Field):
     Parameters
     ----------
     values : (nx, ny, nz) float array
-        Node values; node ``(i, j, k)`` sits at ``bbox_min + (i, j, k) * spacing``.
+        Node values (at least 2 per axis, finite); node ``(i, j, k)`` sits at ``bbox_min + (i, j, k) * spacing``
+        with ``spacing = (bbox_max - bbox_min) / (shape - 1)``.
     bbox_min, bbox_max : (3,) float
-        Corners of the grid.
+        Corners of the grid, model units; ``bbox_max > bbox_min`` on every axis.
+
+    Attributes
+    ----------
+    values, bbox_min, bbox_max
+        As given (float64).
+    shape : (int, int, int)
+        Nodes per axis.
+    spacing : (3,) float64
+        Distance between neighbouring nodes along each axis.
+    grid : gsdf.Grid
+        The grid of the nodes.
+    meta : dict
+        What the method that made the field records about it (e.g. its parameters); not saved.
+
+    Raises
+    ------
+    ValueError
+        Not a 3D array with at least 2 nodes per axis, NaN or infinite values, an empty or inverted box.
+
+    Notes
+    -----
+    Calling the field, ``field(Q)``, interpolates it trilinearly at the points ``Q`` (q, 3) and returns (q,)
+    values; points outside the box take the value at the nearest point of the box.
 
     Examples
     --------
@@ -93,6 +154,7 @@ class GridField(Field):
 
     @property
     def shape(self) -> tuple[int, int, int]:
+        """Nodes per axis ``(nx, ny, nz)``."""
         return tuple(self.values.shape)
 
     @property
@@ -102,10 +164,22 @@ class GridField(Field):
 
     @property
     def spacing(self) -> np.ndarray:
+        """Distance between neighbouring nodes along each axis, (3,) float64."""
         return (self.bbox_max - self.bbox_min) / (np.array(self.values.shape) - 1)
 
     def grid_points(self) -> np.ndarray:
-        """Node positions, shape (nx*ny*nz, 3), in C order of ``values``."""
+        """Node positions in the C order of ``values`` (x slowest).
+
+        Returns
+        -------
+        (nx * ny * nz, 3) float64
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> gsdf.GridField(np.zeros((2, 3, 2)), [0, 0, 0], [1, 2, 1]).grid_points()[:3].tolist()
+        [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]
+        """
         return self.grid.points()
 
     @query_shaped()
@@ -129,15 +203,52 @@ class GridField(Field):
         return out
 
     def isosurface(self, level: float = 0.0, close: bool = False, report: bool = False):
-        """Marching cubes (scikit-image) at ``level``; returns ``(V, F)`` in world coordinates.
+        """The level set ``field = level`` by marching cubes (scikit-image), in world coordinates.
 
         With ``close=True`` a level set that reaches the box is capped on the box faces (the grid is padded
         with one layer of nodes above the level and the cap vertices are projected back onto the box); the
-        result is welded (cap and surface share their seam vertices) and checked: with ``report=True``
-        ``(V, F, report)`` is returned, ``report`` from :func:`gsdf.mesh._topology.manifold_report` (closed,
-        edge- and vertex-manifold, welded). Where the level set touches itself at a grid node (a pinch), that
-        vertex is split per fan, so the mesh stays vertex-manifold and the report says it is not welded.
-        Raises ValueError if the level is outside the range of the field.
+        result is welded (cap and surface share their seam vertices). Where the level set touches itself at a
+        grid node (a pinch), that vertex is split per fan, so the mesh stays vertex-manifold and the report says
+        it is not welded.
+
+        Parameters
+        ----------
+        level : float, default 0.0
+            The value whose level set is extracted (0: the surface of a signed distance; an offset distance for
+            an offset surface), strictly between the field's minimum and maximum.
+        close : bool, default False
+            Cap the surface where it leaves the box, so that it is closed.
+        report : bool, default False
+            Also return the mesh's checks: a dict with ``closed``, ``edge_manifold``, ``vertex_manifold`` and
+            ``welded``.
+
+        Returns
+        -------
+        V : (n, 3) float64
+            Vertices, model units.
+        F : (m, 3) int64
+            Triangles, oriented towards increasing values (outward for a signed distance).
+        report : dict
+            Only with ``report=True``.
+
+        Raises
+        ------
+        ValueError
+            ``level`` is not finite or outside the range of the field (no surface); ``close`` or ``report`` is
+            not a bool.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> x = np.linspace(-1, 1, 17)
+        >>> X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+        >>> f = gsdf.GridField(np.sqrt(X**2 + Y**2 + Z**2) - 0.5, [-1] * 3, [1] * 3)
+        >>> V, F = f.isosurface(0.0)
+        >>> bool(np.abs(np.linalg.norm(V, axis=1) - 0.5).max() < 0.02)
+        True
+        >>> V, F, rep = f.isosurface(1.0, close=True, report=True)         # cut by the box, capped
+        >>> rep["closed"]
+        True
         """
         from skimage.measure import marching_cubes
 
@@ -173,7 +284,34 @@ class GridField(Field):
         return (V, F, rep) if report else (V, F)
 
     def isosurfaces(self, levels, close: bool = False):
-        """Several level sets at once: a list of ``(V, F)``, one per level (e.g. offsets ±1 %, ±3 %)."""
+        """Several level sets at once (e.g. offsets ±1 %, ±3 %), as :meth:`isosurface` of each.
+
+        Parameters
+        ----------
+        levels : float or sequence of float
+            The values, each strictly inside the field's range.
+        close : bool, default False
+            Cap each surface where it leaves the box.
+
+        Returns
+        -------
+        list of (V, F)
+            One mesh per level, in order.
+
+        Raises
+        ------
+        ValueError
+            A level outside the field's range.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> x = np.linspace(-1, 1, 17)
+        >>> X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+        >>> f = gsdf.GridField(np.sqrt(X**2 + Y**2 + Z**2) - 0.5, [-1] * 3, [1] * 3)
+        >>> len(f.isosurfaces([-0.1, 0.0, 0.1]))
+        3
+        """
         return [self.isosurface(float(v), close=close) for v in np.atleast_1d(as_values(levels, "levels"))]
 
     SAVE_EXTENSIONS = (".npz", ".npy", ".vtk", ".vti", ".vtu")
@@ -206,7 +344,32 @@ class GridField(Field):
 
     @classmethod
     def load(cls, path) -> "GridField":
-        """Read a field written by :meth:`save` to ``.npz`` (the only form that stores the box)."""
+        """Read a grid field written by :meth:`save` to ``.npz`` (:func:`gsdf.load_field` reads every format).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A ``.npz`` file with the arrays ``values``, ``bbox_min`` and ``bbox_max``.
+
+        Returns
+        -------
+        GridField
+
+        Raises
+        ------
+        FileNotFoundError
+            No such file.
+        ValueError
+            Not a gsdf grid field ``.npz`` (the message names the missing arrays or the damage).
+
+        Examples
+        --------
+        >>> import numpy as np, os, tempfile, gsdf
+        >>> p = os.path.join(tempfile.mkdtemp(), "g.npz")
+        >>> gsdf.GridField(np.ones((2, 2, 2)), [0, 0, 0], [1, 1, 1]).save(p)
+        >>> gsdf.GridField.load(p).shape
+        (2, 2, 2)
+        """
         d = _load_npz(path, ("values", "bbox_min", "bbox_max"), "grid field", "grid")
         return _build(path, cls, d["values"], d["bbox_min"], d["bbox_max"])
 
@@ -219,6 +382,22 @@ def load_field(path) -> Field:
     the only point data array) on a regular grid (VTK image data, or hexahedra whose points form a grid) →
     GridField, on tetrahedra → TetField, on triangles → SurfaceField. ``.ply``: the vertex property ``values``
     (else the only one) → SurfaceField. (``.npy`` holds the values without their domain: not readable here.)
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.npz``, ``.vti``, ``.vtk``, ``.vtu`` or ``.ply`` file.
+
+    Returns
+    -------
+    GridField, TetField or SurfaceField
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    ValueError
+        A ``.npy`` file, a directory, or a file that holds no gsdf field (the message says what was found).
 
     Examples
     --------
@@ -410,12 +589,34 @@ class TetField(Field):
     Parameters
     ----------
     vertices : (n, 3) float
+        Vertex positions, model units.
     tets : (m, 4) int
+        Tetrahedra as vertex indices (m > 0).
     values : (n,) float
+        One finite value per vertex, interpolated linearly over each tet.
     delaunay : scipy.spatial.Delaunay, optional
         Point locator whose simplices are ``tets`` (what :func:`gsdf.signed_heat_volume` with ``domain="tet"``
         builds). Without it, points are located among ``tets`` themselves (any tet mesh, e.g. TetGen's): the
         tets whose centroids are nearest to the query are tested by their barycentric coordinates.
+
+    Attributes
+    ----------
+    vertices, tets, values
+        As given (float64, int64, float64).
+    bbox_min, bbox_max : (3,) float64
+        Corners of the vertices' bounding box.
+    meta : dict
+        What the method that made the field records about it; not saved.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, indices out of range, NaN or infinite values.
+
+    Notes
+    -----
+    Calling the field, ``field(Q)``, interpolates it at the points ``Q`` (q, 3) and returns (q,) values; points
+    outside the mesh take the value of the nearest vertex.
 
     Examples
     --------
@@ -436,10 +637,12 @@ class TetField(Field):
 
     @property
     def bbox_min(self):
+        """Low corner of the vertices' bounding box, (3,) float64."""
         return self.vertices.min(axis=0)
 
     @property
     def bbox_max(self):
+        """High corner of the vertices' bounding box, (3,) float64."""
         return self.vertices.max(axis=0)
 
     @query_shaped()
@@ -467,12 +670,59 @@ class TetField(Field):
         return out
 
     def isosurface(self, level: float = 0.0, report: bool = False):
-        """Marching tetrahedra at ``level``: a welded triangle mesh ``(V, F)``, oriented so that normals point
-        toward increasing values (outward for a signed distance); ``report=True`` adds its
-        :func:`gsdf.mesh._topology.manifold_report` (see :func:`marching_tetrahedra`)."""
+        """The level set ``field = level`` by marching tetrahedra (:func:`gsdf.marching_tetrahedra`).
+
+        Parameters
+        ----------
+        level : float, default 0.0
+            The value whose level set is extracted, in the field's units.
+        report : bool, default False
+            Also return the mesh's checks (``closed``, ``edge_manifold``, ``vertex_manifold``, ``welded``).
+
+        Returns
+        -------
+        V : (n, 3) float64
+            Vertices, welded.
+        F : (m, 3) int64
+            Triangles oriented so that normals point toward increasing values (outward for a signed distance).
+        report : dict
+            Only with ``report=True``.
+
+        Raises
+        ------
+        ValueError
+            ``level`` is not a finite number.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.]])
+        >>> Vs, Fs = gsdf.TetField(V, [[0, 1, 2, 3]], V[:, 0]).isosurface(0.5)
+        >>> Vs[:, 0].round(6).tolist(), Fs.shape
+        ([0.5, 0.5, 0.5], (1, 3))
+        """
         return marching_tetrahedra(self.vertices, self.tets, self.values, level, report=report)
 
     def isosurfaces(self, levels):
+        """Several level sets at once, as :meth:`isosurface` of each.
+
+        Parameters
+        ----------
+        levels : float or sequence of float
+            The values.
+
+        Returns
+        -------
+        list of (V, F)
+            One mesh per level, in order.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.]])
+        >>> [len(F) for _, F in gsdf.TetField(V, [[0, 1, 2, 3]], V[:, 0]).isosurfaces([0.25, 0.5])]
+        [1, 1]
+        """
         return [self.isosurface(float(v)) for v in np.atleast_1d(as_values(levels, "levels"))]
 
     SAVE_EXTENSIONS = (".npz", ".npy", ".vtk", ".vtu")
@@ -493,7 +743,33 @@ class TetField(Field):
 
     @classmethod
     def load(cls, path) -> "TetField":
-        """Read a field written by :meth:`save` to ``.npz``."""
+        """Read a tet field written by :meth:`save` to ``.npz`` (:func:`gsdf.load_field` reads every format).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A ``.npz`` file with the arrays ``vertices``, ``tets`` and ``values``.
+
+        Returns
+        -------
+        TetField
+
+        Raises
+        ------
+        FileNotFoundError
+            No such file.
+        ValueError
+            Not a gsdf tet field ``.npz``.
+
+        Examples
+        --------
+        >>> import numpy as np, os, tempfile, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.]])
+        >>> p = os.path.join(tempfile.mkdtemp(), "t.npz")
+        >>> gsdf.TetField(V, [[0, 1, 2, 3]], V[:, 0]).save(p)
+        >>> gsdf.TetField.load(p).tets.tolist()
+        [[0, 1, 2, 3]]
+        """
         d = _load_npz(path, ("vertices", "tets", "values"), "tet field", "tet")
         return _build(path, cls, d["vertices"], d["tets"], d["values"])
 
@@ -506,9 +782,28 @@ class SurfaceField(Field):
     Parameters
     ----------
     vertices : (n, 3) float
+        Vertex positions, model units.
     faces : (m, 3) int
+        Triangles as vertex indices.
     values : (n,) float
         One finite value per vertex, interpolated linearly over each triangle.
+
+    Attributes
+    ----------
+    vertices, faces, values
+        As given (float64, int64, float64).
+    meta : dict
+        What the method that made the field records about it; not saved.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, indices out of range, not one finite number per vertex.
+
+    Notes
+    -----
+    Calling the field, ``field(Q)``, returns the (q,) values at the points of the surface closest to ``Q``
+    (q, 3).
 
     Examples
     --------
@@ -533,7 +828,32 @@ class SurfaceField(Field):
         self.meta: dict = {}
 
     def at(self, face, bary) -> np.ndarray:
-        """Values at surface points given as a face index (q,) and barycentric coordinates (q, 3)."""
+        """Values at surface points given by their face and barycentric coordinates.
+
+        Parameters
+        ----------
+        face : (q,) int
+            Face index of each point.
+        bary : (q, 3) float
+            Barycentric coordinates of each point in its face (weights of the face's three corners).
+
+        Returns
+        -------
+        (q,) float64
+
+        Raises
+        ------
+        ValueError
+            Face indices out of range, shapes that do not match, NaN or infinite coordinates.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.]])
+        >>> f = gsdf.SurfaceField(V, [[0, 1, 2], [0, 2, 3]], V[:, 0])
+        >>> f.at([0], [[0.5, 0.5, 0.0]]).tolist()
+        [0.5]
+        """
         face = _array(face, "face")
         if face.size == 0:  # [] is a float array: no face of any dtype is fine
             face = np.zeros(0, dtype=np.int64)
@@ -560,6 +880,25 @@ class SurfaceField(Field):
         return (bary * self.values[self.faces[face]]).sum(axis=1)
 
     def isosurface(self, level: float = 0.0):
+        """A field on a surface has level curves, not level surfaces: use :meth:`isolines`.
+
+        Parameters
+        ----------
+        level : float, default 0.0
+            Ignored.
+
+        Raises
+        ------
+        ValueError
+            Always.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0.]])
+        >>> gsdf.SurfaceField(V, [[0, 1, 2]], V[:, 0]).isolines(0.5)[0].shape      # not isosurface
+        (2, 3)
+        """
         raise ValueError("a SurfaceField has level curves, not level surfaces: use isolines(level)")
 
     def isolines(self, level: float = 0.0) -> list:
@@ -571,11 +910,29 @@ class SurfaceField(Field):
         the face normals (so the zero isoline of a signed distance runs counter-clockwise around the negative
         region, as the curves of the surface signed heat method do).
 
+        Parameters
+        ----------
+        level : float, default 0.0
+            The value whose level curves are traced, in the field's units.
+
         Returns
         -------
         list of (k, 3) float arrays
             One per curve; a closed curve repeats its first point at the end. Empty when ``level`` is not
             crossed.
+
+        Raises
+        ------
+        ValueError
+            ``level`` is not a finite number.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.]])
+        >>> f = gsdf.SurfaceField(V, [[0, 1, 2], [0, 2, 3]], V[:, 0])
+        >>> [len(c) for c in f.isolines(0.5)]
+        [3]
         """
         level = finite(level, "level")
         F = self.faces
@@ -622,7 +979,33 @@ class SurfaceField(Field):
 
     @classmethod
     def load(cls, path) -> "SurfaceField":
-        """Read a field written by :meth:`save` to ``.npz``."""
+        """Read a surface field written by :meth:`save` to ``.npz`` (:func:`gsdf.load_field` reads every format).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A ``.npz`` file with the arrays ``vertices``, ``faces`` and ``values``.
+
+        Returns
+        -------
+        SurfaceField
+
+        Raises
+        ------
+        FileNotFoundError
+            No such file.
+        ValueError
+            Not a gsdf surface field ``.npz``.
+
+        Examples
+        --------
+        >>> import numpy as np, os, tempfile, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0.]])
+        >>> p = os.path.join(tempfile.mkdtemp(), "s.npz")
+        >>> gsdf.SurfaceField(V, [[0, 1, 2]], V[:, 0]).save(p)
+        >>> gsdf.SurfaceField.load(p).values.tolist()
+        [0.0, 1.0, 1.0]
+        """
         d = _load_npz(path, ("vertices", "faces", "values"), "surface field", "surface")
         return _build(path, cls, d["vertices"], d["faces"], d["values"])
 

@@ -95,9 +95,23 @@ class Grid:
     Parameters
     ----------
     box : pair of (3,) float
-        ``(bbox_min, bbox_max)``: the first and the last node.
+        ``(bbox_min, bbox_max)``: the first and the last node, model units.
     shape : three ints >= 2
         Nodes per axis.
+
+    Attributes
+    ----------
+    bbox_min, bbox_max : (3,) float64
+        The first and the last node.
+    shape : (int, int, int)
+        Nodes per axis.
+    box, spacing, size
+        ``(bbox_min, bbox_max)``; the distance between neighbouring nodes per axis, (3,); the number of nodes.
+
+    Raises
+    ------
+    ValueError
+        A box that is empty or inverted on some axis, or fewer than 2 nodes on an axis.
 
     Build one from a resolution with :meth:`fit` (a given box) or :meth:`around` (the padded bounding box of
     an input). Every grid-making function of gsdf takes one as its ``resolution``.
@@ -128,9 +142,31 @@ class Grid:
 
     @classmethod
     def fit(cls, box, resolution: int) -> "Grid":
-        """``resolution`` nodes along the longest side of ``box``, cubic cells (see the module docstring).
+        """A grid of cubic cells over ``box``, ``resolution`` nodes along its longest side.
 
         The lower corner is kept; the upper corner moves up (by less than one cell) to the last node.
+
+        Parameters
+        ----------
+        box : pair of (3,) float
+            ``(bbox_min, bbox_max)``, model units; ``bbox_max > bbox_min`` on every axis.
+        resolution : int
+            Nodes along the longest side (>= 2); the other sides get as many as cells of the same size need.
+
+        Returns
+        -------
+        Grid
+
+        Raises
+        ------
+        ValueError
+            An empty or inverted box, ``resolution < 2``.
+
+        Examples
+        --------
+        >>> import gsdf
+        >>> gsdf.Grid.fit(([0, 0, 0], [2, 1, 0.5]), 5).shape
+        (5, 3, 2)
         """
         lo, hi = _box(box)
         r = integer(resolution, "resolution", lo=2)
@@ -141,7 +177,32 @@ class Grid:
 
     @classmethod
     def around(cls, X, resolution: int, pad: float = PAD) -> "Grid":
-        """:meth:`fit` on the bounding box of the points ``X`` (n, 3) grown by ``pad`` × its diagonal."""
+        """:meth:`fit` on the bounding box of the points ``X`` grown by ``pad`` times its diagonal.
+
+        Parameters
+        ----------
+        X : (n, 3) float
+            Points (vertices of a mesh, a cloud) that the grid surrounds.
+        resolution : int
+            Nodes along the longest side of the padded box (>= 2).
+        pad : float, default 0.1
+            Growth of the box on every side, as a fraction of the points' bounding-box diagonal (>= 0).
+
+        Returns
+        -------
+        Grid
+
+        Raises
+        ------
+        ValueError
+            Empty or non-finite ``X``, ``resolution < 2``, a negative ``pad``.
+
+        Examples
+        --------
+        >>> import gsdf
+        >>> gsdf.Grid.around([[0, 0, 0], [1, 1, 1]], 12, pad=0.0).shape
+        (12, 12, 12)
+        """
         return cls.fit(padded_box(X, pad), resolution)
 
     @property
@@ -160,11 +221,45 @@ class Grid:
         return math.prod(int(s) for s in self.shape)
 
     def axes(self) -> list:
-        """The node coordinates along each axis: three 1-D arrays (``np.linspace`` of the box)."""
+        """The node coordinates along each axis.
+
+        Returns
+        -------
+        list of three 1-D float64 arrays
+            ``np.linspace(bbox_min[d], bbox_max[d], shape[d])`` for d = 0, 1, 2.
+
+        Examples
+        --------
+        >>> import gsdf
+        >>> gsdf.Grid(([0, 0, 0], [1, 1, 1]), (3, 2, 2)).axes()[0].tolist()
+        [0.0, 0.5, 1.0]
+        """
         return [np.linspace(self.bbox_min[d], self.bbox_max[d], self.shape[d]) for d in range(3)]
 
     def points(self, flat_index=None) -> np.ndarray:
-        """Node positions (size, 3) in C order; with ``flat_index`` (int array) only those nodes (chunking)."""
+        """Node positions in C order (the last axis fastest), or only some of them.
+
+        Parameters
+        ----------
+        flat_index : (k,) int, optional
+            Indices of nodes in that order (to evaluate a large grid in chunks). Default: every node.
+
+        Returns
+        -------
+        (size, 3) or (k, 3) float64
+
+        Raises
+        ------
+        ValueError
+            All nodes of a grid too large for the available memory (the message says how large).
+
+        Examples
+        --------
+        >>> import gsdf
+        >>> g = gsdf.Grid(([0, 0, 0], [1, 1, 1]), (2, 2, 2))
+        >>> g.points([0, 7]).tolist()
+        [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]
+        """
         ax = self.axes()
         if flat_index is not None:
             I = np.unravel_index(np.asarray(flat_index, dtype=np.int64), self.shape)
@@ -178,7 +273,19 @@ class Grid:
         return np.column_stack((X.ravel(), Y.ravel(), Z.ravel()))
 
     def voxel_box(self) -> tuple[np.ndarray, np.ndarray]:
-        """Corners of the voxels: the cubes of side ``spacing`` centred on the nodes."""
+        """Corners of the voxels: the cells of side ``spacing`` centred on the nodes.
+
+        Returns
+        -------
+        (3,) float64, (3,) float64
+            The low and the high corner, half a spacing outside the first and the last node.
+
+        Examples
+        --------
+        >>> import gsdf
+        >>> [c.tolist() for c in gsdf.Grid(([0, 0, 0], [1, 1, 1]), (3, 3, 3)).voxel_box()]
+        [[-0.25, -0.25, -0.25], [1.25, 1.25, 1.25]]
+        """
         h = self.spacing
         return self.bbox_min - 0.5 * h, self.bbox_max + 0.5 * h
 

@@ -27,7 +27,7 @@ from gsdf.batch import (
     write_npz_atomic,
 )
 from gsdf.cli.main import main
-from gsdf.io import write_mesh
+from gsdf.io import read_mesh, write_mesh
 
 from tests.shapes import cube, uv_sphere
 
@@ -681,3 +681,35 @@ def test_cli_batch_options_reach_the_library_under_their_names(monkeypatch, tmp_
     assert [(t, o, kw["batch_options"].threads) for t, o, kw in seen] == [
         ("sdf-samples", {"n_samples": 7, "heat_resolution": 9, "margin": 0.2}, None),
         ("occupancy", {"n_points": 5}, 3), ("sdf-grid", {}, 2)]
+
+
+def test_surface_mesh_files_and_input_topology(dataset, tmp_path, local1):
+    """surface_format writes each surface also as a mesh file next to its .npz; the manifest records whether each
+    input mesh is open, non-manifold, oriented and how many components it has."""
+    from gsdf.batch import check_options
+
+    out = tmp_path / "surf"
+    r = run_batch(str(dataset), "surface", str(out), {"resolution": 12, "surface_format": "stl"}, executor=local1)
+    done = {x["output"]: x for x in r.records if x["status"] == "done"}
+    assert set(done) == GOOD
+    for name, rec in done.items():
+        mesh = out / (name[:-4] + ".stl")
+        assert rec["mesh"] == mesh.name and mesh.is_file()
+        with np.load(out / name) as z:
+            V, F = read_mesh(str(mesh))
+            assert len(F) == len(z["faces"])
+    assert done["a/b/open.npz"]["topology"]["open"] and not done["a/cube.npz"]["topology"]["open"]
+    assert all(not x["topology"]["non_manifold"] and x["topology"]["components"] == 1 for x in done.values())
+    assert "input meshes: 1 open, 0 non-manifold, 0 with several components, of 4" in r.summary()
+    # a rerun skips them; a lost mesh file is written again
+    os.unlink(out / "sphere.stl")
+    r2 = run_batch(str(dataset), "surface", str(out), {"resolution": 12, "surface_format": "stl"}, executor=local1)
+    assert [x["output"] for x in r2.records if x["status"] == "done"] == ["sphere.npz"]
+    with pytest.raises(ValueError, match="surface_format"):
+        check_options("surface", {"surface_format": "jpg"})
+    with pytest.raises(ValueError, match="surface_format"):
+        check_options("sdf-grid", {"surface_format": "ply"})
+    res = CliRunner().invoke(main, ["batch", str(dataset / "sphere.obj"), "--task", "surface", "--resolution", "10",
+                                    "--surface-format", "ply", "-o", str(tmp_path / "c"), "-q"])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "c" / "sphere.ply").is_file()

@@ -124,3 +124,52 @@ def test_demo_runs_and_reports_outputs(tmp_path):
         assert name in r.output
     with np.load(out / "soup_winding_samples.npz") as d:
         assert np.mean((d["winding_fast"] > 0.5) == (d["winding_exact"] > 0.5)) > 0.99
+
+
+def test_slice_svg_size_units_and_scale(files):
+    """The viewBox spans the drawing; --units mm gives it --scale millimetres per model unit, --units model no
+    physical size (a browser fits it to the window); auto picks mm only for a plausible print size."""
+    svg = files["dir"] / "u.svg"
+
+    def root(*args):
+        r = run("slice", files["mesh"], "-o", svg, "--layers", 3, "--resolution", 48, "-q", *args)
+        assert r.exit_code == 0, r.output
+        return ET.parse(svg).getroot(), r.output
+
+    el, out = root("--units", "mm", "--scale", 25.4)
+    W, H = map(float, el.get("viewBox").split()[2:])
+    assert 2.0 < W < 2.2 and 2.0 < H < 2.2                       # the unit sphere, 2 % margin
+    assert float(el.get("width")[:-2]) == pytest.approx(25.4 * W)
+    assert "mm (25.4 mm per model unit)" in out
+    el, out = root("--units", "model")
+    assert el.get("width") is None and el.get("height") is None and "no physical size" in out
+    el, _ = root()                                                # auto: 2 mm would be dot-sized
+    assert el.get("width") is None
+    el, _ = root("--scale", 50)                                   # auto: 100 mm prints at true size
+    assert el.get("width").endswith("mm")
+    path = [e for e in el.iter() if e.tag.endswith("path")][0]
+    assert path.get("vector-effect") == "non-scaling-stroke" and path.get("stroke") not in (None, "none")
+
+
+def test_pseudonormal_sign_on_an_open_mesh_warns(files):
+    V, F = files["V"], files["F"]
+    open_F = F[V[F].mean(axis=1)[:, 2] < 0.8]
+    with pytest.warns(UserWarning, match="open"):
+        gsdf.signed_distance(V, open_F, [[0.0, 0.0, 0.0]], sign="pseudonormal")
+    with pytest.warns(UserWarning, match="non-manifold"):
+        gsdf.signed_distance_grid(V, np.vstack([F, F[:1]]), resolution=6, sign="pseudonormal")
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        gsdf.signed_distance(V, F, [[0.0, 0.0, 0.0]], sign="pseudonormal")     # closed: no warning
+    mesh = files["dir"] / "open.obj"
+    gsdf.write_mesh(mesh, V, open_F)
+    try:
+        runner = CliRunner(mix_stderr=False)          # click < 8.2
+    except TypeError:
+        runner = CliRunner()                          # click >= 8.2: stderr apart by default
+    r = runner.invoke(main, ["sdf", str(mesh), "-o", str(files["dir"] / "o.npz"), "--sign", "pseudonormal",
+                             "--resolution", "8", "-q"])
+    assert r.exit_code == 0, r.output
+    assert r.stderr.count("gsdf: warning: sign='pseudonormal' on a mesh that is open") == 1

@@ -46,6 +46,8 @@ SHARED_TYPES = {
     "--offsets": _options.FLOATS,
     "--bisection": _options.BISECTION,
     "--level": _options.NUMBER,
+    "--at": _options.NUMBER,
+    "--axis": _options.AXIS,
     "--workers": _options.COUNT,
     "--png": click.STRING,
     "--mesh-output": click.STRING,

@@ -44,7 +44,7 @@ def _grid():
 def test_saved_grid_field(headless, tmp_path, ext):
     f = tmp_path / f"sdf{ext}"
     _grid().save(f)
-    r = _run(f, "--screenshot", tmp_path / "out.png", "--size", "800x600", "--slice", "z=0.1")
+    r = _run(f, "--screenshot", tmp_path / "out.png", "--size", "800x600", "--axis", "z", "--at", "0.1")
     assert r.exit_code == 0, r.output
     assert "800x600" in r.output
     assert picture.problems(picture.load(tmp_path / "out.png")) == []
@@ -93,8 +93,8 @@ def test_errors_are_one_line(tmp_path, monkeypatch):
     assert r.exit_code == 1 and r.output.count("Error") == 1 and "junk.off" in r.output
     r = _run(tmp_path / "m.off", "--screenshot", tmp_path / "m.off")
     assert r.exit_code == 1 and "refusing to overwrite an input" in r.output
-    r = _run(tmp_path / "m.off", "--slice", "w")
-    assert r.exit_code == 2 and "--slice" in r.output
+    r = _run(tmp_path / "m.off", "--axis", "w")
+    assert r.exit_code == 2 and "--axis" in r.output
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     if sys.platform.startswith("linux"):          # elsewhere a window can always open

@@ -79,8 +79,9 @@ def test_field_kinds_ranges_and_levels():
     w = np.r_[np.zeros(60), np.ones(30), np.linspace(0, 1, 10), [-0.02, 1.03]]
     assert _scene.field_kind(w) == "winding"
     assert _scene.field_kind(np.linspace(0, 3, 50)) == "plain"
-    assert _scene.colour_range(np.array([-0.2, 0.7495]), "signed") == (-0.75, 0.75)
-    assert _scene.colour_range(w, "winding") == pytest.approx((-0.03, 1.03))
+    assert _scene.colour_range(np.array([-0.2, 0.7495]), "signed") == (-0.8, 0.8)
+    assert [_scene.round_up(a) for a in (0.59, 13.5, 1.0, 2.3, 9.1)] == [0.6, 15.0, 1.0, 2.5, 10.0]
+    assert _scene.colour_range(w, "winding") == (0.0, 1.0)
     assert _scene.colour_range(np.array([1.0, 3.0]), "plain") == (1.0, 3.0)
     assert _scene.nice_levels(-0.74, 0.74, 16) == pytest.approx([k / 10 for k in range(-7, 8)])
     assert _scene.nice_levels(0, 1, 4) == [0, 0.25, 0.5, 0.75, 1.0]

@@ -54,9 +54,10 @@ def test_tori_cli_errors(tmp_path):
 def test_sphere_trace_hits_an_analytic_sphere_where_expected():
     img = sphere_trace(lambda Q: np.linalg.norm(Q, axis=1) - 0.5, [-1] * 3, [1] * 3, 40, 40, view=(0, 0, 1))
     hit = (img < 255).any(axis=2)
-    # the sphere is centred in the view; its silhouette matches the pinhole projection: the camera sits at
-    # distance 1.1 * (diag / 2) / tan(17.5°) from the centre, so the disc covers π (0.5 / (dist tan 17.5°))² / 4
-    dist = 1.1 * (np.sqrt(12) / 2) / np.tan(np.radians(17.5))
-    want = np.pi * (0.5 / np.sqrt(dist ** 2 - 0.25) / np.tan(np.radians(17.5))) ** 2 / 4
+    # the camera frames what a first small picture hit: the disc is centred and spans 0.86 - 2/40 of the side
+    # (up to a pixel), so it covers about π (0.81 / 2)² of the picture
+    ys, xs = np.nonzero(hit)
     assert hit[20, 20] and not hit[0, 0]
-    assert abs(hit.mean() - want) < 0.2 * want
+    assert abs(xs.mean() - 19.5) < 1 and abs(ys.mean() - 19.5) < 1
+    assert 0.76 * 40 <= np.ptp(xs) + 1 <= 0.88 * 40 and 0.76 * 40 <= np.ptp(ys) + 1 <= 0.88 * 40
+    assert abs(hit.mean() - np.pi * 0.405 ** 2) < 0.15 * np.pi * 0.405 ** 2

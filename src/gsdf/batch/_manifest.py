@@ -4,7 +4,9 @@ Each finished item appends one record (see ``docs/batch.md`` for every field): `
 item's ``.npz`` path relative to the output folder), ``input``, ``task``, ``status`` (``done`` | ``failed`` |
 ``cancelled``), ``input_sha256`` (content hash of the input file), ``params_sha256`` (hash of the task and its
 options), ``options``, ``seconds`` (``read``, ``compute``, ``write``, ``total``), ``counts`` (input sizes),
-``arrays`` (output shapes), ``error``, ``attempts``, ``worker``, ``run`` and ``time``. The last record of an
+``topology`` (an input mesh's ``open``, ``non_manifold``, ``oriented``, ``components``, ``degenerate_faces``),
+``arrays`` (output shapes), ``mesh`` (the mesh file of ``surface_format``), ``error``, ``attempts``, ``worker``,
+``run`` and ``time``. The last record of an
 item is its state; a line cut short by a hard kill is ignored when reading. Lines are written whole, flushed
 and fsync'ed, so the manifest never claims an output that is not on disk.
 """

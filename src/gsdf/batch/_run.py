@@ -116,6 +116,13 @@ class BatchResult:
         if done:
             lines.append(f"per item (done): median {statistics.median(done):.2f} s, max {max(done):.2f} s, "
                          f"sum {sum(done):.1f} s")
+        tops = [r["topology"] for r in self.records if r.get("topology")]
+        if tops:
+            n_open = sum(t["open"] for t in tops)
+            n_nm = sum(t["non_manifold"] for t in tops)
+            n_cc = sum(t["components"] > 1 for t in tops)
+            lines.append(f"input meshes: {n_open} open, {n_nm} non-manifold, {n_cc} with several components, of "
+                         f"{len(tops)} (manifest field 'topology')")
         again = [r for r in self.records if r["status"] == "skipped" and r.get("previous") == "failed"]
         if again:
             lines.append(f"{len(again)} skipped item(s) had failed before with the same input and options "
@@ -378,6 +385,8 @@ def _reusable(prev, job, out, retry_failed) -> bool:
         return False
     if prev.get("status") == "done":
         ok = os.path.isfile(os.path.join(out, job["output"]))
+        if prev.get("mesh"):                   # the surface's mesh file written next to the .npz
+            ok = ok and os.path.isfile(os.path.join(out, os.path.dirname(job["output"]), prev["mesh"]))
     else:
         ok = prev.get("status") == "failed" and prev.get("failure") == "item" and not retry_failed
     return ok and prev["input_sha256"] == file_sha256(job["input"])

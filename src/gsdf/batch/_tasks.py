@@ -9,7 +9,9 @@ task               arrays (``F`` = the ``dtype`` option, float32 by default)
 ``occupancy``      ``points`` (n, 3) F, ``occupancy`` (n,) bool (inside), ``winding`` (n,) F
 ``sdf-grid``       ``sdf`` (R, R, R) F (negative inside), node (i, j, k) at ``bbox_min + (i, j, k) * spacing``;
                    ``bbox_min``, ``bbox_max`` (3,) float64, ``spacing`` (3,) float64
-``surface``        ``vertices`` (nv, 3) F, ``faces`` (nf, 3) int64 (outward oriented)
+``surface``        ``vertices`` (nv, 3) F, ``faces`` (nf, 3) int64 (outward oriented); with the option
+                   ``surface_format`` ("ply", "obj", "off", "stl") :func:`gsdf.run_batch` also writes the mesh
+                   next to the item's ``.npz``
 every task         ``center`` (3,) float64 and ``scale`` () float64: stored coordinates are
                    ``(x_input - center) / scale`` and stored distances ``d_input / scale`` (identity for
                    ``normalize="none"``)
@@ -313,8 +315,8 @@ def occupancy(source, n_points: int = 100_000, normalize: str = "none", seed: in
     dict
         ``points`` (n, 3) and ``winding`` (n,) in ``dtype``, ``occupancy`` (n,) bool; ``center``, ``scale``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> out = occupancy("soup.obj", n_points=50000)       # doctest: +SKIP
     >>> out["occupancy"].mean()                            # doctest: +SKIP
     0.21
@@ -377,8 +379,8 @@ def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str
         ``sdf`` (R, R, R) in ``dtype`` (C order, x slowest); ``bbox_min``, ``bbox_max``, ``spacing`` (3,);
         ``center``, ``scale``. All in the stored frame.
 
-    Example
-    -------
+    Examples
+    --------
     >>> out = sdf_grid("bunny.off", resolution=64)        # doctest: +SKIP
     >>> out["sdf"].shape                                    # doctest: +SKIP
     (64, 64, 64)
@@ -422,8 +424,8 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
     dict
         ``vertices`` (nv, 3) in ``dtype``, ``faces`` (nf, 3) int64 (outward oriented); ``center``, ``scale``.
 
-    Example
-    -------
+    Examples
+    --------
     >>> out = surface("soup.obj", resolution=96)           # doctest: +SKIP
     >>> out["faces"].shape[1]                               # doctest: +SKIP
     3
@@ -443,12 +445,31 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
     return _stored({"vertices": ((V - c0) / s0).astype(dt), "faces": np.asarray(F, np.int64)}, c0, s0, dt)
 
 
+def input_topology(geo: Geometry):
+    """What the manifest records about an input mesh: ``open`` (some edge has one face), ``non_manifold`` (an edge
+    in more than two faces, or faces around a vertex in several fans), ``oriented`` (neighbouring faces agree),
+    ``components`` (face-connected pieces), ``degenerate_faces``; None for a point cloud
+    (:func:`gsdf.mesh_topology`)."""
+    if not geo.is_mesh:
+        return None
+    from gsdf.mesh._topology import mesh_topology
+
+    t = mesh_topology(geo.X, geo.F)
+    return {"open": not t["closed"], "non_manifold": not (t["edge_manifold"] and t["vertex_manifold"]),
+            "oriented": bool(t["oriented"]), "components": int(t["components"]),
+            "degenerate_faces": int(t["degenerate_faces"])}
+
+
 # ------------------------------------------------------------------------------------------------------------
 # option validation: one table for the library calls, the CLI and per-item manifest options
 # ------------------------------------------------------------------------------------------------------------
 
 TASKS = {"sdf-samples": sdf_samples, "occupancy": occupancy, "sdf-grid": sdf_grid, "surface": surface}
 OPTIONS_CLASSES = {"sdf-samples": SdfSamplesOptions, "occupancy": OccupancyOptions}
+#: Options of what is written besides the ``.npz`` (not of the computation): ``surface_format`` ("ply", "obj",
+#: "off", "stl" or None) writes the surface task's mesh also as ``<item>.<format>`` next to its ``.npz``.
+WRITE_OPTIONS = {"surface": {"surface_format": None}}
+SURFACE_FORMATS = ("ply", "obj", "off", "stl")
 TASK_ALIASES = {"sdf_samples": "sdf-samples", "sdf_grid": "sdf-grid"}
 
 
@@ -539,6 +560,7 @@ def task_defaults(task) -> dict:
     out = {k: p.default for k, p in sig.parameters.items() if k not in ("source", "options")}
     if task in OPTIONS_CLASSES:
         out.update(dataclasses.asdict(OPTIONS_CLASSES[task]()))
+    out.update(WRITE_OPTIONS.get(task, {}))
     return out
 
 
@@ -558,6 +580,9 @@ def check_options(task, options: dict, where: str = "") -> dict:
     for k, v in out.items():
         if k == "method":
             out[k] = choice(v, f"{prefix}method", _METHODS[task])
+        elif k == "surface_format":
+            out[k] = None if v in (None, "", "none") else choice(str(v).lower().lstrip("."), f"{prefix}{k}",
+                                                                  SURFACE_FORMATS)
         elif v is not None or k != "beta":
             out[k] = _CHECKS[k](v, f"{prefix}{k}")
     if "uniform_fraction" in out and out["uniform_fraction"] < 1 and not out["sigmas"]:
@@ -570,6 +595,7 @@ def run_task(task, source, options: dict) -> dict:
     ``run_task("sdf-grid", path, {"resolution": 64})``."""
     task = task_name(task)
     fn = TASKS[task]
+    options = {k: v for k, v in options.items() if k not in WRITE_OPTIONS.get(task, {})}
     keywords = set(inspect.signature(fn).parameters) - {"source", "options"}
     kw = {k: v for k, v in options.items() if k in keywords}
     rest = {k: v for k, v in options.items() if k not in keywords}

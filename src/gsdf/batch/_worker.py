@@ -17,7 +17,7 @@ import numpy as np
 
 from gsdf.batch import _threads
 from gsdf.batch._manifest import file_sha256
-from gsdf.batch._tasks import load_geometry, run_task
+from gsdf.batch._tasks import input_topology, load_geometry, run_task
 
 
 def write_npz_atomic(path, arrays: dict) -> None:
@@ -27,8 +27,8 @@ def write_npz_atomic(path, arrays: dict) -> None:
     ``.NAME.*.part`` file may remain after a hard kill; it never counts as an output and the next run on the
     folder removes it).
 
-    Example
-    -------
+    Examples
+    --------
     >>> write_npz_atomic("out/a.npz", {"sdf": np.zeros(3)})      # doctest: +SKIP
     """
     from gsdf.io._safe_write import _FILE_MODE
@@ -68,6 +68,18 @@ def write_npz_atomic(path, arrays: dict) -> None:
         raise
 
 
+def write_mesh_atomic(npz_path, fmt: str, arrays: dict) -> str:
+    """Write the ``vertices``/``faces`` of ``arrays`` as ``<npz_path without .npz>.<fmt>`` (ply, obj, off, stl;
+    :func:`gsdf.write_mesh`), atomically; returns its name relative to the ``.npz``'s folder."""
+    from gsdf.io import write_mesh
+    from gsdf.io._safe_write import atomic_output
+
+    path = os.path.splitext(os.fspath(npz_path))[0] + "." + fmt
+    with atomic_output(path, extensions=("." + fmt,), make_parents=True) as tmp:
+        write_mesh(tmp, np.asarray(arrays["vertices"], np.float64), arrays["faces"])
+    return os.path.basename(path)
+
+
 def worker_threads(requested, by_worker=None) -> int:
     """Threads of this item: ``requested``; else, on a Dask worker, its entry in ``by_worker`` (worker address ->
     threads, measured by the driver when it connected) or its host's cores divided by its own Dask threads;
@@ -105,12 +117,16 @@ def process_item(job: dict) -> dict:
         rec["input_sha256"] = file_sha256(job["input"])
         geo = load_geometry(job["input"], job["options"].get("estimate_normals", False))
         rec["counts"] = geo.counts()
+        rec["topology"] = input_topology(geo)
         t1 = time.perf_counter()
         seconds["read"] = t1 - t0
         arrays = run_task(job["task"], geo, job["options"])
         t2 = time.perf_counter()
         seconds["compute"] = t2 - t1
         write_npz_atomic(os.path.join(job["out_dir"], job["output"]), arrays)
+        fmt = job["options"].get("surface_format")
+        if fmt:                                # the surface also as a mesh file next to the .npz
+            rec["mesh"] = write_mesh_atomic(os.path.join(job["out_dir"], job["output"]), fmt, arrays)
         seconds["write"] = time.perf_counter() - t2
         rec["arrays"] = {k: list(np.shape(v)) for k, v in arrays.items()}
         rec["status"], rec["error"] = "done", None

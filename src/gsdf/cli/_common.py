@@ -29,6 +29,7 @@ import contextvars
 import functools
 import os
 import tempfile
+import warnings
 
 import click
 import numpy as np
@@ -295,19 +296,34 @@ def output_file(path, extensions=None, what: str = "output"):
         yield tmp
 
 
+def _plain_warnings(show):
+    """A ``warnings.showwarning`` that prints gsdf's own warnings as one ``gsdf: warning: ...`` line on stderr and
+    passes the others to ``show``."""
+
+    def plain(message, category, filename, lineno, file=None, line=None):
+        if category.__module__.startswith("gsdf."):
+            click.echo(f"gsdf: warning: {message}", err=True)
+        else:
+            show(message, category, filename, lineno, file, line)
+
+    return plain
+
+
 def report_errors(fn):
     """Decorate a subcommand (innermost, below the click options): runs it inside :func:`outputs` (inputs = the
     command's ``click.Path`` parameters; ``--no-clobber`` when the command has :data:`no_clobber_option`), refuses
-    up front any parameter of ``OUTPUT_PARAMS`` that names one of the inputs or another output, and turns the
+    up front any parameter of ``OUTPUT_PARAMS`` that names one of the inputs or another output, turns the
     library's ValueError / FileNotFoundError / OSError / MemoryError into a one-line CLI error (exit code 1)
-    without a traceback."""
+    without a traceback, and prints gsdf's warnings (e.g. an unreliable sign rule) as one ``gsdf: warning: ...``
+    line on stderr."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         no_clobber = bool(kwargs.pop("no_clobber", False))
         ctx = click.get_current_context(silent=True)
         try:
-            with outputs(_input_paths(ctx), overwrite=not no_clobber) as out:
+            with outputs(_input_paths(ctx), overwrite=not no_clobber) as out, warnings.catch_warnings():
+                warnings.showwarning = _plain_warnings(warnings.showwarning)
                 for name in OUTPUT_PARAMS:
                     value = kwargs.get(name)
                     if isinstance(value, str) and value:
@@ -346,3 +362,23 @@ def bbox_of(X: np.ndarray, pad: float) -> tuple[np.ndarray, np.ndarray]:
     from gsdf.mesh._geometry import bounding_box
 
     return bounding_box(X, pad)
+
+
+def write_picture(png, *items, view=None, axis=None, at=None) -> None:
+    """The ``--png`` of a command: :func:`gsdf.render.save_png` of ``items`` (polyscope when it renders here, else
+    gsdf's own renderers), written under the command's output policy; ``axis``/``at`` place the slice of a volume
+    field. Prints which renderer drew it and where it went."""
+    import os
+
+    from gsdf.render import ViewOptions, save_png
+
+    options = ViewOptions(slice_axis=axis, slice_at=at)
+    with output_file(png, (".png",), what="--png") as tmp:
+        used = save_png(tmp, *items, view=view, options=options)
+    announce(f"picture ({used}) -> {os.path.abspath(png)}")
+
+
+def check_slice(png, axis, at) -> None:
+    """``--axis``/``--at`` shape the ``--png`` picture: refused without it."""
+    if png is None and (axis is not None or at is not None):
+        raise click.UsageError("--axis and --at place the slice of the --png picture; give --png FILE too")

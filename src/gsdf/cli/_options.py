@@ -127,6 +127,8 @@ DIRECTION = Direction()                                  #: --view
 UP = Up()                                                #: --up
 SIZE = Size()                                            #: --size
 THREADS = ThreadCount()                                  #: --threads
+AXIS = click.Choice(["x", "y", "z"], case_sensitive=False)   #: --axis
+SURFACE_FORMAT = click.Choice(["ply", "obj", "off", "stl"])   #: --surface-format
 BISECTION = click.IntRange(0, 60)                        #: --bisection
 COUNT = click.IntRange(1)                                #: --n-points, --workers, ...
 LEVEL_SET = click.Choice(["zero", "multiple", "none"])   #: --level-set
@@ -221,10 +223,25 @@ def soft_weight_option(default_help: str):
                              f"exactly. {default_help}")
 
 
-def view_option(default: str):
-    """``--view x,y,z``: the direction from the centre of the picture towards the camera."""
+def view_option(default: str | None = None):
+    """``--view x,y,z``: the direction from the centre of the picture towards the camera (default: the 3/4 view
+    of ``gsdf view``)."""
+    if default is None:
+        return click.option("--view", type=DIRECTION, default=None,
+                            help="Direction from the centre of the picture towards the camera (x,y,z). Default: "
+                                 "the 3/4 view of gsdf view (y up, the broad side facing the camera).")
     return click.option("--view", type=DIRECTION, default=default, show_default=True,
-                        help="Direction from the centre towards the camera, for pictures (x,y,z).")
+                        help="Direction from the centre of the picture towards the camera (x,y,z).")
+
+
+def slice_options(fn):
+    """``--axis x|y|z`` and ``--at VALUE``: the slice of a volume field that a picture shows."""
+    fn = click.option("--at", type=NUMBER, default=None, metavar="VALUE",
+                      help="Coordinate of that slice along --axis, in model units (default: the middle of the "
+                           "box).")(fn)
+    return click.option("--axis", type=AXIS, default=None,
+                        help="Axis across the slice of the field that the picture shows (default: the horizontal "
+                             "axis facing the camera).")(fn)
 
 
 def offsets_option(help: str):

@@ -12,6 +12,7 @@ from gsdf.cli._options import (
     COUNT,
     FLOATS,
     PAD,
+    SURFACE_FORMAT,
     beta_option,
     common_options,
     explicit_threads,
@@ -57,7 +58,8 @@ INPUTS is a folder (searched recursively), a quoted glob ("data/**/*.off"), a li
 or a CSV / JSON manifest with a 'path' column / field and per-item task options. Outputs mirror the inputs'
 folder layout. A rerun skips items whose output exists and whose input hash and options match; failing items
 are recorded in the manifest and the run goes on; the exit status is then 3 (--allow-failures: 0); Ctrl-C stops
-cleanly. The output folder may not be, or lie inside, the folder of the inputs.
+cleanly. The output folder may not be, or lie inside, the folder of the inputs. The manifest records each input
+mesh's topology (open, non-manifold, oriented, components).
 
 \b
 Tasks and their arrays (float32 unless --dtype float64; all carry center (3,), scale):
@@ -65,16 +67,18 @@ Tasks and their arrays (float32 unless --dtype float64; all carry center (3,), s
   occupancy    points (n,3), occupancy (n,) bool, winding (n,)   [--n-points --seed ...]
   sdf-grid     sdf (R,R,R), bbox_min, bbox_max, spacing   [--resolution --method fast|heat|pat]
   surface      vertices (nv,3), faces (nf,3) int64   [--resolution --method winding|heat --bisection]
+               (--surface-format ply|obj|off|stl: also the mesh file next to the .npz)
 
 \b
 Executors (choose one): --workers N local processes (default 1), --dask-local N (a Dask LocalCluster),
---scheduler tcp://host:8786 (an existing Dask cluster: dask-jobqueue, Kubernetes, ...; needs gsdf[dask]).
+--scheduler tcp://host:8786 (an existing Dask cluster: dask-jobqueue, Kubernetes, ...; needs the dask extra).
 --threads N: threads of each item (default: the cores divided by the workers).
 
 \b
 Examples:
   gsdf batch meshes/ --task sdf-samples -o samples/ --workers 2 --normalize sphere
   gsdf batch "thingi/**/*.stl" --task sdf-grid --resolution 128 -o grids/ --scheduler tcp://10.0.0.5:8786
+  gsdf batch scans/ --task surface --surface-format stl -o watertight/
 """)
 @click.argument("inputs")
 @click.option("--task", required=True, type=click.Choice(["sdf-samples", "occupancy", "sdf-grid", "surface"]))
@@ -94,6 +98,8 @@ Examples:
 @resolution_option(None, help="Grid nodes per side: the output grid of sdf-grid / surface [128], the signed heat "
                               "grid of sdf-samples --sign heat [64].")
 @click.option("--bisection", type=BISECTION, default=None, help="surface: bisection steps per vertex [10].")
+@click.option("--surface-format", type=SURFACE_FORMAT, default=None,
+              help="surface: also write each mesh as ITEM.ply / .obj / .off / .stl next to its .npz.")
 @click.option("--margin", type=PAD, default=None,
               help="The sampling cube / grid is centred on the input's box with half-side (1 + MARGIN) frame "
                    "scales [0.05; occupancy 0.1].")

@@ -6,17 +6,29 @@ import os
 
 import click
 
-from gsdf.cli._common import announce, check_output, load_geometry, output_file, report_errors
+from gsdf.cli._common import (
+    announce,
+    check_output,
+    check_slice,
+    load_geometry,
+    output_file,
+    report_errors,
+    write_picture,
+)
 from gsdf.cli._options import (
+    SURFACE_FORMAT,
     common_options,
     level_set_option,
     no_clobber_option,
     normals_option,
     offsets_option,
     output_option,
+    png_option,
     resolution_option,
+    slice_options,
     soft_weight_option,
     t_coef_option,
+    view_option,
 )
 
 
@@ -48,11 +60,13 @@ signed heat method: negative inside, robust to holes, flips and noise.
 
 Writes the field to OUTPUT (.npz, .npy, .vtk, .vtu; .vti for grids) and, with --offsets, one surface per offset
 next to it (OUTPUT stem + _offset_<value>.ply, or --surface-format). Offsets are distances, or fractions of the
-input's bounding-box diagonal with --relative.
+input's bounding-box diagonal with --relative. --png draws a slice of the field with isolines and the zero level
+set (--axis, --at: which slice).
 
 \b
 Example:
   gsdf heat bunny.off --resolution 128 --offsets 0,0.01,-0.01 --relative -o bunny_heat.npz
+  gsdf heat scan.xyz -o scan_heat.npz --png scan_heat.png --axis z
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
 @output_option("Output field: .npz, .npy, .vtk, .vtu, or .vti (grid only).")
@@ -67,14 +81,17 @@ Example:
                    "edge length / point spacing (more accurate on clean input with holes).")
 @level_set_option
 @soft_weight_option("Default: 10 on grids, exact on tets.")
-@click.option("--surface-format", type=click.Choice(["ply", "obj", "off", "stl"]), default="ply",
+@click.option("--surface-format", type=SURFACE_FORMAT, default="ply",
               show_default=True, help="Format of the --offsets surfaces.")
+@png_option("Also write a PNG: a slice of the field with isolines, and the zero level set.")
+@slice_options
+@view_option()
 @normals_option
 @common_options
 @no_clobber_option
 @report_errors
 def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, level_set, soft_weight, surface_format,
-         estimate_normals, quiet):
+         png, axis, at, view, estimate_normals, quiet):
 
     from gsdf.heat.volume import VolumeHeatOptions, signed_heat_volume
 
@@ -86,6 +103,8 @@ def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, lev
     surface_paths = [f"{stem}_offset_{v:g}.{surface_format}" for v in levels or []]
     for path in surface_paths:
         check_output(path, None, "--offsets")
+    check_output(png, (".png",), "--png")
+    check_slice(png, axis, at)
     geo = load_geometry(input, estimate_normals)
     kw = dict(mesh=(geo.X, geo.F)) if geo.is_mesh else dict(points=(geo.X, geo.N))
     if soft_weight is None and not tet:
@@ -117,3 +136,5 @@ def heat(input, output, resolution, tet, offsets, relative, t_coef, t_scale, lev
             with output_file(path, what="--offsets") as tmp:
                 write_mesh(tmp, Vs, Fs)
             announce(f"level {v * scale:.6g}: {len(Fs)} triangles -> {os.path.abspath(path)}")
+    if png:
+        write_picture(png, ("signed distance [model units]", field), view=view, axis=axis, at=at)

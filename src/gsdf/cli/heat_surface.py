@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import announce, check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, output_file, report_errors, write_picture
 from gsdf.cli._options import (
     NONNEGATIVE,
     common_options,
@@ -27,7 +27,8 @@ from gsdf.cli._options import (
 Curves come from --curves FILE: the text format of the signed heat method's demo (blocks signed_curve,
 unsigned_curve, unsigned_point; nodes 'v i', 'e i t', 'f i a b c') or OBJ 'l' lines (1-based vertex
 indices). The region to the left of an oriented curve (counter-clockwise seen from the face normals) is
-negative. Writes the mesh with the distance as PLY vertex property 'distance', and optionally a PNG.
+negative. Writes the mesh with the distance as PLY vertex property 'distance', and optionally a PNG (the
+distance with isolines and the curves, a 3/4 view framing the surface, a colour bar).
 
 With --voxels, MESH is a binary volume (.npy bool array, or the .npz of 'gsdf voxelize') and the surface is its
 digital surface (§8.5: boundary quads, corrected normals); the curve is then --curves (vertex indices of the
@@ -54,8 +55,8 @@ Example:
 @click.option("--swn", is_flag=True,
               help="First classify the curves with surface winding numbers and keep only their bounding part "
                    "(thesis §6.4.1); curves must run along mesh edges.")
-@png_option("Also write a PNG of the distance with isolines.")
-@view_option("0,0,1")
+@png_option("Also write a PNG of the distance with isolines and the curves.")
+@view_option()
 @common_options
 @no_clobber_option
 @report_errors
@@ -70,8 +71,8 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
     if voxels:
         if swn:
             raise click.UsageError("--swn and --voxels cannot be combined")
-        V, F, phi, what = _heat_voxels(mesh, curves_path, spacing, normal_radius, cut, level_set, t_coef,
-                                       soft_weight)
+        V, F, phi, what, shown = _heat_voxels(mesh, curves_path, spacing, normal_radius, cut, level_set, t_coef,
+                                              soft_weight)
     else:
         if cut is not None or spacing is not None:
             raise click.UsageError("--cut and --spacing need --voxels")
@@ -99,17 +100,13 @@ def heat_surface(mesh, curves_path, voxels, spacing, normal_radius, cut, output,
         phi = solver.compute_distance(src.curves, points=src.points, curve_signs=src.curve_signs,
                                       level_set_constraint=level_set, soft_weight=soft_weight)
         what = f"{len(V)} vertices, {len(F)} triangles; {len(src.curves)} curves, {len(src.points)} points"
+        shown = list(src.curves) + [[p] for p in src.points]
     with output_file(output) as tmp:
         write_mesh(tmp, V, F, vertex_data={"distance": phi})
     announce(f"{mesh}: {what}\ndistance in [{phi.min():.6g}, {phi.max():.6g}] -> {os.path.abspath(output)}")
-    if F.shape[1] == 4:
-        F = np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])       # the PNG renders triangles
     if png:
-        from gsdf.render._raster import render_function_png
-
-        with output_file(png, what="--png") as tmp:
-            render_function_png(tmp, V, F, phi, view=view)
-        announce(f"image -> {os.path.abspath(png)}")
+        curves = [("curves", shown)] if shown else []       # drawn on the mesh before them
+        write_picture(png, ("signed distance [model units]", (V, F, phi)), *curves, view=view)
 
 
 def _heat_voxels(path, curves_path, spacing, normal_radius, cut, level_set, t_coef, soft_weight):
@@ -161,4 +158,4 @@ def _heat_voxels(path, curves_path, spacing, normal_radius, cut, level_set, t_co
                                   soft_weight=soft_weight)
     what = (f"{int(occ.sum())} voxels -> {len(V)} vertices, {len(solver.faces)} quads; {len(curves)} curves, "
             f"{len(points)} points")
-    return V, solver.faces, phi, what
+    return V, solver.faces, phi, what, list(curves) + [[p] for p in points]

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import announce, check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, output_file, report_errors, write_picture
 from gsdf.cli._options import (
     common_options,
     no_clobber_option,
@@ -45,14 +45,12 @@ Examples:
               help="Alternation rounds of the outlier removal.")
 @resolution_option(128, help="Grid nodes along the longest side of the box, for the comparison methods (ignored "
                              "by simply-connected).")
-@png_option("Also write a PNG preview of the result (shaded by height).")
-@view_option("0.3,0.2,1")
+@png_option("Also write a PNG of the mesh with the input points.")
+@view_option()
 @common_options
 @no_clobber_option
 @report_errors
 def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resolution, png, view, quiet):
-    import numpy as np
-
     from gsdf.io import read_points, write_mesh
     from gsdf.mesh._topology import mesh_topology
 
@@ -87,7 +85,4 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
         write_mesh(tmp, V, F)
     announce(f"mesh -> {os.path.abspath(output)}")
     if png is not None:
-        from gsdf.render._raster import render_function_png
-        with output_file(png, (".png",), what="--png") as tmp:
-            render_function_png(tmp, V, F, np.asarray(V)[:, 1], view=view)
-        announce(f"preview -> {os.path.abspath(png)}")
+        write_picture(png, ("reconstruction", (V, F)), ("input points", P), view=view)

@@ -6,7 +6,16 @@ import os
 
 import click
 
-from gsdf.cli._common import announce, check_output, load_geometry, output_file, progress_bar, report_errors
+from gsdf.cli._common import (
+    announce,
+    check_output,
+    check_slice,
+    load_geometry,
+    output_file,
+    progress_bar,
+    report_errors,
+    write_picture,
+)
 from gsdf.cli._options import (
     beta_option,
     common_options,
@@ -17,6 +26,8 @@ from gsdf.cli._options import (
     pad_option,
     png_option,
     resolution_option,
+    slice_options,
+    view_option,
 )
 from gsdf.grid import PAD
 
@@ -41,11 +52,13 @@ def signed_distance_grid(geo, resolution: int, pad: float, sign: str = "winding"
 
 |d| is the exact distance to the triangles (or nearest point); the sign comes from the fast winding number
 at 1/2 (robust to holes and soups), or from angle-weighted pseudonormals (closed manifold meshes only).
-Writes the grid as .npz (values, bbox_min, bbox_max); optionally a PNG slice and the zero level set.
+Writes the grid as .npz (values, bbox_min, bbox_max); optionally a picture (a slice with isolines and the zero
+level set cut open, with a colour bar) and the zero level set as a mesh.
 
 \b
 Example:
   gsdf sdf bunny.off -o bunny_sdf.npz --resolution 128 --png slice.png --mesh-output zero.ply
+  gsdf sdf bunny.off -o bunny_sdf.npz --png slice.png --axis x --at 0.02
 """)
 @click.argument("input", type=click.Path(dir_okay=False))
 @output_option("Output grid: .npz (reload with gsdf.GridField.load), .npy, .vtk, .vti or .vtu.")
@@ -54,19 +67,22 @@ Example:
 @click.option("--sign", type=click.Choice(["winding", "pseudonormal"]), default="winding", show_default=True,
               help="Sign by the winding number at 1/2, or by angle-weighted pseudonormals (closed manifold "
                    "meshes only).")
-@png_option("Also write a PNG of the middle slice (z) with isolines.")
+@png_option("Also write a PNG: a slice of the field with isolines, and the zero level set.")
+@slice_options
+@view_option()
 @mesh_output_option("Also write the zero level set as a mesh (.ply/.obj/.off/.stl).")
 @beta_option
 @normals_option
 @common_options
 @no_clobber_option
 @report_errors
-def sdf(input, output, resolution, pad, sign, png, mesh_output, beta, estimate_normals, quiet):
+def sdf(input, output, resolution, pad, sign, png, axis, at, view, mesh_output, beta, estimate_normals, quiet):
     from gsdf.field import GridField
     from gsdf.io import MESH_WRITE_FORMATS
 
     check_output(output, GridField.SAVE_EXTENSIONS)
     check_output(png, (".png",), "--png")
+    check_slice(png, axis, at)
     check_output(mesh_output, MESH_WRITE_FORMATS, "--mesh-output")
     geo = load_geometry(input, estimate_normals)
     from gsdf.cli._background import BackgroundWarmup
@@ -79,11 +95,7 @@ def sdf(input, output, resolution, pad, sign, png, mesh_output, beta, estimate_n
         field.save(tmp)
     announce(f"{geo.describe()}\nsigned distance grid {field.shape} -> {os.path.abspath(output)}")
     if png:
-        from gsdf.render._png import write_field_slice_png
-
-        with output_file(png, what="--png") as tmp:
-            write_field_slice_png(tmp, field)
-        announce(f"slice image -> {os.path.abspath(png)}")
+        write_picture(png, ("signed distance [model units]", field), view=view, axis=axis, at=at)
     if mesh_output:
         from gsdf.io import write_mesh
 

@@ -7,7 +7,7 @@ import os
 import click
 import numpy as np
 
-from gsdf.cli._common import announce, check_output, output_file, progress_bar, report_errors
+from gsdf.cli._common import announce, check_output, output_file, progress_bar, report_errors, write_picture
 from gsdf.cli._options import (
     POSITIVE,
     common_options,
@@ -31,8 +31,9 @@ def write_swn_obj(path, V, F, corner_values, face_labels) -> None:
         cols = np.column_stack([F[:, 0] + 1, idx[:, 0], F[:, 1] + 1, idx[:, 1], F[:, 2] + 1, idx[:, 2]])
         np.savetxt(fh, cols, fmt="f %d/%d %d/%d %d/%d")
         fh.write("# face labels, in face order\n")
-        np.savetxt(fh, np.asarray(face_labels).reshape(1, -1), fmt="%d", header="", comments="#label ",
-                   delimiter=" ")
+        lab = np.asarray(face_labels, dtype=np.int64).reshape(-1)
+        for k in range(0, len(lab), 32):                     # comment lines: other OBJ readers skip them
+            fh.write("#label " + " ".join(str(int(x)) for x in lab[k:k + 32]) + "\n")
 
 
 def write_swn_ply(path, V, F, corner_values, face_labels) -> None:
@@ -72,8 +73,8 @@ Example:
               help="LP weight of jumps along the input curves (gap-closing jumps weigh 1).")
 @click.option("--time-limit", type=POSITIVE, default=300.0, show_default=True,
               help="Seconds HiGHS may take.")
-@png_option("Also write a PNG preview of the winding number.")
-@view_option("0,0,1")
+@png_option("Also write a PNG of the face labels (with their share of the area) and the curves.")
+@view_option()
 @common_options
 @no_clobber_option
 @report_errors
@@ -111,10 +112,5 @@ def swn(mesh, curves, output, method, epsilon, time_limit, png, view, quiet):
                f"method {method}: labels (area) {share}; nonbounding share of the input {nb:.2f}; "
                f"{res.timings['total']:.2f} s -> {os.path.abspath(output)}")
     if png:
-        from gsdf.render._raster import render_function_png
-
-        m = len(F2)
-        with output_file(png, (".png",), what="--png") as tmp:
-            render_function_png(tmp, V2[F2].reshape(-1, 3), np.arange(3 * m).reshape(m, 3),
-                                res.corner_values.ravel() - 0.5, view=view)
-        announce(f"image -> {os.path.abspath(png)}")
+        curves = [V2[np.asarray(s)] for s in segs]
+        write_picture(png, ("surface winding number", (V2, F2, res)), ("curves", curves), view=view)

@@ -6,7 +6,7 @@ import os
 
 import click
 
-from gsdf.cli._common import announce, check_output, output_file, report_errors
+from gsdf.cli._common import announce, check_output, check_slice, output_file, report_errors, write_picture
 from gsdf.cli._options import (
     common_options,
     no_clobber_option,
@@ -14,7 +14,10 @@ from gsdf.cli._options import (
     offsets_option,
     output_option,
     pad_option,
+    png_option,
     resolution_option,
+    slice_options,
+    view_option,
 )
 
 GRID_EXTENSIONS = (".npz", ".npy", ".vtk", ".vti", ".vtu")
@@ -41,13 +44,14 @@ Fits one torus per point (k = 64 neighbours, §5.1.1) and blends their distances
 extension: .npz with --resolution: a signed distance grid (values, bbox_min, bbox_max); .npz without
 --resolution: the fitted tori (reload with gsdf.tori.PointsAsTori.load); .npy/.vtk/.vti/.vtu: the grid (as
 gsdf.GridField.save); a mesh extension (.ply/.obj/.off/.stl): the zero level set, or one file per offset with
---offsets (name_<offset>.ext).
+--offsets (name_<offset>.ext). --png draws the result: a slice of the grid (--axis, --at), the level sets with
+the cloud, or the oriented cloud.
 
 \b
 Examples:
   gsdf tori kitten.xyz -o kitten.ply --resolution 96
   gsdf tori kitten.xyz -o shells.ply --offsets -0.01,0,0.02
-  gsdf tori kitten.xyz -o sdf.npz --resolution 64
+  gsdf tori kitten.xyz -o sdf.npz --resolution 64 --png sdf.png --axis z
 """)
 @click.argument("points", type=click.Path(dir_okay=False))
 @output_option("Output: mesh (.ply/.obj/.off/.stl), grid (.npz/.npy/.vtk/.vti/.vtu) or fitted tori (.npz).")
@@ -58,11 +62,14 @@ Examples:
 @offsets_option("Comma-separated level values to contour (default 0).")
 @pad_option(0.1)
 @click.option("-k", "k", type=click.IntRange(6, 1024), default=64, show_default=True, help="Neighbours per torus fit.")
+@png_option("Also write a PNG of the result.")
+@slice_options
+@view_option()
 @normals_option
 @common_options
 @no_clobber_option
 @report_errors
-def tori(points, output, estimator, resolution, offsets, pad, k, estimate_normals, quiet):
+def tori(points, output, estimator, resolution, offsets, pad, k, png, axis, at, view, estimate_normals, quiet):
     from gsdf.io import MESH_WRITE_FORMATS
     from gsdf.tori import PointsAsTori
 
@@ -74,6 +81,8 @@ def tori(points, output, estimator, resolution, offsets, pad, k, estimate_normal
     if ext in MESH_WRITE_FORMATS:
         for path in mesh_paths:
             check_output(path, MESH_WRITE_FORMATS)
+    check_output(png, (".png",), "--png")
+    check_slice(png, axis, at)
     P, N = _load_cloud(points, estimate_normals)
     pat = PointsAsTori(P, N, estimator=estimator, k=k)
     click.echo(f"{points}: {len(pat.P)} oriented points, {len(pat.tori)} tori fitted (estimator={estimator})")
@@ -81,6 +90,8 @@ def tori(points, output, estimator, resolution, offsets, pad, k, estimate_normal
         with output_file(output) as tmp:
             pat.save(tmp)
         announce(f"fitted tori -> {os.path.abspath(output)}")
+        if png:
+            write_picture(png, ("oriented points", pat), view=view)
         return
     from gsdf.tori._pat import level_grid
 
@@ -92,12 +103,18 @@ def tori(points, output, estimator, resolution, offsets, pad, k, estimate_normal
         with output_file(output) as tmp:
             field.save(tmp)
         announce(f"signed distance grid {field.shape} -> {os.path.abspath(output)}")
+        if png:
+            write_picture(png, ("signed distance [model units]", field), view=view, axis=axis, at=at)
         return
     from gsdf.contour import extract_isosurface
     from gsdf.io import write_mesh
 
+    shown = []
     for v, path in zip(levels, mesh_paths):
         V, F = extract_isosurface(pat.signed_distance, resolution=g, level=v, inside="below")
         with output_file(path) as tmp:
             write_mesh(tmp, V, F)
         announce(f"level {v:g}: {len(F)} triangles -> {os.path.abspath(path)}")
+        shown.append((f"level {v:g}", (V, F)))
+    if png:
+        write_picture(png, *shown, ("input points", pat.P), view=view)

@@ -8,7 +8,7 @@ import click
 import numpy as np
 
 from gsdf.cli._common import announce, check_output, output_file, report_errors
-from gsdf.cli._options import NUMBER, SIZE, UP, common_options, no_clobber_option
+from gsdf.cli._options import NUMBER, SIZE, UP, common_options, no_clobber_option, slice_options
 
 _CLOUD_EXTENSIONS = (".xyz", ".pwn", ".pc", ".npy")
 _CURVE_EXTENSIONS = (".txt",)
@@ -24,7 +24,7 @@ and the isosurface), `gsdf heat-surface` meshes (the distance with isolines), `g
 number labels, with their share of the area), `gsdf voxelize` voxels, `gsdf reconstruct` meshes.
 
 The screenshot is a 3/4 view framing everything, with a colour bar titled with the field's name and units.
-Needs polyscope (pip install 'gsdf[view]'); without a display, EGL (Debian/Ubuntu: libegl1 libegl-mesa0
+Needs polyscope (the view extra: pip install -e '.[view]' in a checkout); without a display, EGL (Debian/Ubuntu: libegl1 libegl-mesa0
 libgl1-mesa-dri).
 
 \b
@@ -45,32 +45,20 @@ Examples:
               help="Camera height above the horizon, degrees.")
 @click.option("--level", type=NUMBER, default=None,
               help="Isosurface / bold isoline level (default: 0 for signed fields, 1/2 for winding numbers).")
-@click.option("--slice", "slice_", default=None, metavar="AXIS[=AT]",
-              help="Slice of volume fields: axis x, y or z, optionally at a coordinate (e.g. z=0.25).")
+@slice_options
 @click.option("--field", "field_name", default=None, metavar="NAME",
               help="Vertex property of a PLY/VTK mesh to colour by (default: the first one).")
 @click.option("--title", default=None, help="Colour-bar title of the (first) field, units included.")
 @common_options
 @no_clobber_option
 @report_errors
-def view(files, output, size, up, azimuth, elevation, level, slice_, field_name, title, quiet):
+def view(files, output, size, up, azimuth, elevation, level, axis, at, field_name, title, quiet):
     import time
 
     from gsdf.render._view import ViewOptions
     from gsdf.render._view import view as show
 
     check_output(output, (".png",), "--screenshot")
-    axis, at = None, None
-    if slice_ is not None:
-        axis, _, pos = slice_.partition("=")
-        if axis.strip().lower() not in ("x", "y", "z"):
-            raise click.BadParameter(f"expected x, y or z (optionally =COORDINATE), got {slice_!r}",
-                                     param_hint="--slice")
-        try:
-            at = float(pos) if pos else None
-        except ValueError:
-            raise click.BadParameter(f"expected a coordinate after '=', got {pos!r}", param_hint="--slice") from None
-        axis = axis.strip().lower()
     t = time.perf_counter()
     items = items_from_files(files, field_name, title)
     opts = ViewOptions(level=level, slice_axis=axis, slice_at=at)

@@ -343,7 +343,7 @@ def write_svg(
     z_values=None,
     bbox=None,
     layout: str = "layers",
-    unit_mm: float = 1.0,
+    unit_mm: float | None = 1.0,
     margin: float | None = None,
     style: dict | None = None,
 ) -> str:
@@ -355,35 +355,41 @@ def write_svg(
     is one ``<path>`` with ``fill-rule="evenodd"`` (holes are also oppositely oriented, so
     ``nonzero`` gives the same picture).  Islands nested inside holes are separate paths.
 
-    Coordinates: one SVG user unit is ``unit_mm`` millimetres (``width``/``height`` are given in
-    ``mm`` and the ``viewBox`` spans the data), so data in mm import at true size.  The 2D ``y``
-    axis is flipped (SVG's points down) and the frame is shifted so that ``bbox`` (plus
-    ``margin``) starts at the origin; the shift is recorded on the root element as
-    ``data-origin="xmin ymax"`` so the original coordinates can be recovered
-    (``x = X + xmin - margin``, ``y = ymax + margin - Y``).
+    Coordinates: the ``viewBox`` spans the drawing (the contours' frame plus ``margin``) in data units; the
+    2D ``y`` axis is flipped (SVG's points down) and the frame is shifted so that ``bbox`` (plus ``margin``)
+    starts at the origin; the shift is recorded on the root element as ``data-origin="xmin ymax"`` so the
+    original coordinates can be recovered (``x = X + xmin - margin``, ``y = ymax + margin - Y``). With
+    ``unit_mm`` a number, ``width``/``height`` are given in millimetres (one data unit is ``unit_mm`` mm), so
+    the drawing imports and prints at that size; with ``unit_mm=None`` they are left out and a browser or
+    viewer fits the drawing to its window.
+
+    The default style draws every contour as a thin line (1 screen pixel at any zoom) over a light fill, so
+    the stacked layers of ``layout="layers"`` stay readable; ``style`` replaces any of its attributes.
 
     Parameters
     ----------
     path : str or os.PathLike
-        Output file.
+        Output file; must end in ``.svg``.
     contours_per_slice : list of lists of (k, 2) arrays
-        One list of closed polylines per slice, as returned by :func:`slice_contours`.
+        One list of closed polylines per slice (float, data units), as returned by :func:`slice_contours`.
     z_values : (s,) array_like, optional
-        Height of each slice (stored as ``data-z`` and in the layer label).
+        Height of each slice, data units (stored as ``data-z`` and in the layer label). Default: none stored.
     bbox : ((xmin, ymin), (xmax, ymax)), optional
-        2D frame of the drawing (e.g. the print bed / the slicing box); default: the contours'
+        2D frame of the drawing in data units (e.g. the print bed / the slicing box); default: the contours'
         bounding box.  Required when there are no contours at all.
-    layout : {"layers", "stack"}
-        ``"layers"`` (default): all slices at their true coordinates, one layer each — the form a
-        toolpath importer wants.  ``"stack"``: slices drawn one below the other (slice 0 on
-        top), for looking at them.
-    unit_mm : float
-        Millimetres per data unit (1 for data in mm, 1000 for data in metres, 25.4 for inches).
+    layout : {"layers", "stack"}, default "layers"
+        ``"layers"``: all slices at their true coordinates, one layer each — the form a toolpath importer
+        wants.  ``"stack"``: slices drawn one below the other (slice 0 on top), for looking at them.
+    unit_mm : float or None, default 1.0
+        Millimetres per data unit (1 for data in mm, 1000 for data in metres, 25.4 for inches), > 0; None: no
+        physical size (the drawing fits the window it is opened in).
     margin : float, optional
-        Blank border in data units; default 2 % of the larger frame side.
+        Blank border in data units, >= 0; default 2 % of the larger frame side.
     style : dict, optional
-        SVG attributes of every path, over the defaults ``{"fill": "#000000", "stroke": "none",
-        "stroke-width": 0.2 % of the larger frame side}`` (e.g. ``{"fill": "none", "stroke": "red"}``).
+        SVG attributes of every path, over the defaults ``{"fill": "#4a78b0", "fill-opacity": "0.15",
+        "fill-rule": "evenodd", "stroke": "#1b2f4f", "stroke-width": "1", "vector-effect":
+        "non-scaling-stroke"}`` (e.g. ``{"fill": "#000000", "fill-opacity": "1", "stroke": "none"}`` for
+        solid black regions).
 
     Returns
     -------
@@ -403,9 +409,9 @@ def write_svg(
 
     path = check_output_path(path, extensions=(".svg",))
     choice(layout, "layout", {"layers", "stack"})
-    unit = _finite(unit_mm, "unit_mm")
-    if unit <= 0:
-        raise ValueError(f"unit_mm: must be positive, got {unit_mm!r}")
+    unit = None if unit_mm is None else _finite(unit_mm, "unit_mm")
+    if unit is not None and unit <= 0:
+        raise ValueError(f"unit_mm: must be positive (or None: no physical size), got {unit_mm!r}")
     if isinstance(contours_per_slice, np.ndarray) or not hasattr(contours_per_slice, "__len__"):
         raise ValueError("contours_per_slice: expected a list (one entry per slice) of lists of (k, 2) polylines")
     slices = []
@@ -460,23 +466,20 @@ def write_svg(
         H = H1 * ns if layout == "stack" else H1
     if style is not None and not isinstance(style, dict):
         raise ValueError(f"style: expected a dict of SVG attributes, got {type(style).__name__}")
-    attrs_path = {"fill": "#000000", "fill-rule": "evenodd", "stroke": "none", "stroke-width": _fmt(0.002 * size)}
+    attrs_path = {"fill": "#4a78b0", "fill-opacity": "0.15", "fill-rule": "evenodd", "stroke": "#1b2f4f",
+                  "stroke-width": "1", "vector-effect": "non-scaling-stroke"}
     attrs_path.update({str(k): str(v) for k, v in (style or {}).items()})
 
     ET.register_namespace("", _SVG_NS)
     ET.register_namespace("inkscape", _INKSCAPE_NS)
-    root = ET.Element(
-        f"{{{_SVG_NS}}}svg",
-        {
-            "version": "1.1",
-            "width": f"{_fmt(W * unit)}mm",
-            "height": f"{_fmt(H * unit)}mm",
-            "viewBox": f"0 0 {_fmt(W)} {_fmt(H)}",
-            "data-origin": f"{_fmt(bmin[0])} {_fmt(bmax[1])}",
-            "data-margin": _fmt(margin),
-            "data-unit-mm": _fmt(unit),
-        },
-    )
+    head = {"version": "1.1"}
+    if unit is not None:
+        head.update({"width": f"{_fmt(W * unit)}mm", "height": f"{_fmt(H * unit)}mm"})
+    head.update({"viewBox": f"0 0 {_fmt(W)} {_fmt(H)}", "data-origin": f"{_fmt(bmin[0])} {_fmt(bmax[1])}",
+                 "data-margin": _fmt(margin)})
+    if unit is not None:
+        head["data-unit-mm"] = _fmt(unit)
+    root = ET.Element(f"{{{_SVG_NS}}}svg", head)
     for s, polys in enumerate(slices):
         label = f"slice {s}" if Z is None else f"z={_fmt(Z[s])}"
         attrs = {

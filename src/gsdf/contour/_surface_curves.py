@@ -13,8 +13,14 @@ def level_set_curves(V, F, f, value: float = 0.0) -> list:
 
     Parameters
     ----------
-    V : (n, 3) float; F : (m, 3) int; f : (n,) float
-    value : float
+    V : (n, 3) float
+        Vertex positions.
+    F : (m, 3) int
+        Triangles.
+    f : (n,) float
+        One finite value per vertex, linear over each triangle.
+    value : float, default 0.0
+        The level traced.
 
     Returns
     -------
@@ -22,14 +28,20 @@ def level_set_curves(V, F, f, value: float = 0.0) -> list:
         One polyline per connected piece (closed ones repeat their first point at the end), one node per
         crossed edge, so every segment lies in one face. Oriented so that ``{f < value}`` lies to the left
         (counter-clockwise w.r.t. the face normals): ``SurfaceSignedHeatSolver`` then returns values that are
-        negative where ``f < value``.
+        negative where ``f < value``. Empty when the level is not crossed.
+
+    Raises
+    ------
+    ValueError
+        Bad mesh arrays, or ``f`` not one finite value per vertex.
 
     Examples
     --------
-    >>> import numpy as np
+    >>> import numpy as np, gsdf
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0]]); F = np.array([[0, 1, 2]])
-    >>> len(level_set_curves(V, F, np.array([-1.0, 1.0, 1.0])))
-    1
+    >>> (curve,) = gsdf.level_set_curves(V, F, np.array([-1.0, 1.0, 1.0]))
+    >>> [(face, b.round(2).tolist()) for face, b in curve]
+    [(0, [0.5, 0.5, 0.0]), (0, [0.5, 0.0, 0.5])]
     """
     V, F = _checks.as_mesh(V, F)
     g = _checks.as_values(f, "f", (len(V),))
@@ -98,11 +110,28 @@ def region_boundary_curves(F, face_mask) -> list:
     the region negative. Boundary edges of the mesh that bound the region are included. Where the region
     touches itself at a vertex the loops are split there arbitrarily.
 
+    Parameters
+    ----------
+    F : (m, 3) int
+        Triangles (or quads) of the mesh.
+    face_mask : (m,) bool
+        The faces of the region.
+
+    Returns
+    -------
+    list of (k,) int64 arrays
+        Closed vertex polylines (the first vertex repeated at the end).
+
+    Raises
+    ------
+    ValueError
+        ``face_mask`` not one bool per face.
+
     Examples
     --------
-    >>> import numpy as np
+    >>> import numpy as np, gsdf
     >>> F = np.array([[0, 1, 2], [0, 2, 3]])
-    >>> [c.tolist() for c in region_boundary_curves(F, np.array([True, True]))]
+    >>> [c.tolist() for c in gsdf.region_boundary_curves(F, np.array([True, True]))]
     [[0, 1, 2, 3, 0]]
     """
     F = np.asarray(F, dtype=np.int64)

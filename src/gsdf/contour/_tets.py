@@ -65,6 +65,34 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     of the majority of each component where flat tets have no gradient). ``report=True`` returns
     ``(V, F, report)`` with :func:`gsdf.mesh._topology.manifold_report`.
 
+    Parameters
+    ----------
+    X : (n, 3) float
+        Vertex positions of the tet mesh.
+    T : (m, 4) int
+        Tetrahedra as vertex indices.
+    values : (n,) float
+        One value per vertex, linear over each tet.
+    level : float, default 0.0
+        The level extracted; strictly between the minimum and the maximum of ``values``.
+    report : bool, default False
+        Also return the checks of the mesh: a dict with ``closed``, ``edge_manifold``, ``vertex_manifold``,
+        ``welded`` and the counts of non-manifold edges and vertices.
+
+    Returns
+    -------
+    V : (k, 3) float64
+        Crossing points, welded.
+    F : (f, 3) int64
+        Triangles, normals along the gradient of ``values`` (outward for a signed distance).
+    report : dict
+        Only with ``report=True``.
+
+    Raises
+    ------
+    ValueError
+        ``level`` not finite or outside the range of ``values`` (no surface).
+
     Examples
     --------
     >>> import numpy as np, gsdf

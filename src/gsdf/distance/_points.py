@@ -16,7 +16,22 @@ __all__ = ["PointCloudDistance", "point_cloud_distance"]
 
 
 class PointCloudDistance:
-    """Nearest-point distance to the points ``P`` (p, 3), with the k-d tree built once.
+    """Nearest-point distance to the points ``P``, with the k-d tree (scipy's cKDTree, all cores) built once.
+
+    Parameters
+    ----------
+    P : (p, 3) float
+        The points, model units.
+
+    Attributes
+    ----------
+    P : (p, 3) float64
+        The points, as given.
+
+    Raises
+    ------
+    ValueError
+        ``P`` empty, of the wrong shape, or with NaN or infinite coordinates.
 
     Examples
     --------
@@ -34,7 +49,34 @@ class PointCloudDistance:
 
     @query_shaped()
     def query(self, Q):
-        """Returns ``(d (q,), index (q,) int64, closest (q, 3))`` for the query points ``Q`` (q, 3)."""
+        """The nearest point of the cloud to each query point, and its distance.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        d : (q,) float64
+            Euclidean distance to the nearest point.
+        index : (q,) int64
+            Index into ``P`` of that point (ties broken arbitrarily).
+        closest : (q, 3) float64
+            ``P[index]``.
+
+        Raises
+        ------
+        ValueError
+            ``Q`` of the wrong shape or with NaN or infinite coordinates.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> d, i, c = gsdf.PointCloudDistance(np.eye(3)).query([[2.0, 0.0, 0.0]])
+        >>> float(d[0]), int(i[0]), c[0].tolist()
+        (1.0, 0, [1.0, 0.0, 0.0])
+        """
         Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
         Qf, excess = self._frame.queries(Q, want_excess=True)
         d, idx = self.tree.query(Qf, k=1, workers=-1)
@@ -44,9 +86,31 @@ class PointCloudDistance:
 
 @query_shaped()
 def point_cloud_distance(P, Q, return_closest: bool = False):
-    """Distance from every query ``Q`` (q, 3) to the nearest of the points ``P`` (p, 3).
+    """Distance from every query point to the nearest of the points ``P`` (one call of
+    :class:`PointCloudDistance`; build that once to query the same points repeatedly).
 
-    Returns ``d`` (q,), or ``(d, index, closest)`` when ``return_closest`` is true.
+    Parameters
+    ----------
+    P : (p, 3) float
+        The points, model units.
+    Q : (q, 3) float
+        Query points.
+    return_closest : bool, default False
+        Also return which point is nearest and where it is.
+
+    Returns
+    -------
+    d : (q,) float64
+        Distance to the nearest point.
+    index : (q,) int64
+        Only with ``return_closest``: index into ``P`` of the nearest point.
+    closest : (q, 3) float64
+        Only with ``return_closest``: ``P[index]``.
+
+    Raises
+    ------
+    ValueError
+        Empty ``P``, wrong shapes, NaN or infinite coordinates.
 
     Examples
     --------

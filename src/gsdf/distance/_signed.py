@@ -26,7 +26,8 @@ from gsdf.mesh._pseudonormals import pseudonormals
 from gsdf.distance._points import point_cloud_distance
 from gsdf.distance._triangles import TriangleDistance
 
-__all__ = ["signed_distance", "signed_distance_points", "SIGN_MODES"]
+__all__ = ["signed_distance", "signed_distance_points", "SIGN_MODES", "PseudonormalWarning",
+           "warn_pseudonormal"]
 
 #: Accepted values of ``signed_distance(..., sign=...)``.
 SIGN_MODES = ("winding", "pseudonormal")
@@ -35,6 +36,34 @@ SIGN_MODES = ("winding", "pseudonormal")
 #: on an edge or a vertex (the region-based kernel returns exact zeros there; this only absorbs rounding
 #: for points that project just inside a face, where the face and edge normals agree on the sign).
 BARY_TOL = 1e-10
+
+
+class PseudonormalWarning(UserWarning):
+    """``sign="pseudonormal"`` on a mesh that is open, non-manifold or not consistently oriented, where that sign
+    can be wrong on whole regions."""
+
+
+def warn_pseudonormal(V, F, stacklevel: int = 3) -> dict:
+    """Warn (:class:`PseudonormalWarning`) when the pseudonormal sign is unreliable on the mesh ``(V, F)``: it is
+    open, non-manifold or not consistently oriented (:func:`gsdf.mesh_topology`). Returns the topology."""
+    import warnings
+
+    from gsdf.mesh._topology import mesh_topology
+
+    t = mesh_topology(V, F)
+    problems = []
+    if not t["closed"]:
+        problems.append("open (it has boundary edges)")
+    if not (t["edge_manifold"] and t["vertex_manifold"]):
+        problems.append("non-manifold")
+    elif not t["oriented"]:
+        problems.append("not consistently oriented")
+    if problems:
+        warnings.warn(f"sign='pseudonormal' on a mesh that is {' and '.join(problems)}: the pseudonormal sign is "
+                      "exact only for closed, consistently oriented manifold meshes and can be wrong on whole "
+                      "regions here; sign='winding' is robust to holes and soups", PseudonormalWarning,
+                      stacklevel=stacklevel)
+    return t
 
 
 def _pseudonormal_sign(V, F, Q, closest, face, bary) -> np.ndarray:
@@ -62,18 +91,25 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0, return_cl
                     shell: float | None = None):
     """Signed distance from points ``Q`` (q, 3) to the triangle mesh/soup ``(V, F)``; negative inside.
 
+    ``|d|`` is the exact distance to the nearest triangle. ``sign="winding"`` (Barill et al. 2018, §4): inside
+    where the fast winding number exceeds 1/2, robust to holes, self-intersections and soups.
+    ``sign="pseudonormal"`` (Bærentzen & Aanæs 2005): the sign of ``(q - c) . n``, ``c`` the closest point and
+    ``n`` the angle-weighted pseudonormal of its face, edge or vertex; cheaper, exact on closed, consistently
+    oriented manifold meshes, wrong on whole regions of open or broken ones (then it warns).
+
     Parameters
     ----------
-    V, F : (n, 3) float, (m, 3) int
-        Triangle mesh or soup.
+    V : (n, 3) float
+        Vertex positions, model units.
+    F : (m, 3) int
+        Triangles (a mesh or a soup).
     Q : (q, 3) float
         Query points.
-    sign : {"winding", "pseudonormal"}
-        How the inside is decided; see the module documentation. ``"pseudonormal"`` is only meaningful
-        for closed, consistently oriented manifold meshes.
-    beta : float
+    sign : {"winding", "pseudonormal"}, default "winding"
+        How the inside is decided (above).
+    beta : float, default 2.0
         Accuracy parameter of the fast winding number (``sign="winding"`` only): clusters farther than
-        ``beta`` times their radius are approximated by their expansion.
+        ``beta`` times their radius are approximated by their expansion; larger is more accurate and slower.
     return_closest : bool, default False
         Also return the closest triangle, closest point and normal, as libigl's ``signed_distance``
         (``S, I, C, N``; as :func:`gsdf.signed_distance_grid` does on a grid).
@@ -94,6 +130,16 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0, return_cl
         The normal there: the angle-weighted pseudonormal of the closest feature (face, edge or vertex) with
         ``sign="pseudonormal"``, the unit normal of the closest triangle with ``sign="winding"`` (zero for a
         degenerate triangle).
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, face indices out of range, an unknown ``sign``, ``beta <= 0``.
+
+    Warns
+    -----
+    PseudonormalWarning
+        A ``UserWarning``: ``sign="pseudonormal"`` on a mesh that is open, non-manifold or not consistently
+        oriented.
 
     Examples
     --------
@@ -123,6 +169,7 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0, return_cl
         w = np.asarray(fast_winding_number(V, F, Q, beta=beta, order=2), dtype=np.float64)
         S = np.where(w > 0.5, -d, d)
     else:
+        warn_pseudonormal(V, F)
         d, face, closest, bary = td.query_barycentric(Q)
         S = _pseudonormal_sign(V, F, Q, closest, face, bary) * d
     if shell is not None:
@@ -166,9 +213,32 @@ def closest_pseudonormal(V, F, face, bary):
 def signed_distance_points(P, N, Q, areas=None, beta: float = 2.3):
     """Signed distance to an oriented point cloud; negative inside.
 
-    ``|d|`` is the distance to the nearest point of ``P`` (p, 3); the sign comes from the fast winding
-    number of the oriented points (normals ``N`` (p, 3), optional per-point ``areas`` (p,)): inside where
-    it exceeds 1/2 (Barill et al. 2018).
+    ``|d|`` is the distance to the nearest point of ``P``; the sign comes from the fast winding number of the
+    oriented points: inside where it exceeds 1/2 (Barill et al. 2018, §4 and Eq. 5).
+
+    Parameters
+    ----------
+    P : (p, 3) float
+        Points, model units.
+    N : (p, 3) float
+        Outward normals (any length; normalized internally).
+    Q : (q, 3) float
+        Query points.
+    areas : (p,) float, optional
+        Point areas for the winding number (square model units); default: estimated by :func:`gsdf.point_areas`
+        with k = 20.
+    beta : float, default 2.3
+        Accuracy of the fast winding number: larger is more accurate and slower.
+
+    Returns
+    -------
+    (q,) float64
+        Signed distance, negative inside.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite values, negative areas, ``beta <= 0``.
 
     Examples
     --------

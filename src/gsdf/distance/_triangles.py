@@ -465,13 +465,29 @@ class TriangleDistance:
         Vertex positions.
     F : (m, 3) int
         Triangles (any soup: duplicated, degenerate, non-manifold or unreferenced elements are fine).
-    leaf_size : int
-        Maximum triangles per BVH leaf.
+    leaf_size : int, default 8
+        Maximum triangles per leaf of the bounding volume hierarchy (>= 1); changes speed only.
+
+    Attributes
+    ----------
+    V, F
+        The mesh, as given (float64, int64).
+    n_faces : int
+        Number of triangles.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, face indices out of range.
 
     Examples
     --------
-    >>> td = TriangleDistance(V, F)            # doctest: +SKIP
-    >>> d, face, closest = td.query(Q)         # doctest: +SKIP
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    >>> td = gsdf.TriangleDistance(V, [[0, 1, 2]])           # build once ...
+    >>> d, face, closest = td.query([[0.2, 0.2, 0.5]])       # ... query many times
+    >>> float(d[0]), int(face[0]), closest[0].tolist()
+    (0.5, 0, [0.2, 0.2, 0.0])
     """
 
     def __init__(self, V, F, leaf_size: int = 8):
@@ -488,6 +504,7 @@ class TriangleDistance:
 
     @property
     def n_faces(self) -> int:
+        """Number of triangles."""
         return int(self.F.shape[0])
 
     def _query(self, Q, chunk: int = CHUNK, want_bary: bool = True):
@@ -518,14 +535,30 @@ class TriangleDistance:
         return d2, face, closest, bary
 
     def refit(self, V):
-        """Move the vertices (same faces) and keep the tree: its element order and splits stay, the boxes are
-        recomputed bottom-up from the new triangles (O(n), against the build's O(n log n)).  Queries stay exact
-        (every box bounds its triangles); a tree refitted after large moves only prunes less well.  For meshes
-        whose vertices move a little per round (an iterative fit).  ``V`` (n, 3) float: the new positions, as
-        many as before.  Returns ``self``.
+        """Move the vertices (same faces) and keep the tree.
 
-        Example
+        The tree's element order and splits stay, the boxes are recomputed bottom-up from the new triangles
+        (O(n), against the build's O(n log n)). Queries stay exact (every box bounds its triangles); a tree
+        refitted after large moves only prunes less well. For meshes whose vertices move a little per round (an
+        iterative fit).
+
+        Parameters
+        ----------
+        V : (n, 3) float
+            The new vertex positions, as many as before.
+
+        Returns
         -------
+        TriangleDistance
+            ``self``.
+
+        Raises
+        ------
+        ValueError
+            A different number of vertices, NaN or infinite coordinates.
+
+        Examples
+        --------
         >>> import numpy as np
         >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float); F = np.array([[0, 1, 2]])
         >>> td = TriangleDistance(V, F).refit(V + [0.0, 0.0, 1.0])
@@ -550,6 +583,11 @@ class TriangleDistance:
     def query(self, Q):
         """Unsigned distance from each query point to the nearest triangle.
 
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
         Returns
         -------
         d : (q,) float64
@@ -558,6 +596,19 @@ class TriangleDistance:
             Index into ``F`` of a nearest triangle (ties broken arbitrarily).
         closest : (q, 3) float64
             The closest point on that triangle.
+
+        Raises
+        ------
+        ValueError
+            ``Q`` of the wrong shape or with NaN or infinite coordinates.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+        >>> d, face, closest = gsdf.TriangleDistance(V, [[0, 1, 2]]).query([[2.0, 0.0, 0.0]])
+        >>> float(d[0]), closest[0].tolist()
+        (1.0, [1.0, 0.0, 0.0])
         """
         Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
         d, face, closest, _ = self._query(Q, want_bary=False)
@@ -565,18 +616,71 @@ class TriangleDistance:
 
     @query_shaped()
     def query_barycentric(self, Q):
-        """Like :meth:`query` but also returns the barycentric coordinates (q, 3) of the closest point in
-        its triangle ``F[face]`` (exact zeros on edges, exact one at vertices)."""
+        """Like :meth:`query`, and the barycentric coordinates of each closest point in its triangle.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        d : (q,) float64
+            Euclidean distance.
+        face : (q,) int64
+            Index into ``F`` of a nearest triangle.
+        closest : (q, 3) float64
+            The closest point on that triangle.
+        bary : (q, 3) float64
+            Its barycentric coordinates in ``F[face]`` (exact zeros on edges, an exact one at vertices).
+
+        Raises
+        ------
+        ValueError
+            ``Q`` of the wrong shape or with NaN or infinite coordinates.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+        >>> d, face, closest, bary = gsdf.TriangleDistance(V, [[0, 1, 2]]).query_barycentric([[2.0, 0.0, 0.0]])
+        >>> bary[0].tolist()
+        [0.0, 1.0, 0.0]
+        """
         Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
         return self._query(Q)
 
 
 @query_shaped()
 def unsigned_distance(V, F, Q, return_closest: bool = False):
-    """Unsigned distance from points ``Q`` (q, 3) to the triangle mesh/soup ``(V, F)``.
+    """Unsigned distance from points ``Q`` to the triangle mesh/soup ``(V, F)``.
 
-    Returns ``d`` (q,), or ``(d, face, closest)`` when ``return_closest`` is true. To query the same
-    geometry repeatedly, build a :class:`TriangleDistance` once.
+    To query the same geometry repeatedly, build a :class:`TriangleDistance` once.
+
+    Parameters
+    ----------
+    V : (n, 3) float
+        Vertex positions, model units.
+    F : (m, 3) int
+        Triangles (any soup).
+    Q : (q, 3) float
+        Query points.
+    return_closest : bool, default False
+        Also return the nearest triangle and the closest point on it.
+
+    Returns
+    -------
+    d : (q,) float64
+        Distance to the nearest triangle.
+    face : (q,) int64
+        Only with ``return_closest``: index into ``F`` of a nearest triangle.
+    closest : (q, 3) float64
+        Only with ``return_closest``: the closest point on it.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, face indices out of range.
 
     Examples
     --------

@@ -192,26 +192,34 @@ class YukawaTree:
     W : (m, 3) float
         Vector charges ``|f| N_f`` (area-weighted normals, or normals × point areas).
     t : float
-        Diffusion time; λ = 1/√t.
-    theta : float
+        Diffusion time (square model units, > 0); λ = 1/√t.
+    theta : float, default 0.5
         Cluster acceptance tolerance: a tree node of radius ρ at distance r is used through its second-order
-        expansion when E³ e^{λρ − λ(r − d*)} < theta³, E = ρ (λ + 1/r). Smaller is more accurate and slower; 0 disables clustering.
-    eps : float
-        Relative pruning tolerance of the exponential decay (see module docstring).
-    leaf_size : int
-        Sources per tree leaf.
+        expansion when ``E³ exp(λρ − λ(r − d*)) < theta³``, E = ρ (λ + 1/r). Smaller is more accurate and
+        slower; 0 disables clustering.
+    eps : float, default 1e-6
+        Relative pruning tolerance of the exponential decay, in (0, 1/2]: sources whose weight has decayed
+        below ``eps`` times the nearest one's are skipped.
+    leaf_size : int, default 8
+        Sources per tree leaf; changes speed only.
+
+    Raises
+    ------
+    ValueError
+        ``t <= 0``, ``theta < 0``, ``eps`` outside (0, 1/2].
 
     Notes
     -----
-    Results are returned *scaled* by ``e^{λ d*(x)}``, d* the distance from x to the nearest source, so that
-    they never underflow; the scale is positive and only the direction of X is used by the method.
+    Results are returned *scaled* by ``exp(λ d*(x))``, d* the distance from x to the nearest source, so that
+    they never underflow; the scale is positive and only the direction of X is used by the method. Calling the
+    tree, ``tree(Q, dref=None, slack=0.0, chunk=65536, progress=None)``, returns the scaled X (q, 3) at the
+    query points; ``dref`` is an estimate of d* within ``slack`` (computed exactly when omitted).
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from gsdf.heat._yukawa import YukawaTree
+    >>> import numpy as np, gsdf
     >>> B = np.array([[0.0, 0, 0], [1.0, 0, 0]]); W = np.array([[0, 0, 1.0], [0, 0, 1.0]])
-    >>> X = YukawaTree(B, W, t=0.01)([[0.5, 0, 0.2]])
+    >>> X = gsdf.YukawaTree(B, W, t=0.01)([[0.5, 0, 0.2]])
     >>> bool(X[0, 2] > 0 and abs(X[0, 0]) < 1e-12)
     True
     """
@@ -237,7 +245,24 @@ class YukawaTree:
         self._rmin = 1e-9 * max(float(ext.max()), 1e-300)
 
     def nearest_distance(self, Q) -> np.ndarray:
-        """Distance from each query to the nearest source point (the reference distance d*)."""
+        """Distance from each query to the nearest source point (the reference distance d*).
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        (q,) float64
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> tree = gsdf.YukawaTree(np.eye(3), np.eye(3), t=0.01)
+        >>> tree.nearest_distance([[0.0, 0.0, 0.0]]).round(3).tolist()
+        [1.0]
+        """
         if self._kd is None:
             self._kd = cKDTree(self._src)
         return self._kd.query(Q, workers=-1)[0]
@@ -267,7 +292,26 @@ class YukawaTree:
         return out
 
     def direct(self, Q) -> np.ndarray:
-        """The O(q × m) direct sum with the same scaling (signedheat3d's Step I), for testing."""
+        """The O(q × m) direct sum with the same scaling (signedheat3d's Step I), for testing the tree.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        (q, 3) float64
+            X scaled by ``exp(λ d*)``, as the tree returns it.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> B = np.array([[0.0, 0, 0], [1.0, 0, 0]]); W = np.array([[0, 0, 1.0], [0, 0, 1.0]])
+        >>> tree = gsdf.YukawaTree(B, W, t=0.01)
+        >>> bool(np.allclose(tree([[0.5, 0, 0.2]]), tree.direct([[0.5, 0, 0.2]]), rtol=1e-6))
+        True
+        """
         Q = as_points(Q, "Q", allow_empty=True, seconds_per_row=self.m * SECONDS_PER_PAIR)
         out = np.empty((len(Q), 3))
         _direct_kernel(Q, self.nearest_distance(Q), self._B, self._W, self.lam, self._rmin, out)

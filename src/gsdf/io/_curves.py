@@ -407,7 +407,25 @@ def read_swn_curves(path, F) -> SWNCurves:
 
 def write_curves(path: str, curves, curve_signs=None, points=()) -> None:
     """Write sources in the demo format (vertex-index curves as ``v`` nodes, surface points as ``f`` nodes) to a
-    ``.txt`` file (atomically, :mod:`gsdf.io._safe_write`).
+    ``.txt`` file (atomically), which :func:`gsdf.read_curves` and ``gsdf heat-surface --curves`` read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file; it must end in ``.txt``.
+    curves : list
+        Each curve a sequence of vertex indices or a list of ``(face, barycentric (3,))`` surface points
+        (``(vertex, ())`` is a vertex).
+    curve_signs : list of bool, optional
+        Per curve: True writes a ``signed_curve`` block, False an ``unsigned_curve`` block. Default: all signed.
+    points : sequence, default ()
+        Isolated point sources (vertex indices or ``(face, barycentric)``), written as one ``unsigned_point``
+        block.
+
+    Raises
+    ------
+    ValueError
+        Another extension, or a failed write.
 
     ``curves``, ``curve_signs`` and ``points`` are what ``compute_distance`` takes (:func:`gsdf.curves.as_curves`,
     :func:`gsdf.curves.as_point_sources`), checked as :func:`read_curves` checks a file: integer indices >= 0

@@ -138,13 +138,22 @@ def manifold_report(V, F) -> dict:
 def mesh_topology(V, F) -> dict:
     """Topological summary of the triangle mesh (V, F).
 
+    Parameters
+    ----------
+    V : (n, 3) float
+        Vertex positions (only their count matters).
+    F : (m, 3) int
+        Triangles as vertex indices.
+
     Returns
     -------
-    dict with ``closed`` (every edge in exactly two faces; also False if some edge has one), ``edge_manifold``
-    (no edge in more than two faces), ``vertex_manifold`` (the faces around every used vertex form one fan),
-    ``oriented`` (every interior edge used once in each direction), ``components`` (face-connected through
-    edges), ``euler`` (V − E + F over used vertices), ``genus`` (list, per component, ``(2 − χ_c) / 2`` when the
-    mesh is closed and manifold, else None), ``degenerate_faces`` (faces repeating a vertex), ``n_faces``.
+    dict
+        ``closed`` (every edge in exactly two faces; also False if some edge has one), ``edge_manifold``
+        (no edge in more than two faces), ``vertex_manifold`` (the faces around every used vertex form one fan),
+        ``oriented`` (every interior edge used once in each direction), ``components`` (face-connected through
+        edges), ``euler`` (V − E + F over used vertices), ``genus`` (list, per component, ``(2 − χ_c) / 2``
+        when the mesh is closed and manifold, else None), ``degenerate_faces`` (faces repeating a vertex),
+        ``n_faces``.
 
     Examples
     --------

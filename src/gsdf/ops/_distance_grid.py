@@ -123,10 +123,11 @@ def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: st
         S = GridField((s if shell is None else with_shell(s, shell)).reshape(grid.shape), *grid.box)
         return (S, idx, P[idx], Nrm[idx]) if return_closest else S
 
-    from gsdf.distance._signed import _pseudonormal_sign, closest_pseudonormal
+    from gsdf.distance._signed import _pseudonormal_sign, closest_pseudonormal, warn_pseudonormal
     from gsdf.distance._triangles import TriangleDistance
 
     if sign == "pseudonormal":
+        warn_pseudonormal(V, F)
         d, face, closest, bary = TriangleDistance(V, F).query_barycentric(Q)
         sgn = _pseudonormal_sign(V, F, Q, closest, face, bary)
         s = sgn * d

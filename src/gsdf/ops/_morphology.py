@@ -29,16 +29,35 @@ def _check_field(field):
 
 
 def offset_surface(field, distance: float):
-    """The offset surface {φ = distance} of a signed distance grid, as ``(V, F)``.
+    """The offset surface {φ = distance} of a signed distance grid (Feng & Crane 2024, §9.3.1).
+
+    Parameters
+    ----------
+    field : GridField
+        Signed distance, negative inside (:func:`gsdf.signed_heat_volume`, :func:`gsdf.signed_distance_grid`).
+        A winding number is not a distance: its level sets are not offsets.
+    distance : float
+        The offset, model units: positive grows the shape, negative shrinks it. The box must contain the
+        offset surface.
+
+    Returns
+    -------
+    V : (n, 3) float64
+    F : (m, 3) int64
+        The offset surface, outward oriented.
+
+    Raises
+    ------
+    ValueError
+        ``field`` is not a GridField; ``distance`` is not finite or outside the range of the field (the box
+        leaves no room for it).
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from gsdf.field import GridField
-    >>> from gsdf.ops._morphology import offset_surface
+    >>> import numpy as np, gsdf
     >>> x = np.linspace(-1, 1, 41); X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
-    >>> f = GridField(np.sqrt(X**2 + Y**2 + Z**2) - 0.5, [-1] * 3, [1] * 3)
-    >>> V, F = offset_surface(f, 0.2)
+    >>> f = gsdf.GridField(np.sqrt(X**2 + Y**2 + Z**2) - 0.5, [-1] * 3, [1] * 3)
+    >>> V, F = gsdf.offset_surface(f, 0.2)
     >>> round(float(np.linalg.norm(V, axis=1).mean()), 2)
     0.7
     """
@@ -68,13 +87,22 @@ def dilate_erode(field, radius: float, return_field: bool = False):
     field : GridField
         Signed distance, negative inside; its box must leave room for the +radius offset.
     radius : float
-        Positive distance.
-    return_field : bool
+        Positive distance, model units: gaps and notches narrower than about twice it are filled.
+    return_field : bool, default False
         Also return the signed distance grid of the dilated surface.
 
     Returns
     -------
-    V, F : the closed surface (and the intermediate field when ``return_field``).
+    V : (n, 3) float64
+    F : (m, 3) int64
+        The closed surface.
+    field : GridField
+        Only with ``return_field``: the exact signed distance to the dilated surface on the same grid.
+
+    Raises
+    ------
+    ValueError
+        ``field`` is not a GridField, ``radius <= 0``, or the box leaves no room for the dilation.
 
     Examples
     --------
@@ -93,6 +121,28 @@ def dilate_erode(field, radius: float, return_field: bool = False):
 
 def erode_dilate(field, radius: float, return_field: bool = False):
     """Morphological opening of the shape {φ ≤ 0}: offset by −radius, then by +radius (§9.3.1).
+
+    Parameters
+    ----------
+    field : GridField
+        Signed distance, negative inside.
+    radius : float
+        Positive distance, model units: parts thinner than about twice it are removed.
+    return_field : bool, default False
+        Also return the signed distance grid of the eroded surface.
+
+    Returns
+    -------
+    V : (n, 3) float64
+    F : (m, 3) int64
+        The opened surface.
+    field : GridField
+        Only with ``return_field``: the exact signed distance to the eroded surface on the same grid.
+
+    Raises
+    ------
+    ValueError
+        ``field`` is not a GridField, ``radius <= 0``, or nothing is left after the erosion.
 
     Examples
     --------

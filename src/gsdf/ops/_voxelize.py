@@ -182,12 +182,26 @@ def save_voxels(path, occ, bbox_min, bbox_max) -> None:
     Keys: ``occupancy`` (nx, ny, nz) bool, ``bbox_min``, ``bbox_max`` (3,) float64 (grid corners),
     ``voxel_size`` (3,) float64 and ``kind = "voxels"``. Read back with :func:`load_voxels`.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file; it must end in ``.npz``.
+    occ : (nx, ny, nz) bool or 0/1 array
+        Occupancy of the cells (e.g. from :func:`gsdf.voxelize`).
+    bbox_min, bbox_max : (3,) float
+        Outer corners of the grid of cells, model units.
+
+    Raises
+    ------
+    ValueError
+        Another extension, a non-boolean ``occ``, a bad box, a failed write.
+
     Examples
     --------
-    >>> import numpy as np, tempfile, os
-    >>> from gsdf.ops import save_voxels, load_voxels
+    >>> import numpy as np, tempfile, os, gsdf
+    >>> from gsdf.ops import load_voxels
     >>> p = os.path.join(tempfile.mkdtemp(), "v.npz")
-    >>> save_voxels(p, np.ones((2, 2, 2), bool), [0, 0, 0], [1, 1, 1])
+    >>> gsdf.save_voxels(p, np.ones((2, 2, 2), bool), [0, 0, 0], [1, 1, 1])
     >>> int(load_voxels(p)[0].sum())
     8
     """
@@ -234,6 +248,8 @@ def voxels_to_mesh(occ, bbox_min, bbox_max, report: bool = False):
         Occupancy, e.g. from :func:`voxelize`.
     bbox_min, bbox_max : (3,) float
         Grid corners.
+    report : bool, default False
+        Also return what the mesh is (closed, manifold, welded, and the counts of non-manifold elements).
 
     Returns
     -------
@@ -243,6 +259,11 @@ def voxels_to_mesh(occ, bbox_min, bbox_max, report: bool = False):
         Outward-oriented triangles; ``(0, 3)`` arrays when nothing is occupied.
     report : dict
         Only with ``report=True``: closed / edge-manifold / vertex-manifold / welded and counts.
+
+    Raises
+    ------
+    ValueError
+        A non-boolean ``occ``, a bad box, a grid too large for the memory.
 
     Examples
     --------

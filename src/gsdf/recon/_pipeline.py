@@ -35,8 +35,8 @@ The pipeline of Chen, Li & Huang 2026 (seed 003) with the fixes of the implement
 7. :func:`_output_vertices` — back to input coordinates (input points that kept their place get their exact
    input coordinates).
 
-Example
--------
+Examples
+--------
 >>> import numpy as np, gsdf
 >>> rng = np.random.default_rng(0)
 >>> P = rng.normal(size=(2000, 3)); P /= np.linalg.norm(P, axis=1)[:, None]
@@ -96,7 +96,10 @@ class ReconstructionOptions:
         (:func:`gsdf.recon._relocate.local_surface`). Vertex positions only: the faces are the same for every
         value.
 
-    A ValueError names the attribute when a value is out of range.
+    Raises
+    ------
+    ValueError
+        Naming the attribute when a value is out of range.
 
     Examples
     --------

@@ -171,8 +171,9 @@ def _overlay_boxes(ps, bars, legends, width, height):
     """Pixel boxes (x0, y0, x1, y1) of the colour bars (top left) and of the legends drawn afterwards."""
     ui = ps.get_ui_scale()
     out = []
-    if bars:
-        out.append((0, 0, 18 * ui + sum(_bar_width(t, ui) + 24 * ui for t in bars), 300 * ui))
+    if bars:                                  # with a margin of about 2 % of the picture around the bars
+        out.append((0, 0, 18 * ui + sum(_bar_width(t, ui) + 24 * ui for t in bars) + 0.02 * width,
+                    300 * ui + 0.02 * height))
     if legends:
         s = height / 900
         rows = sum(len(lab.legend) for lab in legends)
@@ -237,17 +238,9 @@ def _register_volume(ps, vol):
 # ---------------------------------------------------------------------------------------------------------------
 
 def _font(size: int):
-    from PIL import ImageFont
+    from gsdf.render._png import font
 
-    for name in ("DejaVuSans.ttf", "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"):
-        try:
-            return ImageFont.truetype(name, size)
-        except OSError:
-            pass
-    try:
-        return ImageFont.load_default(size=size)
-    except TypeError:  # pragma: no cover - Pillow < 10.1
-        return ImageFont.load_default()
+    return font(size)
 
 
 def draw_legends(img, legends, right: bool = False):

@@ -34,8 +34,8 @@ import numpy as np
 #: Colours of the categorical labels (label values in increasing order cycle through them).
 PALETTE = ((0.80, 0.80, 0.82), (0.95, 0.55, 0.20), (0.25, 0.55, 0.85), (0.40, 0.75, 0.35),
            (0.85, 0.30, 0.45), (0.60, 0.45, 0.80), (0.55, 0.40, 0.30), (0.95, 0.85, 0.30))
-#: Colours of curve items, in turn.
-CURVE_COLORS = ((0.95, 0.35, 0.10), (0.10, 0.70, 0.30), (0.75, 0.15, 0.60), (0.10, 0.45, 0.85))
+#: Colours of curve items, in turn (the first, green, stands out on the coolwarm map and on the label colours).
+CURVE_COLORS = ((0.10, 0.70, 0.30), (0.95, 0.35, 0.10), (0.75, 0.15, 0.60), (0.10, 0.45, 0.85))
 MESH_COLOR = (0.75, 0.75, 0.78)
 CLOUD_COLOR = (0.35, 0.55, 0.85)
 _AXES = {"x": 0, "y": 1, "z": 2}
@@ -337,39 +337,48 @@ class Scene:
 # ---------------------------------------------------------------------------------------------------------------
 
 def round_up(a: float) -> float:
-    """``a`` > 0 rounded up to two significant digits (0.7495 -> 0.75), so colour-bar ticks read well."""
-    e = 10.0 ** (math.floor(math.log10(a)) - 1)
-    return math.ceil(a / e - 1e-9) * e
+    """``a`` > 0 rounded up to 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 times a power of ten (0.7495 -> 0.8,
+    0.59 -> 0.6), so that the colour bar's ticks (the ends, their halves and 0) read well."""
+    e = 10.0 ** math.floor(math.log10(a))
+    m = next((m for m in (1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0) if a <= m * e * (1 + 1e-9)), 10.0)
+    return float(f"{m * e:.12g}")
 
 
-def field_kind(v: np.ndarray) -> str:
-    """"winding" (values gather at 0 and 1: a winding number or an occupancy), "signed" (changes sign) or
-    "plain"."""
+def field_kind(v: np.ndarray, title: str | None = None) -> str:
+    """"winding" (values gather at 0 and 1: a winding number or an occupancy; with a ``title`` that says so, values
+    gathered at 0 and other integers: a thin shape, or a soup that covers some regions twice), "signed" (changes
+    sign) or "plain"."""
     v = np.asarray(v, float).ravel()
     if v.size == 0:
         return "plain"
     near0, near1 = np.abs(v) < 0.1, np.abs(v - 1.0) < 0.1
+    # the inside of a thin shape is a small part of the box: a title that names a winding number (or an
+    # occupancy) needs only some values near 1
+    hinted = title is not None and any(w in title.lower() for w in ("winding number", "occupancy"))
     if near1.mean() > 0.02 and near0.mean() > 0.02 and (near0 | near1).mean() > 0.6 and v.min() > -0.5 \
             and v.max() < 1.5:
         return "winding"
+    if hinted and near0.mean() > 0.02 and (np.abs(v - np.round(v)) < 0.1).mean() > 0.6 and v.max() > 0.5:
+        return "winding"        # doubly covered regions of a soup wind twice
     if v.min() < 0.0 < v.max():
         return "signed"
     return "plain"
 
 
 def colour_range(v, kind: str, vrange=None) -> tuple:
-    """The range of the colour map: ``vrange`` if given; symmetric about 0 ("signed") or 1/2 ("winding") with
-    a rounded half-width; else the data range."""
+    """The range of the colour map: ``vrange`` if given; symmetric about 0 with a rounded half-width
+    ("signed"); [0, 1] ("winding"); else the data range."""
     v = np.asarray(v, float)
     if vrange is not None:
         lo, hi = (float(x) for x in vrange)
         if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
             raise ValueError(f"vrange: expected (low, high) with low < high, got {vrange!r}")
         return lo, hi
-    if kind in ("signed", "winding"):
-        c = 0.0 if kind == "signed" else 0.5
-        a = round_up(float(np.max(np.abs(v - c))) or 1.0)
-        return c - a, c + a
+    if kind == "winding":                   # 0 outside, 1 inside: ticks 0, 1/4, 1/2, 3/4, 1 (beyond: the end colours)
+        return 0.0, 1.0
+    if kind == "signed":
+        a = round_up(float(np.max(np.abs(v))) or 1.0)
+        return -a, a
     lo, hi = float(v.min()), float(v.max())
     return (lo, hi) if hi > lo else (lo - 0.5, lo + 0.5)
 
@@ -672,7 +681,7 @@ def build(items, options, view_dir, upv) -> Scene:
 
 
 def _scalar(title, v, on, options):
-    kind = field_kind(v)
+    kind = field_kind(v, title)
     vr = colour_range(v, kind, options.vrange)
     cmap = options.colormap or ("coolwarm" if kind in ("signed", "winding") else "viridis")
     return Scalar(title, v, on, vr, cmap, (float(v.min()), float(v.max()))), kind

@@ -34,8 +34,8 @@ class ViewOptions:
         (white at 0, or at 1/2 for winding numbers) for fields that change sign and for winding numbers,
         "viridis" for the others.
     vrange : (float, float), optional
-        Values at the ends of the colour map. Default: symmetric about 0 (1/2) with a rounded half-width for
-        diverging maps, else the range of the values.
+        Values at the ends of the colour map. Default: symmetric about 0 with a rounded half-width for fields
+        that change sign, [0, 1] for winding numbers and occupancies, else the range of the values.
 
     Examples
     --------
@@ -132,7 +132,7 @@ def view(*items, screenshot=None, size=(1200, 900), up="auto", azimuth: float = 
     Raises
     ------
     ImportError
-        Without polyscope (``pip install 'gsdf[view]'``).
+        Without polyscope (the ``view`` extra: ``pip install -e ".[view]"`` in a checkout of gsdf).
     RuntimeError
         Without a display and no ``screenshot``; or when EGL cannot start for a screenshot.
     ValueError

@@ -4,6 +4,7 @@
 the curves' gaps), ``_insert`` (curves through faces inserted into the mesh by cutting).
 """
 
+from gsdf.swn._insert import insert_surface_points
 from gsdf.swn._solver import SurfaceWindingNumbers, SWNOptions, surface_winding_number
 
-__all__ = ["SurfaceWindingNumbers", "SWNOptions", "surface_winding_number"]
+__all__ = ["SurfaceWindingNumbers", "SWNOptions", "surface_winding_number", "insert_surface_points"]

@@ -94,21 +94,44 @@ def surface_points_to_curves(curves, F):
 
 def insert_surface_points(V, F, curves):
     """Cut the mesh along curves given as surface points (geometry unchanged), so that surface winding
-    numbers can be solved on it: :func:`insert_curves` of :func:`surface_points_to_curves`. Consecutive points
-    must share a face (a curve crossing an edge has a point on it, as :func:`gsdf.contour._surface_curves.
-    level_set_curves` makes them).
+    numbers can be solved on it: :func:`insert_curves` of :func:`surface_points_to_curves`.
 
-    Returns ``(V2, F2, segments, parent)`` as :func:`insert_curves`; ``SurfaceWindingNumbers(V2, F2)
-    .solve(list(segments))`` then solves for the curves.
+    Parameters
+    ----------
+    V : (n, 3) float
+        Vertex positions.
+    F : (m, 3) int
+        Triangles.
+    curves : list of lists of (face, barycentric (3,))
+        Curves as surface points; consecutive points must share a face (a curve crossing an edge has a point
+        on it, as :func:`gsdf.level_set_curves` makes them).
 
-    Example
+    Returns
     -------
-    >>> import numpy as np
+    V2 : (n2, 3) float64
+        The input vertices, then the points inserted.
+    F2 : (m2, 3) int64
+        The cut triangles (the same surface).
+    segments : (s, 2) int64
+        The curves as vertex pairs of ``V2`` along edges of ``F2``, in the input's orientation.
+    parent : (m2,) int64
+        The input face each cut triangle lies in.
+
+    Raises
+    ------
+    ValueError
+        Points outside their faces, consecutive points without a common face.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> from gsdf.swn import insert_surface_points
     >>> V = np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]); F = np.array([[0, 1, 2], [1, 3, 2]])
     >>> curve = [(0, [0.6, 0.2, 0.2]), (0, [0.0, 0.5, 0.5]), (1, [0.2, 0.6, 0.2])]   # crosses edge 1-2 at its middle
     >>> V2, F2, segs, parent = insert_surface_points(V, F, [curve])
     >>> len(V2), len(segs)
     (7, 2)
+    >>> res = gsdf.SurfaceWindingNumbers(V2, F2).solve(list(segs))      # the curves' regions, on the cut mesh
     """
     return insert_curves(V, F, surface_points_to_curves(curves, F))
 

@@ -40,8 +40,8 @@ Boundaries (spec §1(e).5): the jump Laplace problem has zero-Neumann conditions
 (together with the boundary) and an arc joining two boundary circles does not; curves ending on the boundary are
 closed.
 
-Example
--------
+Examples
+--------
 >>> import numpy as np
 >>> from gsdf.swn._solver import SurfaceWindingNumbers
 >>> swn = SurfaceWindingNumbers(V, F)                                         # doctest: +SKIP
@@ -89,7 +89,10 @@ class SWNOptions:
         Seconds the residual LPs may take, summed over the decomposition passes; beyond it a ValueError that
         names ``method="reduced"`` (one unknown per curve piece) as the fallback.
 
-    A ValueError names the attribute when a value is out of range.
+    Raises
+    ------
+    ValueError
+        Naming the attribute when a value is out of range.
 
     Examples
     --------
@@ -163,21 +166,35 @@ class SurfaceWindingNumbers:
     Parameters
     ----------
     V : (n, 3) float
-    F : (m, 3) int — a manifold, consistently oriented mesh (any genus, boundary allowed); a ValueError names
-        the first non-manifold edge / vertex or misoriented edge otherwise.
+        Vertex positions, model units.
+    F : (m, 3) int
+        Triangles of a manifold, consistently oriented mesh (any genus, boundary allowed).
 
     Attributes
     ----------
-    dec : TriangleDEC
-    betti_1 : int, first Betti number (0: simply connected, no LP needed)
+    dec : gsdf.dec.TriangleDEC
+        The discrete exterior calculus operators of the mesh (edges, d0, d1, Hodge stars).
+    betti_1 : int
+        First Betti number (0: simply connected, no LP needed).
+    simply_connected : bool
+        ``betti_1 == 0``.
+
+    Raises
+    ------
+    ValueError
+        Naming the first non-manifold edge or vertex, or misoriented edge; bad shapes or indices.
 
     Examples
     --------
     A closed loop on a flat grid bounds the square it runs around (counter-clockwise: label 1 inside):
 
-    >>> from gsdf.data._shapes import grid_mesh
-    >>> V, F = grid_mesh(8)                                  # 9 x 9 vertices, vertex (i, j) = 9 i + j
-    >>> swn = SurfaceWindingNumbers(V, F)
+    >>> import numpy as np, gsdf
+    >>> x = np.linspace(-1, 1, 9)
+    >>> V = np.array([[a, b, 0.0] for a in x for b in x])     # 9 x 9 vertices, vertex (i, j) = 9 i + j
+    >>> i = np.arange(81).reshape(9, 9)
+    >>> a, b, c, d = i[:-1, :-1].ravel(), i[1:, :-1].ravel(), i[1:, 1:].ravel(), i[:-1, 1:].ravel()
+    >>> F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])      # normals +z
+    >>> swn = gsdf.SurfaceWindingNumbers(V, F)
     >>> sq = [list(range(a, b, s)) for a, b, s in ((20, 56, 9), (56, 60, 1), (60, 24, -9), (24, 20, -1))]
     >>> res = swn.solve([sum(sq, []) + [20]])                # (-.5,-.5) -> (.5,-.5) -> (.5,.5) -> (-.5,.5)
     >>> int(res.face_labels.sum())                           # the 4 x 4 square: 32 triangles
@@ -195,13 +212,35 @@ class SurfaceWindingNumbers:
 
     # ------------------------------------------------------------------------------------------ curve input
     def chain(self, curves) -> np.ndarray:
-        """Integer edge chain g (nE,) of curves given along mesh edges.
+        """The integer edge chain of curves given along mesh edges (how many times, and which way, each edge is
+        traversed).
 
-        ``curves`` is a list whose items are vertex polylines (a closed curve repeats its first vertex at the
-        end), :class:`gsdf.Curve` objects (vertex polylines, oriented edge sets, or surface points that all lie
-        on vertices), or an integer array (nE,) that already is a chain. Every pair of consecutive vertices must
-        be joined by a mesh edge. Curves with points inside faces or on edges are refused: cut the mesh along
-        them first (:func:`gsdf.swn._insert.insert_surface_points`).
+        Parameters
+        ----------
+        curves : list or (nE,) int array
+            Vertex polylines (a closed curve repeats its first vertex at the end), :class:`gsdf.Curve` objects
+            (vertex polylines, oriented edge sets, or surface points that all lie on vertices), or an integer
+            array (nE,) that already is a chain. Every pair of consecutive vertices must be joined by a mesh
+            edge. Curves with points inside faces or on edges are refused: cut the mesh along them first
+            (:func:`gsdf.swn._insert.insert_surface_points`).
+
+        Returns
+        -------
+        (nE,) float64
+            Integer counts per edge of ``dec.edges``: +1 along the edge's direction (low to high vertex), -1
+            against it.
+
+        Raises
+        ------
+        ValueError
+            Consecutive vertices not joined by an edge, indices out of range, unsigned curves, points inside
+            faces, an empty list.
+
+        Examples
+        --------
+        >>> g = swn.chain([loop])                                    # doctest: +SKIP
+        >>> int(np.abs(g).sum())                                     # doctest: +SKIP
+        16
         """
         from gsdf.curves import Curve, _looks_like_point_list
 
@@ -311,18 +350,40 @@ class SurfaceWindingNumbers:
 
         Parameters
         ----------
-        curves : list of vertex polylines along mesh edges, :class:`gsdf.Curve` objects, or an integer edge
-            chain (nE,) (see :meth:`chain`)
-        method : "lp" (full residual LP, thesis §6.1), "reduced" (reduced LP, §6.3) or "none" (naive rounding of
-            u). On simply connected surfaces no LP is needed and "lp" and "reduced" give the same result.
-        options : SWNOptions, optional — the residual LP's weight ε and time limit
-        progress : callable ``progress(stage, fraction)``, optional — called as each step starts (jump solve,
-            Darboux derivative, Hodge decomposition, residual LP, final solve) and once at the end (fraction 1)
+        curves : list or (nE,) int array
+            Vertex polylines along mesh edges, :class:`gsdf.Curve` objects, or an integer edge chain (see
+            :meth:`chain`). Curves may be broken (gaps) or not bound anything (nonbounding loops round a
+            handle).
+        method : {"lp", "reduced", "none"}, default "lp"
+            The residual that removes the nonbounding part: the full LP (thesis §6.1), the reduced LP (one
+            unknown per curve piece, §6.3; faster on large meshes with handles), or none (naive rounding of u).
+            On simply connected surfaces no LP is needed and "lp" and "reduced" give the same result.
+        options : SWNOptions, optional
+            The residual LP's weight ε and time limit (:class:`gsdf.SWNOptions`).
+        progress : callable, optional
+            ``progress(stage, fraction)``, called as each step starts (jump solve, Darboux derivative, Hodge
+            decomposition, residual LP, final solve) and once at the end (fraction 1).
 
         Returns
         -------
         SWNResult
+            ``face_labels`` (m,) int, ``corner_values`` (m, 3), ``residual`` per edge, ``u`` per corner,
+            timings.
 
+        Raises
+        ------
+        ValueError
+            Malformed curves (see :meth:`chain`), an unknown ``method``, curves only on the boundary, an LP
+            that fails or exceeds its time limit.
+
+        Examples
+        --------
+        >>> res = swn.solve([loop], method="reduced")                # doctest: +SKIP
+        >>> res.face_labels.shape                                    # doctest: +SKIP
+        (128,)
+
+        Notes
+        -----
         Interior endpoints: a discrete branch point on simply connected surfaces (an angular ramp of the corner
         values round the endpoint, :meth:`gsdf.dec.TriangleDEC.branch_coordinates`), excluded with projective
         interpolation of their corners on the others (:meth:`_jump_solve`). Face labels: with ``method="lp"`` or
@@ -503,13 +564,31 @@ class SurfaceWindingNumbers:
                          label_shift=shift, timings=T)
 
     def label_values(self, w: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        """Corner values used for the labels: at interior endpoints, projective interpolation (spec §1(b) step ①,
-        thesis §6.1: near an endpoint the winding number is constant along rays from it) — the corner of an
-        endpoint takes the mean of its face's other corners, so a face touching an endpoint is labelled by the
-        value of its far edge (for a linear w that is also the side holding most of its area). A face whose
-        corners are all endpoints keeps its values. With the exclusion rule of :meth:`_jump_solve` the corners are
-        filled this way already (no change); with the branch rule the endpoint corners hold the ramp of the
-        branch point, whose values say little about the face's side of the level set."""
+        """Corner values used for the labels: at interior endpoints, projective interpolation (thesis §6.1: near
+        an endpoint the winding number is constant along rays from it).
+
+        The corner of an endpoint takes the mean of its face's other corners, so a face touching an endpoint is
+        labelled by the value of its far edge (for a linear w that is also the side holding most of its area).
+        A face whose corners are all endpoints keeps its values. With the exclusion rule of the jump solve the
+        corners are filled this way already (no change); with the branch rule the endpoint corners hold the ramp
+        of the branch point, whose values say little about the face's side of the level set.
+
+        Parameters
+        ----------
+        w : (m, 3) float
+            Corner values of the winding number.
+        ends : (n,) bool
+            The curves' interior endpoints (vertices).
+
+        Returns
+        -------
+        (m, 3) float64
+            ``w`` with the endpoint corners filled (``w`` itself when there are no endpoints).
+
+        Examples
+        --------
+        >>> wl = swn.label_values(res.corner_values, ends)          # doctest: +SKIP
+        """
         E = ends[self.dec.F]
         if not E.any():
             return w
@@ -536,7 +615,7 @@ class SurfaceWindingNumbers:
 
         1. pairing: the label boundary of ``round(wf - s)`` off the curves is split into connected pieces; a
            piece that touches exactly two endpoints of the bounding curves names a gap (a, b);
-        2. closing path: the shortest edge path from a to b off the curves, edges weighted ℓ / (|Δw| + eps)
+        2. closing path: the shortest edge path from a to b off the curves, edges weighted ``ℓ / (|Δw| + eps)``
            with Δw the jump of the face values across the edge — it follows the steepest part of w, where the
            pencil's members crowd, i.e. where w crosses the gap (one numba pass of point-to-point Dijkstra
            searches over all gaps, :mod:`gsdf.swn._gaps`);
@@ -549,16 +628,28 @@ class SurfaceWindingNumbers:
 
         Parameters
         ----------
-        wf : (m,) face values (the mean of a face's corners, :meth:`label_values` applied)
-        bounding : (nE,) the bounding curves as an edge chain (rounded; nonzero edges are curve edges)
-        ends : (n,) bool, the chain's interior endpoints
-        s : float, the global offset of :meth:`rounding_offset`
-        eps : float > 0, the path weight's floor on |Δw|
-        max_edges : int >= 1, the longest closing path (in edges) whose level is used
+        wf : (m,) float
+            Face values (the mean of a face's corners, :meth:`label_values` applied).
+        bounding : (nE,) float
+            The bounding curves as an edge chain (rounded; nonzero edges are curve edges).
+        ends : (n,) bool
+            The chain's interior endpoints.
+        s : float
+            The global offset of :meth:`rounding_offset`.
+        eps : float, default 0.1
+            The path weight's floor on ``|Δw|`` (> 0).
+        max_edges : int, default 8
+            The longest closing path (in edges, >= 1) whose level is used.
 
         Returns
         -------
-        (m,) float in [-½, ½), 0 away from the gaps
+        (m,) float64
+            Shifts in [-½, ½), 0 away from the gaps.
+
+        Examples
+        --------
+        >>> shift = swn.gap_shift(wf, bounding, ends, s)             # doctest: +SKIP
+        >>> labels = np.round(wf - s - shift)                         # doctest: +SKIP
         """
         dec = self.dec
         wf = np.asarray(wf, dtype=float)
@@ -583,7 +674,7 @@ class SurfaceWindingNumbers:
         Across a bounding input edge w jumps by ≈ 1, so the mean of its two faces' values is the half-integer
         level separating them (thesis §7.1 takes the half-integer level from the values along the input curves).
         s is the circular mean (mod 1) of these mid-values minus ½, weighted by edge length times the bounding
-        part |g − Jv|, over the edges whose bounding part rounds to a nonzero jump (edges found mostly
+        part ``|g − Jv|``, over the edges whose bounding part rounds to a nonzero jump (edges found mostly
         nonbounding should not separate labels and carry no information). Without bounding input edges:
         the area-weighted circular mean of w (w is known up to a constant; a 50/50 split leaves w ≈ ±½).
 
@@ -592,7 +683,26 @@ class SurfaceWindingNumbers:
         part of the circle (f the fraction present) — exactly the mean of the two sides on the arcs, (f+1)/2
         and (f−1)/2. So rounding at the curves' level closes such gaps along the circle. Near a mesh boundary
         the zero-Neumann reflection moves the level inside gaps away from the curves' level; not corrected
-        here."""
+        here.
+
+        Parameters
+        ----------
+        wf : (m,) float
+            Face values of the winding number.
+        g : (nE,) float
+            The input curves as an edge chain (:meth:`chain`).
+        Jv : (nE,) float
+            The residual (nonbounding part) per edge; zeros when there is none.
+
+        Returns
+        -------
+        float
+            The offset s.
+
+        Examples
+        --------
+        >>> s = swn.rounding_offset(wf, g, np.zeros_like(g))         # doctest: +SKIP
+        """
         dec, topo = self.dec, self.topology
         ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
         b = g[ce] - Jv[ce]
@@ -777,8 +887,8 @@ def bounding_segments(swn: SurfaceWindingNumbers, res: SWNResult) -> list:
     distance) as oriented 2-vertex polylines: every input edge whose bounding multiplicity ``round(g − Jv)`` is
     nonzero, repeated that many times, in its direction.
 
-    Example
-    -------
+    Examples
+    --------
     >>> res = swn.solve(curves)                                               # doctest: +SKIP
     >>> segs = bounding_segments(swn, res)                                    # doctest: +SKIP
     >>> phi = SurfaceSignedHeatSolver(V, F).compute_distance(segs)            # doctest: +SKIP
@@ -796,18 +906,49 @@ def surface_winding_number(V, F, curves, *, method: str = "lp", options: SWNOpti
                            progress=None) -> SWNResult:
     """One-call surface winding numbers (thesis ch. 6): ``SurfaceWindingNumbers(V, F).solve(curves, ...)``.
 
+    The integer-valued winding number of curves drawn on a surface, per face: the regions the curves bound,
+    also when they have gaps (closed by the LP) or run round handles without bounding anything.
+
     Parameters
     ----------
-    V : (n, 3) float; F : (m, 3) int — a manifold, consistently oriented triangle mesh
-    curves, method, options, progress : as :meth:`SurfaceWindingNumbers.solve`
+    V : (n, 3) float
+        Vertex positions.
+    F : (m, 3) int
+        Triangles of a manifold, consistently oriented mesh (any genus, boundary allowed).
+    curves : list or (nE,) int array
+        Vertex polylines along mesh edges, :class:`gsdf.Curve` objects or an edge chain (see
+        :meth:`SurfaceWindingNumbers.chain`); a counter-clockwise loop (seen from the normals) makes its
+        inside 1.
+    method : {"lp", "reduced", "none"}, default "lp"
+        The residual that removes the nonbounding part: the full LP (thesis §6.1), the reduced LP (§6.3), or
+        none (naive rounding).
+    options : SWNOptions, optional
+        The LP's weight ε of jumps along the input curves and its time limit (:class:`gsdf.SWNOptions`).
+    progress : callable, optional
+        ``progress(stage, fraction)`` as each step starts.
 
     Returns
     -------
-    SWNResult (``face_labels``, ``corner_values``, ``residual``, ``u``, ...)
+    SWNResult
+        ``face_labels`` (m,) int, ``corner_values`` (m, 3) float, ``residual`` (nE,) (the nonbounding part per
+        edge), ``u`` (m, 3), ``timings``.
+
+    Raises
+    ------
+    ValueError
+        A non-manifold or misoriented mesh, malformed curves, an unknown method, an LP that fails.
 
     Examples
     --------
-    >>> res = surface_winding_number(V, F, [loop])                          # doctest: +SKIP
-    >>> res.face_labels                                                     # doctest: +SKIP
+    >>> import numpy as np, gsdf
+    >>> x = np.linspace(-1, 1, 9)
+    >>> V = np.array([[a, b, 0.0] for a in x for b in x])          # vertex (i, j) = 9 i + j
+    >>> i = np.arange(81).reshape(9, 9)
+    >>> a, b, c, d = i[:-1, :-1].ravel(), i[1:, :-1].ravel(), i[1:, 1:].ravel(), i[:-1, 1:].ravel()
+    >>> F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    >>> loop = np.concatenate([i[2:6, 2], i[6, 2:6], i[6:2:-1, 6], i[2, 6:1:-1]])   # counter-clockwise
+    >>> res = gsdf.surface_winding_number(V, F, [loop])
+    >>> int(res.face_labels.sum())                                   # the 4 x 4 square inside: 32 triangles
+    32
     """
     return SurfaceWindingNumbers(V, F).solve(curves, method=method, options=options, progress=progress)

@@ -137,15 +137,30 @@ class SignedHopfCole(_Convolution):
     Parameters
     ----------
     P, N : (n, 3) float
-        Oriented points (outward normals).
+        Oriented points (outward normals, any length), model units.
     areas : (n,) float, optional
-        Point areas A_i (default :func:`gsdf.point_areas`).
-    C : float
-        λ_x = C/σ_x (Eq. 5.7) unless ``lam`` fixes λ.
+        Point areas A_i (square model units); default :func:`gsdf.point_areas` (k = 20; ones below 21 points).
+    C : float, default 64.0
+        Screening constant of Eq. 5.7: λ_x = C / σ_x, σ_x the query's distance scale (thesis §5.1.3); larger is
+        sharper. Ignored when ``lam`` is given.
     lam : float, optional
-        A fixed screening λ instead of the per-query heuristic.
-    r_eval, k_eval, k_fallback
-        Neighbour selection (see :class:`gsdf.tori._blend.NeighbourBlend`).
+        A fixed screening λ (1 / model units) instead of the per-query C / σ_x.
+    r_eval : float, optional
+        Summation radius R_eval, model units: points within it are summed. Default: twice the median distance
+        from a point to its 32nd neighbour.
+    k_eval : int, default 64
+        Most points summed per query.
+    k_fallback : int, default 32
+        Points summed (the nearest) when fewer than this many lie within R_eval (§5.1.3).
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite values, negative or all-zero areas, non-positive constants.
+
+    Notes
+    -----
+    Calling the object, ``f(Q)``, is the same as :meth:`signed_distance`.
 
     Examples
     --------
@@ -161,14 +176,59 @@ class SignedHopfCole(_Convolution):
 
     @query_shaped()
     def signed_distance(self, Q) -> np.ndarray:
-        """φ_SHC at the query points (q,)."""
+        """φ_SHC (Eq. 5.8) at the query points.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        (q,) float64
+            Signed distance estimate, negative inside.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> P = np.array([[x, y, 0.0] for x in range(-3, 4) for y in range(-3, 4)])
+        >>> f = gsdf.SignedHopfCole(P, np.tile([0, 0, 1.0], (49, 1)), areas=np.ones(49))
+        >>> bool(f.signed_distance([[0.0, 0.0, 0.5]])[0] > 0)
+        True
+        """
         return self(Q)
 
 
 class SmoothedSignedPlanarDistance(_Convolution):
     """Smoothed signed planar distance, Eq. 5.9 (self-normalized tangent-plane blend); negative inside.
 
-    Same parameters as :class:`SignedHopfCole`.
+    Parameters
+    ----------
+    P, N : (n, 3) float
+        Oriented points (outward normals, any length), model units.
+    areas : (n,) float, optional
+        Point areas A_i (square model units); default :func:`gsdf.point_areas` (k = 20; ones below 21 points).
+    C : float, default 64.0
+        Screening constant of Eq. 5.7: λ_x = C / σ_x, σ_x the query's distance scale (thesis §5.1.3); larger is
+        sharper. Ignored when ``lam`` is given.
+    lam : float, optional
+        A fixed screening λ (1 / model units) instead of the per-query C / σ_x.
+    r_eval : float, optional
+        Summation radius R_eval, model units: points within it are summed. Default: twice the median distance
+        from a point to its 32nd neighbour.
+    k_eval : int, default 64
+        Most points summed per query.
+    k_fallback : int, default 32
+        Points summed (the nearest) when fewer than this many lie within R_eval (§5.1.3).
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite values, negative or all-zero areas, non-positive constants.
+
+    Notes
+    -----
+    Calling the object, ``f(Q)``, is the same as :meth:`signed_distance`.
 
     Examples
     --------
@@ -182,14 +242,63 @@ class SmoothedSignedPlanarDistance(_Convolution):
 
     @query_shaped()
     def signed_distance(self, Q) -> np.ndarray:
-        """φ_SSPD at the query points (q,)."""
+        """φ_SSPD (Eq. 5.9) at the query points.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        (q,) float64
+            Signed distance estimate, negative inside.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> P = np.array([[x, y, 0.0] for x in range(-3, 4) for y in range(-3, 4)])
+        >>> f = gsdf.SmoothedSignedPlanarDistance(P, np.tile([0, 0, 1.0], (49, 1)), areas=np.ones(49))
+        >>> f.signed_distance([[0.2, 0.1, -0.5]]).tolist()
+        [-0.5]
+        """
         return self(Q)
 
 
 class LogSumExpDistance(_Convolution):
     """Unsigned LogSumExp distance (Eq. 3.15 with h = A_i; Madan & Levin 2022). Normals are not used.
 
-    Same parameters as :class:`SignedHopfCole`; ``N`` may be None.
+    Parameters
+    ----------
+    P : (n, 3) float
+        Points, model units.
+    N : (n, 3) float, optional
+        Ignored (accepted for the same call as the signed baselines).
+    areas : (n,) float, optional
+        Point areas A_i (square model units); default :func:`gsdf.point_areas` (k = 20; ones below 21 points).
+    C : float, default 64.0
+        Screening constant of Eq. 5.7: λ_x = C / σ_x, σ_x the query's distance scale (thesis §5.1.3); larger is
+        sharper. Ignored when ``lam`` is given.
+    lam : float, optional
+        A fixed screening λ (1 / model units) instead of the per-query C / σ_x.
+    r_eval : float, optional
+        Summation radius R_eval, model units: points within it are summed. Default: twice the median distance
+        from a point to its 32nd neighbour.
+    k_eval : int, default 64
+        Most points summed per query.
+    k_fallback : int, default 32
+        Points summed (the nearest) when fewer than this many lie within R_eval (§5.1.3).
+    **kw
+        ``areas``, ``C``, ``lam``, ``r_eval``, ``k_eval``, ``k_fallback`` as above, by keyword.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite values, negative or all-zero areas, non-positive constants.
+
+    Notes
+    -----
+    Calling the object, ``f(Q)``, is the same as :meth:`unsigned_distance`.
 
     Examples
     --------
@@ -213,7 +322,25 @@ class LogSumExpDistance(_Convolution):
 
     @query_shaped()
     def unsigned_distance(self, Q) -> np.ndarray:
-        """LogSumExp distance at the query points (q,)."""
+        """LogSumExp distance (Eq. 3.15) at the query points.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        (q,) float64
+            Unsigned distance estimate (a smooth minimum of the distances to the points).
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> f = gsdf.LogSumExpDistance([[0, 0, 0.0], [5, 0, 0.0]], None, areas=np.ones(2), lam=50.0)
+        >>> f.unsigned_distance([[0, 0, 2.0]]).round(3).tolist()
+        [2.0]
+        """
         return self(Q)
 
 
@@ -223,14 +350,28 @@ class WindingNumberPipeline:
     Parameters
     ----------
     P, N : (n, 3) float
-        Oriented points.
+        Oriented points (outward normals), model units.
     bbox_min, bbox_max : (3,) float, optional
-        Box contoured (default: the cloud's bounding box grown by :data:`gsdf.grid.PAD` × its diagonal).
-    resolution : int or gsdf.Grid
+        Box contoured (default: the cloud's bounding box grown by 0.1 of its diagonal on every side).
+    resolution : int or gsdf.Grid, default 64
         Marching-cubes grid nodes along the longest side of the box (64 as in §7.2); or the
         :class:`gsdf.Grid` to contour on (then omit the box).
     areas : (n,) float, optional
-        Point areas for the winding number.
+        Point areas for the winding number (default: estimated, k = 20).
+
+    Attributes
+    ----------
+    V, F
+        The extracted mesh, (nv, 3) float64 and (nf, 3) int64.
+
+    Raises
+    ------
+    ValueError
+        Bad inputs, or a winding number that never crosses 1/2 in the box (no surface).
+
+    Notes
+    -----
+    Calling the object, ``f(Q)``, is the same as :meth:`signed_distance`.
 
     Examples
     --------
@@ -261,6 +402,27 @@ class WindingNumberPipeline:
 
     @query_shaped()
     def __call__(self, Q) -> np.ndarray:
+        """Signed distance to the extracted mesh at the query points.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        (q,) float64
+            Exact distance to the mesh, negative where its winding number exceeds 1/2.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> i = np.arange(2000) + 0.5
+        >>> ph, th = np.arccos(1 - 2 * i / 2000), np.pi * (1 + 5 ** 0.5) * i
+        >>> P = np.column_stack([np.cos(th) * np.sin(ph), np.sin(th) * np.sin(ph), np.cos(ph)])
+        >>> gsdf.WindingNumberPipeline(P, P, resolution=24).signed_distance([[0, 0, 0]]).round(1).tolist()
+        [-1.0]
+        """
         d = self._dist.query(Q)[0]
         w = self._fwn(Q)
         return np.where(w > 0.5, -d, d)

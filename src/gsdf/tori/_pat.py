@@ -188,19 +188,43 @@ class PointsAsTori:
     N : (n, 3) float
         Outward normals (normalized internally). Rows with zero normals are dropped and exact duplicate
         points are merged (their normals averaged); ``None`` raises ``ValueError``.
-    estimator : {"jet", "learned"}
+    estimator : {"jet", "learned"}, default "jet"
         Coefficient estimator: weighted least-squares jet fitting (:func:`gsdf.tori._fit.jet_coefficients`), or
         the learned regressor of §5.1.2 (:mod:`gsdf.tori._learned`; a small network, weights shipped in
         ``gsdf/tori/pat_weights.npz``, evaluated in numpy; it corrects the jet coefficients, so
         ``normal_weight``/``ridge`` do not apply to it).
-    k : int
-        Neighbours per fit (64 in the thesis); the cloud needs at least ``k`` distinct points.
-    C : float
-        Screening constant of Eq. 5.7 (λ_x = C/σ_x).
+    k : int, default 64
+        Neighbours per fit (64 in the thesis, >= 6); the cloud needs at least ``k`` distinct points. More
+        neighbours fit smoother tori.
+    C : float, default 64.0
+        Screening constant of Eq. 5.7 (λ_x = C/σ_x); larger blends fewer tori per query (sharper, noisier).
     r_eval : float, optional
-        Summation radius R_eval; default twice the median distance of a point to its 32nd neighbour.
+        Summation radius R_eval, model units; default twice the median distance of a point to its 32nd
+        neighbour.
     options : PointsAsToriOptions, optional
         Neighbour selection and jet-fitting options.
+
+    Attributes
+    ----------
+    P, N : (n, 3) float64
+        The cleaned cloud (duplicates merged, zero normals dropped) and its unit normals.
+    tori : (n, 13) float64
+        The fitted tori (thesis Fig. 5.4), model units: per point its position, normal, principal direction,
+        curvatures k1 >= k2 >= 0, s = sign of the larger curvature and e = +1 (same signs) or -1 (saddle)
+        (columns 0-2, 3-5, 6-8, 9, 10, 11, 12).
+    coefficients : (n, 6) float64
+        Height-field coefficients (a00, a10, a01, a20, a11, a02) per point, model units.
+    r_eval : float
+        The summation radius used, model units.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite values, normals missing, fewer than ``k`` distinct points, bad options.
+
+    Notes
+    -----
+    Calling the object, ``pat(Q)``, is the same as :meth:`signed_distance`.
 
     Examples
     --------
@@ -312,21 +336,99 @@ class PointsAsTori:
 
     @query_shaped()
     def signed_distance(self, Q) -> np.ndarray:
-        """Generalized signed distance φ(Q) of Eq. 5.6, (q,) float64; negative inside."""
+        """Generalized signed distance φ of Eq. 5.6 at the query points; negative inside.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units (anywhere: no grid is needed).
+
+        Returns
+        -------
+        (q,) float64
+            φ(Q), model units.
+
+        Raises
+        ------
+        ValueError
+            ``Q`` of the wrong shape or with NaN or infinite coordinates.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> i = np.arange(2000) + 0.5
+        >>> ph, th = np.arccos(1 - 2 * i / 2000), np.pi * (1 + 5 ** 0.5) * i
+        >>> P = np.column_stack([np.cos(th) * np.sin(ph), np.sin(th) * np.sin(ph), np.cos(ph)])
+        >>> gsdf.PointsAsTori(P, P).signed_distance([[0, 0, 0.5], [0, 0, 2.0]]).round(2).tolist()
+        [-0.5, 1.0]
+        """
         return self._eval(Q, False)
 
     __call__ = signed_distance
 
     @query_shaped()
     def gradient(self, Q) -> np.ndarray:
-        """Analytic gradient ∇φ(Q) of Eq. 5.6, (q, 3) float64."""
+        """Analytic gradient ∇φ of Eq. 5.6 at the query points (about unit length, pointing outward).
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, model units.
+
+        Returns
+        -------
+        (q, 3) float64
+
+        Raises
+        ------
+        ValueError
+            ``Q`` of the wrong shape or with NaN or infinite coordinates.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> i = np.arange(2000) + 0.5
+        >>> ph, th = np.arccos(1 - 2 * i / 2000), np.pi * (1 + 5 ** 0.5) * i
+        >>> P = np.column_stack([np.cos(th) * np.sin(ph), np.sin(th) * np.sin(ph), np.cos(ph)])
+        >>> gsdf.PointsAsTori(P, P).gradient([[0, 0, 2.0]]).round(2).tolist()
+        [[0.0, 0.0, 1.0]]
+        """
         return self._eval(Q, True)
 
     def isosurface(self, level: float = 0.0, resolution=64, pad: float = PAD):
         """Mesh of the level set φ = ``level`` (marching cubes + bisection, :func:`gsdf.extract_isosurface`).
 
-        ``resolution``: nodes along the longest side of the cloud's bounding box grown by ``pad`` × its diagonal
-        and by ``|level|`` (:func:`level_grid`), or the :class:`gsdf.Grid` to sample."""
+        Parameters
+        ----------
+        level : float, default 0.0
+            The level, model units (0: the surface; an offset distance for an offset surface).
+        resolution : int or gsdf.Grid, default 64
+            Grid nodes along the longest side of the cloud's bounding box grown by ``pad`` times its diagonal
+            and by ``|level|``; or the :class:`gsdf.Grid` to sample. Time grows with its cube.
+        pad : float, default 0.1
+            Growth of the box on every side, as a fraction of the cloud's bounding-box diagonal.
+
+        Returns
+        -------
+        V : (nv, 3) float64
+        F : (nf, 3) int64
+            Outward oriented (φ < level inside).
+
+        Raises
+        ------
+        ValueError
+            A non-finite level, a bad resolution or pad.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> i = np.arange(2000) + 0.5
+        >>> ph, th = np.arccos(1 - 2 * i / 2000), np.pi * (1 + 5 ** 0.5) * i
+        >>> P = np.column_stack([np.cos(th) * np.sin(ph), np.sin(th) * np.sin(ph), np.cos(ph)])
+        >>> V, F = gsdf.PointsAsTori(P, P).isosurface(0.0, resolution=24)
+        >>> bool(np.abs(np.linalg.norm(V, axis=1) - 1).max() < 0.05)
+        True
+        """
         from gsdf.contour import extract_isosurface
 
         grid = resolution if isinstance(resolution, Grid) else level_grid(self.P, resolution, level, pad)
@@ -335,8 +437,27 @@ class PointsAsTori:
     def save(self, path) -> None:
         """Write the fitted tori (and the cloud) to an ``.npz`` file; reload with :meth:`load`.
 
-        The file is written atomically; a name not ending in ``.npz`` is a ValueError (numpy would silently
-        append the extension)."""
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file, written atomically; it must end in ``.npz`` (numpy would silently append the extension).
+
+        Raises
+        ------
+        ValueError
+            Another extension, or a failed write.
+
+        Examples
+        --------
+        >>> import numpy as np, os, tempfile, gsdf
+        >>> i = np.arange(500) + 0.5
+        >>> ph, th = np.arccos(1 - 2 * i / 500), np.pi * (1 + 5 ** 0.5) * i
+        >>> P = np.column_stack([np.cos(th) * np.sin(ph), np.sin(th) * np.sin(ph), np.cos(ph)])
+        >>> p = os.path.join(tempfile.mkdtemp(), "tori.npz")
+        >>> gsdf.PointsAsTori(P, P).save(p)
+        >>> gsdf.PointsAsTori.load(p).tori.shape
+        (500, 13)
+        """
         from gsdf.io._safe_write import atomic_output
 
         # coefficients and tori in input units (the normalised frame is recomputed from P on load)
@@ -349,8 +470,29 @@ class PointsAsTori:
 
     @classmethod
     def load(cls, path) -> "PointsAsTori":
-        """Read a file written by :meth:`save`; every array is checked against the points (shape, length,
-        finiteness) before any kernel reads it."""
+        """Read a file written by :meth:`save`.
+
+        Every array is checked against the points (shape, length, finiteness) before any kernel reads it.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            An ``.npz`` file written by :meth:`save`.
+
+        Returns
+        -------
+        PointsAsTori
+            Evaluates exactly as the object that was saved.
+
+        Raises
+        ------
+        ValueError
+            Not a saved PointsAsTori file, missing or malformed arrays.
+
+        Examples
+        --------
+        >>> pat = gsdf.PointsAsTori.load("tori.npz")          # doctest: +SKIP
+        """
         from gsdf._checks import readable_file
 
         try:

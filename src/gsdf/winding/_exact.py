@@ -151,6 +151,27 @@ def winding_number_points(P, N, Q, areas=None) -> np.ndarray:
 def winding_number_2d(V, E, Q) -> np.ndarray:
     """Exact winding number of 2D polylines (edge list ``E`` into ``V``) at 2D query points.
 
+    The sum of the signed angles the edges subtend at each query, over 2π (Jacobson et al. 2013, Eq. 2): 1
+    inside a closed counter-clockwise polygon, 0 outside, in between near gaps of an open one.
+
+    Parameters
+    ----------
+    V : (n, 2) float
+        Polyline vertices.
+    E : (m, 2) int
+        Directed edges ``i → j`` into ``V`` (a closed polygon, several, or open pieces).
+    Q : (q, 2) float
+        Query points.
+
+    Returns
+    -------
+    (q,) float64
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, indices out of range.
+
     Examples
     --------
     >>> import numpy as np, gsdf

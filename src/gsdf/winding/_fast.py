@@ -775,13 +775,40 @@ class _FastWindingBase:
 
     @query_shaped()
     def __call__(self, Q, progress=None) -> np.ndarray:
-        """Winding numbers at query points ``Q`` (q, 3); evaluated in parallel chunks."""
+        """Winding numbers at the query points ``Q``, evaluated in parallel chunks (the same as :meth:`query`).
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, in the input's units.
+        progress : callable, optional
+            ``progress(stage, fraction)``, called after each chunk of queries with ``fraction`` in (0, 1].
+
+        Returns
+        -------
+        (q,) float64
+            Generalized winding numbers: about 1 inside a closed outward-oriented surface, 0 outside.
+
+        Raises
+        ------
+        ValueError
+            ``Q`` is not an (q, 3) array of finite numbers, or ``progress`` is not callable.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        >>> gsdf.FastWindingNumber(V, F).query([[0.1, 0.1, 0.1]]).round(3)
+        array([1.])
+        """
         return map_queries(self._kernel, Q, progress=progress, coherent=True, frame=self._frame)
 
     query = __call__
 
     @property
     def n_nodes(self) -> int:
+        """Number of nodes of the tree."""
         return self.tree.n_nodes
 
 
@@ -795,12 +822,20 @@ class FastWindingNumber(_FastWindingBase):
     F : (m, 3) int
         Triangles; soups, holes, self-intersections and flipped components are all fine. Zero-area faces
         contribute nothing.
-    beta : float
-        Accuracy parameter β of Algorithm 1 (default 2: RMS error ~1e-3 in the paper).
-    order : {0, 1, 2}
-        Taylor order of the far-field expansion.
-    leaf_size : int
-        Triangles per tree leaf.
+    beta : float, default 2.0
+        Accuracy parameter β of Algorithm 1 (Barill et al. 2018): a tree node is approximated by its expansion
+        when the query is farther than β times the node's radius. Larger is more accurate and slower (β = 2:
+        RMS error ~1e-3 in the paper).
+    order : {0, 1, 2}, default 2
+        Taylor order of the far-field expansion (§3.2, Eqs. 8–10).
+    leaf_size : int, default 4
+        Triangles per tree leaf (>= 1); changes speed only.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, face indices out of range, ``beta <= 0``, ``order`` not 0, 1 or
+        2.
 
     Examples
     --------
@@ -808,7 +843,7 @@ class FastWindingNumber(_FastWindingBase):
     >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.]])
     >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     >>> fwn = gsdf.FastWindingNumber(V, F)
-    >>> fwn([[0.1, 0.1, 0.1], [5, 5, 5]]).round(3)
+    >>> fwn([[0.1, 0.1, 0.1], [5, 5, 5]]).round(3) + 0.0
     array([1., 0.])
     """
 
@@ -847,13 +882,20 @@ class FastWindingNumberPoints(_FastWindingBase):
     Parameters
     ----------
     P, N : (m, 3) float
-        Points and outward normals (normalized internally).
+        Points and outward normals (normalized internally; their length does not matter).
     areas : (m,) float, optional
-        Point areas a_i; estimated by :func:`gsdf.point_areas` (k = 20) when omitted.
-    beta : float
-        Accuracy parameter (default 2.3: RMS error ~1e-2 in the paper).
-    order : {0, 1, 2}
-        Taylor order.
+        Point areas a_i (Eq. 5; square input units); estimated by :func:`gsdf.point_areas` (k = 20) when omitted.
+    beta : float, default 2.3
+        Accuracy parameter β (the paper's value for clouds: RMS error ~1e-2); larger is more accurate and slower.
+    order : {0, 1, 2}, default 2
+        Taylor order of the far-field expansion (Eqs. 13–15).
+    leaf_size : int, default 8
+        Points per tree leaf (>= 1); changes speed only.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite values, negative areas, ``beta <= 0``, ``order`` not 0, 1 or 2.
 
     Examples
     --------
@@ -889,7 +931,30 @@ class FastWindingNumberPoints(_FastWindingBase):
 def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarray:
     """Fast generalized winding number of a triangle soup at ``Q`` (one call: build the tree, query).
 
-    See :class:`FastWindingNumber` to reuse the tree across calls.
+    Barill et al. 2018, Algorithm 1; see :class:`FastWindingNumber` to reuse the tree across calls.
+
+    Parameters
+    ----------
+    V : (n, 3) float
+        Vertex positions.
+    F : (m, 3) int
+        Triangles; soups, holes, self-intersections and flipped components are all fine.
+    Q : (q, 3) float
+        Query points.
+    beta : float, default 2.0
+        Accuracy parameter β: larger is more accurate and slower (see :class:`FastWindingNumber`).
+    order : {0, 1, 2}, default 2
+        Taylor order of the far-field expansion.
+
+    Returns
+    -------
+    (q,) float64
+        Winding numbers: about 1 inside a closed outward-oriented surface, 0 outside, in between near holes.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, face indices out of range, ``beta <= 0``, a bad ``order``.
 
     Examples
     --------
@@ -908,7 +973,33 @@ def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarra
 def fast_winding_number_points(P, N, Q, areas=None, beta: float = 2.3, order: int = 2) -> np.ndarray:
     """Fast winding number of an oriented point cloud at ``Q``; ``areas=None`` estimates point areas.
 
-    See :class:`FastWindingNumberPoints` to reuse the tree across calls.
+    Barill et al. 2018, Eq. 5 approximated by Eqs. 13–15; see :class:`FastWindingNumberPoints` to reuse the tree
+    across calls.
+
+    Parameters
+    ----------
+    P : (m, 3) float
+        Points.
+    N : (m, 3) float
+        Outward normals (normalized internally).
+    Q : (q, 3) float
+        Query points.
+    areas : (m,) float, optional
+        Point areas (square input units); default: estimated by :func:`gsdf.point_areas` with k = 20.
+    beta : float, default 2.3
+        Accuracy parameter β: larger is more accurate and slower.
+    order : {0, 1, 2}, default 2
+        Taylor order of the far-field expansion.
+
+    Returns
+    -------
+    (q,) float64
+        Winding numbers: about 1 inside, 0 outside.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite values, negative areas, ``beta <= 0``, a bad ``order``.
 
     Examples
     --------

@@ -119,7 +119,28 @@ def _eval(Q, T, lo, hi, right, skip, start, end, ptr, EC, use_cap, out):
 class ExactWindingNumber:
     """Exact winding number of a triangle soup, hierarchical (build once, query many).
 
-    Same values as :func:`gsdf.winding_number` (up to round-off), usually far faster for many queries.
+    Same values as :func:`gsdf.winding_number` (up to round-off), usually far faster for many queries: a node of
+    the tree whose query lies outside its box contributes the solid angle of a small cap over its boundary edges
+    instead of its triangles (the winding number depends only on the boundary there).
+
+    Parameters
+    ----------
+    V : (n, 3) float
+        Vertex positions.
+    F : (m, 3) int
+        Triangles (a soup is fine).
+    leaf_size : int, default 8
+        Triangles per tree leaf (>= 1); changes speed only.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, face indices out of range.
+
+    Notes
+    -----
+    Call the object with query points: ``ewn(Q, progress=None)`` takes ``Q`` (q, 3) and an optional
+    ``progress(stage, fraction)`` callback and returns the (q,) float64 winding numbers.
 
     Examples
     --------
@@ -148,6 +169,8 @@ class ExactWindingNumber:
 
     @query_shaped()
     def __call__(self, Q, progress=None) -> np.ndarray:
+        """Exact winding numbers (q,) at the query points ``Q`` (q, 3); ``progress(stage, fraction)`` after each
+        chunk."""
         return map_queries(self._kernel, Q, progress=progress, coherent=True, frame=self._frame)
 
     def _kernel(self, q, out):

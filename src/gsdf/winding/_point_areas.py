@@ -677,7 +677,7 @@ def estimate_normals(P, k: int = 20, orient_towards=None, chunk: int = 65536) ->
         point *away* from ``c`` (``n_i . (p_i - c) >= 0``), which orients any cloud that is
         star-shaped around ``c`` (e.g. ``c`` = the centroid of a convex-ish scan).
     chunk : int
-        Points processed per batch (bounds memory to ~``chunk * k * 72`` bytes).
+        Points processed per batch (bounds memory to about ``chunk * k * 72`` bytes).
 
     Returns
     -------

@@ -23,21 +23,48 @@ class PointCloudSignedHeatSolver:
 
     Parameters
     ----------
-    P : (n, 3) points; N : (n, 3) consistently oriented normals, or None for PCA normals oriented away from
-        the centroid (fine for star-shaped clouds); k : neighbours per local triangulation of the tufted cover
-        (``n_neighbors`` of robust-laplacian); t_coef : diffusion time ``t = t_coef · ℓ̄²``, ℓ̄ the mean cover
-        edge length.
+    P : (n, 3) float
+        Points (at least 4, spanning a surface), model units.
+    N : (n, 3) float, optional
+        Consistently oriented normals. Default: PCA normals oriented away from the centroid (fine for
+        star-shaped clouds).
+    k : int, default 30
+        Neighbours per local triangulation of the tufted cover (``n_neighbors`` of robust-laplacian).
+    t_coef : float, default 1.0
+        Diffusion time ``t = t_coef · ℓ̄²``, ℓ̄ the mean cover edge length; larger smooths over gaps.
 
     Attributes
     ----------
-    L : (n, n) tufted-cover Laplacian; M : (n,) lumped masses; N, e1, e2 : frames; n_edges : cover edges;
-    domain, core : the :class:`~gsdf.heat.pointcloud._domain.PointCloudDomain` and its
-    :class:`~gsdf.heat._core.SignedHeatCore`.
+    L : (n, n) sparse float64
+        Tufted-cover Laplacian.
+    M : (n,) float64
+        Lumped masses (square model units).
+    N, e1, e2 : (n, 3) float64
+        Per-point frames (normal and two tangents).
+    n_edges : int
+        Edges of the cover.
+    t : float
+        The diffusion time, square model units.
+    domain, core
+        The :class:`~gsdf.heat.pointcloud._domain.PointCloudDomain` and its
+        :class:`~gsdf.heat._core.SignedHeatCore`.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 4 distinct points, identical or collinear points, bad normals, ``k`` or ``t_coef``.
 
     Examples
     --------
-    >>> solver = PointCloudSignedHeatSolver(P, N)                       # doctest: +SKIP
-    >>> phi = solver.compute_distance([np.array([3, 17, 42, 8, 3])])    # doctest: +SKIP
+    >>> import numpy as np, gsdf
+    >>> i = np.arange(1500) + 0.5
+    >>> ph, th = np.arccos(1 - 2 * i / 1500), np.pi * (1 + 5 ** 0.5) * i
+    >>> P = np.column_stack([np.cos(th) * np.sin(ph), np.sin(th) * np.sin(ph), np.cos(ph)])   # unit sphere
+    >>> ring = np.flatnonzero(np.abs(P[:, 2]) < 0.03)
+    >>> loop = ring[np.argsort(np.arctan2(P[ring, 1], P[ring, 0]))]      # counter-clockwise seen from +z
+    >>> phi = gsdf.PointCloudSignedHeatSolver(P, P).compute_distance([np.append(loop, loop[0])])
+    >>> round(float(phi[np.argmax(P[:, 2])]), 1)                            # the north pole, inside
+    -1.6
     """
 
     def __init__(self, P, N=None, k: int = 30, t_coef: float = 1.0):
@@ -56,11 +83,39 @@ class PointCloudSignedHeatSolver:
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint: str = "zero",
                          soft_weight=None, progress=None):
-        """Signed distance (n,) at the points to curves given as sequences of point indices (left negative).
+        """Generalized signed distance at the points to curves through them (signed heat method, §8.4).
 
-        ``level_set_constraint``: "zero" (φ = 0 at the curve points), "multiple" (constant along each connected
-        curve component) or "none"; ``soft_weight`` replaces the hard constraint by a penalty (§7.1).
-        ``points``: isolated point sources (unsigned); ``curve_signs``: False makes a curve unsigned.
+        Parameters
+        ----------
+        curves : list of int arrays
+            Each curve a sequence of point indices (a polyline through the cloud; repeat the first index to
+            close it) or a :class:`gsdf.Curve` of them. The region on the left of a curve (seen from the
+            normals) is negative.
+        points : sequence of int, default ()
+            Isolated point sources (unsigned distance).
+        curve_signs : list of bool, optional
+            Per curve: True = signed (default), False = unsigned distance to it.
+        level_set_constraint : {"zero", "multiple", "none"}, default "zero"
+            φ = 0 at the curve points, constant along each connected curve component, or no constraint (for
+            broken curves) (§7.1).
+        soft_weight : float, optional
+            Impose the constraint by a penalty of this weight instead of exactly (§7.1).
+        progress : callable, optional
+            ``progress(stage, fraction)`` during the solves.
+
+        Returns
+        -------
+        (n,) float64
+            Signed distance per point, model units; negative on the left of the curves.
+
+        Raises
+        ------
+        ValueError
+            Indices out of range, bad ``curve_signs``, an unknown constraint, ``soft_weight <= 0``.
+
+        Examples
+        --------
+        >>> phi = solver.compute_distance([loop], level_set_constraint="none")     # doctest: +SKIP
         """
         phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,

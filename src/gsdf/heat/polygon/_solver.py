@@ -25,26 +25,46 @@ class PolygonMeshSignedHeatSolver:
 
     Parameters
     ----------
-    V : (n, 3) float; polygons : list of int sequences (or an (m, k) array), any mix of degrees, planar or not
-    (a polygon that repeats a vertex is dropped with a warning); t_coef : float, diffusion time
-    ``t = t_coef · (mean polygon edge length)²``.
+    V : (n, 3) float
+        Vertex positions, model units.
+    polygons : list of int sequences or (m, k) int array
+        Faces as vertex indices, any mix of degrees (triangles, quads, ...), planar or not, consistently
+        oriented; a polygon that repeats a vertex is dropped with a warning.
+    t_coef : float, default 1.0
+        Diffusion time ``t = t_coef · (mean polygon edge length)²``; larger smooths over gaps.
 
     Attributes
     ----------
-    L : (n, n) PSD polygon Laplacian ``Pᵀ C_fan P``; M : (n,) lumped mass; P : prolongation;
-    V_refined, F_refined : the virtual-vertex refinement; N, e1, e2 : vertex tangent frames;
-    domain : the :class:`~gsdf.heat.polygon._domain.PolygonDomain`; core : its
-    :class:`~gsdf.heat._core.SignedHeatCore` (factorizations kept between calls).
+    L : (n, n) sparse float64
+        The positive semidefinite polygon Laplacian ``Pᵀ C_fan P``.
+    M : (n,) float64
+        Lumped masses (square model units).
+    P : sparse float64
+        Prolongation from the vertices to the virtual-vertex refinement.
+    V_refined, F_refined
+        The virtual-vertex refinement (a triangle mesh).
+    N, e1, e2 : (n, 3) float64
+        Vertex tangent frames.
+    t : float
+        The diffusion time, square model units.
+    domain, core
+        The :class:`~gsdf.heat.polygon._domain.PolygonDomain` and its :class:`~gsdf.heat._core.SignedHeatCore`
+        (factorizations kept between calls).
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, indices out of range, degenerate polygons, ``t_coef <= 0``.
 
     Examples
     --------
-    >>> import numpy as np
+    >>> import numpy as np, gsdf
     >>> x = np.linspace(-1, 1, 9)
     >>> V = np.array([[a, b, 0.0] for a in x for b in x])
     >>> i = np.arange(81).reshape(9, 9)
     >>> quads = np.stack([i[:-1, :-1].ravel(), i[1:, :-1].ravel(), i[1:, 1:].ravel(), i[:-1, 1:].ravel()], 1)
     >>> loop = np.concatenate([i[2:6, 2], i[6, 2:6], i[6:2:-1, 6], i[2, 6:1:-1]])   # counter-clockwise
-    >>> phi = PolygonMeshSignedHeatSolver(V, quads).compute_distance([loop])
+    >>> phi = gsdf.PolygonMeshSignedHeatSolver(V, quads).compute_distance([loop])
     >>> bool(phi[40] < 0)                                          # the centre is inside
     True
     """
@@ -71,18 +91,38 @@ class PolygonMeshSignedHeatSolver:
 
     def compute_distance(self, curves, *, points=(), curve_signs=None, level_set_constraint="zero",
                          soft_weight=None, progress=None):
-        """Generalized signed distance (n,) at the vertices.
+        """Generalized signed distance at the vertices (signed heat method, §8.3).
 
         Parameters
         ----------
-        curves : list of :class:`gsdf.Curve` or 1-D int arrays, vertex polylines along polygon edges (closed:
-            first = last); a counter-clockwise loop (seen from the normal side) encloses the negative region.
-        points : vertex indices of isolated point sources (unsigned).
-        curve_signs : per curve True (signed, default) or False (unsigned: its vertices act as point sources).
-        level_set_constraint : "zero" (φ = 0 on all source vertices), "multiple" (φ constant along every
-            connected curve component) or "none"; then φ is shifted to mean zero along the curves (Alg. 13).
-        soft_weight : replaces the hard constraint by the penalty λ Σ (φ(v) - φ(v0))² (§7.1).
-        progress : ``progress(stage, fraction)`` (:mod:`gsdf.heat._core`).
+        curves : list of gsdf.Curve or 1-D int arrays
+            Vertex polylines along polygon edges (closed: first = last); a counter-clockwise loop (seen from the
+            normal side) encloses the negative region.
+        points : sequence of int, default ()
+            Vertex indices of isolated point sources (unsigned).
+        curve_signs : list of bool, optional
+            Per curve True (signed, default) or False (unsigned: its vertices act as point sources).
+        level_set_constraint : {"zero", "multiple", "none"}, default "zero"
+            φ = 0 on all source vertices, φ constant along every connected curve component, or none; then φ is
+            shifted to mean zero along the curves (Alg. 13).
+        soft_weight : float, optional
+            Replaces the hard constraint by the penalty λ Σ (φ(v) - φ(v0))² (§7.1).
+        progress : callable, optional
+            ``progress(stage, fraction)`` during the solves.
+
+        Returns
+        -------
+        (n,) float64
+            Signed distance per vertex, model units; negative inside counter-clockwise loops.
+
+        Raises
+        ------
+        ValueError
+            Curves not along polygon edges, indices out of range, bad ``curve_signs``, an unknown constraint.
+
+        Examples
+        --------
+        >>> phi = solver.compute_distance([loop], level_set_constraint="none")     # doctest: +SKIP
         """
         phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,

@@ -34,19 +34,21 @@ class SurfaceSignedHeatSolver:
     Parameters
     ----------
     V : (n, 3) float array
+        Vertex positions, model units.
     F : (m, 3) int array
         Triangle mesh of any topology: boundary, several components, nonmanifold edges/vertices (operators are
         per-face sums, §9.4). Nonorientable meshes (and faces whose orientation disagrees with a neighbour's)
         are handled exactly: transport across such an edge is a reflection, so the connection Laplacian of step I
-        is then assembled as a real ``2|E| × 2|E|`` block matrix that represents the reflections (the complex
-        ``|E| × |E|`` form of Eq. 9 when all faces agree); give the curve normals (``curve_normals=`` of
+        is then assembled as a real block matrix of size ``2|E| × 2|E|`` that represents the reflections (the
+        complex ``|E| × |E|`` form of Eq. 9 when all faces agree); give the curve normals (``curve_normals=`` of
         :meth:`compute_distance`) there, since face normals flip across the seam.
         Faces that repeat a vertex have no area and are dropped with a warning (``F`` of the solver lists the
         faces kept; face indices given in curves and point sources still refer to the input ``F``); other faces
         of zero area raise ValueError (remove them first).
-    t_coef : float
-        Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6) of the input mesh.
-    intrinsic_delaunay : bool
+    t_coef : float, default 1.0
+        Diffusion time ``t = t_coef · h²`` with h the mean spacing of edge midpoints (§6) of the input mesh;
+        smaller follows the curves more closely, larger smooths over gaps and noise.
+    intrinsic_delaunay : bool, default False
         Build the operators on an intrinsic Delaunay triangulation of the input (§9.4, Fig. 22): Lawson edge
         flips on edge lengths only (:mod:`gsdf.heat.intrinsic._kernels`), operators from per-face planar
         layouts; output stays per input vertex. This helps on meshes with obtuse slivers. Curve segments along
@@ -59,6 +61,8 @@ class SurfaceSignedHeatSolver:
         available; ``compute_distance_l1`` raises NotImplementedError. On a mesh that is already Delaunay no
         edge flips and the results equal those on the input triangulation.
 
+    Notes
+    -----
     Scale: the mesh is mapped once into its frame (:class:`gsdf._normalize.Frame`: centred, power-of-two
     scale) and solved there, so results are scale-covariant (φ of ``s·V`` is ``s·φ``) from 1e-150 to 1e150;
     ``ops`` and ``C`` are in frame units (``frame.length`` / ``frame.area`` map lengths and areas back);
@@ -67,17 +71,32 @@ class SurfaceSignedHeatSolver:
     Components of the mesh without sources get an arbitrary (near-constant) value; unreferenced vertices
     get 0 before the final shift.
 
+    Attributes
+    ----------
+    V, F
+        The input mesh (``V`` in model units; also ``V_world``).
+    t : float
+        The diffusion time, square model units.
+    frame : gsdf._normalize.Frame
+        The centred, power-of-two-scaled frame the solver works in.
+    ops, C
+        The operators of the triangulation in use and its cotan Laplacian (frame units).
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, indices out of range, degenerate faces, ``t_coef <= 0``.
+
     Examples
     --------
-    >>> import numpy as np
-    >>> from gsdf.heat import SurfaceSignedHeatSolver
-    >>> from gsdf.data._shapes import grid_mesh
-    >>> from gsdf.contour._surface_curves import level_set_curves
-    >>> V, F = grid_mesh(32)                                   # the square [-1, 1]², normals +z
-    >>> circle = level_set_curves(V, F, np.linalg.norm(V, axis=1) - 0.5)   # counter-clockwise
-    >>> phi = SurfaceSignedHeatSolver(V, F).compute_distance(circle)
-    >>> round(float(phi[np.argmin(np.linalg.norm(V, axis=1))]), 1)          # the centre: 0.5 inside
-    -0.5
+    >>> import numpy as np, trimesh, gsdf
+    >>> s = trimesh.creation.icosphere(subdivisions=3)
+    >>> V, F = np.asarray(s.vertices), np.asarray(s.faces)
+    >>> equator = gsdf.level_set_curves(V, F, V[:, 2], 0.0)      # z < 0 on its left
+    >>> solver = gsdf.SurfaceSignedHeatSolver(V, F)               # factorize once ...
+    >>> phi = solver.compute_distance(equator)                    # ... solve per curve set
+    >>> round(float(phi[np.argmin(V[:, 2])]), 1), round(float(phi[np.argmax(V[:, 2])]), 1)   # poles: ±π/2
+    (-1.6, 1.6)
     """
 
     def __init__(self, V, F, t_coef: float = 1.0, intrinsic_delaunay: bool = False):
@@ -141,11 +160,44 @@ class SurfaceSignedHeatSolver:
         return self.core.vector_heat_factorization
 
     def diffuse(self, sources) -> np.ndarray:
-        """Step I: X = (M + tL∇)⁻¹ X0, complex per edge (Alg. 2)."""
+        """Step I of the method: the curves' normals diffused, X = (M + tL∇)⁻¹ X0 (Alg. 2).
+
+        Parameters
+        ----------
+        sources : gsdf.heat._core.Sources
+            The assembled sources of a curve set (``solver.core.sources(curves, points, curve_signs)``); its
+            ``X0`` is the right-hand side of Eq. 12.
+
+        Returns
+        -------
+        (nE,) complex128 or (2 nE,) float64
+            The diffused vector field, one complex number per edge (nE edges; the real block form on
+            inconsistently oriented meshes).
+
+        Examples
+        --------
+        >>> S = solver.core.sources([curve], (), None)               # doctest: +SKIP
+        >>> Y = solver.unit_field(solver.diffuse(S))                 # doctest: +SKIP
+        """
         return self.vector_heat_factorization.solve(sources.X0)
 
     def unit_field(self, X: np.ndarray) -> np.ndarray:
-        """Step II: face-averaged, normalized vectors Y (m, 3) (§6, Alg. 3); zero where X vanishes."""
+        """Step II of the method: the diffused field averaged per face and normalized (§6, Alg. 3).
+
+        Parameters
+        ----------
+        X : array
+            The output of :meth:`diffuse`.
+
+        Returns
+        -------
+        (m, 3) float64
+            Unit vectors per face, zero where the diffused field vanishes.
+
+        Examples
+        --------
+        >>> Y = solver.unit_field(solver.diffuse(S))                 # doctest: +SKIP
+        """
         return self.core.unit_field(X)
 
     def _kept_faces(self, curves, points, curve_signs):
@@ -177,27 +229,34 @@ class SurfaceSignedHeatSolver:
                          soft_weight=None, curve_normals=None, progress=None) -> np.ndarray:
         """Generalized signed distance at the vertices, negative inside.
 
+        Steps I–III of the signed heat method (Feng & Crane 2024, Alg. 1): the curves' normals are diffused for
+        the time ``t`` (Eq. 12), normalized per face, and φ is the function whose gradient best matches that
+        unit field (the Poisson problem of Eq. 13), with the level-set constraint of §7.1.
+
         Parameters
         ----------
         curves : list
             Each curve a :class:`gsdf.Curve`, an int array of vertex indices (a polyline along edges), an (k, 2)
             edge set inside a :class:`gsdf.Curve`, or a list of surface points ``(face_index, barycentric
             (3,))`` (``(vertex, ())`` also means a vertex). A curve oriented counter-clockwise (seen from the
-            side the face normals point to) encloses the negative region. Keyword-only from here on.
-        points : sequence
+            side the face normals point to) encloses the negative region. Curves may have gaps (broken curves):
+            the diffused normals still separate an inside from an outside. Keyword-only from here on.
+        points : sequence, default ()
             Isolated point sources (App. A.1): vertex indices or ``(face, barycentric)`` tuples (split over the
             face's vertices). Distance to points is unsigned.
         curve_signs : list of bool, optional
             Per curve: True = oriented (signed, default), False = unoriented (unsigned distance, App. A.2; must
             run along edges). Bools only; must agree with ``Curve.signed``.
-        level_set_constraint : {"zero", "multiple", "none"}
+        level_set_constraint : {"zero", "multiple", "none"}, default "zero"
             ``"zero"``: φ = 0 on all sources (saddle system Eq. 14; vertex sources are eliminated directly);
             ``"multiple"``: φ constant along every connected curve component (curves sharing a vertex are one
-            component); ``"none"``: no constraint. In every case φ is finally shifted to mean zero along the
-            curves (Alg. 13), or to minimum zero when there are only points.
+            component); ``"none"``: no constraint (use it for broken curves: the constraint pins φ = 0 on the
+            given pieces only). In every case φ is finally shifted to mean zero along the curves (Alg. 13), or to
+            minimum zero when there are only points.
         soft_weight : float, optional
             Replace the hard constraint of ``"zero"`` / ``"multiple"`` by the penalty λ Σ (φ(p_i) - φ(p_0))²
-            over the nodes (§7.1): solves ``(C + λAᵀA)φ = b``. Ignored with ``"none"``.
+            over the nodes (§7.1): solves ``(C + λAᵀA)φ = b``; larger λ holds the constraint more tightly.
+            Default: the hard constraint. Ignored with ``"none"``.
         curve_normals : list, optional
             Explicit surface normals for the signed curves (one entry per curve: None = face normals, a (3,)
             vector, or one (3,) per curve point), used instead of the face normals in N = T × n (Eq. 11) — the
@@ -221,14 +280,29 @@ class SurfaceSignedHeatSolver:
         Returns
         -------
         phi : (n,) float64
+            Generalized signed distance per vertex, model units; negative on the left of (inside) the curves.
 
-        Example
-        -------
-        >>> from gsdf.data._shapes import grid_mesh
-        >>> V, F = grid_mesh(4)
-        >>> solver = SurfaceSignedHeatSolver(V, F)
-        >>> solver.compute_distance([np.array([6, 7, 12, 6])], level_set_constraint="none").shape
-        (25,)
+        Raises
+        ------
+        ValueError
+            A malformed curve (indices out of range, nodes not consecutive along edges, a bad surface point),
+            ``curve_signs`` of the wrong length or not bools, an unknown ``level_set_constraint``,
+            ``soft_weight <= 0``, no sources at all.
+
+        Examples
+        --------
+        >>> import numpy as np, trimesh, gsdf
+        >>> s = trimesh.creation.icosphere(subdivisions=3)
+        >>> V, F = np.asarray(s.vertices), np.asarray(s.faces)
+        >>> (equator,) = gsdf.level_set_curves(V, F, V[:, 2], 0.0)    # surface points, z < 0 on the left
+        >>> solver = gsdf.SurfaceSignedHeatSolver(V, F)
+        >>> phi = solver.compute_distance([equator])
+        >>> phi.shape, round(float(phi[np.argmin(V[:, 2])]), 1)       # the south pole: π/2 inside
+        ((642,), -1.6)
+        >>> half = equator[: len(equator) // 2]                       # a broken curve: half of it
+        >>> phi = solver.compute_distance([half], level_set_constraint="none")
+        >>> bool(phi[np.argmin(V[:, 2])] < 0 < phi[np.argmax(V[:, 2])])
+        True
         """
         curves, points, curve_signs = self._kept_faces(curves, points, curve_signs)
         phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
@@ -241,12 +315,33 @@ class SurfaceSignedHeatSolver:
 
         For curves that do not bound a region (or are inconsistently oriented) the unit field cannot be
         integrated by a continuous function; this integrates it exactly in every face and puts the
-        discontinuities where the weighted L1 jump (Eq. 16) is least — a linear program on |F| unknowns solved
+        discontinuities where the weighted L1 jump (Eq. 16) is least — a linear program on ``|F|`` unknowns solved
         by HiGHS (seconds for ~10⁴ faces; it grows superlinearly). Shifted so that the length-weighted mean
         along the curves is zero.
 
-        Example
+        Parameters
+        ----------
+        curves : list
+            As for :meth:`compute_distance`.
+        points : sequence, default ()
+            Isolated point sources, as for :meth:`compute_distance`.
+        curve_signs : list of bool, optional
+            As for :meth:`compute_distance`.
+
+        Returns
         -------
+        (m, 3) float64
+            φ at the three corners of every face, model units.
+
+        Raises
+        ------
+        ValueError
+            Malformed curves or points.
+        NotImplementedError
+            With ``intrinsic_delaunay=True``.
+
+        Examples
+        --------
         >>> corners = solver.compute_distance_l1([open_curve])     # doctest: +SKIP
         >>> phi_face = corners.mean(axis=1)                          # doctest: +SKIP
         """
@@ -272,14 +367,35 @@ class SurfaceSignedHeatSolver:
         return self.frame.length(Phi - float(Phi.min()))
 
     def sharpen(self, phi0: np.ndarray, curves, *, points=(), iterations: int = 3000) -> np.ndarray:
-        """Distance sharpening (§7.3, Eq. 18): the largest |∇φ| ≤ 1 function with the sign pattern of ``phi0``
-        that vanishes on the sources, by PDHG warm-started from ``phi0`` (a signed heat result).
+        """Distance sharpening (§7.3, Eq. 18): the largest function with gradient norm at most 1 and the sign
+        pattern of ``phi0`` that vanishes on the sources, by PDHG warm-started from ``phi0``.
 
         Vertex sources are pinned to 0; for surface points the vertices of their faces keep their values from
-        ``phi0`` (exactly zero on the curve after a ``"zero"`` solve). Returns φ (n,).
+        ``phi0`` (exactly zero on the curve after a ``"zero"`` solve).
 
-        Example
+        Parameters
+        ----------
+        phi0 : (n,) float
+            A signed heat result on this mesh (:meth:`compute_distance`), model units.
+        curves : list
+            The curves it was computed for (as for :meth:`compute_distance`).
+        points : sequence, default ()
+            Its point sources.
+        iterations : int, default 3000
+            PDHG iterations; more get closer to a true distance (slowly).
+
+        Returns
         -------
+        (n,) float64
+            The sharpened distance, model units.
+
+        Raises
+        ------
+        ValueError
+            ``phi0`` not one finite value per vertex, malformed curves.
+
+        Examples
+        --------
         >>> phi = solver.compute_distance(curves)                  # doctest: +SKIP
         >>> sharp = solver.sharpen(phi, curves)                     # doctest: +SKIP
         """
@@ -308,7 +424,27 @@ class SurfaceSignedHeatSolver:
 
     def split_curve(self, curve) -> list:
         """The nodes of ``curve`` as (face, barycentric) points, split where segments cross edges, so that
-        consecutive nodes share a face (the form potpourri3d requires)."""
+        consecutive nodes share a face (the form potpourri3d requires).
+
+        Parameters
+        ----------
+        curve : gsdf.Curve, int array or list of (face, barycentric)
+            One curve, as for :meth:`compute_distance`.
+
+        Returns
+        -------
+        list of (int, ndarray)
+            ``(vertex, empty array)`` per node of a vertex polyline, else ``(face, barycentric (3,))``.
+
+        Raises
+        ------
+        ValueError
+            A malformed curve, or an edge set that is not one path.
+
+        Examples
+        --------
+        >>> nodes = solver.split_curve(equator)                       # doctest: +SKIP
+        """
         from gsdf.heat.triangle._sources import _bary_curve_segments
 
         (curve,), _, _ = self._kept_faces([Curve(curve)], (), None)
@@ -327,7 +463,27 @@ class SurfaceSignedHeatSolver:
 
     def split_segments(self, curve) -> list:
         """The segments of ``curve`` as pairs ``[(f, bary_a), (f, bary_b)]`` in one face each (vertex polylines
-        and points on edges included): the per-segment form of potpourri3d's curves."""
+        and points on edges included): the per-segment form of potpourri3d's curves.
+
+        Parameters
+        ----------
+        curve : gsdf.Curve, int array or list of (face, barycentric)
+            One curve, as for :meth:`compute_distance`.
+
+        Returns
+        -------
+        list of [(int, (3,) float), (int, (3,) float)]
+            Both ends of each segment in the same face.
+
+        Raises
+        ------
+        ValueError
+            A malformed curve.
+
+        Examples
+        --------
+        >>> segments = solver.split_segments(equator)                 # doctest: +SKIP
+        """
         from gsdf.heat.triangle._sources import _bary_in_face, _faces_of_node
 
         nodes = self.split_curve(curve)

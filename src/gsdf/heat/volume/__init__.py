@@ -198,27 +198,37 @@ def signed_heat_volume(mesh=None, points=None, domain: str = "grid", resolution=
         Triangle mesh or soup (V (n, 3) float, F (m, 3) int): holes, flips and self-intersections are fine.
     points : (P, N), optional
         Oriented point cloud; normals need not be unit length. Point areas are estimated (§3.1 of Barill 2018).
-    domain : {"grid", "tet"}
+    domain : {"grid", "tet"}, default "grid"
         Regular grid (§8.2) or tetrahedral mesh (§8.1: Delaunay of the input points and a lattice graded toward
         them, h = the grid spacing near the input, :mod:`gsdf.heat.tet._mesh`).
-    resolution : int or (3,) ints
-        Grid nodes along the longest side (cubic cells), or exact node counts per axis.
+    resolution : int or (3,) ints, default 64
+        Grid nodes along the longest side (cubic cells), or exact node counts per axis. The error falls about
+        linearly with the spacing; time and memory grow with the number of nodes.
     bbox_min, bbox_max : (3,) float, optional
         Box of the domain; defaults to the input's box padded by 10 % of its diagonal. Must contain the input.
-    t_coef : float
-        Diffusion time t = t_coef · h² (§10 of the seed: t = h²), h set by ``options.t_scale``.
+    t_coef : float, default 1.0
+        Diffusion time t = t_coef · h² (§10 of the seed: t = h²), h set by ``options.t_scale``: smaller follows
+        the input more closely, larger smooths over holes and noise (see the guide page "Choosing a method").
     options : VolumeHeatOptions, optional
         Level-set constraint, soft penalty, the scale of t, the Yukawa tree tolerance, the tet mesher, a memory
         limit and a progress callback (:class:`VolumeHeatOptions`).
-
-    Everything runs in the input's frame (centred, power-of-two scale: exact), so φ of ``s·V`` is ``s·φ`` from
-    1e-150 to 1e150; the returned field, ``t`` and ``meta`` are in input units.
 
     Returns
     -------
     GridField or TetField
         Signed distance on the grid nodes (tet vertices), negative inside; ``field(Q)``, ``field.isosurface(level)``;
         ``field.meta`` holds t, the timings of the steps and the constraint used.
+
+    Raises
+    ------
+    ValueError
+        Neither or both of ``mesh`` and ``points``, bad arrays, a box that does not contain the input, a bad
+        resolution or option, a grid too large for the memory limit.
+
+    Notes
+    -----
+    Everything runs in the input's frame (centred, power-of-two scale: exact), so φ of ``s·V`` is ``s·φ`` from
+    1e-150 to 1e150; the returned field, ``t`` and ``meta`` are in input units.
 
     Examples
     --------

@@ -362,11 +362,11 @@ class VoxelSurfaceSignedHeatSolver:
         curves : list of 1-D int arrays
             Vertex polylines; consecutive vertices share a quad (an edge or a diagonal); closed curves repeat the
             first vertex. A loop counter-clockwise seen from outside the volume encloses the negative region.
-        points : sequence of int
+        points : sequence of int, default ()
             Vertex indices of point sources (unsigned distance).
         curve_signs : list of bool, optional
             Per curve: True (signed, default) or False (unsigned: its vertices act as point sources).
-        level_set_constraint : {"zero", "multiple", "none"}
+        level_set_constraint : {"zero", "multiple", "none"}, default "zero"
             φ = 0 on every source vertex, φ constant per connected curve component, or no constraint; φ is
             finally shifted to mean zero along the curves (Alg. 13).
         soft_weight : float, optional
@@ -377,6 +377,23 @@ class VoxelSurfaceSignedHeatSolver:
         Returns
         -------
         phi : (n,) float64
+            Signed distance per vertex of the digital surface, model units (the voxel ``spacing``'s units).
+
+        Raises
+        ------
+        ValueError
+            Consecutive curve vertices that share no quad, indices out of range, bad ``curve_signs``, an unknown
+            constraint.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> x = np.indices((20, 20, 20)) - 9.5
+        >>> solver = gsdf.VoxelSurfaceSignedHeatSolver((x ** 2).sum(0) < 8 ** 2)      # a voxel ball
+        >>> loops = gsdf.region_boundary_curves(solver.faces, solver.face_centres[:, 2] < 10)
+        >>> phi = solver.compute_distance(loops)
+        >>> bool(phi[np.argmin(solver.vertices[:, 2])] < 0 < phi[np.argmax(solver.vertices[:, 2])])
+        True
         """
         phi = self.core.compute_distance(curves, points=points, curve_signs=curve_signs,
                                          level_set_constraint=level_set_constraint, soft_weight=soft_weight,
