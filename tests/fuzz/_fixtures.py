@@ -101,7 +101,7 @@ class Fixtures:
 
         t = {
             "V": [lambda: s.V, lambda: s.V2, lambda: s.Xt], "VA": [lambda: s.V], "VB": [lambda: s.V + 0.3],
-            "vertices": [lambda: s.V, lambda: s.Xt], "X": [lambda: s.Xt, lambda: s.V],
+            "vertices": [lambda: s.V, lambda: s.Xt], "X": [lambda: s.Xt, lambda: s.V, lambda: s.V[s.F].mean(axis=1)],
             "F": [lambda: s.F], "FA": [lambda: s.F], "FB": [lambda: s.F], "faces": [lambda: s.F],
             "E": [lambda: s.E2], "T": [lambda: s.Tt], "tets": [lambda: s.Tt],
             "Q": [lambda: s.Q, lambda: s.Q2], "P": [lambda: s.V], "N": [lambda: s.V], "W": [lambda: s.V],
@@ -121,7 +121,7 @@ class Fixtures:
             "z_values": [lambda: [0.0]], "contours_per_slice": [lambda: [[s.square]]],
             "occ": [lambda: s.occ], "occupancy": [lambda: s.occ], "face_mask": [lambda: s.face_mask],
             "polygons": [lambda: [f for f in s.F]],
-            "curves": [lambda: [s.loop]], "curve": [lambda: s.loop], "nodes": [lambda: s.loop],
+            "curves": [lambda: [s.loop], lambda: [np.array([0, 1, 2, 3, 0])]], "curve": [lambda: s.loop], "nodes": [lambda: s.loop],
             "curve_signs": [lambda: [True]],
             "face": [lambda: np.array([0, 1])], "bary": [lambda: np.full((2, 3), 1 / 3)],
             "mesh": [lambda: (s.V, s.F)], "points": [lambda: (s.V, s.V)], "items": [lambda: (s.V, s.F)],

@@ -177,6 +177,8 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=max(1, min(2, os.cpu_count() or 1)), help="cases run in parallel")
     ap.add_argument("--timeout", type=float, default=60.0,
                     help="seconds per case (at least 3x the target's baseline time + 10 s)")
+    ap.add_argument("--max-seconds", type=float, default=None,
+                    help="skip the cases of a target / command whose baseline takes longer (reported as skipped)")
     ap.add_argument("--only", default="", help="only cases whose id contains this text")
     ap.add_argument("--list", action="store_true", help="print the case ids and exit (no run)")
     ap.add_argument("--gaps", action="store_true", help="print the coverage gaps and exit (no run)")
@@ -255,7 +257,21 @@ def _run(args, areas, root, t_start) -> int:
         extra = 2 if c["mutation"] in ("scale_tiny", "scale_huge") or c["expect"] == "accept" else 1
         return max(args.timeout, extra * 3 * s + 10)
 
+    def base_seconds(c):
+        name = c["target"] + ".json" if c.get("target") else f"cli-{c.get('command')}.json"
+        try:
+            with open(os.path.join(root, "baselines", name)) as fh:
+                return (json.load(fh) or {}).get("seconds", 0) or 0
+        except (OSError, ValueError, AttributeError):
+            return 0
+
+    def slow(c):
+        return args.max_seconds is not None and base_seconds(c) > args.max_seconds
+
     def fn_of(c):
+        if slow(c):
+            return (lambda: ("skip", f"slow baseline ({base_seconds(c):.0f} s > --max-seconds "
+                                     f"{args.max_seconds:g})")), ()
         if c["area"].startswith("cli"):
             return _execute.run_cli_case, (c, root, tmap, limit_of(c))
         if c["area"].startswith("files"):
