@@ -76,7 +76,7 @@ def reconstruct(cloud, output, method, outliers, clusters, max_iterations, resol
         from gsdf.recon import _compare as compare
         fn = {"winding": compare.reconstruct_winding, "heat": compare.reconstruct_heat,
               "pat": compare.reconstruct_pat}[method]
-        say(f"{method} level set")
+        say(f"{method} level set", 0.0)
         V, F, rep = fn(P, N, resolution=resolution, return_report=True)
         click.echo(f"  {rep['time']:.2f} s")
     top = mesh_topology(V, F)

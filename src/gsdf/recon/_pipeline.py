@@ -97,8 +97,9 @@ class ReconstructionOptions:
 
     A ValueError names the attribute when a value is out of range.
 
-    Example
-    -------
+    Examples
+    --------
+    >>> from gsdf import ReconstructionOptions
     >>> ReconstructionOptions(subdivide=0).fit_k
     8
     """

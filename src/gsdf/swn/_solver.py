@@ -91,8 +91,9 @@ class SWNOptions:
 
     A ValueError names the attribute when a value is out of range.
 
-    Example
-    -------
+    Examples
+    --------
+    >>> from gsdf import SWNOptions
     >>> SWNOptions(epsilon=0.05)
     SWNOptions(epsilon=0.05, time_limit=300.0)
     """
