@@ -112,10 +112,13 @@ class Job:
             pass
 
 
+MEM_GB = [6.0]          # address-space cap of a case process (--mem-gb)
+
+
 def run_jobs(specs, jobs: int, on_done=None):
     """Run ``[(key, fn, args, out_path, limit)]`` with ``jobs`` at a time; returns {key: result}."""
     results, running, queue = {}, [], list(specs)
-    mem = 8 << 30
+    mem = int(MEM_GB[0] * (1 << 30))
     try:
         while queue or running:
             while queue and len(running) < jobs:
@@ -179,6 +182,7 @@ def main(argv=None) -> int:
                     help="seconds per case (at least 3x the target's baseline time + 10 s)")
     ap.add_argument("--max-seconds", type=float, default=None,
                     help="skip the cases of a target / command whose baseline takes longer (reported as skipped)")
+    ap.add_argument("--mem-gb", type=float, default=6.0, help="address-space cap of each case process (GiB)")
     ap.add_argument("--only", default="", help="only cases whose id contains this text")
     ap.add_argument("--list", action="store_true", help="print the case ids and exit (no run)")
     ap.add_argument("--gaps", action="store_true", help="print the coverage gaps and exit (no run)")
@@ -187,6 +191,7 @@ def main(argv=None) -> int:
     ap.add_argument("-q", "--quiet", action="store_true", help="no line per failing case while running")
     args = ap.parse_args(argv)
     os.environ.setdefault("GSDF_NUM_THREADS", "1")
+    MEM_GB[0] = args.mem_gb
     areas = {a.strip() for a in args.areas.split(",") if a.strip()}
     t_start = time.time()
     if args.gaps:
