@@ -289,9 +289,11 @@ def scalar_mutations(s: Spec) -> dict:
             m["none"] = "accept"
         return m
     if s.kind == "str":
-        m = {"bogus": "refuse", "empty": "refuse", "bytes": "refuse", "none": "accept" if s.optional else "refuse",
-             "int": "refuse" if s.choices else "either", "upper": "either"}
-        return m
+        if s.choices:
+            return {"bogus": "refuse", "empty": "refuse", "bytes": "refuse", "int": "refuse", "upper": "either",
+                    "none": "accept" if s.optional else "refuse"}
+        # free text (a name, a title): only wrong types are bad
+        return {"empty": "either", "bytes": "refuse", "int": "either", "none": "accept" if s.optional else "refuse"}
     if s.kind == "bool":
         return {"yes": "refuse", "no": "refuse", "two": "refuse", "none": "either", "np_bool": "accept",
                 "str": "refuse"}

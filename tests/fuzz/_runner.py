@@ -27,6 +27,8 @@ COLS = _cases.OUTCOMES + ["review", "skip"]
 
 
 def _child_limits(mem: int) -> None:
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
     try:
         os.setsid()
     except OSError:
@@ -199,6 +201,12 @@ def main(argv=None) -> int:
             print(" | ".join(g))
         return 0
     root = tempfile.mkdtemp(prefix="gsdf-fuzz-")
+
+    def stop(signum, frame):                   # SIGTERM / SIGINT (even when started in the background)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGINT, stop)
     try:
         return _run(args, areas, root, t_start)
     finally:
