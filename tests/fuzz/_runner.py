@@ -242,17 +242,29 @@ def _run(args, areas, root, t_start) -> int:
         b = _execute.baseline_of(t, tmap, fx, d)
         return ("pass", json.dumps(b)[:200])
 
+    # with --max-seconds a baseline search gets twice that (its target's cases are then skipped as slow)
+    base_limit = 700.0 if args.max_seconds is None else max(30.0, 2 * args.max_seconds)
+
+    def mark_slow(prefix):
+        def done(key, r, dt):
+            if r[0] == "hang":
+                with open(os.path.join(root, "baselines", f"{prefix}{key}.json"), "w") as fh:
+                    json.dump({"error": f"slow baseline: no answer in {base_limit:.0f} s", "seconds": dt}, fh)
+        return done
+
+    commands = sorted({c["command"] for c in cases if c["area"].startswith("cli")})
     ctors = sorted(t for t in need if "." not in t)
     methods = sorted(t for t in need if "." in t)
     for group in (ctors, methods):                        # constructors first: methods reuse their baselines
-        run_jobs([(t, api_base, (t,), os.path.join(res_dir, f"base-{t}.json"), 600) for t in group], args.jobs)
-    commands = sorted({c["command"] for c in cases if c["area"].startswith("cli")})
+        run_jobs([(t, api_base, (t,), os.path.join(res_dir, f"base-{t}.json"), base_limit) for t in group],
+                 args.jobs, mark_slow(""))
 
     def cli_base(name):
         b = _execute.find_cli_baseline(name, root, 300.0)
         return ("pass", json.dumps(b)[:200])
 
-    run_jobs([(n, cli_base, (n,), os.path.join(res_dir, f"clibase-{n}.json"), 700) for n in commands], args.jobs)
+    run_jobs([(n, cli_base, (n,), os.path.join(res_dir, f"clibase-{n}.json"), base_limit) for n in commands],
+             args.jobs, mark_slow("cli-"))
     t_base = time.time()
 
     def limit_of(c):
@@ -304,7 +316,8 @@ def _run(args, areas, root, t_start) -> int:
     for i, c in enumerate(cases):
         fn, fargs = fn_of(c)
         # the CLI's own timeout (env cases run a subprocess) sits below the runner's
-        specs.append((c["id"], fn, fargs, os.path.join(res_dir, f"case-{i}.json"), limit_of(c) + 15))
+        specs.append((c["id"], fn, fargs, os.path.join(res_dir, f"case-{i}.json"),
+                      limit_of(c) + (15 if c.get("where") == "env" else 0)))
     run_jobs(specs, args.jobs, done)
     dt = time.time() - t_start
     results.sort(key=lambda r: r["id"])
