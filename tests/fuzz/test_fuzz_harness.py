@@ -30,9 +30,16 @@ def test_every_public_name_is_attacked(api_cases):
     per = collections.Counter(c["target"] for c in api_cases)
     sigs = _cases.target_map()
     gap_targets = {t for t, _, why in _cases.coverage_gaps() if why.startswith("required")}
+    options = _knowledge.option_classes(gsdf)
     for t, (sig, _) in sigs.items():
-        if t not in gap_targets and any(p.kind != p.VAR_KEYWORD for p in sig.parameters.values()):
+        if t not in gap_targets and t not in options and \
+                any(p.kind != p.VAR_KEYWORD for p in sig.parameters.values()):
             assert per[t] > 1, f"{t}: only a baseline"
+    # every field of every options dataclass is attacked through a function that takes it
+    fields = {c["param"].split(".", 1)[1] for c in api_cases if c["area"] == "api:options" and "." in c["param"]}
+    for cls, fs in options.items():
+        for f in fs:
+            assert f in fields, f"{cls}.{f}: attacked through no function"
 
 
 def test_every_cli_option_is_attacked(cli_cases):
