@@ -286,8 +286,15 @@ def cli_mutations(cmd) -> list:
                     out.append((p.name, "file:" + m, "arg", e, "cli:files"))
             continue
         if p.name in outs:
+            folder = p.name in ("output_dir", "out_alias")
+            main = p.name in ("output", "output_dir")
+            clobber = any(q.name == "no_clobber" for q in cmd.params)
             for m in ("same_as_input", "directory", "bad_ext", "nested_new", "same_as_other_output",
                       "existing_no_clobber"):
+                if (m == "bad_ext" and folder) or (m == "same_as_other_output" and main) or \
+                        (m == "existing_no_clobber" and (folder or not clobber)) or \
+                        (m == "same_as_input" and not any(isinstance(q, click.Argument) for q in cmd.params)):
+                    continue
                 out.append((p.name, m, flag, "accept" if m == "nested_new" else "refuse", "cli:outputs"))
             continue
         if kind == "flag":

@@ -77,6 +77,8 @@ class Fixtures:
         gsdf.write_curves(p("curves.txt"), [self.loop])
         with open(p("curves.obj"), "w") as fh:
             fh.write("l " + " ".join(str(int(v) + 1) for v in self.loop) + "\n")
+        with open(p("curves_swn.txt"), "w") as fh:        # the surface-winding-number demo's node format
+            fh.write("".join(f"v {int(v)}\n" for v in self.loop[:-1]) + "l 0 1 2 0\n")
         gsdf.GridField(self.grid_vals, [-1.5] * 3, [1.5] * 3).save(p("field.npz"))
         os.makedirs(p("in_dir"), exist_ok=True)
         gsdf.write_mesh(p("in_dir/m.off"), self.V, self.F)

@@ -193,6 +193,14 @@ def main(argv=None) -> int:
     ap.add_argument("-q", "--quiet", action="store_true", help="no line per failing case while running")
     args = ap.parse_args(argv)
     os.environ.setdefault("GSDF_NUM_THREADS", "1")
+    # commands that start gsdf again (warmup, batch workers) run in the case folders: absolute import paths, the
+    # gsdf under test and these tests first
+    import gsdf
+
+    here = [os.path.dirname(os.path.dirname(gsdf.__file__)),
+            os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))]
+    rest = [os.path.abspath(x) for x in os.environ.get("PYTHONPATH", "").split(os.pathsep) if x]
+    os.environ["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(here + rest))
     MEM_GB[0] = args.mem_gb
     areas = {a.strip() for a in args.areas.split(",") if a.strip()}
     t_start = time.time()
