@@ -250,8 +250,8 @@ def _run(args, areas, root, t_start) -> int:
         b = _execute.baseline_of(t, tmap, fx, d)
         return ("pass", json.dumps(b)[:200])
 
-    # with --max-seconds a baseline search gets twice that (its target's cases are then skipped as slow)
-    base_limit = 700.0 if args.max_seconds is None else max(30.0, 2 * args.max_seconds)
+    # with --max-seconds a baseline search gets that long (its target's cases are then skipped as slow)
+    base_limit = 700.0 if args.max_seconds is None else max(10.0, args.max_seconds)
 
     def mark_slow(prefix):
         def done(key, r, dt):

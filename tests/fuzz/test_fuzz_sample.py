@@ -58,13 +58,15 @@ def _run_sample(tmp_path):
         return json.load(fh), p.stdout, dt
 
 
-def test_fuzz_sample(tmp_path):
+def test_fuzz_sample(tmp_path, capsys):
     from tests.fuzz._cases import FAILURES
 
     report, stdout, dt = _run_sample(tmp_path)
     cases = report["cases"]
-    print(stdout[stdout.find("| area"):] if "| area" in stdout else stdout[-3000:])
-    print(f"fuzz sample: {len(cases)} of {report['generated']} generated cases in {dt:.0f} s")
+    with capsys.disabled():                      # the table and the timing, also when the test passes
+        print("\n" + (stdout[stdout.find("| area"):] if "| area" in stdout else stdout[-3000:]))
+        print(f"fuzz sample: {len(cases)} of {report['generated']} generated cases in {dt:.0f} s "
+              f"(sample {SAMPLE}, seed {SEED}, {JOBS} jobs)")
     failed = {c["id"]: c for c in cases if c["outcome"] in FAILURES}
     ids = {c["id"] for c in cases}
     new = {i: c for i, c in failed.items() if i not in KNOWN_OPEN}
