@@ -1,4 +1,4 @@
-"""Benchmark of `gsdf batch` (issue 16): dataset throughput and sign accuracy against mesh-to-sdf and mesh2sdf.
+"""Benchmark of `gsdf batch`: dataset throughput and sign accuracy against mesh-to-sdf and mesh2sdf.
 
 1. Throughput (meshes / minute) on a folder of CGAL meshes (broken ones included), 1 vs 2 workers, local
    processes vs a Dask LocalCluster, for sdf-samples (250k samples / mesh) and sdf-grid 128^3.
@@ -25,7 +25,7 @@ import traceback
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import data_dir, machine, write_section  # noqa: E402
+from common import command, data_dir, heading, write_section  # noqa: E402
 
 MESH_EXT = (".off", ".obj", ".ply", ".stl")
 CHECK = 20_000  # query points per mesh checked against the exact winding number
@@ -194,12 +194,15 @@ def main():
     if loads:
         load0 = "; ".join(loads)
     print("load: " + load1, flush=True)
-    lines = [f"Machine: {machine()}. Load before: `{load0}`; after: `{load1}` (the 2 cores are shared with "
-             "other helpers' jobs: absolute times are inflated, the ratios measured in the same run are what count).",
-             "", f"Command: `PYOPENGL_PLATFORM=egl PYTHONPATH=src /work/anchors/bin/python bench/bench_batch.py "
-             f"--meshes {args.meshes} --grid-meshes {args.grid_meshes} --anchor-meshes {args.anchor_meshes}` "
-             "(this run: its phases separately — `--skip-grid --skip-anchors`, `--skip-samples --skip-anchors`, "
-             "`--skip-samples --skip-grid` — then `--rows-from LOGS` to write this section)", "",
+    cmd = command("bench_batch.py", [f"--meshes {args.meshes} --grid-meshes {args.grid_meshes} "
+                                     f"--anchor-meshes {args.anchor_meshes}"],
+                  python="/work/anchors/bin/python", env="PYOPENGL_PLATFORM=egl")
+    lines = [heading("Batch jobs (`gsdf batch`): throughput and sign accuracy against mesh-to-sdf and mesh2sdf",
+                     cmd).rstrip(), "",
+             f"Load before: `{load0}`; after: `{load1}`. Absolute times are inflated on a shared machine; the ratios "
+             "measured in the same run are what count. The phases can run separately (`--skip-grid --skip-anchors`, "
+             "`--skip-samples --skip-anchors`, `--skip-samples --skip-grid`, then `--rows-from LOGS` writes the "
+             "section).", "",
              f"Mesh set: {len(paths)} CGAL meshes (`pick_meshes`: 2-400 KB files evenly over the sorted list, plus "
              f"ten named broken ones), {n_broken} of them not closed manifold (holes, borders, non-manifold edges); "
              "unreadable or degenerate files are recorded as failed and count in the throughput.", ""]
@@ -231,7 +234,7 @@ def main():
     print(text)
     if args.rows_from is None and (args.skip_samples or args.skip_grid or args.skip_anchors):
         return  # a partial phase: its rows are in the log for --rows-from
-    write_section("batch", "## batch (issue 16: `gsdf batch`)\n\n" + text)
+    write_section("batch", text)
 
 
 if __name__ == "__main__":

@@ -23,7 +23,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import data_dir, machine, table, write_section  # noqa: E402
+from common import command, data_dir, heading, machine, table, write_section  # noqa: E402
 
 
 def inputs(d: str) -> dict:
@@ -78,6 +78,7 @@ def main(argv=None):
     ap.add_argument("--only", default=None, help="comma-separated subset of demo,sdf,tori,heat-surface")
     ap.add_argument("--no-write", action="store_true", help="print only, do not rewrite RESULTS.md")
     a = ap.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
     src = os.path.abspath(a.src)
     print(machine())
     rows = []
@@ -97,10 +98,10 @@ def main(argv=None):
             rows.append(row)
     header = ["command", "source", "cold wall s", "cold CPU s", "warm wall s", "warm CPU s", "notice (cold only)",
               "exit", "uptime load before / after"]
-    text = (f"Machine: {machine()}. Shared with other processes: wall time depends on the load (column), CPU "
-            "time (process and children, e.g. the background compile of `gsdf demo`) does not.\n"
-            f"Command: `PYTHONPATH=src python3 bench/bench_cold_start.py` (cold = empty NUMBA_CACHE_DIR).\n\n"
-            + table(header, rows))
+    text = (heading("Cold start of the command line", command("bench_cold_start.py", argv))
+            + "Cold = an empty NUMBA_CACHE_DIR (a fresh install: every kernel compiles), warm = the same command "
+            "again. Wall time depends on the load (column), CPU time (process and children, e.g. the background "
+            "compile of `gsdf demo`) does not.\n\n" + table(header, rows))
     print(text)
     if not a.no_write:
         write_section("cold-start", text)

@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import data_dir, machine, median_time, table, write_section  # noqa: E402
+from common import command, data_dir, heading, machine, median_time, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
 
@@ -33,8 +33,10 @@ def main():
 
     root = data_dir()
     rng = np.random.default_rng(0)
-    info = machine()
-    print("machine:", info, flush=True)
+    from load import uptime
+
+    start = uptime()
+    print("machine:", machine(), start, flush=True)
     t0 = time.time()
     rows = []
     for name in MESHES:
@@ -53,12 +55,9 @@ def main():
         print(rows[-1], flush=True)
     header = ["mesh", "faces", f"gsdf {args.queries:.0e} q s (build+query)", "igl s", "ratio", "max |Δd|",
               "sign agrees with igl (winding)"]
-    text = f"""## Distance (bench/bench_distance.py --queries {args.queries})
-
-Machine: {info}. Run took {time.time() - t0:.0f} s. Medians of 3 runs in one process.
-
-{table(header, rows)}
-"""
+    cmd = command("bench_distance.py", [f"--queries {args.queries}"], python="/work/anchors/bin/python")
+    text = (heading("Distance to triangle meshes against libigl", cmd, start)
+            + f"Run took {time.time() - t0:.0f} s. Medians of 3 runs in one process.\n\n{table(header, rows)}\n")
     write_section("distance", text)
     print(text)
 

@@ -1,30 +1,54 @@
-"""Benchmark of the signed heat method on surfaces (Feng & Crane 2024, §9.5) against potpourri3d.
+"""Benchmark of the signed heat method on surfaces (Feng & Crane 2024, §8–9.5) against potpourri3d.
 
 Run in the anchors' venv so that both run in ONE process on the same meshes and curves:
 
-    /work/anchors/bin/python bench/bench_heat_surface.py [--quick]
+    PYTHONPATH=src /work/anchors/bin/python bench/bench_heat_surface.py [--quick] [--only PART,...] [--load]
 
-Sections: planar convergence (§9.5.1), a latitude circle on a sphere (closed-form geodesic SDF), broken curves
-on CGAL meshes (§9.5.3), and the comparison with potpourri3d's MeshSignedHeatSolver (differences per
-constraint mode, first / repeated solve times on bunny00.off). Results go to bench/RESULTS.md.
+Parts (``--only``, default all but ``speed-polygon``, whose rows ``speed`` includes), each writing its own
+section of bench/RESULTS.md:
+
+* ``accuracy`` ("heat-surface"): against potpourri3d's MeshSignedHeatSolver per constraint mode on bunny00.off,
+  planar convergence and the diffusion time (§9.5.1), a latitude circle on a sphere (closed-form geodesic SDF),
+  broken curves on CGAL meshes (§9.5.3), robustness, a point cloud as the domain, extensions;
+* ``polygon-pointcloud`` ("heat-surface-polygon-pointcloud"): §8.3 polygon meshes and §8.4 point clouds against
+  potpourri3d's PolygonMeshHeatSolver / PointCloudHeatSolver;
+* ``speed`` ("heat-surface-speed"): first and repeated solves against potpourri3d on 16 triangle meshes and 6
+  polygon meshes (``--small``: without the three above 20k vertices), idle and with ``--load`` under two busy
+  processes in alternating rounds; ``speed-polygon`` ("heat-surface-speed-polygon"): the polygon rows alone;
+* ``solver-rule`` ("heat-surface-solver-rule"): factorization time of the two systems of a first solve by SuperLU
+  orderings, CHOLMOD and gsdf's LDLᴴ: the backend rule of gsdf.linalg;
+* ``ordering`` ("heat-surface-ordering"): approximate minimum degree vs nested dissection in gsdf's LDLᴴ on the
+  same systems (fill, ordering, factorization and solve times, SuperLU's MMD fill as the reference);
+* ``voxel`` ("heat-voxel"): §8.5 digital surfaces: convergence on a digital sphere and slanted planes (corrected,
+  trivial and exact normals), the diffusion time, the smooth-mesh baseline, timings.
+
+``--quick`` runs every part at reduced sizes (fewer meshes, coarser levels).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import time
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import batch_mean, data_dir, machine, median_time, table, write_section  # noqa: E402
+from common import batch_mean, command, data_dir, heading, machine, median_time, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
 from gsdf.heat import SurfaceSignedHeatSolver  # noqa: E402
 from gsdf.contour._surface_curves import level_set_curves, region_boundary_curves  # noqa: E402
 from gsdf.data._shapes import grid_mesh, sphere_mesh  # noqa: E402
+from gsdf.heat.voxel._digital import digital_surface, integral_invariant_normals  # noqa: E402
+from gsdf.heat.voxel._domain import VoxelSurfaceSignedHeatSolver  # noqa: E402
+from gsdf.linalg._direct import LDL_MAX_UNKNOWNS, Factorization  # noqa: E402
+from gsdf.linalg._ldl import LDLFactorization, fill_count  # noqa: E402
+from gsdf.linalg._ordering import order_csr  # noqa: E402
 
 try:
     import potpourri3d as pp3d
@@ -115,7 +139,7 @@ def planar(levels):
              + ", ".join(f"{np.log(es4[i] / es4[i + 1]) / np.log(hs[i] / hs[i + 1]):.2f}" for i in range(len(es) - 1))
              + (f" (least squares {order(hs, es4):.2f}); none: {order(hs, ens):.2f}, potpourri3d none: "
                 f"{order(hs, epps):.2f}" if epps else "") + ".\n\n"
-           + "Why the order is below 1 (issue 3 item 3): potpourri3d gives the *same* ε as gsdf's \"none\" on every "
+           + "Why the order is below 1: potpourri3d gives the *same* ε as gsdf's \"none\" on every "
              "level (the solutions agree to ~1e-7 relative), so t = t_coef·h² with h = half the mean edge length "
              "is the reference implementation's time step, and the sources and ε are not the cause (ε over "
              "|x|, |y| < 0.85 or within 0.15 of the curve, and ε after the best constant shift, show the same "
@@ -123,7 +147,7 @@ def planar(levels):
              "is fixed, so the direction error of the discrete vector heat kernel far from the sources (its "
              "log approaches a mesh-dependent path metric rather than the Euclidean one, Varadhan's formula on a "
              "graph) does not vanish under refinement and gives an ε floor that a larger t_coef lowers (at the cost "
-             "of more smoothing error). One-off check of the same star (the kept study is the next section, --time-step): under 1-to-4 midpoint "
+             "of more smoothing error). One-off check of the same star (the kept study is the next section): under 1-to-4 midpoint "
              "subdivision of the n = 28 jittered mesh, ε zero 0.0104, 0.0059, 0.0037, 0.0029 (orders 0.82, 0.68, "
              "0.34) with t_coef 1 but 0.0158, 0.0099, 0.0056, 0.0031 (0.67, 0.83, 0.85) with t_coef 4; on regular "
              "diagonal-split grids (a strongly anisotropic lattice) t_coef 1 stalls harder (0.64, 0.41, 0.35) while "
@@ -653,7 +677,6 @@ def time_step_study(levels):
     §9.5.1 planar setup (barycentric level-set star) and on the paper's setup (star inserted as mesh edges); plus
     the far-field direction error of the diffused field Y at fixed c (what limits the order at t = h²)."""
     from gsdf.data._shapes import polygon_sdf_2d
-    from gsdf.heat.triangle._sources import build_sources
 
     res, hs, far = {}, {"bary": [], "edges": []}, {}
     for n in levels:
@@ -677,7 +700,7 @@ def time_step_study(levels):
                     res.setdefault((setup, name, mode), []).append(e)
                 if setup == "bary" and tc in (1.0, 4.0):
                     # direction error of Y (degrees) in faces farther than 0.3 from the curve
-                    Y = s.unit_field(s.diffuse(build_sources(s.ops, curves, None, None)))
+                    Y = s.unit_field(s.diffuse(s.core.sources(curves, (), None)))
                     Cc = V[F].mean(1)
                     sel = np.abs(star_sdf(Cc)) > 0.3
                     d = 1e-4
@@ -695,8 +718,7 @@ def time_step_study(levels):
                      name, mode] + [f"{e:.5f}" for e in es] + [", ".join(f"{o:.2f}" for o in lvl),
                                                                 f"{order(h, es):.2f}"])
     best = min(((k, v[-1]) for k, v in res.items()), key=lambda kv: kv[1])
-    txt = ("### Diffusion time and convergence order (§9.5.1; issue 3 item 3)\n\nCommand: `/work/anchors/bin/python "
-           "bench/bench_heat_surface.py --time-step`. ε of §9.1 on the planar star of the previous section, levels "
+    txt = ("### Diffusion time and convergence order (§9.5.1)\n\nε of §9.1 on the planar star of the previous section, levels "
            f"n = {levels} ({', '.join(str(2 * k * k) for k in levels)} faces for the barycentric setup). Rows: "
            "t = c·h² with h = half the mean edge length (the paper's §6 choice is c = 1: \"we let t = h², where h "
            "is the mean distance between nodes — in our case, edge midpoints\"), and t ∝ h (equal to h² at the "
@@ -726,8 +748,8 @@ def time_step_study(levels):
     return txt
 
 
-# ------------------------------------------------------------------------------------------ speed (issue 17)
-#: The --speed inputs: CGAL scans, CAD parts, meshes with holes / boundaries, the author data of the paper.
+# ------------------------------------------------------------------------------------------ speed
+#: The speed inputs: CGAL scans, CAD parts, meshes with holes / boundaries, the author data of the paper.
 SPEED_MESHES = ["bunny00.off", "refined_elephant.off", "armadillo.off", "mannequin-devil.off",
                 "ChineseDragon-10kv.off", "camel.off", "cow.off", "fandisk.off", "blade.off", "turbine.off",
                 "mech-holes-shark.off", "holes.off", "elephant-with-holes.off", "shm:bumpy-sphere.obj",
@@ -773,7 +795,7 @@ def _speed_case(path):
 #: the first solve, the same solver for the repeated one) and the mean taken — the same rule for both libraries.
 #: Under load the scheduler hands the cores out in slices of a few milliseconds, so a single millisecond-scale
 #: call either runs unpreempted or waits a whole slice of another process: per-call times of short solves jump
-#: between ~1× and 3–4× the idle time with the share of calls preempted (RESULTS "heat-repeat-load"; per stage:
+#: between ~1× and 3–4× the idle time with the share of calls preempted (per stage:
 #: bench/profile_heat_surface_load.py), while a batch of ≥ 0.1 s averages over many slices.
 BATCH_S = 0.1
 #: Fresh solvers (rounds) per library and condition; LARGE_ROUNDS for SPEED_LARGE, whose first solves (0.6–3 s
@@ -895,7 +917,7 @@ def _summary(res, what):
 
 
 def _tri_setup(name):
-    """A triangle-mesh --speed case: mesh (degenerate faces dropped), the loops of {y < median}, both solvers."""
+    """A triangle-mesh speed case: mesh (degenerate faces dropped), the loops of {y < median}, both solvers."""
     path = os.path.join(SHM_DATA, name[4:]) if name.startswith("shm:") else os.path.join(data_dir(), "meshes", name)
     V, F, loops = _speed_case(path)
     pp_loops = [[(int(v), []) for v in c] for c in loops]
@@ -914,8 +936,7 @@ POLY_HDR = ["polygon mesh", "vertices", "polygons", "loops", "rel. L2 diff (two 
 def _protocol(rounds_note):
     return ("first = constructor + first solve, repeat = a further solve with the same solver and curves; every "
             f"sample is the mean over calls back to back lasting ≥ {BATCH_S} s (fresh solvers for first; "
-            "millisecond calls are otherwise either unpreempted or a whole time slice late under load, section "
-            f"\"heat-repeat-load\"); each figure the median over {rounds_note} rounds, the libraries interleaved with "
+            "millisecond calls are otherwise either unpreempted or a whole time slice late under load); each figure the median over {rounds_note} rounds, the libraries interleaved with "
             "alternating order. The rounds alternate idle and loaded (two busy processes, bench/load.py BusyLoad(2), "
             "started and stopped per round; the order flips every round), so that both conditions see the same "
             "background load (`load 1 min` = the 1-minute load average at the start of the condition's first and "
@@ -943,7 +964,7 @@ def _tables(res, hdr, poly_note=""):
 
 
 def poly_speed(quick=False, load=False):
-    """Issue 17 goal 4, polygon meshes only (the polygon rows of :func:`speed`, same protocol), idle and, with
+    """Polygon meshes only (the polygon rows of :func:`speed`, same protocol), idle and, with
     ``load``, with two busy processes competing; RESULTS section "heat-surface-speed-polygon"."""
     from importlib.metadata import version
 
@@ -958,8 +979,8 @@ def poly_speed(quick=False, load=False):
     if load:
         parts.append("### Loaded ratio / idle ratio per mesh\n\n" + _grow_rows(res))
     return (f"## Surface signed heat method on polygon meshes: speed against potpourri3d on {len(pnames)} meshes "
-            f"(issue 17)\n\nMachine: {machine()}; shared with other helpers ({start} at start, {end} at end). "
-            f"Command: `/work/anchors/bin/python bench/bench_heat_surface.py --speed --polygon --load"
+            f"\n\nMachine: {machine()}; shared with other helpers ({start} at start, {end} at end). "
+            f"Command: `/work/anchors/bin/python bench/bench_heat_surface.py --only speed-polygon --load"
             f"{' --quick' if quick else ''}`. potpourri3d {version('potpourri3d')} `PolygonMeshHeatSolver` "
             "(`compute_signed_distance`), gsdf `PolygonMeshSignedHeatSolver`; the polygon rows of the "
             "\"heat-surface-speed\" section, same protocol: " + _protocol(ROUNDS)
@@ -968,7 +989,7 @@ def poly_speed(quick=False, load=False):
 
 
 def speed(quick=False, load=False, small=False):
-    """Issue 17 goals 4–5: the surface signed heat method against potpourri3d on ≥ 10 meshes, idle and with two
+    """The surface signed heat method against potpourri3d on ≥ 10 meshes, idle and with two
     busy processes competing (bench/load.py), in alternating rounds per mesh (:func:`_compare`)."""
     from importlib.metadata import version
 
@@ -1000,9 +1021,9 @@ def speed(quick=False, load=False, small=False):
     summ = _summary(res, "Triangle meshes") + " " + _summary(pres, "Polygon meshes")
     large = [m for m in names if m in SPEED_LARGE]
     rounds_note = f"{ROUNDS}" + (f" ({LARGE_ROUNDS} for {', '.join(large)})" if large else "")
-    txt = (f"## Surface signed heat method: speed against potpourri3d on {len(names)} meshes (issue 17)\n\n"
+    txt = (f"## Surface signed heat method: speed against potpourri3d on {len(names)} meshes\n\n"
            f"Machine: {machine()}; shared with other helpers ({start} at start, {end} at end). Command: "
-           f"`/work/anchors/bin/python bench/bench_heat_surface.py --speed --load{' --quick' if quick else ''}"
+           f"`/work/anchors/bin/python bench/bench_heat_surface.py --only speed --load{' --quick' if quick else ''}"
            f"{' --small' if small else ''}`. "
            f"potpourri3d {version('potpourri3d')} `MeshSignedHeatSolver`, gsdf `SurfaceSignedHeatSolver`, one "
            "process, same mesh and curves (the boundary loops of {y < median} along edges), constraint \"zero\" = "
@@ -1013,7 +1034,7 @@ def speed(quick=False, load=False, small=False):
 
 
 # ------------------------------------------------------------------------------------------ factorization rule
-#: SuperLU options compared by --solver-rule: (label, permc_spec, renumber by RCM first). SuperLU's supernode
+#: SuperLU options compared by the solver-rule part: (label, permc_spec, renumber by RCM first). SuperLU's supernode
 #: settings (splu's relax / panel_size) are not varied: relax 40 with panel_size 5 factorized 10–40 % faster in
 #: a first measurement but corrupted the heap (glibc "corrupted size vs. prev_size", LLVM assertions later in
 #: the process), so gsdf keeps SuperLU's defaults.
@@ -1025,7 +1046,7 @@ SUPERLU_OPTIONS = [("MMD", "MMD_AT_PLUS_A", False),
 
 def _solver_matrices(name):
     """The two systems of a first "zero" solve: the vector heat operator (complex Hermitian, CR edges) and the
-    Dirichlet-reduced Poisson operator (real SPD) of the --speed curves."""
+    Dirichlet-reduced Poisson operator (real SPD) of the speed curves."""
     import scipy.sparse as sp
 
     if name.startswith("poly:"):
@@ -1098,75 +1119,6 @@ def solver_rule(names, repeat=3):
     hdr = (["mesh", "system", "unknowns", "nonzeros"] + [o[0] for o in SUPERLU_OPTIONS] + ["LDLᴴ, ND", "CHOLMOD",
            "CHOLMOD of I (overhead)"] + ["fastest"])
     return table(hdr, rows), wins
-
-
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--quick", action="store_true", help="smaller sizes, no RESULTS.md update")
-    ap.add_argument("--time-step", action="store_true", help="only the diffusion-time / convergence-order study")
-    ap.add_argument("--speed", action="store_true", help="only the speed table against potpourri3d (issue 17)")
-    ap.add_argument("--solver-rule", action="store_true", help="factorization options per mesh (issue 17)")
-    ap.add_argument("--small", action="store_true", help="with --speed: without the three meshes above 20k vertices")
-    ap.add_argument("--load", action="store_true", help="with --speed: also under two busy processes")
-    ap.add_argument("--polygon", action="store_true",
-                    help="with --speed: only the polygon meshes (own RESULTS section; with --quick 3 meshes)")
-    args = ap.parse_args()
-    if args.solver_rule:
-        from load import uptime
-
-        start = uptime()
-        tab, wins = solver_rule(SPEED_QUICK + POLY_QUICK if args.quick else SPEED_MESHES + POLY_SPEED,
-                                repeat=2 if args.quick else 3)
-        count = {lab: {k: v.count(k) for k in sorted(set(v))} for lab, v in wins.items()}
-        txt = ("## Surface signed heat method: factorization rule (issue 17)\n\n"
-               f"Machine: {machine()}; shared ({start} at start, {uptime()} at end). Command: "
-               f"`/work/anchors/bin/python bench/bench_heat_surface.py --solver-rule{' --quick' if args.quick else ''}`. "
-               f"Factorization time (best of {2 if args.quick else 3}, seconds; in parentheses the ratio to plain MMD) of the two systems of a first \"zero\" solve "
-               "of the --speed cases: the vector heat operator M + tL∇ (complex Hermitian; CR edges on triangle "
-               "meshes, vertices on polygon meshes) and the Poisson operator with the curve vertices eliminated "
-               "(real SPD). SuperLU in symmetric mode with one BLAS thread (gsdf.threads.blas_region); CHOLMOD = "
-               "cholespy (the complex system as its 2n real form); LDLᴴ, ND = gsdf.linalg._ldl (serial numba, BFS "
-               "nested dissection), which gsdf uses up to gsdf.linalg.LDL_MAX_UNKNOWNS real unknowns (complex count 2; SuperLU with the "
-               "RCM + MMD ordering above; polygon meshes: MMD alone). Fastest per system: "
-               + "; ".join(f"{lab}: " + ", ".join(f"{k} {n}×" for k, n in c.items()) for lab, c in count.items())
-               + ".\n\n" + tab + "\n")
-        print(txt)
-        write_section("heat-surface-solver-rule" + ("-quick" if args.quick else ""), txt)
-        return
-    if args.speed and args.polygon:
-        txt = poly_speed(quick=args.quick, load=args.load)
-        print(txt)
-        if args.load and not args.quick:
-            write_section("heat-surface-speed-polygon", txt)
-        return
-    if args.speed:
-        txt = speed(quick=args.quick, load=args.load, small=args.small)
-        print(txt)
-        if args.load:
-            write_section("heat-surface-speed" + ("-quick" if args.quick else ""), txt)
-        return
-    if args.time_step:
-        time_step_study([20, 40, 80] if args.quick else [28, 56, 112, 224])
-        return
-    parts = [f"## Signed heat method on surfaces (issue 3)\n\nMachine: {machine()}; load average at start {os.getloadavg()[0]:.1f} (shared machine)\n\nCommand: "
-             "`/work/anchors/bin/python bench/bench_heat_surface.py`\n"]
-    if pp3d is not None:
-        parts.append(against_potpourri())
-    parts.append(planar([20, 40, 80] if args.quick else [28, 56, 112, 224]))
-    parts.append(time_step_study([20, 40, 80] if args.quick else [28, 56, 112, 224]))
-    parts.append(sphere([2, 3, 4] if args.quick else [3, 4, 5, 6]))
-    meshes = (["elephant.off"] if args.quick else
-              ["elephant.off", "cow.off", "homer.off", "camel.off", "bunny00.off", "refined_elephant.off"])
-    parts.append(broken(meshes, 2 if args.quick else 4))
-    parts.append(robustness())
-    parts.append(point_clouds([3, 4] if args.quick else [3, 4, 5]))
-    parts.append(extensions())
-    text = "\n".join(parts)
-    print(text)
-    if not args.quick:
-        write_section("heat-surface", text)
-
-
 
 
 # ------------------------------------------------------------------------------------------ §8.3 / §8.4 vs potpourri3d
@@ -1248,16 +1200,15 @@ def _pp_shifted(q, loops, V):
     return q - float((0.5 * (q[a] + q[b]) * ell).sum() / ell.sum())
 
 
-def polygon_pointcloud_vs_potpourri():
+def polygon_pointcloud_vs_potpourri(quick=False):
     """§8.3 polygon meshes (Bunge et al. 2020 Laplacian) and §8.4 point clouds (tufted-cover Laplacian) against
     potpourri3d's PolygonMeshHeatSolver / PointCloudHeatSolver (one process, same inputs and curves).
 
-    Run: ``/work/anchors/bin/python bench/bench_heat_surface.py --polygon-pointcloud [--quick]``."""
+    Run: ``/work/anchors/bin/python bench/bench_heat_surface.py --only polygon-pointcloud [--quick]``."""
     from importlib.metadata import version
 
     from gsdf.heat import PointCloudSignedHeatSolver, PolygonMeshSignedHeatSolver
 
-    quick = "--quick" in sys.argv
     modes = [("zero", "ZeroSet"), ("none", "None"), ("multiple", "Multiple")]
 
     def rel(p, q):
@@ -1404,7 +1355,7 @@ def polygon_pointcloud_vs_potpourri():
                "the mesh)", V, Nv / np.linalg.norm(Nv, axis=1, keepdims=True), loop, ref.get)
 
     txt = (f"### Polygon meshes (§8.3) and point clouds (§8.4) against potpourri3d {version('potpourri3d')}\n\n"
-           "Command: `/work/anchors/bin/python bench/bench_heat_surface.py --polygon-pointcloud`. gsdf: "
+           "Command: `/work/anchors/bin/python bench/bench_heat_surface.py --only polygon-pointcloud`. gsdf: "
            "`PolygonMeshSignedHeatSolver` (Bunge et al. 2020 virtual-refinement Laplacian, lumped mass, vertex "
            "connection Laplacian) and `PointCloudSignedHeatSolver` (robust-laplacian tufted cover). potpourri3d's "
            "polygon solver uses the de Goes et al. 2020 virtual-element operators instead (geometry-central "
@@ -1424,17 +1375,10 @@ def polygon_pointcloud_vs_potpourri():
              "normals.\n\n"
            + table(["point cloud / curve", "constraint", "rel. L2 vs potpourri3d", "gsdf vs exact (rel / max)",
                     "potpourri3d vs exact (rel / max)", "gsdf s", "potpourri3d s"], crow) + "\n")
-    print(txt)
-    if not quick:
-        write_section("heat-surface-polygon-pointcloud", txt)
     return txt
 
 
-if __name__ == "__main__" and "--polygon-pointcloud" in sys.argv:
-    polygon_pointcloud_vs_potpourri()
-
-
-# ------------------------------------------------------------------------------------------ polygon speed (issue 17)
+# ------------------------------------------------------------------------------------------ polygon speed
 POLY_SPEED = ["poly:cube sphere 32", "poly:cube sphere 64", "poly:UV sphere", "poly:quad torus",
               "poly:polygon_mesh merged", "poly:polygon-bear.obj"]
 POLY_QUICK = ["poly:cube sphere 32", "poly:quad torus", "poly:polygon-bear.obj"]
@@ -1451,7 +1395,7 @@ def _poly_region_loops(V, polys, inside):
 
 
 def _poly_speed_case(name):
-    """(V, polygons, loops) of a polygon-mesh --speed case; loops = boundary of {centroid y < median}."""
+    """(V, polygons, loops) of a polygon-mesh speed case; loops = boundary of {centroid y < median}."""
     key = name[5:]
     if key.startswith("cube sphere"):
         V, Q = _cube_sphere(int(key.split()[-1]))
@@ -1479,7 +1423,7 @@ def _poly_speed_case(name):
 
 
 def _poly_setup(name):
-    """A polygon-mesh --speed case: gsdf PolygonMeshSignedHeatSolver vs potpourri3d PolygonMeshHeatSolver,
+    """A polygon-mesh speed case: gsdf PolygonMeshSignedHeatSolver vs potpourri3d PolygonMeshHeatSolver,
     constructor + first signed-distance solve and a repeated solve, "zero" = potpourri3d's default ZeroSet."""
     from gsdf.heat import PolygonMeshSignedHeatSolver
 
@@ -1494,5 +1438,360 @@ def _poly_setup(name):
                 diff=lambda p, q: float(np.linalg.norm(p - q) / np.linalg.norm(q)))
 
 
-if __name__ == "__main__" and "--polygon-pointcloud" not in sys.argv:
+# ------------------------------------------------------------------------------------------ LDL orderings
+RULE = ("`LDLFactorization(ordering=\"auto\")` (gsdf.linalg._ldl): AMD; on systems of at most AUTO_ND_MAX_N = "
+        "10,000 unknowns whose AMD factor is flop-heavy (Σ_j c_j² ≥ 12 · nnz(A) · log2 n, c_j = column counts "
+        "of L) nested dissection is computed too and kept when its flop count is below 0.9× AMD's. Measured "
+        "reason: AMD's ordering + factorization wins on the triangle-mesh systems (fill 0.5–0.9× ND's, "
+        "ordering 1.5–4× faster); ND wins only on regular quad grids, where the factor is flop-heavy; trying ND "
+        "on large meshes (up to 160 ms of ordering on bunny00) costs more than it can save. The backend limit "
+        "(gsdf.linalg._direct.LDL_MAX_UNKNOWNS) went from 64k to 300k real unknowns: with AMD the LDL beats "
+        "SuperLU (its factorization column) on every system here, the largest included.")
+
+
+def best(fn, repeat):
+    ts = []
+    out = None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        ts.append(time.perf_counter() - t0)
+    return min(ts), out
+
+
+def measure(names, repeat=3):
+    rows, summary = [], []
+    for name in names:
+        A, P = _solver_matrices(name)
+        for lab, M in (("vector heat", A), ("Poisson", P)):
+            M = sp.csr_matrix(M)
+            real_unknowns = M.shape[0] * (2 if np.iscomplexobj(M.data) else 1)
+            ip, ix, n = M.indptr.astype(np.int64), M.indices.astype(np.int64), M.shape[0]
+            b = np.random.default_rng(0).normal(size=n).astype(M.dtype)
+            res = {}
+            for meth in ("amd", "nd"):
+                t_ord, perm = best(lambda: order_csr(ip, ix, n, meth), repeat)
+                t_fac, f = best(lambda: LDLFactorization(M, ordering=perm), repeat)
+                t_sol, _ = best(lambda: f.solve(b), repeat)
+                res[meth] = (t_ord, t_fac, t_sol, f.nnz)
+            lu = spla.splu(sp.csc_matrix(M), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                           options={"SymmetricMode": True})
+            auto = "nd" if np.array_equal(LDLFactorization(M).perm, order_csr(ip, ix, n, "nd")) else "amd"
+            t_slu, lu_g = best(lambda: Factorization(sp.csc_matrix(M), reorder=True), repeat)
+            t_slu_s, _ = best(lambda: lu_g.solve(b), repeat)
+            pmmd = np.empty(n, np.int64)
+            pmmd[lu.perm_c] = np.arange(n)                # perm_c[j] = the position of column j
+            mmd = fill_count(M, pmmd)
+            a, d = res["amd"], res["nd"]
+            tot_a, tot_d = a[0] + a[1], d[0] + d[1]
+            win = "amd" if tot_a <= tot_d else "nd"
+            summary.append((name, lab, real_unknowns, win, tot_a / tot_d, a[3] / d[3], a[3] / mmd, tot_a / t_slu,
+                            a[2] / t_slu_s))
+            rows.append([name.replace("shm:", "").replace("poly:", "polygon "), lab, n, real_unknowns <= LDL_MAX_UNKNOWNS,
+                         f"{a[0] * 1e3:.1f} / {d[0] * 1e3:.1f}", f"{a[1] * 1e3:.1f} / {d[1] * 1e3:.1f}",
+                         f"{tot_a * 1e3:.1f} / {tot_d * 1e3:.1f} ({tot_a / tot_d:.2f})",
+                         f"{a[2] * 1e3:.2f} / {d[2] * 1e3:.2f}", f"{a[3]} / {d[3]} ({a[3] / d[3]:.2f})",
+                         f"{mmd} ({a[3] / mmd:.3f})", win, auto, f"{t_slu * 1e3:.1f} ({tot_a / t_slu:.2f})",
+                         f"{t_slu_s * 1e3:.2f} ({a[2] / t_slu_s:.2f})"])
+            print(rows[-1], f"load {os.getloadavg()[0]:.1f}", flush=True)
+    hdr = ["mesh", "system", "unknowns", "LDL used (≤ LDL_MAX_UNKNOWNS real)", "ordering ms AMD / ND", "factorize ms AMD / ND",
+           "ordering + factorize ms AMD / ND (ratio)", "solve ms AMD / ND", "nnz(L) AMD / ND (ratio)",
+           "nnz(L) SuperLU MMD (AMD / MMD)", "faster", "auto picks", "SuperLU factorize ms (LDL-AMD / SuperLU)",
+           "SuperLU solve ms (LDL-AMD / SuperLU)"]
+    return table(hdr, rows), summary
+
+
+# ------------------------------------------------------------------------------------------ digital surfaces (§8.5)
+def vx_eps(phi, ref, A):
+    return float(np.sqrt((A * (phi - ref) ** 2).sum() / A.sum()) / (ref.max() - ref.min()))
+
+
+def vx_ball(N, R):
+    x = np.indices((N,) * 3) - (N - 1) / 2
+    return (x ** 2).sum(0) <= R ** 2
+
+
+@contextlib.contextmanager
+def vx_domain(**forced):
+    """Inside the block the voxel solver's domain gets ``forced`` options (``normals=``: analytic normals,
+    ``connection="B"``: the other connection Laplacian), which are not options of the public solver."""
+    from gsdf.heat.voxel._domain import VoxelSurfaceDomain
+
+    init = VoxelSurfaceDomain.__init__
+
+    def patched(self, *args, **kwargs):
+        init(self, *args, **{**kwargs, **forced})
+
+    VoxelSurfaceDomain.__init__ = patched
+    try:
+        yield
+    finally:
+        VoxelSurfaceDomain.__init__ = init
+
+
+def vx_sphere(N, radius=3.0, broken=False, connection="A", timings=None, t_coef=1.0):
+    R = N / 2 - 2
+    occ = vx_ball(N, R)
+    t0 = time.perf_counter()
+    with vx_domain(connection=connection):
+        s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, t_coef=t_coef)
+    t_build = time.perf_counter() - t0
+    c = N / 2
+    # the curve at the grid plane z = zc nearest to c + 0.3 R (quads with centres below zc + ¼: the region's
+    # boundary edges then lie on that plane, not up to half a voxel off it)
+    zc = c + np.round(0.3 * R)
+    region = s.face_centres[:, 2] < zc + 0.25
+    curves = region_boundary_curves(s.faces, region)
+    if broken:
+        curves = [p for g in curves for p in (g[a:a + 5] for a in range(0, len(g) - 1, 8)) if len(p) >= 2]
+    t0 = time.perf_counter()
+    phi = s.compute_distance(curves)
+    t_first = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    s.compute_distance(curves)
+    t_again = time.perf_counter() - t0
+    P = s.vertices - c
+    ref = R * (np.arccos(np.clip(-P[:, 2] / np.linalg.norm(P, axis=1), -1, 1)) - np.arccos(-(zc - c) / R))
+    A = s.domain.mass()
+    nin = np.bincount(s.faces.ravel(), weights=np.repeat(region, 4).astype(float), minlength=len(P))
+    nall = np.bincount(s.faces.ravel(), minlength=len(P))
+    inside, outside = nin == nall, nin == 0
+    ok = (inside & (phi < 0)) | (outside & (phi > 0))
+    if timings is not None:
+        timings.update(build=t_build, first=t_first, again=t_again, n=len(s.vertices), m=len(s.faces))
+    return vx_eps(phi, ref, A), float(A[ok].sum() / A[inside | outside].sum())
+
+
+def vx_plane(N, nrm, mdir, radius=3.0, exact=False, t_coef=1.0):
+    nrm = np.asarray(nrm, float) / np.linalg.norm(nrm)
+    m = np.asarray(mdir, float) / np.linalg.norm(mdir)
+    x = np.indices((N,) * 3).transpose(1, 2, 3, 0) + 0.5
+    occ = ((x - N / 2) @ nrm) < 0
+    normals = None
+    if exact:
+        S = digital_surface(occ, np.ones(3))
+        on = ((S.trivial_normals @ nrm) > 0) & (np.abs((S.centres - N / 2) @ nrm) < 1.0)
+        normals = np.where(on[:, None], nrm, S.trivial_normals)
+    with vx_domain(normals=normals):
+        s = VoxelSurfaceSignedHeatSolver(occ, normal_radius=radius, t_coef=t_coef)
+    ctr = np.full(3, N / 2)
+    phi = s.compute_distance(region_boundary_curves(s.faces, (s.face_centres - ctr) @ m < 0))
+    P = s.vertices - ctr
+    sel = (np.linalg.norm(P - np.outer(P @ nrm, nrm), axis=1) < 0.3 * N) & (np.abs(P @ nrm) < 1.0)
+    return vx_eps(phi[sel], (P @ m)[sel], s.domain.mass()[sel])
+
+
+def vx_icosphere(subdivisions, R=1.0, z_rel=0.3):
+    """Baseline: the triangle-mesh (Crouzeix–Raviart) signed heat method on an icosphere, curve z = z_rel·R."""
+    from gsdf.heat import SurfaceSignedHeatSolver
+    from gsdf.contour._surface_curves import level_set_curves
+    from gsdf.data._shapes import sphere_mesh
+
+    V, F = sphere_mesh(subdivisions, R)
+    s = SurfaceSignedHeatSolver(V, F)
+    t0 = time.perf_counter()
+    phi = s.compute_distance(level_set_curves(V, F, V[:, 2] - z_rel * R))
+    dt = time.perf_counter() - t0
+    ref = R * (np.arccos(np.clip(-V[:, 2] / R, -1, 1)) - np.arccos(-z_rel))
+    return vx_eps(phi, ref, s.ops.vertex_mass()), len(V), dt
+
+
+def vx_order(errs):
+    return [float("nan")] + [float(np.log2(a / b)) for a, b in zip(errs[:-1], errs[1:])]
+
+
+def part_voxel(quick):
+    """§8.5 digital surfaces: convergence, diffusion time, smooth baseline, Option A vs B, component timings."""
+    sizes = [16, 32] if quick else [16, 32, 64, 128]
+    lines = ["ε is the §9.1 error (mass-weighted L2 / range of φ⁰ / √area); 'order' = log2(ε_N/2 / ε_N). "
+             "Single-threaded BLAS (OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1): on a shared, oversubscribed "
+             "machine threaded BLAS made the factorizations 10-70x slower.", ""]
+    # ---------------------------------------------------------------- sphere
+    lines += ["### Digital sphere R = N/2 − 2, curve on the grid plane z = c + round(0.3R), φ⁰ = R(θ − θ0)", "",
+              "| N | vertices | ε II r=3 | order | sign | ε II r=½N^⅔ | order | ε trivial | order | "
+              "ε broken (50 %) | sign broken | build s | 1st solve s | again s |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    rows = []
+    for N in sizes:
+        tm = {}
+        e3, s3 = vx_sphere(N, 3.0, timings=tm)
+        es, _ = vx_sphere(N, 0.5 * N ** (2 / 3))
+        et, _ = vx_sphere(N, 0.0)
+        eb, sb = vx_sphere(N, 3.0, broken=True)
+        rows.append((N, tm, e3, s3, es, et, eb, sb))
+        print(f"sphere N={N}: {e3:.5f} {s3:.4f} {es:.5f} {et:.5f} {eb:.5f} {sb:.4f} {tm}", flush=True)
+    o3 = vx_order([r[2] for r in rows])
+    osc = vx_order([r[4] for r in rows])
+    ot = vx_order([r[5] for r in rows])
+    for k, (N, tm, e3, s3, es, et, eb, sb) in enumerate(rows):
+        lines.append(f"| {N} | {tm['n']} | {e3:.5f} | {o3[k]:.2f} | {100 * s3:.2f} % | {es:.5f} | {osc[k]:.2f} | "
+                     f"{et:.5f} | {ot[k]:.2f} | {eb:.5f} | {100 * sb:.2f} % | {tm['build']:.2f} | "
+                     f"{tm['first']:.2f} | {tm['again']:.3f} |")
+    # ---------------------------------------------------------------- planes
+    lines += ["", "### Slanted digital planes, straight curve, φ⁰ = in-plane signed distance", "",
+              "| plane | N | ε II r=3 | order | ε trivial | order | ε exact normals | order |",
+              "|---|---|---|---|---|---|---|---|"]
+    for nrm, m in (((1, 1, 1), (1, -1, 0)), ((1, 2, 0), (2, -1, 0))):
+        ii = [vx_plane(N, nrm, m) for N in sizes]
+        tr = [vx_plane(N, nrm, m, radius=0.0) for N in sizes]
+        ex = [vx_plane(N, nrm, m, exact=True) for N in sizes]
+        print(f"plane {nrm}: {ii} {tr} {ex}", flush=True)
+        oi, ot_, oe = vx_order(ii), vx_order(tr), vx_order(ex)
+        for k, N in enumerate(sizes):
+            lines.append(f"| {nrm} | {N} | {ii[k]:.5f} | {oi[k]:.2f} | {tr[k]:.5f} | {ot_[k]:.2f} | {ex[k]:.5f} | "
+                         f"{oe[k]:.2f} |")
+    # ---------------------------------------------------------------- diffusion time
+    lines += ["", "Diffusion time t = t_coef·h² (default t_coef = 1, the notes' t = h²): ε at the two finest N.", "",
+              "| case | N | t_coef = 1 | 2 | 4 | 16 |", "|---|---|---|---|---|---|"]
+    for N in sizes[-2:]:
+        row = [vx_sphere(N, 0.5 * N ** (2 / 3), t_coef=tc)[0] for tc in (1, 2, 4, 16)]
+        lines.append(f"| sphere, II r=½N^⅔ | {N} | " + " | ".join(f"{e:.5f}" for e in row) + " |")
+        row = [vx_plane(N, (1, 2, 0), (2, -1, 0), exact=True, t_coef=tc) for tc in (1, 2, 4, 16)]
+        lines.append(f"| plane (1,2,0), exact normals | {N} | " + " | ".join(f"{e:.5f}" for e in row) + " |")
+        print("t_coef", N, lines[-2:], flush=True)
+    # ---------------------------------------------------------------- smooth baseline
+    lines += ["", "Baseline, the same method on a smooth triangle mesh (Crouzeix–Raviart SHM, "
+              "`SurfaceSignedHeatSolver`) on icospheres of similar vertex counts, curve z = 0.3R:", "",
+              "| subdivisions | vertices | ε | order | 1st solve s |", "|---|---|---|---|---|"]
+    base = [vx_icosphere(k) for k in (3, 4, 5)]            # 6 (41k vertices): minutes in the complex SuperLU
+    ob = vx_order([b[0] for b in base])
+    for k, (e, nv, dt) in enumerate(base):
+        lines.append(f"| {k + 3} | {nv} | {e:.5f} | {ob[k]:.2f} | {dt:.2f} |")
+    print("icosphere", base, flush=True)
+    # ---------------------------------------------------------------- option A vs B, component timings
+    N = sizes[-2] if len(sizes) > 1 else sizes[0]
+    eA, _ = vx_sphere(N)
+    eB, _ = vx_sphere(N, connection="B")
+    occ = vx_ball(sizes[-1], sizes[-1] / 2 - 2)
+    t0 = time.perf_counter()
+    S = digital_surface(occ, np.ones(3))
+    t_surf = time.perf_counter() - t0
+    integral_invariant_normals(occ, np.ones(3), S, 3.0)               # compile (cached) and warm
+    t0 = time.perf_counter()
+    integral_invariant_normals(occ, np.ones(3), S, 3.0)
+    t_norm = time.perf_counter() - t0
+    lines += ["", f"Option A (de Goes/DGtal connection Laplacian) vs Option B (rotated scalar off-diagonals), sphere "
+              f"N = {N}: ε = {eA:.5f} vs {eB:.5f}.", "",
+              f"Components at N = {sizes[-1]} ({len(S.faces)} quads): surface extraction + manifold split "
+              f"{t_surf:.2f} s, integral-invariant normals (r = 3, numba parallel) {t_norm:.2f} s; 'build' above "
+              "= extraction + normals + operators, '1st solve' includes the two factorizations (vector heat, "
+              "Dirichlet Poisson), 'again' reuses them."]
+    return "Signed heat method on digital surfaces (§8.5)", "\n".join(lines)
+
+
+# ------------------------------------------------------------------------------------------ parts
+def _body(txt):
+    """A part's text without its own title line and machine / command preamble (the section heading has them)."""
+    import re
+
+    txt = re.sub(r"^#+ [^\n]*\n\n", "", txt.lstrip())
+    return re.sub(r"^(Machine: .*?)?Command: `[^`]*`\.? ?", "", txt, count=1, flags=re.S)
+
+
+def part_accuracy(quick):
+    levels = [20, 40, 80] if quick else [28, 56, 112, 224]
+    parts = []
+    if pp3d is not None:
+        parts.append(against_potpourri())
+    parts.append(planar(levels))
+    parts.append(_body(time_step_study(levels)).join(["### Diffusion time and convergence order (§9.5.1)\n\n", ""]))
+    parts.append(sphere([2, 3, 4] if quick else [3, 4, 5, 6]))
+    meshes = (["elephant.off"] if quick else
+              ["elephant.off", "cow.off", "homer.off", "camel.off", "bunny00.off", "refined_elephant.off"])
+    parts.append(broken(meshes, 2 if quick else 4))
+    parts.append(robustness())
+    parts.append(point_clouds([3, 4] if quick else [3, 4, 5]))
+    parts.append(extensions())
+    return "Signed heat method on surfaces: accuracy", "\n".join(parts)
+
+
+def part_solver_rule(quick):
+    tab, wins = solver_rule(SPEED_QUICK + POLY_QUICK if quick else SPEED_MESHES + POLY_SPEED, repeat=2 if quick else 3)
+    count = {lab: {k: v.count(k) for k in sorted(set(v))} for lab, v in wins.items()}
+    return ("Surface signed heat method: factorization backends",
+            f"Factorization time (best of {2 if quick else 3}, seconds; in parentheses the ratio to plain MMD) of the "
+            "two systems of a first \"zero\" solve of the speed cases: the vector heat operator M + tL∇ (complex "
+            "Hermitian; CR edges on triangle meshes, vertices on polygon meshes) and the Poisson operator with the "
+            "curve vertices eliminated (real SPD). SuperLU in symmetric mode with one BLAS thread "
+            "(gsdf.threads.blas_region); CHOLMOD = cholespy (the complex system as its 2n real form); LDLᴴ, ND = "
+            "gsdf.linalg._ldl (serial numba, BFS nested dissection), which gsdf uses up to "
+            "gsdf.linalg._direct.LDL_MAX_UNKNOWNS real unknowns (complex count 2; SuperLU with the RCM + MMD ordering "
+            "above; polygon meshes: MMD alone). Fastest per system: "
+            + "; ".join(f"{lab}: " + ", ".join(f"{k} {n}×" for k, n in c.items()) for lab, c in count.items())
+            + ".\n\n" + tab)
+
+
+def part_ordering(quick):
+    from load import uptime
+
+    names = SPEED_QUICK + POLY_QUICK if quick else SPEED_MESHES + POLY_SPEED
+    LDLFactorization(sp.identity(3, format="csr"), ordering="amd")      # compile first (not timed)
+    LDLFactorization(sp.identity(3, format="csr"), ordering="nd")
+    tab, summary = measure(names)
+    used = [s for s in summary if s[2] <= LDL_MAX_UNKNOWNS]
+    amd_wins = sum(s[3] == "amd" for s in used)
+    return (f"LDL orderings: approximate minimum degree vs nested dissection ({len(names)} meshes)",
+            "Times: best of 3, ms; every ratio compares two runs in the same process. AMD = "
+            "gsdf.linalg._ordering.approximate_minimum_degree, ND = nested_dissection (BFS level-structure "
+            "separators); the MMD column is SuperLU's multiple minimum degree (perm_c of "
+            "`splu(..., permc_spec='MMD_AT_PLUS_A')`) counted by the same symbolic factorization.\n\n"
+            f"**Rule:** AMD is faster (ordering + factorization) on {amd_wins} of {len(used)} systems the LDL "
+            f"factorizes (≤ {LDL_MAX_UNKNOWNS} real unknowns); ordering + factorization AMD/ND ratio "
+            f"{min(s[4] for s in used):.2f}–{max(s[4] for s in used):.2f}, fill AMD/ND "
+            f"{min(s[5] for s in used):.2f}–{max(s[5] for s in used):.2f}, fill AMD/MMD "
+            f"{min(s[6] for s in summary):.3f}–{max(s[6] for s in summary):.3f}.\n\n" + RULE + "\n\nLDL (AMD, "
+            f"ordering + factorization) / SuperLU factorization on all systems: {min(s[7] for s in summary):.2f}–"
+            f"{max(s[7] for s in summary):.2f} (above {LDL_MAX_UNKNOWNS} real unknowns: "
+            + ", ".join(f"{s[0].replace('shm:', '')} {s[1]} {s[7]:.2f}" for s in summary if s[2] > LDL_MAX_UNKNOWNS)
+            + f"); solves {min(s[8] for s in summary):.2f}–{max(s[8] for s in summary):.2f}. Load at the end: "
+            f"{uptime()}.\n\n" + tab)
+
+
+PARTS = ("accuracy", "polygon-pointcloud", "speed", "speed-polygon", "solver-rule", "ordering", "voxel")
+SECTIONS = {"accuracy": "heat-surface", "voxel": "heat-voxel"}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="smaller sizes in every part")
+    ap.add_argument("--only", default="", help=f"comma list of parts: {','.join(PARTS)}")
+    ap.add_argument("--load", action="store_true", help="speed parts: also under two busy processes")
+    ap.add_argument("--small", action="store_true", help="speed: without the three meshes above 20k vertices")
+    args = ap.parse_args(argv)
+    parts = [p for p in args.only.split(",") if p] or [p for p in PARTS if p != "speed-polygon"]
+    for p in parts:
+        if p not in PARTS:
+            ap.error(f"--only: unknown part {p!r}; known: {', '.join(PARTS)}")
+    from load import uptime
+
+    for part in parts:
+        start = uptime()
+        flags = [f"--only {part}"] + (["--quick"] if args.quick else []) + \
+            (["--load"] if args.load and part.startswith("speed") else []) + \
+            (["--small"] if args.small and part == "speed" else [])
+        env = "OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1" if part == "voxel" else ""
+        cmd = command("bench_heat_surface.py", flags, python="/work/anchors/bin/python", env=env)
+        if part == "accuracy":
+            title, body = part_accuracy(args.quick)
+        elif part == "polygon-pointcloud":
+            title = "Signed heat method on polygon meshes (§8.3) and point clouds (§8.4) against potpourri3d"
+            body = _body(polygon_pointcloud_vs_potpourri(args.quick))
+        elif part == "speed":
+            title = "Surface signed heat method: speed against potpourri3d"
+            body = _body(speed(quick=args.quick, load=args.load, small=args.small))
+        elif part == "speed-polygon":
+            title = "Surface signed heat method on polygon meshes: speed against potpourri3d"
+            body = _body(poly_speed(quick=args.quick, load=args.load))
+        elif part == "solver-rule":
+            title, body = part_solver_rule(args.quick)
+        elif part == "ordering":
+            title, body = part_ordering(args.quick)
+        else:
+            title, body = part_voxel(args.quick)
+        text = heading(title, cmd, start) + body.strip() + "\n"
+        print(text, flush=True)
+        write_section(SECTIONS.get(part, f"heat-surface-{part}"), text)
+
+
+if __name__ == "__main__":
     main()

@@ -10,10 +10,10 @@ Run: ``PYTHONPATH=src python3 bench/bench_io.py [n_lat]`` (default 400 -> ~0.32 
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import os
-import subprocess
 import sys
 import tempfile
 import warnings
@@ -21,7 +21,7 @@ import warnings
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
-from common import machine, median_time, table, write_section  # noqa: E402
+from common import command, heading, median_time, table, write_section  # noqa: E402
 
 import gsdf  # noqa: E402
 
@@ -56,7 +56,9 @@ def exact(V, F, V0, F0) -> str:
 
 
 def main():
-    n_lat = int(sys.argv[1]) if len(sys.argv) > 1 else 400
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("n_lat", nargs="?", type=int, default=400, help="latitude rings of the soup (400: ~0.32 M triangles)")
+    n_lat = ap.parse_args().n_lat
     import meshio
     import trimesh
 
@@ -85,9 +87,8 @@ def main():
             del cells
         except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio calls sys.exit on failures
             rows.append([ext, "meshio.read", "-", f"fails: {type(exc).__name__}", ""])
-    load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
-    text = (f"## Mesh readers (bench/bench_io.py {n_lat})\n\n{machine()}\n\nload: `{load}` (other helpers share the "
-            f"2 cores: times are indicative, compare within a row group)\n\n"
+    text = (heading("Mesh readers against trimesh and meshio", command("bench_io.py", [str(n_lat)]))
+            + "Times are indicative on a shared machine: compare within a row group.\n\n"
             f"Soup: {len(V0)} vertices (100 unreferenced), {len(polys)} polygons (quads, duplicated and degenerate "
             f"triangles) -> {len(F0)} triangles after fan triangulation. 'exact' = vertices and triangles identical "
             "to what was written, in order.\n\n"

@@ -1,78 +1,37 @@
-"""Surface winding numbers benchmark (issue 12): a seeded, regenerable generator of broken-curve cases on meshes
-of genus 0–3 with and without boundary, scored by mislabeled area; plus timing growth and the author data.
+"""Surface winding numbers: a seeded, regenerable generator of broken-curve cases on meshes of genus 0–3 with
+and without boundary, scored by mislabeled area; plus timing growth and the author data.
 
-Cases (the thesis' 934 are not published; spec notes §1(e).4): for every mesh, ground-truth regions are
-either super-level sets of a low Laplace eigenfunction (L φ = λ M φ, eigenvectors 2–6, level at a random
-quantile) or region growing from 1–3 random seed faces (Dijkstra over face centroids up to 15–50 % of the
-area). The region's oriented boundary is broken by deleting a fraction f ~ U(0.1, 0.5) of its edges, by one
-of two schemes (``--breaking``; both seeded, same case draws):
+Cases (the thesis' 934 are not published): for every mesh, ground-truth regions are either super-level sets of a
+low Laplace eigenfunction (L φ = λ M φ, eigenvectors 2–6, level at a random quantile) or region growing from 1–3
+random seed faces (Dijkstra over face centroids up to 15–50 % of the area). The region's oriented boundary is
+broken by deleting a fraction f ~ U(0.1, 0.5) of its edges, by one of two schemes (``--breaking``; both seeded,
+same case draws):
 
-* ``random`` (default) — "random intervals", as the thesis describes its benchmark (§6.3, Fig. 6.7; §7.1:
-  curves deleted "at random intervals"): the chain is cut into edge walks (loops, or paths ending on the mesh
-  boundary); in a walk of n edges, round(f·n) edges go in many short gaps of 1..ℓmax edges each, uniform,
-  ℓmax = clip(n // 20, 2, 5), so no gap is longer than 5 edges (nor than 5 % of a loop of 40+ edges); the
-  kept runs between gaps are a uniformly random composition of the other edges with at least 2 edges each
-  (1 if 2 do not fit; a path's two end runs may be empty), and on a loop the pattern starts at a random edge.
-  Walks under 8 edges stay whole (:meth:`MeshCases.break_random`).
-* ``long`` — the first run's scheme: per connected curve component, f·n edges in k ~ U{1..4} intervals grown
-  by BFS along the curve from k random seed edges (few long gaps; :meth:`MeshCases.break_long`). With 40–50 %
-  deleted in one or two gaps the truth inside them is not determined by the input (see below).
+* ``random`` (default) — "random intervals", as the thesis describes its benchmark (§6.3, Fig. 6.7; §7.1):
+  the chain is cut into edge walks; in a walk of n edges, round(f·n) edges go in many short gaps of 1..ℓmax
+  edges each, ℓmax = clip(n // 20, 2, 5); the kept runs between gaps are a uniformly random composition of the
+  other edges with at least 2 edges each; walks under 8 edges stay whole (:meth:`MeshCases.break_random`).
+* ``long`` — per connected curve component, f·n edges in k ~ U{1..4} intervals grown by BFS along the curve
+  from k random seed edges (few long gaps; :meth:`MeshCases.break_long`). With 40–50 % deleted in one or two
+  gaps the truth inside them is not determined by the input.
 
 On closed surfaces of genus > 0, half the cases add 1–2 broken homology generators (tree–cotree loops, 0–30 %
-deleted by the same scheme) as nonbounding loops; they leave the truth unchanged. How the loops are drawn
-(``MeshCases(..., loops=...)``, ``bench_swn_choice.py --loops``):
+deleted by the same scheme) as nonbounding loops; they leave the truth unchanged. Error = area(W + k ≠ truth)
+/ area, minimised over the integer k. Methods: full LP ("lp", the default), reduced LP ("reduced"), naive
+rounding of u ("none").
 
-* ``"tree-cotree"`` (default; every CSV and section before the option) — loops of one tree–cotree basis per
-  mesh, drawn without regard to the region: a loop may run along the region boundary or along the other loop.
-  Running the same way an edge of the input then carries 2; running opposite ways the two cancel (0) and that
-  stretch of both curves is missing from the input with no trace (section swn-ns-runs: 94 of the 157 broken-loop
-  cases of the 504-case run share edges).
-* ``"disjoint"`` — loops that share no edge with the case's (unbroken) region boundary nor with each other; they
-  may meet it and each other at vertices (crossings). Each loop is a tree–cotree loop of a shortest-path tree of
-  the edge graph *without* the forbidden edges (the region boundary, the loops drawn before; infinite weight),
-  from a random root, with edges that touch a forbidden vertex weighted (1 + 2·touches)× so a loop crosses the
-  boundary rather than hugging it vertex by vertex; forbidden edges are preferred into the cotree, so the
-  leftover (generator) edges are free ones. The candidates are the loops of that tree whose homology class
-  (pairing with the closed forms dual to the library's tree–cotree basis, gsdf.dec._cycles.TreeCotree) is
-  nonzero and independent of the loops already drawn; one is picked at random. When a loop has no candidate,
-  the case's loop set is drawn again from new roots (a *resample*, counted per case); after MAX_SETS = 6 failed
-  sets the region itself is drawn again (same kind, then broken again) from the case's stream
-  (:meth:`MeshCases.disjoint_loops`). A loop set can be impossible: where the faces along a boundary zigzag
-  across it (a staircase on a grid), the dual edges of its edges form a nonbounding dual cycle, and any primal
-  loop crossing that cycle must use one of its edges — the boundary's wedge on one side holds no edge at those
-  vertices, so no loop crosses there at a vertex. Paired with the default: the case's region, its breaking, the
-  number of loops and each loop's deletion fraction are the default generator's draws (its loops are still
-  drawn, then discarded, so the main random stream is unchanged); the loops and their breaking (and a redrawn
-  region) come from a per-case stream seeded by (mesh seed, case index), so every case stays seeded and
-  reproducible. A loop's class may differ from the default's loop's. Error = area(W + k ≠ truth)
-/ area, minimised over the integer k. Methods: full LP ("lp"), reduced LP ("reduced"), naive rounding of u
-("none").
+Parts (``--only``, default all), each writing its own section of bench/RESULTS.md:
 
-How fair the error is (``--only diagnose``): the truth inside a gap is whatever the eigenfunction level set or
-the region growing did there, which the broken input does not determine — with 40–50 % of a boundary deleted
-in one or two intervals, half a region's outline is simply missing and no method (nor a human) can recover
-it. With the boundaries unbroken every simply connected case is solved exactly (0 % error), so the jump solve
-is not the loss. The diagnosis reports, next to the plain error, the error *outside the gap zones* (faces
-farther than half a gap's length from it, :func:`gap_zones`), which is what the input does determine, and the
-error with the best offset in hindsight (an oracle that looks at the truth, a lower bound for any global
-rounding offset). Both are reported beside the plain error; no case is dropped.
+* ``cases`` ("swn-cases", "swn-cases-long-gaps" with ``--breaking long``): 42 cases per mesh (5 on 10 meshes
+  with ``--quick``); per-case rows are appended to ``--rows`` (default in the temporary folder: a rerun resumes,
+  ``--fresh`` starts over);
+* ``scaling`` ("swn-scaling"): time against faces on a torus grid;
+* ``author`` ("swn-author"): the authors' meshes and curves (/work/shared/data/swn); pictures with
+  ``--output-dir``.
 
-Usage::
-
-    PYTHONPATH=src python3 bench/bench_swn.py --quick        # 50 cases, random intervals
-    PYTHONPATH=src python3 bench/bench_swn.py                # 924 cases (+ scaling + author data)
-    PYTHONPATH=src python3 bench/bench_swn.py --breaking long   # the same 924 draws, few long gaps (cases only)
-    PYTHONPATH=src python3 bench/bench_swn.py --topology simply # the 420 simply connected cases only (~1 min)
-    PYTHONPATH=src python3 bench/bench_swn.py --topology simply --endpoint-rule exclude   # ... with the old rule
-    PYTHONPATH=src python3 bench/bench_swn.py --only scaling|author|cases
-    PYTHONPATH=src python3 bench/bench_swn.py --only offsets    # solver offset vs oracle (50 fresh cases)
-    PYTHONPATH=src python3 bench/bench_swn.py --only diagnose   # simply connected cases: where the error is
-    PYTHONPATH=src python3 bench/bench_swn.py --only compare    # both schemes side by side, from the CSVs
-
-Per-case rows go to bench/swn_cases.csv (random) / bench/swn_cases_long.csv (long), ``_simply`` for --topology
-simply, ``_quick`` for --quick, ``_exclude`` for --endpoint-rule exclude,
-appended as they finish (a rerun resumes; ``--fresh`` starts over); the summary goes to the sections "swn" /
-"swn-long" (+ "-quick", "-simply", "-diagnose", ...) of bench/RESULTS.md.
+    PYTHONPATH=src python3 bench/bench_swn.py --quick        # 50 cases, small scaling run
+    PYTHONPATH=src python3 bench/bench_swn.py                # 924 cases + scaling + author data
+    PYTHONPATH=src python3 bench/bench_swn.py --only cases --breaking long
 """
 
 from __future__ import annotations
@@ -80,8 +39,8 @@ from __future__ import annotations
 import argparse
 import csv
 import os
-import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -90,16 +49,16 @@ from scipy.sparse.csgraph import connected_components, dijkstra, minimum_spannin
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import data_dir, machine, write_section  # noqa: E402
+from common import command, data_dir, heading, output_dir, write_section
+from load import uptime  # noqa: E402  # noqa: E402
 
 from gsdf.io import read_mesh  # noqa: E402
-from gsdf.mesh._connectivity import MeshTopology  # noqa: E402
-from gsdf.swn._solver import SurfaceWindingNumbers  # noqa: E402
+from gsdf.swn import SurfaceWindingNumbers, SWNOptions  # noqa: E402
 
 AUTHOR = "/work/shared/data/swn"
-CSV = os.path.join(HERE, "swn_cases.csv")
+CSV = None  # the per-case rows (main: --rows)
 FIELDS = ["case", "mesh", "faces", "b1", "boundary", "region", "broken", "nonbounding", "endpoints",
-          "err_lp", "err_reduced", "err_none", "err_lp_global", "err_reduced_global", "t_jump", "t_lp_total", "t_lp_highs", "t_reduced_total",
+          "err_lp", "err_reduced", "err_none", "t_jump", "t_lp_total", "t_lp_highs", "t_reduced_total",
           "t_reduced_lp", "t_none", "lp_status"]
 
 
@@ -610,14 +569,11 @@ def generate_cases_parts(mc, n, breaking="random"):
         yield c, f"{mc.name}:{c}", kind, truth, g, gb, frac, nb, parts
 
 
-def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", topology="all",
-              endpoint_rule="auto"):
+def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random"):
     global NEW_ROWS
     meshes = list(enumerate(mesh_list()))
     if quick:
         meshes = [meshes[i] for i in (0, 2, 8, 10, 12, 14, 16, 18, 19, 21)]
-    if topology == "simply":
-        meshes = [mm for mm in meshes if mm[0] < N_SIMPLY]
     done = set()
     if resume and os.path.exists(CSV):
         with open(CSV) as fh:
@@ -644,7 +600,7 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", top
             row = {"case": cid, "mesh": name, "faces": mc.dec.n_faces, "b1": mc.swn.betti_1,
                    "boundary": int(not mc.closed), "region": kind, "broken": round(frac, 3),
                    "nonbounding": nb}
-            r0 = mc.swn.solve(gb, method="none", endpoint_rule=endpoint_rule, labels="global")
+            r0 = mc.swn.solve(gb, method="none")
             row["endpoints"] = int(r0.endpoints.sum())
             row["err_none"] = mislabeled(r0.face_labels, truth, mc.area)
             row["t_none"] = r0.timings["total"]
@@ -652,16 +608,13 @@ def run_cases(n_per_mesh, quick, time_limit, resume=True, breaking="random", top
             status = "ok"
             for meth in ("lp", "reduced"):
                 try:
-                    r = mc.swn.solve(gb, method=meth, time_limit=time_limit, endpoint_rule=endpoint_rule)
+                    r = mc.swn.solve(gb, method=meth, options=SWNOptions(time_limit=time_limit))
                     row[f"err_{meth}"] = mislabeled(r.face_labels, truth, mc.area)
-                    # the labels of one global rounding level (labels="global", before) from the same solve
-                    Wg = np.round(r.corner_values.mean(axis=1) + r.label_shift).astype(np.int64)
-                    row[f"err_{meth}_global"] = mislabeled(Wg, truth, mc.area)
                     row[f"t_{meth}_total" if meth == "reduced" else "t_lp_total"] = r.timings["total"]
                     row["t_lp_highs" if meth == "lp" else "t_reduced_lp"] = r.timings.get("lp", 0.0)
                 except ValueError as exc:
                     status = f"{meth} failed: {str(exc)[:60]}"
-                    row[f"err_{meth}"] = row[f"err_{meth}_global"] = float("nan")
+                    row[f"err_{meth}"] = float("nan")
             row["lp_status"] = status
             wr.writerow(row)
             fh.flush()
@@ -680,25 +633,20 @@ def summarize():
     sc = [r for r in rows if int(r["b1"]) == 0]
     ns = [r for r in rows if int(r["b1"]) > 0]
     out = [f"{len(rows)} cases on {len({r['mesh'] for r in rows})} meshes ({len(sc)} simply connected, "
-           f"{len(ns)} not); per-case rows in bench/{os.path.basename(CSV)}"
+           f"{len(ns)} not); per-case rows in {CSV}"
            + (f" ({NEW_ROWS} computed in this run, the others read back from earlier runs of the same generator; "
               "--fresh recomputes all)" if NEW_ROWS < len(rows) else "") + ".", ""]
     if sc:
         e = np.array([f(r, "err_lp") for r in sc])
-        eg = np.array([f(r, "err_lp_global") for r in sc])
         en = np.array([f(r, "err_none") for r in sc])
         t = np.array([f(r, "t_lp_total") for r in sc])
         lt = lambda x: f"{100 * np.nanmean(x < 0.005):.1f} %" if np.isfinite(x).any() else "–"  # noqa: E731
         out += ["**Simply connected** (no LP; one jump solve):", "",
                 "| | mean error | max error | cases < 0.5 % | median time | max time |", "|---|---|---|---|---|---|",
-                f"| SWN (labels=\"gaps\", default) | {100 * np.nanmean(e):.3f} % | {100 * np.nanmax(e):.2f} % | "
+                f"| SWN (default) | {100 * np.nanmean(e):.3f} % | {100 * np.nanmax(e):.2f} % | "
                 f"{lt(e)} | {np.nanmedian(t):.3f} s | {np.nanmax(t):.2f} s |"]
-        if np.isfinite(eg).any():
-            out.append(f"| SWN, labels=\"global\" (one rounding level; before) | {100 * np.nanmean(eg):.3f} % | "
-                       f"{100 * np.nanmax(eg):.2f} % | {lt(eg)} | | |")
         out += [f"| naive rounding of u | {100 * np.nanmean(en):.3f} % | {100 * np.nanmax(en):.2f} % | {lt(en)} | | |",
-                "", "Thesis: mean 0.14 %, max 5 %, typically < 2 s. Both label rows come from the same solves "
-                "(SWNResult.label_shift).", ""]
+                "", "Thesis: mean 0.14 %, max 5 %, typically < 2 s.", ""]
     if ns:
         el = np.array([f(r, "err_lp") for r in ns])
         er = np.array([f(r, "err_reduced") for r in ns])
@@ -717,12 +665,6 @@ def summarize():
                 f"{100 * np.nanmedian(er):.3f} % | {np.nanmedian(tr):.3f} s | {np.nanmax(tr):.2f} s |",
                 f"| naive rounding of u | {100 * np.nanmean(en < 0.005):.1f} % | {100 * np.nanmean(en):.2f} % | "
                 f"{100 * np.nanmedian(en):.3f} % | | |"]
-        for k, lab in (("err_lp_global", "full LP, labels=\"global\" (before; same solves)"),
-                       ("err_reduced_global", "reduced LP, labels=\"global\" (before; same solves)")):
-            x = np.array([f(r, k) for r in ns])
-            if np.isfinite(x).any():
-                out.append(f"| {lab} | {100 * np.nanmean(x < 0.005):.1f} % | {100 * np.nanmean(x):.2f} % | "
-                           f"{100 * np.nanmedian(x):.3f} % | | |")
         out += ["",
                 f"Reduced-LP speed-up: total time median {np.nanmedian(tl / tr):.1f}× (mean {np.nanmean(tl / tr):.1f}×); "
                 f"the LP alone median {np.nanmedian(hl / np.maximum(hr, 1e-6)):.0f}×. LP failures: {fail}.",
@@ -742,63 +684,6 @@ def summarize():
                            f"{a('err_none'):.1f} % |")
         out.append("")
     return "\n".join(out)
-
-
-def compare_endpoint_rules(n_worst=10):
-    """Simply connected cases under both endpoint rules of the jump solve (``--topology simply`` with
-    ``--endpoint-rule branch`` / ``exclude``): the same case ids, side by side, and the worst cases of the old
-    rule. Empty string unless both CSVs exist."""
-    paths = {r: os.path.join(HERE, "swn_cases_simply" + ("" if r == "branch" else "_exclude") + ".csv")
-             for r in ("exclude", "branch")}
-    if not all(os.path.exists(p) for p in paths.values()):
-        return ""
-    err = {}
-    for r, p in paths.items():
-        with open(p) as fh:
-            # like with like: the exclude CSV predates labels="gaps", so the global-level labels of both
-            err[r] = {row["case"]: float(row.get("err_lp_global") or row["err_lp"]) for row in csv.DictReader(fh)}
-    ids = sorted(set(err["exclude"]) & set(err["branch"]))
-    a = {r: np.array([err[r][i] for i in ids]) for r in err}
-    out = ["| endpoint rule of the jump solve | cases | mean error | max error | cases < 0.5 % |", "|---|---|---|---|---|"]
-    names = {"exclude": "exclude (endpoints and their halfedges dropped, projective fill; before)",
-             "branch": "branch (discrete branch point, the default on simply connected surfaces now)"}
-    out_note = ("Both with labels=\"global\" (one rounding level; the exclude CSV predates labels=\"gaps\"; the "
-                "default labels are in the table above).")
-    for r in ("exclude", "branch"):
-        out.append(f"| {names[r]} | {len(ids)} | {100 * a[r].mean():.3f} % | {100 * a[r].max():.2f} % | "
-                   f"{100 * (a[r] < 0.005).mean():.1f} % |")
-    out += ["", "Thesis: mean 0.14 %, max 5 %. " + out_note, "", f"Worst {n_worst} cases of the old rule:", "",
-            "| case | exclude | branch |", "|---|---|---|"]
-    for k in np.argsort(-a["exclude"])[:n_worst]:
-        out.append(f"| {ids[k]} | {100 * a['exclude'][k]:.2f} % | {100 * a['branch'][k]:.2f} % |")
-    kb = np.argsort(-a["branch"])[:n_worst]
-    out += ["", f"Worst {n_worst} cases of the new rule: " + ", ".join(
-        f"{ids[k]} {100 * a['branch'][k]:.2f} % (was {100 * a['exclude'][k]:.2f} %)" for k in kb) + "."]
-    return "\n".join(out)
-
-
-def compare_breakings(quick=False):
-    """One table of both breaking schemes from their per-case CSVs (those present)."""
-    f = lambda r, k: float(r[k]) if r.get(k) not in (None, "", "nan") else np.nan  # noqa: E731
-    body = []
-    for b in ("random", "long"):
-        path = os.path.join(HERE, "swn_cases" + ("" if b == "random" else "_long") + ("_quick" if quick else "")
-                            + ".csv")
-        if not os.path.exists(path):
-            continue
-        with open(path) as fh:
-            rows = list(csv.DictReader(fh))
-        sc = np.array([f(r, "err_lp") for r in rows if int(r["b1"]) == 0])
-        ns = [r for r in rows if int(r["b1"]) > 0]
-        a = lambda k: 100 * np.nanmean(np.array([f(r, k) for r in ns]) < 0.005) if ns else np.nan  # noqa: E731
-        body.append(f"| {b} | {len(rows)} | {100 * np.nanmean(sc):.3f} % / {100 * np.nanmax(sc):.2f} % / "
-                    f"{100 * np.nanmean(sc < 0.005):.0f} % | {len(ns)} | {a('err_lp'):.1f} % | "
-                    f"{a('err_reduced'):.1f} % | {a('err_none'):.1f} % |")
-    if not body:
-        return ""
-    return "\n".join(["| breaking | cases | simply connected: mean / max error / < 0.5 % | not simply connected: "
-                      "cases | full LP < 0.5 % | reduced < 0.5 % | naive < 0.5 % |", "|---|---|---|---|---|---|---|"]
-                     + body)
 
 
 # ----------------------------------------------------------------------------------------------- scaling
@@ -828,7 +713,7 @@ def scaling(time_limit, sizes):
         res = {}
         for meth in ("lp", "reduced"):
             try:
-                r = swn.solve(g, method=meth, time_limit=time_limit)
+                r = swn.solve(g, method=meth, options=SWNOptions(time_limit=time_limit))
                 res[meth] = r
                 line.append(f" {r.timings.get('lp', 0):.3f} s / {r.timings['total']:.2f} s |")
             except ValueError as exc:
@@ -842,7 +727,7 @@ def scaling(time_limit, sizes):
 
 
 # ----------------------------------------------------------------------------------------------- authors
-def author_data():
+def author_data(out_dir=None):
     from gsdf.io._swn_curves import read_swn_curves
     from gsdf.swn._insert import insert_curves
 
@@ -866,208 +751,73 @@ def author_data():
         nb = float(np.abs(r.residual[r.chain != 0]).sum() / max(np.abs(r.chain).sum(), 1))
         rows.append(f"| {mesh} / {cur} | {len(F2)} | {swn.betti_1} | {int(r.endpoints.sum())} | {share} | "
                     f"{nb:.2f} | {r.timings['total']:.2f} s | {agree:.1f} % / {rr.timings['total']:.2f} s |")
-        from gsdf.render._raster import render_function_png
+        if out_dir:
+            from gsdf.render._raster import render_function_png
 
-        m = len(F2)
-        png = os.path.join(HERE, f"swn_author_{os.path.splitext(cur)[0]}.png")
-        render_function_png(png, V2[F2].reshape(-1, 3), np.arange(3 * m).reshape(m, 3),
-                            r.corner_values.ravel() - 0.5, view=[float(t) for t in view.split(",")], size=500)
+            m = len(F2)
+            png = os.path.join(out_dir, f"swn_author_{os.path.splitext(cur)[0]}.png")
+            render_function_png(png, V2[F2].reshape(-1, 3), np.arange(3 * m).reshape(m, 3),
+                                r.corner_values.ravel() - 0.5, view=[float(t) for t in view.split(",")], size=500)
         print(rows[-1], flush=True)
     return "\n".join(rows)
-
-
-def offsets_diagnostic(per_mesh=10, breaking="random"):
-    """How much of the error is the rounding offset: error with the offset of the solver vs the best offset in
-    hindsight (an oracle over 101 offsets), full LP, on fresh cases of five meshes."""
-    from gsdf.swn._solver import circular_mean
-
-    meshes = dict(mesh_list())
-    rows = {"solver offset (level on the curves)": [], "area circular mean of w": [], "oracle offset": []}
-    for name, seed in [("cow", 1), ("sphere-uv", 3), ("torus", 4), ("author-annulus", 5), ("dino", 7)]:
-        V, F = meshes[name]()
-        mc = MeshCases(name, V, F, seed=seed)
-        for c in range(per_mesh):
-            truth, g = mc.region("eigen" if c % 2 == 0 else "grow")
-            if truth is None:
-                continue
-            gb = mc.break_chain(g, mc.rng.uniform(0.1, 0.5), int(mc.rng.integers(1, 5)), breaking)
-            r = mc.swn.solve(gb, method="lp")
-            w = r.corner_values.mean(1) + r.label_shift + r.offset
-            E = lambda s: mislabeled(np.round(w - s).astype(int), truth, mc.area)  # noqa: E731
-            rows["solver offset (level on the curves)"].append(E(r.offset))
-            rows["area circular mean of w"].append(E(circular_mean(w, mc.area) or 0.0))
-            rows["oracle offset"].append(min(E(s) for s in np.linspace(-0.5, 0.5, 101)))
-    out = ["| rounding offset | mean error | max error | cases < 0.5 % |", "|---|---|---|---|"]
-    for k, v in rows.items():
-        v = np.array(v)
-        out.append(f"| {k} | {100 * v.mean():.2f} % | {100 * v.max():.1f} % | {100 * (v < 0.005).mean():.0f} % |")
-    return f"{len(v)} cases (cow, sphere, torus, author annulus, dino; full LP):\n\n" + "\n".join(out)
-
-
-def gap_zones(mc, g, gb):
-    """Faces whose label the broken input does not determine: for every gap (a connected run of deleted
-    boundary edges, total length ℓ) the faces with a vertex within edge-graph distance ℓ/2 of the gap's vertices
-    — any closure a human would draw (e.g. the chord) stays inside this zone. (m,) bool."""
-    d = mc.dec
-    gone = np.flatnonzero((g != 0) & (gb == 0))
-    zone_v = np.zeros(d.n_vertices, bool)
-    if len(gone) == 0:
-        return zone_v[d.F].any(1)
-    E = d.edges[gone]
-    nv = d.n_vertices
-    inc = sp.coo_matrix((np.ones(2 * len(gone)), (np.repeat(np.arange(len(gone)), 2), E.ravel())),
-                        shape=(len(gone), nv)).tocsr()
-    adj = (inc @ inc.T).tocsr()
-    nc, lab = connected_components(adj, directed=False)
-    G = sp.coo_matrix((d.edge_length, (d.edges[:, 0], d.edges[:, 1])), shape=(nv, nv)).tocsr()
-    for c in range(nc):
-        mem = gone[lab == c]
-        ell = float(d.edge_length[mem].sum())
-        src = np.unique(d.edges[mem].ravel())
-        D = dijkstra(G, directed=False, indices=src, limit=ell / 2, min_only=True)
-        zone_v |= np.isfinite(D)
-    return zone_v[d.F].any(1)
-
-
-def diagnose(n_worst=12, per_mesh=42, breaking="random"):
-    """Where the error of the simply connected cases comes from (replays cases 0..per_mesh-1 of the simply
-    connected meshes of the full run, the same ids as bench/swn_cases.csv): the same truth with its unbroken
-    boundary (tests the jump solve), the best offset in hindsight (the rounding), and the error outside the gap
-    zones (:func:`gap_zones`: the part of the surface whose label the broken input determines)."""
-    out = ["| case | deleted | endpoints | error | unbroken boundary | best offset in hindsight | gap zones' area | "
-           "error outside the gap zones |", "|---|---|---|---|---|---|---|---|"]
-    recs = []
-    for mi, (name, load) in enumerate(mesh_list()):
-        try:
-            V, F = load()
-            mc = MeshCases(name, V, F, seed=1000 + mi)
-        except Exception as exc:
-            print(f"skip {name}: {exc}", flush=True)
-            continue
-        if mc.swn.betti_1 != 0:
-            continue
-        for c, cid, kind, truth, g, gb, frac, nb in generate_cases(mc, per_mesh, breaking):
-            if not np.any(gb):
-                continue
-            A = mc.area
-            r = mc.swn.solve(gb, method="lp")
-            rc = mc.swn.solve(g, method="lp")
-            w = r.corner_values.mean(1) + r.label_shift + r.offset
-            E = lambda s: mislabeled(np.round(w - s).astype(int), truth, A)  # noqa: E731
-            e = E(r.offset)
-            oracle = min(E(s) for s in np.linspace(-0.5, 0.5, 101))
-            z = gap_zones(mc, g, gb)
-            W = r.face_labels
-            shift = min(np.unique(truth - W), key=lambda k: A[(W + k) != truth].sum())
-            bad = (W + shift) != truth
-            e_out = float(A[bad & ~z].sum() / A.sum())
-            recs.append((e, mislabeled(rc.face_labels, truth, A), oracle, e_out, frac,
-                         f"| {cid} | {100 * frac:.0f} % | {int(r.endpoints.sum())} | {100 * e:.1f} % | "
-                         f"{{closed}} | {100 * oracle:.1f} % | {100 * A[z].sum() / A.sum():.0f} % | "
-                         f"{100 * e_out:.2f} % |"))
-        print(f"  diagnosed {name}", flush=True)
-    recs.sort(key=lambda t: -t[0])
-    for t in recs[:n_worst]:
-        out.append(t[5].replace("{closed}", f"{100 * t[1]:.2f} %"))
-    a = np.array([t[:5] for t in recs])
-    out += ["", f"All {len(a)} simply connected cases:", "",
-            "| deleted | cases | error (mean / < 0.5 %) | unbroken boundary (max) | best offset in hindsight "
-            "(mean) | error outside the gap zones (mean / < 0.5 %) |", "|---|---|---|---|---|---|"]
-    for lo, hi in ((0.1, 0.2), (0.2, 0.3), (0.3, 0.4), (0.4, 0.5), (0.1, 0.5)):
-        s = (a[:, 4] >= lo) & (a[:, 4] < hi)
-        if s.any():
-            out.append(f"| {100 * lo:.0f}–{100 * hi:.0f} % | {int(s.sum())} | {100 * a[s, 0].mean():.2f} % / "
-                       f"{100 * (a[s, 0] < 0.005).mean():.0f} % | {100 * a[s, 1].max():.2f} % | "
-                       f"{100 * a[s, 2].mean():.2f} % | {100 * a[s, 3].mean():.2f} % / "
-                       f"{100 * (a[s, 3] < 0.005).mean():.0f} % |")
-    return "\n".join(out)
 
 
 BREAKING_RULES = {
     "random": ("random intervals (default): per curve walk of n edges, round(f·n) edges deleted in gaps of "
                "1..clip(n//20, 2, 5) edges (uniform), kept runs a uniform random composition of the rest with "
                ">= 2 edges each, random start on loops; f ~ U(0.1, 0.5) per case (MeshCases.break_random)"),
-    "long": ("long gaps (the first run's scheme): per curve component, f·n edges deleted in k ~ U{1..4} "
-             "intervals grown by BFS from k random seed edges; f ~ U(0.1, 0.5) (MeshCases.break_long)"),
+    "long": ("long gaps: per curve component, f·n edges deleted in k ~ U{1..4} intervals grown by BFS from k "
+             "random seed edges; f ~ U(0.1, 0.5) (MeshCases.break_long)"),
 }
+PARTS = ("cases", "scaling", "author")
 
 
-def main():
-    ap = argparse.ArgumentParser()
+def main(argv=None):
+    global CSV
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="50 cases on 10 meshes, small scaling run")
-    ap.add_argument("--per-mesh", type=int, default=None)
-    ap.add_argument("--only", choices=["cases", "scaling", "author", "summary", "offsets", "diagnose",
-                                                  "compare"], default=None)
+    ap.add_argument("--only", default="", help=f"comma list of parts: {','.join(PARTS)} (default all)")
+    ap.add_argument("--per-mesh", type=int, default=None, help="cases per mesh (default 42, 5 with --quick)")
     ap.add_argument("--breaking", choices=["random", "long"], default="random",
                     help="how boundaries are broken: many short random intervals (default) or few long gaps")
-    ap.add_argument("--topology", choices=["all", "simply"], default="all",
-                    help="'simply': only the 10 simply connected meshes (fast; no LP)")
-    ap.add_argument("--time-limit", type=float, default=120.0)
-    ap.add_argument("--endpoint-rule", choices=["auto", "branch", "exclude"], default="auto",
-                    help="interior endpoints in the jump solves (SurfaceWindingNumbers.solve endpoint_rule); "
-                         "'auto' (default): branch on simply connected meshes, exclude otherwise; 'exclude' is the "
-                         "rule before (per-case CSV tagged _exclude / _branch)")
-    ap.add_argument("--fresh", action="store_true", help="discard this variant's per-case CSV first")
-    a = ap.parse_args()
-    if (a.topology == "simply" or a.breaking == "long") and a.only is None:
-        a.only = "cases"                # the cases alone: scaling and author data do not depend on the breaking
-    global CSV
-    tag = ("" if a.breaking == "random" else "_long") + ("_simply" if a.topology == "simply" else "") + \
-        ("_quick" if a.quick else "") + ("" if a.endpoint_rule == "auto" else "_" + a.endpoint_rule)
-    CSV = os.path.join(HERE, f"swn_cases{tag}.csv")
+    ap.add_argument("--time-limit", type=float, default=120.0, help="seconds per LP")
+    ap.add_argument("--rows", default=None, help="per-case CSV (default: in the temporary folder)")
+    ap.add_argument("--fresh", action="store_true", help="discard the per-case CSV first")
+    ap.add_argument("--output-dir", default=None, help="folder for the author data pictures")
+    a = ap.parse_args(argv)
+    parts = [p for p in a.only.split(",") if p] or list(PARTS)
+    for p in parts:
+        if p not in PARTS:
+            ap.error(f"--only: unknown part {p!r}; known: {', '.join(PARTS)}")
+    tag = ("" if a.breaking == "random" else "_long") + ("_quick" if a.quick else "")
+    CSV = a.rows or os.path.join(tempfile.gettempdir(), "gsdf-bench", f"swn_cases{tag}.csv")
+    os.makedirs(os.path.dirname(os.path.abspath(CSV)), exist_ok=True)
     if a.fresh and os.path.exists(CSV):
         os.remove(CSV)
-    load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
-    t0 = time.perf_counter()
-    parts = {}
-    if a.only in (None, "cases"):
-        run_cases(a.per_mesh or (5 if a.quick else 42), a.quick, a.time_limit, breaking=a.breaking,
-                  topology=a.topology, endpoint_rule=a.endpoint_rule)
-    if a.only in (None, "cases", "summary"):
-        parts["cases"] = summarize()
-    if a.only in (None, "scaling"):
-        sizes = [48, 96] if a.quick else [56, 112, 224, 448, 700]
-        parts["scaling"] = scaling(a.time_limit * 3, sizes)
-    if a.only in (None, "author"):
-        parts["author"] = author_data()
-    if a.only == "offsets":
-        parts["offsets"] = offsets_diagnostic(breaking=a.breaking)
-    if a.only == "diagnose":
-        parts["diagnose"] = diagnose(breaking=a.breaking)
-    if a.only == "compare":
-        text_cmp = compare_breakings(a.quick)
-    flags = "".join(" " + t for t in sys.argv[1:])
-    text = [f"Machine: {machine()}. Load at start: `{load}` (shared with other helpers; times are indicative).",
-            f"Command: `PYTHONPATH=src python3 bench/bench_swn.py{flags}` ({time.perf_counter() - t0:.0f} s).",
-            "", f"Breaking: {BREAKING_RULES[a.breaking]}.", ""]
-    if "cases" in parts:
-        text += ["### Generated cases" + (" (quick)" if a.quick else ""), "", parts["cases"], ""]
-        cmp_ = compare_breakings(a.quick) if a.topology != "simply" else ""
-        if a.topology == "simply" and a.breaking == "random" and compare_endpoint_rules():
-            text += ["### Endpoint rule of the jump solve, old vs new (bench/swn_cases_simply*.csv)", "",
-                     compare_endpoint_rules(), ""]
-        if cmp_:
-            text += ["### Both breaking schemes (from bench/swn_cases*.csv)", "", cmp_, ""]
-    if "scaling" in parts:
-        text += ["### Time vs faces (torus grid, one broken meridian + a 30 %-broken band boundary)", "",
-                 parts["scaling"], ""]
-    if "author" in parts:
-        text += ["### Author data (/work/shared/data/swn; PNGs bench/swn_author_*.png)", "", parts["author"], ""]
-    if "offsets" in parts:
-        text += ["### Rounding offset: solver rule vs oracle", "", parts["offsets"], ""]
-    if "diagnose" in parts:
-        text += ["### Worst simply connected cases: where the error comes from", "", parts["diagnose"], ""]
-    if a.only == "compare":
-        text += ["### Both breaking schemes (from bench/swn_cases*.csv)", "", text_cmp, ""]
-    name = "swn" + ("-long" if a.breaking == "long" else "") + ("-quick" if a.quick else "")
-    if a.topology == "simply" and a.only == "cases":
-        name += "-simply" + ("" if a.endpoint_rule == "auto" else "-" + a.endpoint_rule)
-    elif a.only and not (a.only == "cases" and a.breaking == "long"):
-        name += "-" + a.only
-    title = "## Surface winding numbers (issue 12)" + (", long gaps" if a.breaking == "long" else "")
-    write_section(name, title + (" — " + a.only if a.only else "") + (" — simply connected meshes only"
-                  if a.topology == "simply" else "") + "\n\n" + "\n".join(text))
-    print("\n".join(text))
+    output_dir(a.output_dir)
+    for part in parts:
+        start, t0 = uptime(), time.perf_counter()
+        flags = [f"--only {part}"] + (["--quick"] if a.quick else []) + \
+            ([f"--breaking {a.breaking}"] if part == "cases" and a.breaking != "random" else []) + \
+            ([f"--per-mesh {a.per_mesh}"] if part == "cases" and a.per_mesh else [])
+        cmd = command("bench_swn.py", flags)
+        if part == "cases":
+            run_cases(a.per_mesh or (5 if a.quick else 42), a.quick, a.time_limit, breaking=a.breaking)
+            title = "Surface winding numbers: generated broken-curve cases" + (
+                ", few long gaps" if a.breaking == "long" else "")
+            body = f"Breaking: {BREAKING_RULES[a.breaking]}.\n\n" + summarize()
+            name = "swn-cases" + ("-long-gaps" if a.breaking == "long" else "")
+        elif part == "scaling":
+            sizes = [48, 96] if a.quick else [56, 112, 224, 448, 700]
+            title = "Surface winding numbers: time against faces"
+            body = ("Torus grid, one broken meridian + a 30 %-broken band boundary.\n\n"
+                    + scaling(a.time_limit * 3, sizes))
+            name = "swn-scaling"
+        else:
+            title, body, name = "Surface winding numbers on the authors' data", author_data(a.output_dir), "swn-author"
+        text = heading(title, cmd, start) + f"Part took {time.perf_counter() - t0:.0f} s.\n\n" + body.strip() + "\n"
+        print(text, flush=True)
+        write_section(name, text)
 
 
 if __name__ == "__main__":

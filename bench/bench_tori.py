@@ -2,10 +2,16 @@
 
     python bench/bench_tori.py                 # reduced sweep on a 48³ grid (~10 min on 2 busy cores)
     python bench/bench_tori.py --grid 64 --full  # the §7.2 grid resolution and a finer sweep
+    python bench/bench_tori.py --quick         # the speed-under-load part only, one cloud size
+    python bench/bench_tori.py --only real --output-dir /tmp/tori   # ... with the renders
 
-Outputs in bench/: tori_landscape.csv, tori_landscape_<shape>.png (heatmaps: rows = methods, columns =
-corruption types, each panel radius × level), tori_real_<name>.png (sphere-traced renders), and the "tori"
-section of RESULTS.md. Methods: PAT (learned / jet estimator), smoothed signed planar distance, signed Hopf–Cole,
+Parts (``--only``, default all), each writing its own section of bench/RESULTS.md: ``speed-load``
+("tori-speed-load": queries/s against ``cKDTree.query(k=64)``, idle and under two busy processes), ``speed``
+("tori-speed": growth with cloud size), ``real`` ("tori-real": CGAL clouds, fit / zero set / render times,
+accuracy on the noisy sphere), ``landscape`` ("tori-landscape": §7.2 corruption landscapes, mean error per
+method). With ``--output-dir``: tori_landscape.csv, tori_landscape_<shape>.png (heatmaps: rows = methods,
+columns = corruption types, each panel radius × level) and tori_real_<name>.png (sphere-traced renders) go
+there. Methods: PAT (learned / jet estimator), smoothed signed planar distance, signed Hopf–Cole,
 the winding-number pipeline, and the volumetric signed heat method on the evaluation grid (gsdf.heat.volume,
 default options: Yukawa step I by tree, soft zero-set constraint).
 """
@@ -23,12 +29,13 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import data_dir, machine, median_time, table, write_section  # noqa: E402
+from common import command, data_dir, heading, median_time, output_dir, table, write_section  # noqa: E402
 from load import BusyLoad, uptime  # noqa: E402
 
 from gsdf.data import _shapes as S  # noqa: E402
 from gsdf.tori._baselines import SignedHopfCole, SmoothedSignedPlanarDistance, WindingNumberPipeline, _conv_kernel
 from gsdf.heat.volume import signed_heat_volume  # noqa: E402
+from gsdf.tori import PointsAsToriOptions  # noqa: E402
 from gsdf.tori._pat import PointsAsTori, _pat_kernel  # noqa: E402
 
 METHODS = ["PAT (learned)", "PAT (jet)", "SSPD", "SHC", "WN pipeline", "SHM (grid)"]
@@ -65,7 +72,7 @@ def evaluate_all(P, N, X, resolution):
     except ValueError:
         res["WN pipeline"] = np.zeros(len(X))  # no surface: counts as φ = 0
     times["wn"] = time.perf_counter() - t
-    # the volumetric signed heat method (issue 4) on the evaluation grid itself, default options
+    # the volumetric signed heat method on the evaluation grid itself, default options
     t = time.perf_counter()
     try:
         res["SHM (grid)"] = signed_heat_volume(points=(P, N), resolution=(resolution,) * 3, bbox_min=[-1, -1, -1],
@@ -105,12 +112,13 @@ def landscapes(args):
                                      error=float(np.abs(res[m] - tr).mean())))
                 print(shape, r, kind, lv, {m: round(rows[-len(METHODS) + j]["error"], 4) for j, m in enumerate(METHODS)},
                       {k: round(v, 1) for k, v in tm.items()}, flush=True)
-    with open(os.path.join(HERE, "tori_landscape.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    for shape in ("cylinder", "sphere"):
-        heatmap(rows, shape, radii[shape], levels, os.path.join(HERE, f"tori_landscape_{shape}.png"))
+    if args.output_dir:
+        with open(os.path.join(args.output_dir, "tori_landscape.csv"), "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+        for shape in ("cylinder", "sphere"):
+            heatmap(rows, shape, radii[shape], levels, os.path.join(args.output_dir, f"tori_landscape_{shape}.png"))
     return rows, radii, levels
 
 
@@ -249,10 +257,12 @@ def real_clouds(args):
                     break
                 ee = np.abs(cls(P, N)(X) - (np.linalg.norm(X - c, axis=1) - rho))
                 extra += f"; {mname} {ee.mean():.5f}"
-        png = os.path.join(HERE, f"tori_real_{os.path.splitext(name)[0]}_{est}.png")
-        t = time.perf_counter()
-        render_png(pat, png, width=240, height=240)
-        trend = time.perf_counter() - t
+        trend = float("nan")
+        if args.output_dir:
+            png = os.path.join(args.output_dir, f"tori_real_{os.path.splitext(name)[0]}_{est}.png")
+            t = time.perf_counter()
+            render_png(pat, png, width=240, height=240)
+            trend = time.perf_counter() - t
         rows.append([name, est, len(P), f"{tfit:.2f}", f"{tiso:.1f}", len(F), "yes" if closed else f"no: {bad} open edges inside the box, {cut} where it leaves the box",
                      f"{trend:.1f}", extra])
         print(rows[-1], flush=True)
@@ -303,11 +313,7 @@ def speed(args):
             pat.signed_distance(Q)
             cpu.append(time.process_time() - c0)
         tcpu = float(np.median(cpu))
-        pat2 = PointsAsTori.__new__(PointsAsTori)
-        pat2.__dict__.update(pat.__dict__)
-        from gsdf.tori._blend import NeighbourBlend
-        pat2._blend = NeighbourBlend(pat.P, pat.C, pat.r_eval, pat.k_eval, pat.k_fallback, tree=pat._blend.knn,
-                                     kd_eps=0.5)
+        pat2 = PointsAsTori(P, N, options=PointsAsToriOptions(kd_eps=0.5))
         tq2, _ = median_time(lambda: pat2.signed_distance(Q), repeat=2)
         tg, _ = median_time(lambda: pat.gradient(Q), repeat=1)
         rows.append([n, f"{tfit:.2f}", f"{tfitl:.2f}", f"{nq / tq:.3g}", f"{2 * nq / tcpu:.3g}", f"{nq / tq2:.3g}",
@@ -377,47 +383,41 @@ def speed_load(args):
             f"BusyLoad(2). Peak RSS of this benchmark process: {rss:.0f} MB.\n\n" + "\n".join("* " + s for s in summary))
 
 
+PARTS = ("speed-load", "speed", "real", "landscape")
+
+
 def main():
-    ap = argparse.ArgumentParser()
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="only the speed-under-load part, one cloud size")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--grid", type=int, default=48)
     ap.add_argument("--full", action="store_true")
-    ap.add_argument("--skip", default="", help="comma list of parts to skip: landscape,real,speed")
+    ap.add_argument("--only", default="", help=f"comma list of parts: {','.join(PARTS)} (default all)")
+    ap.add_argument("--output-dir", default=None, help="folder for the landscape CSV, heatmaps and renders")
     args = ap.parse_args()
-    skip = set(args.skip.split(","))
-    if args.quick:
-        skip |= {"speed", "real", "landscape"}
-    head = (f"Machine: {machine()}. Command: `python bench/bench_tori.py "
-            f"{'--quick' if args.quick else f'--grid {args.grid}'}{' --full' if args.full else ''}` (parts can be run separately with --skip; each part's text is kept "
-            f"in bench/tori_part_<name>.md and the section is assembled from them).")
-    if "speed-load" not in skip:
-        _save_part("speed-load", f"### Speed against the k-nearest-neighbour query, idle and under load (issue 17)\n\n"
-                   f"Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_tori.py "
-                   f"{'--quick' if args.quick else '--skip landscape,real,speed'}`; machine: {machine()}; "
-                   f"load at start {uptime()}.\n\n" + speed_load(args))
-    if "speed" not in skip:
-        _save_part("speed", "### Speed (Fig. 5.15 analogue)\n\n" + speed(args))
-    if "real" not in skip:
-        _save_part("real", "### Real clouds\n\n" + real_clouds(args))
-    if "landscape" not in skip:
-        rows, radii, levels = landscapes(args)
-        _save_part("landscape", f"### Corruption landscapes (§7.2), grid {args.grid}³ over [-1,1]³\n\n"
-                   f"Levels: {levels}; clean = 2048 points. Heatmaps: bench/tori_landscape_cylinder.png, "
-                   f"bench/tori_landscape_sphere.png; all numbers: bench/tori_landscape.csv.\n\n" + summarize(rows, radii))
-    parts = [head] + [open(_part(n)).read() for n in ("speed-load", "speed", "real", "landscape") if os.path.exists(_part(n))]
-    text = "## Points as Tori (issue 5)\n\n" + "\n\n".join(parts)
-    print(text)
-    write_section("tori", text)
-
-
-def _part(name):
-    return os.path.join(HERE, f"tori_part_{name}.md")
-
-
-def _save_part(name, text):
-    with open(_part(name), "w") as f:
-        f.write(text)
+    output_dir(args.output_dir)
+    parts = ["speed-load"] if args.quick else ([p for p in args.only.split(",") if p] or list(PARTS))
+    for p in parts:
+        if p not in PARTS:
+            ap.error(f"--only: unknown part {p!r}; known: {', '.join(PARTS)}")
+    flags = ("--quick" if args.quick else f"--grid {args.grid}") + (" --full" if args.full else "")
+    for part in parts:
+        start = uptime()
+        cmd = command("bench_tori.py", [flags] + ([] if args.quick else [f"--only {part}"]),
+                      python="/work/anchors/bin/python")
+        if part == "speed-load":
+            title, body = "Points as Tori: speed against the k-nearest-neighbour query, idle and under load", speed_load(args)
+        elif part == "speed":
+            title, body = "Points as Tori: speed against cloud size (Fig. 5.15 analogue)", speed(args)
+        elif part == "real":
+            title, body = "Points as Tori on real clouds", real_clouds(args)
+        else:
+            rows, radii, levels = landscapes(args)
+            title = f"Points as Tori: corruption landscapes (§7.2), grid {args.grid}³ over [-1,1]³"
+            body = f"Levels: {levels}; clean = 2048 points.\n\n" + summarize(rows, radii)
+        text = heading(title, cmd, start) + body + "\n"
+        print(text, flush=True)
+        write_section(f"tori-{part}", text)
 
 
 if __name__ == "__main__":

@@ -5,11 +5,19 @@ Run in a Python that has gsdf and the anchors (``../shared/tools/install-anchors
     VENV/bin/python bench/bench_winding.py            # full run (~15 min on 2 cores)
     VENV/bin/python bench/bench_winding.py --quick    # fewer queries, no 100^3 voxel check
 
-Prints every table and writes them to bench/RESULTS.md (section "winding"; a run with --only gets
-"winding-PARTS", and one with --only and --queries other than 10^6 "winding-PARTS-qN", e.g.
-``--quick --queries 100000 --load --only triangles`` writes "winding-triangles-q100000").
-Speed is a ratio of medians of 3 runs in this process (with --load: alternating idle / loaded rounds of batches ≥ 0.1 s, see LOAD_NOTE); accuracy is against exact winding numbers
-(gsdf's hierarchical exact evaluation, cross-checked against igl.winding_number).
+    VENV/bin/python bench/bench_winding.py --only triangles --load   # also under two busy processes
+
+Parts (``--only``, default all), each writing its own section of bench/RESULTS.md:
+
+* ``triangles`` ("winding-triangles"): exact and fast winding numbers of 13 CGAL meshes (scans, CAD, meshes with
+  holes): RMS of the fast evaluation against the exact one, 100³ voxel misclassification, time of build + 10⁶
+  queries against libigl (with ``--load``: also alternating idle / loaded rounds, common.alternating_rounds);
+* ``points`` ("winding-points"): point clouds, gsdf's point areas given to both; point areas on sphere_20k
+  against 4πr² (and the plain 3D k-NN rule);
+* ``growth`` ("winding-growth"): build and per-query time against element count (icosphere meshes).
+
+Speed is a ratio of medians of 3 runs in this process; accuracy is against exact winding numbers (gsdf's
+hierarchical exact evaluation, cross-checked against igl.winding_number).
 """
 
 from __future__ import annotations
@@ -22,43 +30,27 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import alternating_rounds, data_dir, machine, median_time, table, write_section  # noqa: E402
+from common import alternating_rounds, command, data_dir, heading, machine, median_time, table, write_section  # noqa: E402
 from load import uptime  # noqa: E402
 
 import gsdf  # noqa: E402
 
-# >= 10 triangle inputs of different kinds (issue 17): scans, CAD parts, soups / meshes with holes
+# triangle inputs of different kinds: scans, CAD parts, soups / meshes with holes
 MESHES = ["bunny00.off", "refined_elephant.off", "armadillo.off", "man.off", "ChineseDragon-10kv.off",   # scans
           "fandisk.off", "blade.off", "couplingdown.off", "cheese.off", "rotor.off",                     # CAD
           "holes.off", "elephant-with-holes.off", "mech-holes-shark.off"]                               # holes
 CLOUDS = ["kitten.xyz", "oni.pwn", "sphere_20k_normal.xyz"]
 
 
-#: Rounds of the loaded protocol (common.alternating_rounds, as bench_winding_load.py).
+#: Rounds of the loaded protocol (common.alternating_rounds).
 LOAD_ROUNDS = 7
 
-LOAD_NOTE = ("\n\"loaded\" columns (issue 17 goal 5): build + query of gsdf and libigl, each timed as the mean of a "
+LOAD_NOTE = (" \"loaded\" columns: build + query of gsdf and libigl, each timed as the mean of a "
              f"batch of calls lasting ≥ 0.1 s, in {LOAD_ROUNDS} rounds alternating idle / loaded (two busy processes, "
              "bench/load.py, started and stopped per round; common.alternating_rounds); \"rounds: idle / loaded "
              "ratio\" = median over rounds of the per-round gsdf/igl ratio, \"loaded/idle ratio\" = their quotient "
-             "(issue 17 asks for ≤ 1.25); \"loaded: gsdf s / igl s\" = medians of the loaded batch means. The "
+             "(target ≤ 1.25); \"loaded: gsdf s / igl s\" = medians of the loaded batch means. The "
              "idle columns before them are medians of 3 single calls.")
-
-
-READING = """
-
-Triangle walk (src/gsdf/winding/fast.py): the binary tree (volume splits, leaves of 4 triangles) is walked
-4 children at a time: per node the 4 children's far-field tests and order-2 expansions are evaluated
-together in one unrolled loop that LLVM turns into 4-lane SIMD (AVX2 doubles), the near children are
-descended. The query points of a chunk are grouped by a counting sort on coarse Morton cells, and small
-builds / query sets run on the calling thread (a parallel launch waits for workers under load).
-Build (src/gsdf/spatial/binned.py, winding/fast.py): the tree moves element rows instead of indexing them,
-bins the two longest axes of each node's centroid box in one pass and sweeps every split position along
-them in nodes of ≤ 24 triangles; the node moments are summed bottom-up (children shifted to the parent's
-centre), O(m + k) instead of O(m log m), and folded straight into the 4-wide lanes; from 20k faces the element rows, the two halves below the root
-and the lower subtrees (pipelined), the leaf moments (with the wide view beside them) and the lanes use the
-threads of one persistent pool (gsdf.threads.run_tasks). "gsdf pre s" is this whole build
-(bench/profile_fwn_build.py prints it stage by stage)."""
 
 
 def queries_in_box(X, n, rng, pad=0.1):
@@ -187,6 +179,9 @@ def bench_growth(igl, n_queries, rng):
     return table(header, rows)
 
 
+PARTS = ("triangles", "points", "growth")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="10^5 queries, no 100^3 voxel check")
@@ -194,9 +189,12 @@ def main(argv=None):
                     help="also time the fast triangle winding numbers with two busy processes running")
     ap.add_argument("--queries", type=int, default=0,
                     help="queries per input for the speed tables (default 10^6, 10^5 with --quick)")
-    ap.add_argument("--only", default="", help="comma list of parts: triangles,points,growth (default all)")
+    ap.add_argument("--only", default="", help=f"comma list of parts: {','.join(PARTS)} (default all)")
     args = ap.parse_args(argv)
-    parts = set(args.only.split(",")) if args.only else {"triangles", "points", "growth"}
+    parts = [p for p in args.only.split(",") if p] or list(PARTS)
+    for p in parts:
+        if p not in PARTS:
+            ap.error(f"--only: unknown part {p!r}; known: {', '.join(PARTS)}")
     import igl
 
     root = data_dir()
@@ -204,53 +202,41 @@ def main(argv=None):
     n_q = args.queries or (100_000 if args.quick else 1_000_000)
     if n_q < 10_000:
         raise SystemExit("--queries: need at least 10000 (the accuracy columns use the first 10^4)")
-    info = machine()
-    print("machine:", info, flush=True)
-    t0 = time.time()
+    print("machine:", machine(), uptime(), flush=True)
     # warm up numba (compile or load from cache) outside the timings
     V, F = gsdf.read_mesh(os.path.join(root, "meshes", "holes.off"))
     gsdf.FastWindingNumber(V, F)(V[:5000] + 1e-3)
     gsdf.ExactWindingNumber(V, F)(V[:5000] + 1e-3)
     gsdf.FastWindingNumberPoints(V, V, areas=np.ones(len(V)))(V[:5000])
-    skipped = "(not run: --only)"
-    tri = bench_triangles(igl, root, n_q, not args.quick, rng, load=args.load) if "triangles" in parts else skipped
-    pts = bench_points(igl, root, n_q, rng) if "points" in parts else skipped
-    growth = bench_growth(igl, 100_000, rng) if "growth" in parts else skipped
     flags = (f"{' --quick' if args.quick else ''}{f' --queries {args.queries}' if args.queries else ''}"
-             f"{' --load' if args.load else ''}{f' --only {args.only}' if args.only else ''}")
-    text = f"""## Winding numbers (bench/bench_winding.py{flags})
-
-Machine: {info}. Run took {time.time() - t0:.0f} s. Times are medians of 3 runs in one process.
-The machine is shared with other work: the `uptime` column is the load average when each row was measured;
-ratios against libigl measured in the same run are what count.{LOAD_NOTE if args.load else ""}
-Command: `NUMBA_NUM_THREADS=2 PYTHONPATH=src /work/anchors/bin/python bench/bench_winding.py{flags}`
-(gsdf and libigl both use all cores of this machine: {os.cpu_count()}).{{reading}}
-
-### Triangle meshes and soups, β = 2, order 2 (RMS against exact on 10⁴ random queries in the padded box)
-
-{tri}
-
-"voxels wrong" counts voxel centres of a 100³ grid whose inside/outside (w > 1/2) differs from the exact
-winding number (libigl's count on the same grid in brackets); the next column is the largest |w_exact − 1/2|
-among them: on meshes with holes the 1/2 level set crosses open space, where w is within the approximation
-error of 1/2 and either method may flip a voxel. "ratio" is (gsdf precompute + query) / libigl (which precomputes inside its call); < 1 is faster.
-
-### Oriented point clouds, β = 2.3, order 2, gsdf point areas given to both
-
-{pts}
-
-### Growth with element count (icosphere meshes / their vertices as a cloud, 10⁵ queries)
-
-{growth}
-"""
-    text = text.replace("{reading}", READING if "triangles" in parts else "")
-    # a partial run (--only) gets its own section, so the full tables of the last full run stay
-    # (a query count other than the default 10^6 of a partial run gets its own section too: --queries 100000)
-    name = "winding" if not args.only else "winding-" + "-".join(sorted(parts))
-    if args.only and args.queries and args.queries != 1_000_000:
-        name += f"-q{args.queries}"
-    write_section(name, text)
-    print(text)
+             f"{' --load' if args.load and 'triangles' in parts else ''}")
+    for part in parts:
+        start, t0 = uptime(), time.time()
+        if part == "triangles":
+            body = bench_triangles(igl, root, n_q, not args.quick, rng, load=args.load)
+            title = "Winding numbers of triangle meshes and soups against libigl"
+            note = (f"β = 2, order 2; RMS against the exact winding number on 10⁴ random queries in the padded box; "
+                    f"times are medians of 3 in one process, {n_q:,} queries. \"voxels wrong\" counts voxel centres "
+                    "of a 100³ grid whose inside/outside (w > 1/2) differs from the exact winding number (libigl's "
+                    "count in brackets); the next column is the largest |w_exact − 1/2| among them (on meshes with "
+                    "holes the 1/2 level set crosses open space, where either method may flip a voxel). \"ratio\" is "
+                    "(gsdf precompute + query) / libigl (which precomputes inside its call); < 1 is faster."
+                    + (LOAD_NOTE if args.load else ""))
+        elif part == "points":
+            body = bench_points(igl, root, n_q, rng)
+            title = "Winding numbers of oriented point clouds against libigl"
+            note = (f"β = 2.3, order 2, gsdf's point areas given to both; {n_q:,} queries; times are medians of 3 "
+                    "in one process.")
+        else:
+            body = bench_growth(igl, 100_000, rng)
+            title = "Winding numbers: growth with element count"
+            note = "Icosphere meshes and their vertices as a cloud, 10⁵ queries; medians of 3."
+        cmd = command("bench_winding.py", [f"--only {part}{flags}"], python="/work/anchors/bin/python",
+                      env="NUMBA_NUM_THREADS=2")
+        text = (heading(title, cmd, start) + f"{note} Part took {time.time() - t0:.0f} s "
+                f"(gsdf and libigl both use all {os.cpu_count()} cores).\n\n{body}\n")
+        write_section(f"winding-{part}", text)
+        print(text, flush=True)
 
 
 if __name__ == "__main__":

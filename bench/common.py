@@ -1,4 +1,9 @@
-"""Shared helpers of the benchmarks: data location, machine description, timing, RESULTS.md sections."""
+"""Shared helpers of the benchmarks: data location, machine description, timing, RESULTS.md sections.
+
+Every table of RESULTS.md is one section ``<!-- name:start -->`` … ``<!-- name:end -->`` written by one part of
+one script (:func:`write_section`); its text starts with :func:`heading`: the title, the machine, the load
+average at start and end, and the command that prints it.
+"""
 
 from __future__ import annotations
 
@@ -6,22 +11,25 @@ import os
 import platform
 import re
 import subprocess
+import sys
 import time
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-RESULTS = os.path.join(HERE, "RESULTS.md")
+#: Where the sections go: bench/RESULTS.md, or ``$GSDF_BENCH_RESULTS`` (a trial run that must not touch it).
+RESULTS = os.environ.get("GSDF_BENCH_RESULTS") or os.path.join(HERE, "RESULTS.md")
 
 
 def data_dir() -> str:
-    """The CGAL data folder (fetched by ../shared/tools/get-cgal-data when missing)."""
+    """The CGAL data folder: ``$GSDF_CGAL_DATA``, else ~/.cache/gsdf-data/cgal/data or /work/cgal/data when they
+    hold meshes/, else fetched by ../shared/tools/get-cgal-data."""
     env = os.environ.get("GSDF_CGAL_DATA")
     if env:
         return env
-    default = os.path.expanduser("~/.cache/gsdf-data/cgal/data")
-    if os.path.isdir(os.path.join(default, "meshes")):
-        return default
+    for default in (os.path.expanduser("~/.cache/gsdf-data/cgal/data"), "/work/cgal/data"):
+        if os.path.isdir(os.path.join(default, "meshes")):
+            return default
     tool = os.path.join(HERE, "..", "..", "shared", "tools", "get-cgal-data")
     return subprocess.run(["bash", tool], check=True, capture_output=True, text=True).stdout.strip()
 
@@ -39,6 +47,27 @@ def machine() -> str:
 
     return (f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, numpy {np.__version__}, "
             f"numba {numba.__version__}, {platform.system()} {platform.release()}")
+
+
+def command(script: str, argv=None, python: str = "python3", env: str = "") -> str:
+    """The shell command that reruns ``script`` (a file name in bench/) with ``argv`` (default: this process's)."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    return " ".join(x for x in [env, "PYTHONPATH=src", python, f"bench/{script}", *args] if x)
+
+
+def heading(title: str, cmd: str, start_load: str | None = None) -> str:
+    """A section's first lines: ``## title``, the machine, the load average (at start and now) and the command."""
+    from load import uptime
+
+    load = f"{start_load} at start, {uptime()} at end" if start_load else uptime()
+    return f"## {title}\n\nMachine: {machine()}; {load} (shared machine). Command: `{cmd}`.\n\n"
+
+
+def output_dir(path: str | None) -> str | None:
+    """``path`` created if given: where a script writes its pictures and per-case files (never bench/)."""
+    if path:
+        os.makedirs(path, exist_ok=True)
+    return path
 
 
 def median_time(fn, repeat: int = 3):
@@ -64,7 +93,7 @@ def batch_mean(fn, min_s: float = 0.1, min_calls: int = 1) -> float:
 
 
 def alternating_rounds(fns: dict, rounds: int = 7, nbusy: int = 2) -> dict:
-    """Issue 17's loaded protocol: ``rounds`` rounds alternating idle / loaded (``nbusy`` busy processes,
+    """The loaded protocol: ``rounds`` rounds alternating idle / loaded (``nbusy`` busy processes,
     bench/load.py BusyLoad, started and stopped per round; the order flips every round), each round timing
     every ``fns[name]()`` as :func:`batch_mean` (≥ 0.1 s back to back). Returns ``{("idle" | "loaded", name):
     [mean seconds per round]}``; ratios are best taken per round (same background load) and then the median."""
@@ -106,8 +135,8 @@ def results_index(body: str) -> str:
         heading = next((ln.lstrip("#").strip() for ln in text.splitlines() if ln.startswith("#")), "")
         cmd = re.search(r"`[^`\n]*bench/[^`\n]+\.py[^`\n]*`", text)
         rows.append((f"`{name}`", heading.replace("|", "/"), cmd.group(0) if cmd else ""))
-    return ("## Index\n\nEvery section below is rewritten by the command beside it; `bench/run_all.py` runs "
-            "all speed tables.\n\n" + table(["section", "heading", "command"], rows))
+    return ("## Index\n\nCurrent figures only: every section below is rewritten by the command beside it; "
+            "`bench/run_all.py` runs them all.\n\n" + table(["section", "heading", "command"], rows))
 
 
 def with_index(body: str) -> str:

@@ -1,7 +1,7 @@
 """Artificial load for the benchmarks: busy processes that the benchmark starts and stops itself.
 
-Issue 17 asks for every speed ratio both on the (shared, never really idle) machine and with two extra
-busy processes competing for the two cores. :class:`BusyLoad` starts ``n`` pure-Python spinning processes
+Speed ratios are measured both on the (shared, never really idle) machine and with two extra busy processes
+competing for the two cores. :class:`BusyLoad` starts ``n`` pure-Python spinning processes
 (no I/O, no memory) and stops them, by their own pids, on exit from the ``with`` block; a spinner whose
 parent died (the benchmark was killed) stops by itself.
 

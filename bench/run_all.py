@@ -1,16 +1,15 @@
-"""Every speed table in one command: runs the benchmark scripts, each rewriting its RESULTS.md section.
+"""Every table of RESULTS.md in one command: runs the area scripts, each rewriting its own sections.
 
-    PYTHONPATH=src /work/anchors/bin/python bench/run_all.py --quick     # < 20 min on 2 idle cores
+    PYTHONPATH=src /work/anchors/bin/python bench/run_all.py --quick     # reduced sizes, speed parts only
     PYTHONPATH=src /work/anchors/bin/python bench/run_all.py             # everything, full sizes (hours)
     PYTHONPATH=src /work/anchors/bin/python bench/run_all.py --only winding,cold-start --load
 
 Each part runs in its own process (the anchors' venv when it exists, so libigl / potpourri3d / signedheat3d
-are importable) with this source tree first on PYTHONPATH. The machine and the load average (`uptime`)
-are printed before and after every part and written, with each part's duration, peak RSS (``wait4``: the
-part's process; parts that start a process per case report those in their own sections) and exit status, to the
-"run-all" section of RESULTS.md. ``--load`` asks the parts that support it (winding, heat-surface, heat-volume-speed) to time
-everything a second time with two busy processes that the benchmark starts and stops itself (bench/load.py);
-the tori part measures under that load in every mode. A part without a quick mode (``None``) is skipped by
+are importable) with this source tree first on PYTHONPATH. The machine and the load average are printed before
+and after every part and written, with each part's duration, peak RSS (``wait4``: the part's process; parts that
+start a process per case report those in their own sections) and exit status, to the "run-all" section of
+RESULTS.md. ``--load`` asks the parts that support it to time everything a second time with two busy processes
+that the benchmark starts and stops itself (bench/load.py). A part without a quick mode (``None``) is skipped by
 ``--quick``.
 """
 
@@ -25,7 +24,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from common import machine, table, write_section  # noqa: E402
+from common import command, heading, machine, table, write_section  # noqa: E402
 from load import uptime  # noqa: E402
 
 ANCHORS_PYTHON = "/work/anchors/bin/python"
@@ -35,10 +34,17 @@ PARTS = {
     "cold-start": ("bench_cold_start.py", ["--only", "demo,sdf"], [], False),
     "winding": ("bench_winding.py", ["--quick"], [], True),
     "distance": ("bench_distance.py", ["--queries", "50000"], [], False),
+    "io": ("bench_io.py", ["100"], [], False),
     "tori": ("bench_tori.py", ["--quick"], [], False),
-    "heat-surface": ("bench_heat_surface.py", ["--speed", "--quick"], ["--speed"], True),
-    "heat-volume-speed": ("bench_heat_volume_speed.py", ["--quick"], [], True),
-    "heat-volume": ("bench_heat_volume.py", None, [], False),  # accuracy tables incl. tets: tens of minutes
+    "heat-surface-speed": ("bench_heat_surface.py", ["--only", "speed", "--quick"], ["--only", "speed"], True),
+    "heat-surface": ("bench_heat_surface.py", None, ["--only", "accuracy,polygon-pointcloud,solver-rule,ordering,voxel"],
+                     False),
+    "heat-volume-speed": ("bench_heat_volume.py", ["--only", "speed", "--quick"], ["--only", "speed,scaling"], True),
+    "heat-volume": ("bench_heat_volume.py", None, ["--only", "accuracy,choices,solvers"], False),
+    "swn": ("bench_swn.py", None, [], False),
+    "recon": ("bench_recon.py", None, [], False),
+    "parameters": ("bench_parameters.py", None, [], False),
+    "batch": ("bench_batch.py", None, [], False),
 }
 
 
@@ -90,12 +96,10 @@ def main(argv=None):
     if a.dry_run:
         return 0
     total = time.perf_counter() - t_all
-    text = (f"## All speed tables (bench/run_all.py{' --quick' if a.quick else ''}{' --load' if a.load else ''})\n\n"
-            f"Machine: {info}. Total {total / 60:.1f} min. The machine is shared: load averages before and after "
-            "each part are listed; each part's own section states what it measured. Peak RSS: the part's "
-            "process (largest of it and the children it waited for; per-case figures are in the parts' sections). "
-            f"Command: `PYTHONPATH=src {py} bench/run_all.py {' '.join(sys.argv[1:] if argv is None else argv)}`."
-            "\n\n"
+    text = (heading("All benchmarks in one run", command("run_all.py", argv, python=py))
+            + f"Total {total / 60:.1f} min. Load averages before and after each part are listed; each part's own "
+            "section states what it measured. Peak RSS: the part's process (largest of it and the children it "
+            "waited for; per-case figures are in the parts' sections).\n\n"
             + table(["part", "command", "status", "seconds", "peak RSS MB", "uptime before", "uptime after"], rows))
     write_section("run-all", text)
     print("\n" + text)

@@ -4,9 +4,7 @@ gsdf runs two kinds of threaded code: numba ``parallel=True`` kernels (threading
 numba's workqueue) and the BLAS that sparse factorizations call (SuperLU/CHOLMOD supernodes, dense
 updates). Both default to one thread per core. Run together, or in several gsdf processes at once, they
 oversubscribe the cores: OpenBLAS's idle threads spin for a while after each call, OpenMP's likewise, so
-a numba kernel right after a solve (or three processes side by side) fights threads that do no work. On
-a 2-core machine three concurrent ``gsdf heat-surface`` runs took 62 s with default threads and 3.5 s
-with BLAS limited to one thread (issue 17).
+a numba kernel right after a solve (or three processes side by side) fights threads that do no work.
 
 The rule this module enforces: **gsdf never runs BLAS threads and numba threads against each other.**
 
@@ -16,24 +14,14 @@ The rule this module enforces: **gsdf never runs BLAS threads and numba threads 
   fixed when numba starts); while they run BLAS is idle, so nothing else needs limiting;
 - around sparse factorizations and solves (:func:`blas_region`) BLAS is limited by threadpoolctl and
   restored afterwards: to ``n`` threads when the setting was made explicitly, else to **one** thread
-  (:func:`blas_solve_threads`). Measured (issue 17, 2 cores, shared machine at load ~30):
-  ``gsdf heat-surface bunny00.off`` took 337 s wall / 19.8 s CPU with OpenBLAS's default 2 threads and
-  54 s / 1.65 s with one; three such runs at once took 390 s each with 2 BLAS threads and 43 s with
-  ``--threads 1``. The supernodes of gsdf's sparse factorizations are too small for BLAS threads to pay,
-  and OpenBLAS's spinning idle threads collapse under contention. The ``gsdf`` command applies this
-  default process-wide at start (:func:`apply_cli_default`).
+  (:func:`blas_solve_threads`): the supernodes of gsdf's sparse factorizations are too small for BLAS
+  threads to pay, and idle BLAS threads spin under contention (figures in docs/decisions.md, "Trees and
+  threads"). The ``gsdf`` command applies this default process-wide at start (:func:`apply_cli_default`).
 
-Which calls to wrap (for heat/ and linalg/; wired by the lead after the heat refactor):
-
-- ``gsdf.linalg``: every ``splu`` / ``cholespy.CholeskySolverD`` / ``scipy.sparse.linalg.factorized`` call
-  and every ``solve`` of a stored factorization -> ``with threads.blas_region(): ...``. One wrapper inside
-  the factorization object's ``__init__`` and ``solve`` covers all heat users;
-- ``gsdf.heat.triangle._solver`` / ``polygon`` / ``pointcloud``: nothing beyond the linalg wrappers (the
-  numba kernels there follow :func:`numba_threads` automatically once the setting is applied);
-- ``gsdf.heat.grid._poisson``: the DCT Poisson solves (scipy.fft workers) -> pass
-  ``workers=threads.get_num_threads()``; the CG loops' sparse mat-vecs are single-threaded already;
-- ``gsdf.heat.tet._mesh``: the P1 Poisson factorization / CG -> ``blas_region``;
-- ``gsdf.linalg`` LPs (HiGHS): ``blas_region``.
+Where it applies: the factorizations and solves of :mod:`gsdf.linalg` run inside :func:`blas_region` (one
+wrapper in each factorization object's construction and ``solve``, which covers every signed heat
+discretization); the grid method's DCT Poisson solves pass ``workers=get_num_threads()`` to scipy.fft; numba
+kernels follow :func:`numba_threads`.
 
 Example
 -------
@@ -155,8 +143,7 @@ if hasattr(os, "register_at_fork"):
 
 def _workers(n: int):
     """The process's one pool of ``n`` or more idle Python worker threads (created on first use, grown on
-    demand). Reused across calls: a build of a tree used to start three pools (~0.1 ms and a stack mapping
-    each) per call."""
+    demand), reused across calls."""
     global _pool_executor, _pool_size
     with _pool_lock:
         if _pool_executor is None or _pool_size < n:
@@ -233,7 +220,7 @@ def run_ranges(fn, n: int, grain: int = 512, per_thread: int = 4) -> None:
 
     For serial ``nogil=True`` numba kernels over row ranges: the ranges run on Python threads (the kernels
     release the GIL), so the kernel needs no ``parallel=True`` loop, whose compilation costs about a second
-    per kernel on a cold start (issue 17). ``n <= grain`` or one thread: one call on the calling thread.
+    per kernel on a cold start. ``n <= grain`` or one thread: one call on the calling thread.
     About ``per_thread`` ranges per thread (at least ``grain`` rows each; 4 balance uneven rows, 1 suits rows
     of equal cost) taken in turn by the threads of :func:`run_tasks`. Exceptions propagate.
 

@@ -206,11 +206,8 @@ class TriangleDEC:
         endpoint keeps its degree of freedom and every halfedge stays in the energy; nothing is excluded and
         no projective interpolation is needed (``endpoints`` of the result is all False).
 
-        Why (measured, bench/bench_swn.py cases replayed on meshes refined 4× and 16× by midpoint subdivision,
-        geometry unchanged): with the endpoints excluded the one-rings of the endpoints act as holes — the far
-        field jump of a loop broken into 2-edge runs was 0.29 on dino:3 against 0.456 on the refined meshes,
-        and on dino:37 a ring of excluded endpoints cut a 7 % region off the solve altogether (w ≡ 0 there).
-        With the ramp the coarse mesh gives 0.453 and 0.660 (refined: 0.456, 0.659).
+        Excluded endpoints would act as holes (their one-rings out of the solve); the figures are in
+        docs/decisions.md, "Surface winding numbers".
 
         Parameters
         ----------

@@ -2,16 +2,14 @@
 and principal submatrices plus a diagonal (:func:`principal_submatrix`).
 
 ``scipy.sparse.csr_matrix((vals, (rows, cols)))`` converts, then sorts every row and sums duplicates in
-separate passes with Python-level checks around each; on the small meshes of issue 17 that was ~1 ms per
-operator, a visible share of a 20 ms first solve. :func:`coo_to_csr` computes the canonical CSR pattern once
-(bucket by row, duplicates merged through a column marker, each short row insertion-sorted) together with the
-output slot of every triplet, and sums the values with ``np.bincount`` in input order — so real and complex
-values share one compiled kernel.
+separate passes with Python-level checks around each (~1 ms per operator on small meshes). :func:`coo_to_csr`
+computes the canonical CSR pattern once (bucket by row, duplicates merged through a column marker, each short
+row insertion-sorted) together with the output slot of every triplet, and sums the values with ``np.bincount``
+in input order — so real and complex values share one compiled kernel.
 
 :func:`principal_submatrix` forms ``s · A[keep][:, keep] + diag(d)`` of a canonical CSR (or CSC) matrix in one
 pass, the same matrix as scipy's indexing, scaling and addition (entries whose sum is exactly zero dropped, as
-scipy's addition does), which cost ~1 ms per system on the small meshes (scipy's index checks and the
-intermediate matrices).
+scipy's addition does), without scipy's index checks and intermediate matrices.
 
 Example
 -------

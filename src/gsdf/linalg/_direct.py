@@ -43,13 +43,8 @@ def _in_blas_region(method):
 __all__ = ["Factorization", "HermitianFactorization", "BlockHermitianFactorization", "CholeskyFactorization",
            "cholesky", "cached_factorization", "spd_factorization", "LDL_MAX_UNKNOWNS"]
 
-#: Size rule of the factorization backend (bench/bench_ldl_ordering.py, issue 17), in real unknowns (a complex
-#: unknown counts 2): up to this size the numba LDLᴴ of :mod:`gsdf.linalg._ldl` (approximate minimum degree
-#: ordering). With nested dissection it lost to SuperLU above 64k (ND's fill was 1.5–2× SuperLU's minimum
-#: degree); with AMD the fill matches SuperLU's MMD (0.95–1.04×) without SuperLU's L *and* U and supernode
-#: overhead: ordering + factorization 0.31–0.41× SuperLU's time on the three largest systems of the benchmark
-#: (bunny00 113k complex unknowns, armadillo 78k, refined_elephant 133k), solves 0.4–0.9×. The limit is the
-#: largest system measured (267k real unknowns), rounded up; above it SuperLU.
+#: Size rule of the factorization backend, in real unknowns (a complex unknown counts 2): up to this size the
+#: numba LDLᴴ of :mod:`gsdf.linalg._ldl` (approximate minimum degree ordering), above it SuperLU.
 LDL_MAX_UNKNOWNS = 300_000
 
 
@@ -102,7 +97,7 @@ class Factorization:
         Column ordering (``permc_spec``) and partial-pivoting threshold of the general LU.
     reorder : bool
         Renumber the unknowns by reverse Cuthill–McKee before SuperLU's minimum-degree ordering (same fill; the
-        ordering step is up to ~15× faster on badly numbered inputs, bench_heat_surface.py --solver-rule).
+        ordering step is much faster on badly numbered inputs).
         Rounding then differs from the unreordered factorization (≈ 1e-15 relative on well-conditioned
         systems, so it is used for the vector heat and Dirichlet systems, not for the ε-regularized ones).
     """
@@ -117,9 +112,9 @@ class Factorization:
         self._perm = None
         with blas_region():                            # SuperLU's tiny BLAS calls: threads only cost
             if symmetric:
-                # SuperLU's minimum degree ordering takes up to ~15× longer on some input numberings (CAD
-                # meshes, edges numbered by vertex pairs) for the same fill; a reverse Cuthill–McKee numbering
-                # first (O(nnz), milliseconds) removes that (bench_heat_surface.py --solver-rule)
+                # SuperLU's minimum degree ordering is slow on some input numberings (CAD meshes, edges
+                # numbered by vertex pairs) for the same fill; a reverse Cuthill–McKee numbering first
+                # (O(nnz), milliseconds) removes that
                 p = reverse_cuthill_mckee(A.tocsr(), symmetric_mode=True) if reorder and A.shape[0] > 1 else None
                 Ap = sp.csc_matrix(A[p][:, p]) if p is not None else A
                 try:
@@ -160,9 +155,7 @@ class HermitianFactorization:
     ``backend="ldl"``: the numba LDLᴴ of :mod:`gsdf.linalg._ldl` (SuperLU when a pivot is not positive).
     ``backend="superlu"``: SciPy's SuperLU on the complex matrix in symmetric mode.
     ``backend="cholmod"``: CHOLMOD through ``cholespy`` on the equivalent real symmetric system of size 2n (the
-    2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved). Measured on the vector heat operators (bunny00 CR edges,
-    113k unknowns; a 24.6k-vertex quad sphere): SuperLU factorizes 2–3.5× faster (0.58 vs 1.14 s,
-    0.15 vs 0.53 s) and solves as fast (bench/bench_solver_choices.py), so the 2n embedding is not worth it.
+    2×2 blocks ``[[Re, -Im], [Im, Re]]`` interleaved).
     ``reorder``: the reverse Cuthill–McKee renumbering of :class:`Factorization` (default True).
     ``ordering``: the LDLᴴ backend's fill-reducing ordering (:class:`~gsdf.linalg._ldl.LDLFactorization`).
 

@@ -84,10 +84,9 @@ class SPDSolver:
     """Solve with a sparse symmetric positive definite matrix, set up once for many right-hand sides.
 
     Small systems (n ≤ ``direct_max``) are factorized: CHOLMOD via cholespy (SuperLU if it is missing or the
-    matrix is numerically not PD). Larger ones use preconditioned conjugate gradients: the graded tet
-    Laplacians are well conditioned (Jacobi-CG to 1e-10 takes 0.06 s on the 23k-unknown mech-holes-shark system,
-    CHOLMOD 1.3 s, SuperLU 65 s; bench/bench_solver_choices.py) — pyamg's smoothed aggregation preconditions when
-    installed, Jacobi otherwise. If CG does not converge the matrix is factorized after all.
+    matrix is numerically not PD). Larger ones use preconditioned conjugate gradients (the graded tet
+    Laplacians are well conditioned): pyamg's smoothed aggregation preconditions when installed, Jacobi
+    otherwise. If CG does not converge the matrix is factorized after all.
     """
 
     def __init__(self, A, direct_max: int = 5000, rtol: float = 1e-10):

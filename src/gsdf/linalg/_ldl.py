@@ -1,10 +1,8 @@
 """Sparse LDLᴴ factorization of small and mid-size Hermitian / symmetric positive definite matrices (numba).
 
 Why it exists: on the heat method's systems of a few thousand unknowns SuperLU spends most of its time in
-fixed costs (its supernode and panel machinery, minimum-degree ordering, L *and* U), not in arithmetic: the
-vector heat operator of a 2.8k-vertex scan (7.4k unknowns, L with 47k entries) took 11 ms to factorize while
-the arithmetic is ~10⁵ multiply-adds (issue 17: first solves on small meshes were slower than potpourri3d,
-whose Eigen ``SimplicialLDLT`` does exactly this). Here:
+fixed costs (its supernode and panel machinery, minimum-degree ordering, L *and* U), not in arithmetic. Like
+Eigen's ``SimplicialLDLT``:
 
 * **ordering** — a fill-reducing permutation from :mod:`.ordering`: by default approximate minimum degree,
   and on small systems whose AMD factor is flop-heavy also nested dissection, keeping the one with fewer
@@ -17,9 +15,7 @@ whose Eigen ``SimplicialLDLT`` does exactly this). Here:
   (:func:`_supernodal_numeric`), the same L and D up to rounding.
 
 L's row indices and column pointers are int32 (``int64`` for the symbolic work arrays only): L takes 12 bytes
-per entry instead of 16 for real factors (20 instead of 24 complex), bit-identical results. Under two busy
-processes the repeated solves' loaded/idle factor was the same as with int64 indices within the run-to-run noise
-(bench/RESULTS.md "heat-ldl-int32-load").
+per entry instead of 16 for real factors (20 instead of 24 complex).
 
 All kernels are serial: their sizes are the ones where thread wake-up would cost more than the work (and a
 parallel region waits for a descheduled thread under contention).
@@ -46,37 +42,22 @@ INDEX_MAX = 2**31 - 1     # entries of L addressable by its int32 indices (large
 __all__ = ["LDLFactorization", "nested_dissection", "fill_count", "AUTO_ND_MAX_N", "AUTO_ND_FLOPS",
            "HINT_AMD_FLOPS"]
 
-#: The ``ordering="auto"`` rule (bench/bench_ldl_ordering.py, RESULTS section "ldl-ordering", 16 + 6 meshes):
-#: AMD's fill is 0.5–0.9× nested dissection's on the triangle-mesh systems and its ordering 1.5–4× faster, so
-#: AMD is the default. Nested dissection has fewer flops only on regular grids (the quad meshes of the polygon
-#: benchmark, 0.57–0.96×, and one CAD part); there the factor is flop-heavy: Σ_j c_j² ≥ AUTO_ND_FLOPS ·
-#: nnz(A) · log2 n (c_j = entries of column j of L). Up to AUTO_ND_MAX_N unknowns, when the AMD factor is that
-#: heavy, nested dissection is computed too (its ordering and symbolic pass cost ≤ ~10 % of such a
-#: factorization) and kept when its flop count is below AUTO_ND_GAIN × AMD's. Above that size an ND attempt
-#: (up to 160 ms on bunny00) costs more than it can save.
+#: The ``ordering="auto"`` rule: approximate minimum degree (AMD); up to AUTO_ND_MAX_N unknowns, when the AMD
+#: factor is flop-heavy, Σ_j c_j² ≥ AUTO_ND_FLOPS · nnz(A) · log2 n (c_j = entries of column j of L), nested
+#: dissection is computed too and kept when its flop count is below AUTO_ND_GAIN × AMD's.
 AUTO_ND_MAX_N = 10_000
 AUTO_ND_FLOPS = 12.0
 AUTO_ND_GAIN = 0.9
 
 #: An ordering ``hint`` (:class:`LDLFactorization`) is taken as it is unless its factor is flop-heavy, Σ_j c_j² ≥
-#: HINT_AMD_FLOPS · nnz(A) · log2 n; then AMD is computed too and the fewer-flop one kept. Measured on step III's
-#: Dirichlet systems of the 6 polygon meshes of bench_heat_surface.py --speed --polygon (hint = step I's AMD
-#: order restricted to the free vertices; Σ c_j² / (nnz log2 n) = 7–36) AMD had 0.62–0.85× the hint's flops on
-#: 5 of them (2.3× on the quad torus), but its ordering and second symbolic pass cost more than the numeric
-#: time they saved on every one (net loss 1.6 ms of a ~25 ms first solve on polygon-bear, 1.3 ms on cube sphere
-#: 32, 8 ms on cube sphere 64, 20 ms on polygon_mesh merged; load ~5). The induced order's fill is at most that
-#: of the factor it came from.
+#: HINT_AMD_FLOPS · nnz(A) · log2 n; then AMD is computed too and the fewer-flop one kept. (A hint such as step
+#: I's order restricted to the free vertices of step III: the induced order's fill is at most that of the factor
+#: it came from.)
 HINT_AMD_FLOPS = 60.0
 
 #: Complex (Hermitian) factors with at least SUPERNODAL_FLOPS flops (Σ_j c_j², :func:`_flops`), a fundamental
 #: supernode of at least SUPERNODAL_WIDTH columns and at least SUPERNODAL_MEAN columns per supernode on average
 #: are computed by the supernodal kernel (:func:`_supernodal_numeric`), the others by the up-looking one.
-#: Measured (numeric time, supernodal incl. its symbolic pass / up-looking; load 1–2.7): the vertex connection
-#: Laplacians of the polygon benchmark (bench_heat_surface.py --speed --polygon; mean width 2.0–2.6, widest
-#: 134–475) 0.74× (cube sphere 64, 2.0e8 flops), 0.9× (quad torus 2.4e7, polygon-bear 5.7e6); the CR-edge
-#: systems of triangle meshes (mean width 1.5) 0.9–1.08× (fandisk, blade 0.9; mannequin-devil 1.0; camel, bunny00
-#: 1.05–1.08) and 1.1× with narrow supernodes (cow, widest 73); the real Poisson systems 0.9–1.0× before the
-#: extra symbolic pass. So: complex, flop-heavy, wide supernodes.
 SUPERNODAL_FLOPS = 4e6
 SUPERNODAL_WIDTH = 100
 SUPERNODAL_MEAN = 1.8
@@ -312,7 +293,7 @@ class LDLFactorization:
         Only the pattern's symmetry and the values of the upper triangle of the reordered matrix are used (A is
         assumed Hermitian; nothing checks it).
     ordering : {"auto", "amd", "nd"} or int array (n,)
-        The fill-reducing ordering: ``"auto"`` the measured rule (module docs, :data:`AUTO_ND_MAX_N`), a
+        The fill-reducing ordering: ``"auto"`` the rule of :data:`AUTO_ND_MAX_N` (module docs), a
         name of :func:`gsdf.linalg._ordering.fill_reducing_ordering`, or a permutation (``ordering[k]`` = the
         unknown eliminated k-th). The factors are those of ``A``, whatever the ordering.
     hint : int array (n,), optional
@@ -467,12 +448,12 @@ def _supernodes(colptr, rows, n, parent, lp):
 def _supernodal_numeric(colptr, rows, vals, n, lp, first, snode, rptr, srow):
     """Left-looking supernodal LDLᴴ (the scheme of CHOLMOD's supernodal factorization, without BLAS): each
     supernode is a dense block (its rows × its columns, row-major); it receives the updates
-    ``L_d[r, :] D_d L_d[c, :]ᴴ`` of every earlier supernode d whose pattern meets its columns (scattered through
-    a row map), then is factorized densely, ``D_j = a_jj − Σ_k |l_jk|² D_k``, ``l_ij = (a_ij − Σ_k l_ik D_k
+    ``L_d[r, :] D_d L_d[c, :]ᴴ`` of every earlier supernode d whose pattern meets its columns (scattered through a
+    row map), then is factorized densely, ``D_j = a_jj − Σ_k |l_jk|² D_k``, ``l_ij = (a_ij − Σ_k l_ik D_k
     conj(l_jk)) / D_j``; the update of a descendant is applied two target columns per pass over its rows (each
-    sum formed as with one column: the same L, D; 0.90–0.93× the time on the polygon benchmark's connection
-    Laplacians). (colptr, rows, vals): the lower triangle of the reordered matrix in CSC. Returns
-    (Li, Lx, D, k_bad) in the simplicial layout of :func:`_numeric` (column pointers ``lp``)."""
+    sum formed as with one column: the same L, D, fewer passes). (colptr, rows, vals): the lower triangle of the
+    reordered matrix in CSC. Returns (Li, Lx, D, k_bad) in the simplicial layout of :func:`_numeric` (column
+    pointers ``lp``)."""
     ns_tot = len(first) - 1
     off = np.zeros(ns_tot + 1, np.int64)
     wmax = 1

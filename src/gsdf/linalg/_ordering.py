@@ -20,7 +20,7 @@
   two sides recurse, the separator is numbered last. O(nnz log n); disconnected subgraphs split into
   components for free.
 * :func:`fill_reducing_ordering` — either, by name (:class:`~gsdf.linalg._ldl.LDLFactorization` chooses
-  between them by the rule measured in bench/bench_ldl_ordering.py).
+  between them by its ``ordering="auto"`` rule).
 
 Example
 -------

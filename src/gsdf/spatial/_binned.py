@@ -3,23 +3,20 @@ constants.
 
 Each node is split where n_L·r_L³ + n_R·r_R³ is smallest (r = half-diagonal of the child's element box,
 n = its element count); the tree layout is the flat preorder one of :mod:`gsdf.spatial._bvh`. What keeps the
-build cheap (on the 75k-face bunny it is several times faster than splitting by index-indirect passes):
+build cheap:
 
 * elements are *moved*, not indexed: a working array holds each element's centroid and box (9 numbers) in
   the current order, and a node's partition swaps these rows, so every pass over a node reads memory
   sequentially;
 * one pass over a node bins its elements along the two longest axes of its centroid box at once (32 bins
   per axis over the node's centroid box), and the candidate planes are the 2 × 31 bin boundaries (the
-  shortest axis, across a surface patch, rarely holds the best plane: binning and sweeping it too made the
-  serial build of refined_elephant ~20 % slower, 44.7 vs 36.7 ms, for trees whose queries open the same
-  number of nodes within ±1 % on the CGAL meshes);
+  shortest axis, across a surface patch, rarely holds the best plane);
 * the partition pass also collects the two children's centroid boxes, and the children's element boxes
   come out of the bins, so no node is read again for its bounds;
 * a node of at most :data:`SMALL` elements instead tries every split of its elements sorted along each of
   the same two axes (stable, by ranks): there the bins cost more than the elements, and an exhaustive sweep
   never finds a worse split than the bins. Its prefix / suffix boxes are running bounds, each position's
-  cost computed as the bound is extended (storing the bounds for a loop of vectorised square roots took
-  ~25 % longer on nodes of 6).
+  cost computed as the bound is extended.
 
 Example
 -------
@@ -410,7 +407,7 @@ def build_volume_rows(E, leaf_size, threads=1, root=None):
     (:func:`_parallel_grow`; :func:`_grow` releases the GIL; the subtrees own disjoint rows) and
     spliced into the preorder arrays by :func:`_splice` (the same tree as the serial build). Both builds are
     the one compiled kernel :func:`_grow` driven from here: no parallel numba kernel (a parfor over the tasks
-    cost ~6 s of compilation on a cold start, issue 17, for a build of 0.05-0.3 s)."""
+    would compile for seconds on a cold start, for a build of 0.05-0.3 s)."""
     n = E.shape[0]
     order = np.arange(n, dtype=np.int64)
     root = _root_bounds(E) if root is None else np.ascontiguousarray(root, dtype=np.float64)
@@ -435,11 +432,11 @@ def _parallel_grow(E, order, root, leaf_size, cutoff, threads, sub_i, sub_b):
     tasks), as :func:`_grow` with that cutoff returns it, and every task's subtree, grown into rows
     2·start .. of ``sub_i`` / ``sub_b``. Returns (kt, top_i, top_b, ntask, task_i, counts) for :func:`_splice`.
 
-    The root is split on the calling thread; then the two halves below it are grown at the same time, and a
-    thread whose half is done takes the largest task published so far (its own half's or the other's)
-    instead of waiting for the other half (the halves differ by up to 1.6× in size on the CGAL meshes, and
-    the top levels were ~25 % of the build). One :func:`_grow` kernel throughout, so the same tree as the
-    serial build: the root's split, then each child's subtree, numbered root, left's nodes, right's."""
+    The root is split on the calling thread; then the two halves below it are grown at the same time, and a thread
+    whose half is done takes the largest task published so far (its own half's or the other's) instead of
+    waiting for the other half (the halves can differ much in size). One :func:`_grow` kernel throughout, so the
+    same tree as the serial build: the root's split, then each child's subtree, numbered root, left's nodes,
+    right's."""
     n = E.shape[0]
     # the root alone: nodes of at most n − 1 elements (its two children) become tasks
     k0, i0, b0, nt0, ti0, tb0 = _grow(E, order, 0, n, root, leaf_size, n - 1, np.empty((4, 4), np.int64),

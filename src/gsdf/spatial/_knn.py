@@ -1,14 +1,14 @@
 """The k nearest neighbours of every point of a cloud among the cloud itself, on a uniform cell grid.
 
-What :func:`gsdf.winding._point_areas` needs (its 21-161 candidates per point): scipy's ``cKDTree.query`` keeps a
-sorted heap of k per query, and its cost grows with k (1.4k points: 25-45 ms for k = 161 against 3 ms for
-k = 21). Here the points are bucketed in cubic cells of about the typical k-th neighbour distance; each point
-scans the cubes of cells around its own (Chebyshev distance R = 1, 2, ...) keeping the points closer than the
-nearest face of the scanned cube (faces on the border of the grid do not count: nothing lies beyond them; cells
-wholly beyond that face are not read) until at least k are kept — every unseen point is farther, so those k are
-exact. The k-th smallest squared distance is found by a histogram of the kept ones (:func:`_kth_smallest`) and
-the points up to it are kept; ties at the threshold go to the smallest indices. A point whose block keeps fewer
-than k rescans the next cube out to the k-th distance among its block's points, an upper bound of its own k-th.
+What :func:`gsdf.winding._point_areas` needs (its 21-161 candidates per point; a k-d tree query keeps a sorted heap
+of k per query, so its cost grows with k). Here the points are bucketed in cubic cells of about the typical k-th
+neighbour distance; each point scans the cubes of cells around its own (Chebyshev distance R = 1, 2, ...) keeping
+the points closer than the nearest face of the scanned cube (faces on the border of the grid do not count: nothing
+lies beyond them; cells wholly beyond that face are not read) until at least k are kept — every unseen point is
+farther, so those k are exact. The k-th smallest squared distance is found by a histogram of the kept ones
+(:func:`_kth_smallest`) and the points up to it are kept; ties at the threshold go to the smallest indices. A
+point whose block keeps fewer than k rescans the next cube out to the k-th distance among its block's points, an
+upper bound of its own k-th.
 
 Rows come out in no particular order unless ``ordered`` (sorted by distance, ties by index: the rows of
 ``cKDTree.query``, so a caller gets bit-identical results from either; the sort costs ~15 % at k = 41).
@@ -37,7 +37,7 @@ __all__ = ["SelfKNN", "knn_self"]
 
 MAX_CELLS = 1 << 22  # dense cell table; coarser cells above this
 NBUCKET = 64  # buckets of the selection histogram (:func:`_kth_smallest`)
-CELL_FACTOR = 1.0  # cell / median k-th neighbour distance (0.4-2 measured on three CGAL clouds: 1 was fastest)
+CELL_FACTOR = 1.0  # cell / median k-th neighbour distance
 
 
 class SelfKNN:
@@ -98,7 +98,7 @@ class SelfKNN:
 
 #: From this many points the cells are split into ranges of about equal point counts, run on the threads of
 #: :func:`gsdf.threads.run_tasks` (4 per thread, taken in turn, so a descheduled worker delays one range); below,
-#: one call on the calling thread. k = 41 on CGAL's hippo1 (6.1k points): 5.6 ms on one thread.
+#: one call on the calling thread.
 PARALLEL_POINTS = 1024
 
 

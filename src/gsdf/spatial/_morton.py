@@ -63,8 +63,7 @@ def cell_order(Q: np.ndarray) -> np.ndarray:
     n = Q.shape[0]
     if n < 2:
         return np.arange(n)
-    # 2^(3 bits) cells; more than 2^15 measured no better on 10^6 queries (bench/bench_winding.py) and the
-    # histogram then leaves the L2 cache
+    # 2^(3 bits) cells, at most 2^15 (the histogram stays in the L2 cache)
     bits = int(min(5, max(1, round(np.log2(max(n / 4, 2)) / 3))))
     lo, hi = _bounds(Q)
     return _counting_order(Q, lo, hi, bits)

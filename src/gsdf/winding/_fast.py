@@ -38,8 +38,7 @@ Build (triangles): the volume-split tree of :mod:`gsdf.spatial._binned`; the nod
 :func:`_tree_moments` (leaves from their triangles, parents from their two children shifted by the
 parallel-axis theorem); the compact rows folded straight into the wide lanes by :func:`_lanes`.
 
-Cost: precompute O(m log m) (the tree; moments O(m + k)); a query O(log m) for well-distributed input
-(bench/ measures both).
+Cost: precompute O(m log m) (the tree; moments O(m + k)); a query O(log m) for well-distributed input.
 """
 
 from __future__ import annotations
@@ -592,8 +591,8 @@ def _pack_nodes(D, tree):
     return N
 
 
-# children per node of the wide walk (a compile-time constant: the lane loop is unrolled). 8 measured no
-# faster than 4 on the CGAL meshes (fewer visits, but 8 lanes do not fit one AVX2 register)
+# children per node of the wide walk (a compile-time constant: the lane loop is unrolled; 4 lanes of doubles fill
+# one AVX2 register)
 WIDTH = 4
 _WF = 4 + COMPACT_WIDTH - 1  # fields per child slot: centre (3), β²r², the 23 compact coefficients
 
@@ -660,9 +659,7 @@ def _lanes(D, kids, start, end, beta2, keep, W, LS, LE, i0, i1):
             LE[n, c] = end[b]
 
 
-# The walks stay one parallel kernel each, with the per-query loop inside the prange body: moved to a
-# serial kernel of its own (called per chunk) the same loop ran 1.3-2x slower (measured on bunny00 and rotor,
-# one and two threads), for no compile time saved.
+# The walks are one parallel kernel each, with the per-query loop inside the prange body.
 @njit(parallel=True, cache=True, fastmath=_FASTMATH)
 def _eval_triangles_wide(Q, T, W, CH, LS, LE, stack_size, out):
     n = Q.shape[0]
@@ -756,11 +753,10 @@ def _check_params(beta, order):
 
 
 # Below these sizes the build kernels / the walk run on the calling thread: a numba parallel launch waits
-# for its worker threads, which on a loaded machine took 30-200 ms per launch (issue 17: measured the build
-# of rotor.off, 1200 faces, at 192 ms with 2 threads and 1 ms with one, at load 16).
+# for its worker threads, which on a loaded machine can take longer than the work.
 SERIAL_BUILD_FACES = 100_000  # points (clouds)
-# Triangle builds use the threads from this size on: three parallel launches (the tree's lower subtrees,
-# the leaf moments, the lanes) against ~60 ms of serial work at 75k faces.
+# Triangle builds use the threads from this size on (three parallel launches: the tree's lower subtrees,
+# the leaf moments, the lanes).
 PARALLEL_BUILD_FACES = 20_000
 SERIAL_QUERIES = 16_384
 
@@ -808,7 +804,7 @@ class FastWindingNumber(_FastWindingBase):
     order : {0, 1, 2}
         Taylor order of the far-field expansion.
     leaf_size : int
-        Triangles per tree leaf (4: measured fastest for build + 10⁶ queries on the CGAL meshes, bench/bench_winding.py).
+        Triangles per tree leaf.
 
     Examples
     --------
@@ -833,10 +829,8 @@ class FastWindingNumber(_FastWindingBase):
         V = np.ascontiguousarray(self._frame.geometry(V))
         E, root = _triangle_elements_root(V, F)
         self.tree = t = build_volume_bvh(E, leaf_size, root)
-        # Far-field radius for triangles (set by _tree_moments): the farthest corner of the node's box from p̃.
-        # It bounds the paper's r (farthest element point) and, measured on the CGAL meshes
-        # (bench/bench_winding.py), brings the RMS error at β = 2 from ~1.3e-3 to ~7e-4 — the paper's
-        # "β = 2 gives ~1e-3".
+        # Far-field radius for triangles (set by _tree_moments): the farthest corner of the node's box from p̃,
+        # which bounds the paper's r (farthest element point).
         # the (k, 40) moments D are folded into the lanes and dropped (18 MB at 89k faces, a third of the object;
         # tests rebuild them with _tree_moments)
         wide = []  # the walk tests the WIDTH children of a node together (see _eval_triangles_wide): the wide

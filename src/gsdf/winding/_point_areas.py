@@ -330,19 +330,14 @@ def _cell_area(P, N, plane, idx, i, row, clip_hull, Q, A, B, H, F, G):
 
 
 #: Below this many points the two kernels run as one call on the calling thread; from it, ranges of 256 or more
-#: points on the threads of :func:`gsdf.threads.run_ranges` (about 4 per thread, taken in turn). Measured in
-#: the volume signed heat method at 32³ (bench/bench_heat_volume_speed.py's clouds, interleaved rounds idle /
-#: under two busy processes): hippo1 (6.1k points) 32.2 → 26.3 ms idle, 56.7 → 41.0 ms loaded; kitten (5.2k)
-#: 32.0 → 27.7 / 43.0 → 41.3; oni (1.4k) 20.2 → 19.5 / 39.1 → 37.9 (an older pool that started threads per
-#: call waited 10-25 ms for a descheduled thread at load 5-6; issue 17).
+#: points on the threads of :func:`gsdf.threads.run_ranges` (about 4 per thread, taken in turn).
 SERIAL_POINTS = 1024
 
 
 def _candidate_search(P, k):
     """The k nearest of every point (itself included), rows unordered: the cell grid of :class:`SelfKNN`.
-    Measured on the CGAL clouds oni / kitten / hippo1 (1.4k-6k points) against the scipy k-d tree it replaced
-    for k <= 64: 1.3-1.7× faster at k = 41, 1.4-1.6× at k = 161, on one thread. Only the neighbour sets decide
-    the areas: the row order changes the plane fit's sums by rounding (areas within ~1e-15 relative)."""
+    Only the neighbour sets decide the areas: the row order changes the plane fit's sums by rounding (areas
+    within ~1e-15 relative)."""
     return SelfKNN(P, k)
 
 
@@ -408,9 +403,8 @@ def point_areas(P, N, k: int = 20, boundary: str = "hull", candidates: int = 8) 
     *Noisy, thick samples.*  When the noise across the surface exceeds the point spacing, the plain
     3D k-neighbourhood only sees a slab of the noise layer, its projection is too sparse and the areas
     come out too large: on CGAL's ``sphere_20k_normal.xyz`` (radial noise std 4 % of r, about twice the
-    spacing) the plain rule (``candidates=1``) sums to 1.48 x 4 pi r^2, ``candidates=4`` to 1.03, the default
-    (8) to within 1 %
-    (``bench/bench_winding.py`` prints the figure). On a clean sphere both are within 0.1 %.
+    spacing) the plain rule (``candidates=1``) sums to about 1.4 x 4 pi r^2, ``candidates=4`` to 1.03, the
+    default (8) to within 1.5 %. On a clean sphere both are within 0.1 %.
 
     Cost: one k-nearest-neighbour search (the cell grid of :class:`gsdf.spatial._knn.SelfKNN`) plus
     O(n (candidates k + k^2)) work in numba kernels on the threads.

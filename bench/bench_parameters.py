@@ -1,4 +1,4 @@
-"""Error and time against the user-facing parameters (issue 15: "Choosing a method and its parameters").
+"""Error and time against the user-facing parameters (the tables of docs/guide/parameters.md).
 
 One shape, four conditions of it: CGAL's elephant.off (closed, genus 3) as the truth, and as inputs
 
@@ -18,21 +18,22 @@ Swept, one parameter at a time, the others at their defaults:
   flipped conditions perturb positions / normals);
 * ``signed_distance_grid``: ``resolution`` (time, and error on the nodes — it is exact up to the sign).
 
-Run: ``PYTHONPATH=src python3 bench/parameters.py`` (~5-10 min on 2 loaded cores); writes the "parameters"
+Run: ``PYTHONPATH=src python3 bench/bench_parameters.py`` (~5-10 min on 2 loaded cores); writes the "parameters"
 section of bench/RESULTS.md and docs/_generated/parameters.md (included by docs/guide/parameters.md).
 """
 
 from __future__ import annotations
 
+import argparse
 import os
-import subprocess
 import sys
 import time
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import data_dir, machine, table, write_section  # noqa: E402
+from common import command, data_dir, heading, table, write_section
+from load import uptime  # noqa: E402  # noqa: E402
 
 import gsdf  # noqa: E402
 
@@ -69,6 +70,7 @@ def timed(fn):
 
 
 def main():
+    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()
     truth, inputs, diag = load_inputs()
     Vt, Ft = truth
     exact_truth = gsdf.ExactWindingNumber(Vt, Ft)
@@ -78,10 +80,9 @@ def main():
         return np.sign(0.5 - exact_truth(Q)) * dist_truth.query(Q)[0]
 
     lines = [
-        "## Parameters (bench/parameters.py; issue 15)", "",
-        f"Machine: {machine()}; load at start: {os.getloadavg()[0]:.1f} (shared by other jobs: times are "
-        "indicative, compare within a table).", "",
-        "Command: `PYTHONPATH=src python3 bench/parameters.py`", "",
+        heading("Parameters: error and time against the user-facing parameters",
+                command("bench_parameters.py", [])).rstrip(), "",
+        "Times are indicative on a shared machine: compare within a table.", "",
         "Shape: CGAL elephant.off (5,558 faces, closed, genus 3, bbox diagonal "
         f"{diag:.3f}); inputs: clean, holey = elephant-with-holes.off, noisy = vertex noise σ = 0.5 % of the "
         "diagonal, flipped = 30 % of the faces reversed. Reference: exact signed distance to the clean elephant.", "",
@@ -100,8 +101,8 @@ def main():
         row = [name]
         for t_scale in ("grid", "input"):
             for t_coef in (0.25, 1.0, 4.0):
-                sec, field = timed(lambda: gsdf.signed_heat_volume(mesh=(V, F), resolution=32, t_coef=t_coef,
-                                                                    t_scale=t_scale))
+                sec, field = timed(lambda: gsdf.signed_heat_volume(
+                    mesh=(V, F), resolution=32, t_coef=t_coef, options=gsdf.VolumeHeatOptions(t_scale=t_scale)))
                 X = grid_nodes(field)
                 ref = ref_sdf(X)
                 near = np.abs(ref) < 0.1 * diag
@@ -190,16 +191,15 @@ def main():
         print(row, flush=True)
     lines += [table(["input", "k=10", "k=20", "k=40"], rows), ""]
 
-    try:
-        load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
-    except OSError:
-        load = ""
-    lines += [f"uptime at the end: `{load}`"]
+    lines += [f"At the end: {uptime()}."]
     text = "\n".join(lines)
     write_section("parameters", text)
+    if os.environ.get("GSDF_BENCH_RESULTS"):  # a trial run: leave the docs page alone
+        print(text)
+        return
     os.makedirs(os.path.dirname(DOCS_OUT), exist_ok=True)
     with open(DOCS_OUT, "w") as f:
-        f.write(text.replace("## Parameters", "## Measured", 1) + "\n")
+        f.write(text.replace("## Parameters: error and time against the user-facing parameters", "## Measured", 1) + "\n")
     print(text)
 
 

@@ -1,0 +1,184 @@
+"""Run the same workloads on two checkouts of gsdf side by side: outputs compared, times interleaved.
+
+    python scripts/compare_checkouts.py OLD_SRC NEW_SRC [--rounds 5] [--only a,b]
+
+Each workload runs in its own process per checkout (``PYTHONPATH=<src>``, numba caches kept apart), once to
+warm the compilation cache, then ``--rounds`` times alternating old / new; the table prints the median wall
+time of each side, their ratio, and the largest relative difference of the outputs (0 = bit-identical). Only the
+public API (``gsdf.<name>`` and the options both checkouts accept) is called, so the two layouts can differ.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+#: name -> code; the code defines ``out`` (a dict of arrays) and ``seconds`` (the timed part).
+WORKLOADS = {
+    "fast winding (soup, 2e5 queries)": """
+V, F = shapes["soup"]
+Q = rng.uniform(-1.3, 1.3, (200_000, 3))
+t = time.perf_counter(); w = gsdf.fast_winding_number(V, F, Q); seconds = time.perf_counter() - t
+out = {"w": w}
+""",
+    "signed distance (sphere, 1e5)": """
+V, F = shapes["sphere"]
+Q = rng.uniform(-1.3, 1.3, (100_000, 3))
+t = time.perf_counter(); s = gsdf.signed_distance(V, F, Q); seconds = time.perf_counter() - t
+out = {"s": s}
+""",
+    "signed_distance_grid (soup, 64)": """
+V, F = shapes["soup"]
+lo, hi = V.min(0) - 0.2, V.max(0) + 0.2
+grid = gsdf.Grid.fit((lo, hi), 64) if hasattr(gsdf, "Grid") else None
+t = time.perf_counter()
+S = gsdf.signed_distance_grid(V, F, resolution=grid) if grid is not None else \
+    gsdf.signed_distance_grid(V, F, resolution=64, bbox_min=lo, bbox_max=hi)
+seconds = time.perf_counter() - t
+out = {"S": np.asarray(S.values)}
+""",
+    "surface signed heat (sphere, curve)": """
+V, F = shapes["sphere"]
+ring = np.flatnonzero(np.abs(V[:, 2]) < 0.05)
+ring = ring[np.argsort(np.arctan2(V[ring, 1], V[ring, 0]))]
+t = time.perf_counter()
+solver = gsdf.SurfaceSignedHeatSolver(V, F)
+phi = solver.compute_distance([gsdf.Curve(ring[::3], signed=False)], points=[int(ring[0])])
+seconds = time.perf_counter() - t
+out = {"phi": phi}
+""",
+    "volume signed heat (soup, grid 32)": """
+V, F = shapes["soup"]
+t = time.perf_counter()
+f = gsdf.signed_heat_volume(mesh=(V, F), resolution=32)
+seconds = time.perf_counter() - t
+out = {"phi": np.asarray(f.values)}
+""",
+    "Points as Tori (cloud, 5e4 queries)": """
+P, N = shapes["cloud"]
+Q = rng.uniform(-1.2, 1.2, (50_000, 3))
+t = time.perf_counter(); pat = gsdf.PointsAsTori(P, N); d = pat.signed_distance(Q); seconds = time.perf_counter() - t
+out = {"d": d}
+""",
+    "surface winding numbers (torus, broken meridian)": """
+V, F, idx = shapes["torus"]
+t = time.perf_counter()
+r = gsdf.surface_winding_number(V, F, [idx[5, :17], idx[30, 3:15]], method="lp")
+seconds = time.perf_counter() - t
+out = {"labels": np.asarray(r.face_labels), "u": np.asarray(r.u)}
+""",
+    "reconstruction (ellipsoid, 600 points)": """
+P = shapes["ellipsoid"]
+t = time.perf_counter(); V2, F2 = gsdf.reconstruct_simply_connected(P); seconds = time.perf_counter() - t
+out = {"V": V2, "F": F2.astype(np.float64)}
+""",
+}
+
+PRELUDE = r'''
+import sys, time, json
+import numpy as np
+import gsdf
+rng = np.random.default_rng(0)
+
+def _sphere(n=40):
+    u, v = np.meshgrid(np.linspace(0, np.pi, n), np.linspace(0, 2 * np.pi, 2 * n, endpoint=False), indexing="ij")
+    V = np.stack([np.sin(u) * np.cos(v), np.sin(u) * np.sin(v), np.cos(u)], -1).reshape(-1, 3)
+    idx = np.arange(n * 2 * n).reshape(n, 2 * n)
+    F = []
+    for i in range(n - 1):
+        for j in range(2 * n):
+            a, b, c, d = idx[i, j], idx[i, (j + 1) % (2 * n)], idx[i + 1, j], idx[i + 1, (j + 1) % (2 * n)]
+            F += [[a, c, b], [b, c, d]]
+    V, F = np.asarray(V), np.asarray(F)
+    # weld the poles
+    key = np.round(V, 9)
+    _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    F = inv.ravel()[F]
+    F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
+    return V[first], F
+
+def _torus(nu=48, nv=24, R=1.0, r=0.4):
+    u = 2 * np.pi * np.arange(nu) / nu
+    v = 2 * np.pi * np.arange(nv) / nv
+    U, W = np.meshgrid(u, v, indexing="ij")
+    V = np.stack([(R + r * np.cos(W)) * np.cos(U), (R + r * np.cos(W)) * np.sin(U), r * np.sin(W)], -1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
+    a = i * nv + j; b = ((i + 1) % nu) * nv + j; c = ((i + 1) % nu) * nv + (j + 1) % nv; d = i * nv + (j + 1) % nv
+    F = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    return V, F, a
+
+Vs, Fs = _sphere()
+g = np.random.default_rng(1)
+keep = g.random(len(Fs)) > 0.1
+Fsoup = np.concatenate([Fs[keep], Fs[keep][g.random(keep.sum()) < 0.05]])
+flip = g.random(len(Fsoup)) < 0.1
+Fsoup[flip] = Fsoup[flip][:, ::-1]
+Pc = g.normal(size=(20_000, 3)); Pc /= np.linalg.norm(Pc, axis=1, keepdims=True)
+Pe = g.normal(size=(600, 3)) * [1.0, 0.7, 0.5]; Pe /= np.linalg.norm(Pe / [1.0, 0.7, 0.5], axis=1)[:, None]
+shapes = {"sphere": (Vs, Fs), "soup": (Vs, Fsoup), "cloud": (Pc, Pc.copy()), "torus": _torus(), "ellipsoid": Pe}
+'''
+
+EPILOGUE = r'''
+np.savez(sys.argv[1], **out)
+print(json.dumps({"seconds": seconds}))
+'''
+
+
+def run(src, code, path, cache):
+    env = dict(os.environ, PYTHONPATH=src, NUMBA_CACHE_DIR=cache, PYTHONDONTWRITEBYTECODE="1")
+    r = subprocess.run([sys.executable, "-c", PRELUDE + code + EPILOGUE, path], env=env, capture_output=True,
+                       text=True)
+    if r.returncode:
+        raise RuntimeError(r.stderr[-2000:])
+    return json.loads(r.stdout.strip().splitlines()[-1])["seconds"]
+
+
+def rel_diff(a, b):
+    if a.shape != b.shape:
+        return float("inf")
+    if a.size == 0:
+        return 0.0
+    scale = max(float(np.abs(a).max()), 1e-300)
+    return float(np.abs(a - b).max()) / scale
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("old")
+    ap.add_argument("new")
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--only", default=None, help="comma-separated substrings of workload names")
+    args = ap.parse_args(argv)
+    names = [n for n in WORKLOADS if not args.only or any(s in n for s in args.only.split(","))]
+    tmp = tempfile.mkdtemp(prefix="gsdf-compare-")
+    caches = {side: os.path.join(tmp, f"numba-{side}") for side in ("old", "new")}
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
+          f"load {os.getloadavg()[0]:.1f}; rounds {args.rounds}")
+    print(f"| workload | old s (median) | new s (median) | new / old | max relative output difference |")
+    print("|---|---|---|---|---|")
+    for name in names:
+        code = WORKLOADS[name]
+        paths = {side: os.path.join(tmp, f"{side}.npz") for side in ("old", "new")}
+        for side, src in (("old", args.old), ("new", args.new)):
+            run(src, code, paths[side], caches[side])            # compile / warm
+        times = {"old": [], "new": []}
+        for _ in range(args.rounds):
+            for side, src in (("old", args.old), ("new", args.new)):
+                times[side].append(run(src, code, paths[side], caches[side]))
+        a, b = np.load(paths["old"]), np.load(paths["new"])
+        diff = max(rel_diff(a[k], b[k]) for k in a.files) if sorted(a.files) == sorted(b.files) else float("inf")
+        to, tn = statistics.median(times["old"]), statistics.median(times["new"])
+        print(f"| {name} | {to:.3f} | {tn:.3f} | {tn / to:.2f} | {diff:.1e} |", flush=True)
+    print(f"load at the end: {os.getloadavg()[0]:.1f}")
+
+
+if __name__ == "__main__":
+    main()
