@@ -495,6 +495,8 @@ def prepare_files(root: str) -> None:
                 pass
     with open(os.path.join(root, "pairs.json"), "w") as fh:
         json.dump(pairs, fh)
+    with open(os.path.join(root, "written.json"), "w") as fh:
+        json.dump(sorted(written), fh)
 
 
 def _roundtrip(r, exp: dict):

@@ -345,8 +345,15 @@ def _run(args, areas, root, t_start) -> int:
               "(python -m tests.fuzz --gaps lists them)")
         for k, v in skips.most_common(12):
             print(f"  {v:4d} x {k}")
+    try:
+        with open(os.path.join(root, "written.json")) as fh:
+            unread = sorted(set(json.load(fh)) - {f for _, f in pairs})
+    except OSError:
+        unread = []
+    if unread and "files" in {a.split(":")[0] for a in areas}:
+        print(f"written by a public writer but read by no public reader (no file cases): {', '.join(unread)}")
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"generated": n_all, "seconds": dt, "sample": args.sample, "seed": args.seed,
-                       "areas": sorted(areas), "gaps": gaps, "cases": results}, fh, indent=1, default=str)
+                       "areas": sorted(areas), "gaps": gaps, "unread_files": unread, "cases": results}, fh, indent=1, default=str)
     return 1 if bad else 0
