@@ -19,6 +19,7 @@ from gsdf._checks import as_mesh, as_normals, as_points, as_weights, choice, pos
 from gsdf.mesh._pseudonormals import pseudonormals
 from gsdf.distance._points import point_cloud_distance
 from gsdf.distance._triangles import TriangleDistance
+from gsdf.spatial._triangle_tree import triangle_tree
 
 __all__ = ["signed_distance", "signed_distance_points", "SIGN_MODES"]
 
@@ -84,12 +85,13 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0):
     Q = as_points(Q, "Q")
     choice(sign, "sign", SIGN_MODES)
     beta = positive(beta, "beta")
-    td = TriangleDistance(V, F)
+    tt = triangle_tree(V, F)  # one tree for the distance and the winding number
+    td = TriangleDistance._of_tree(V, F, tt)
     if sign == "winding":
-        from gsdf.winding import fast_winding_number  # lazy: the winding module is independent of this one
+        from gsdf.winding import FastWindingNumber  # lazy: the winding module is independent of this one
 
         d, _, _ = td.query(Q)
-        w = np.asarray(fast_winding_number(V, F, Q, beta=beta, order=2), dtype=np.float64)
+        w = FastWindingNumber._of_tree(tt, beta=beta, order=2)(Q)
         return np.where(w > 0.5, -d, d)
     d, face, closest, bary = td.query_barycentric(Q)
     return _pseudonormal_sign(V, F, Q, closest, face, bary) * d

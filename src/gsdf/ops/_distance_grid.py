@@ -112,9 +112,12 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
 
     from gsdf.distance._signed import _pseudonormal_sign
     from gsdf.distance._triangles import TriangleDistance
+    from gsdf.spatial._triangle_tree import triangle_tree
 
+    beta = positive(2.0 if beta is None else beta, "beta")
+    tt = triangle_tree(V, F)  # one tree for the distance and the winding number
     if sign == "pseudonormal":
-        d, face, closest, bary = TriangleDistance(V, F).query_barycentric(Q)
+        d, face, closest, bary = TriangleDistance._of_tree(V, F, tt).query_barycentric(Q)
         sgn = _pseudonormal_sign(V, F, Q, closest, face, bary)
         s = sgn * d
     else:
@@ -122,8 +125,8 @@ def signed_distance_grid(V, F=None, *, points=None, resolution=64, sign: str = "
 
         # the winding numbers first: on a cold cache `gsdf sdf` compiles the distance kernels in a background
         # process meanwhile (gsdf.cli._background), which are then ready when the distance is reached
-        w = _chunked(FastWindingNumber(V, F, beta=positive(2.0 if beta is None else beta, "beta")), Q, report)
-        d, face, closest = TriangleDistance(V, F).query(Q)
+        w = _chunked(FastWindingNumber._of_tree(tt, beta=beta), Q, report)
+        d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
         s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
     S = GridField(s.reshape(grid.shape), *grid.box)
     if not return_closest:
