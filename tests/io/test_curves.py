@@ -12,13 +12,13 @@ V, F = uv_sphere(6, 12)
 
 @pytest.mark.parametrize("body, why", [
     ("signed_curve\nv 0\nv -5\n", "negative vertex index -5"),
-    ("signed_curve\nv 0\nv 99999\n", f"vertex index 99999 out of range for a mesh of {len(V)} vertices"),
-    ("signed_curve\nf 99999 0.3 0.3 0.4\nf 1 0.3 0.3 0.4\n", f"face index 99999 out of range for {len(F)} faces"),
-    ("signed_curve\nf 0 5 -4 0\nf 1 0.3 0.3 0.4\n", "are not those of a point in the face"),
-    ("signed_curve\nf 0 nan 0.5 0.5\nf 1 0.3 0.3 0.4\n", "not finite"),
-    ("signed_curve\nv 0\ne 0 7.5\n", r"edge parameter t must be in \[0, 1\]"),
+    ("signed_curve\nv 0\nv 99999\n", f"vertex 99999 out of range for {len(V)} vertices"),
+    ("signed_curve\nf 99999 0.3 0.3 0.4\nf 1 0.3 0.3 0.4\n", f"face 99999 out of range for {len(F)} faces"),
+    ("signed_curve\nf 0 5 -4 0\nf 1 0.3 0.3 0.4\n", "are not in the face"),
+    ("signed_curve\nf 0 nan 0.5 0.5\nf 1 0.3 0.3 0.4\n", "NaN or infinite"),
+    ("signed_curve\nv 0\ne 0 7.5\n", r"edge parameter 7.5 outside \[0, 1\]"),
     ("signed_curve 7\nv 0\nv 1\n", "flip: expected 0 or 1"),
-    ("signed_curve\nv 0\nv 1.5\n", "vertex index: expected an integer, got '1.5'"),
+    ("signed_curve\nv 0\nv 1.5\n", "vertex index '1.5' is not an integer"),
     ("l 1 0\n", "OBJ line indices must be positive"),
 ])
 def test_read_curves_refuses_bad_nodes_with_file_and_line(tmp_path, body, why):

@@ -25,6 +25,7 @@ from gsdf._memory import SECONDS_PER_QUERY
 from gsdf.mesh._pseudonormals import pseudonormals
 from gsdf.distance._points import point_cloud_distance
 from gsdf.distance._triangles import TriangleDistance
+from gsdf.spatial._triangle_tree import triangle_tree
 
 __all__ = ["signed_distance", "signed_distance_points", "SIGN_MODES", "PseudonormalWarning",
            "warn_pseudonormal"]
@@ -161,12 +162,13 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0, return_cl
         raise ValueError(f"return_closest: expected True or False, got {return_closest!r}")
     if shell is not None:
         shell = positive(shell, "shell")
-    td = TriangleDistance(V, F)
+    tt = triangle_tree(V, F)  # one tree for the distance and the winding number
+    td = TriangleDistance._of_tree(V, F, tt)
     if sign == "winding":
-        from gsdf.winding import fast_winding_number  # lazy: the winding module is independent of this one
+        from gsdf.winding import FastWindingNumber  # lazy: the winding module is independent of this one
 
         d, face, closest = td.query(Q)
-        w = np.asarray(fast_winding_number(V, F, Q, beta=beta, order=2), dtype=np.float64)
+        w = FastWindingNumber._of_tree(tt, beta=beta, order=2)(Q)
         S = np.where(w > 0.5, -d, d)
     else:
         warn_pseudonormal(V, F)

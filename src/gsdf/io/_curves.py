@@ -193,7 +193,9 @@ def _node(key, args, mesh, where, offset=0):
         if len(args) != 1:
             raise ValueError(f"{where}: 'v' takes one vertex index")
         i = _int(args[0], where, "vertex index") + offset
-        if i < 0 or (mesh.n is not None and i >= mesh.n):
+        if i < 0:
+            raise ValueError(f"{where}: negative vertex index {i}")
+        if mesh.n is not None and i >= mesh.n:
             raise ValueError(f"{where}: vertex {i} out of range for {mesh.n} vertices")
         return ("v", i, (0.0, 0.0, 0.0), (-1, -1))
     if key == "e":
@@ -211,7 +213,9 @@ def _node(key, args, mesh, where, offset=0):
         raise ValueError(f"{where}: 'f' takes a face index and three barycentric coordinates")
     i = _int(args[0], where, "face index") + offset
     b = tuple(_float(x, where, "barycentric coordinate") for x in args[1:])
-    if i < 0 or (mesh.m is not None and i >= mesh.m):
+    if i < 0:
+        raise ValueError(f"{where}: negative face index {i}")
+    if mesh.m is not None and i >= mesh.m:
         raise ValueError(f"{where}: face {i} out of range for {mesh.m} faces")
     if min(b) < -1e-9 or abs(sum(b) - 1) > 1e-6:
         raise ValueError(f"{where}: barycentric coordinates {list(b)} are not in the face")

@@ -125,10 +125,13 @@ def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: st
 
     from gsdf.distance._signed import _pseudonormal_sign, closest_pseudonormal, warn_pseudonormal
     from gsdf.distance._triangles import TriangleDistance
+    from gsdf.spatial._triangle_tree import triangle_tree
 
+    beta = positive(2.0 if beta is None else beta, "beta")
+    tt = triangle_tree(V, F)  # one tree for the distance and the winding number
     if sign == "pseudonormal":
         warn_pseudonormal(V, F)
-        d, face, closest, bary = TriangleDistance(V, F).query_barycentric(Q)
+        d, face, closest, bary = TriangleDistance._of_tree(V, F, tt).query_barycentric(Q)
         sgn = _pseudonormal_sign(V, F, Q, closest, face, bary)
         s = sgn * d
     else:
@@ -136,8 +139,8 @@ def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: st
 
         # the winding numbers first: on a cold cache `gsdf sdf` compiles the distance kernels in a background
         # process meanwhile (gsdf.cli._background), which are then ready when the distance is reached
-        w = _chunked(FastWindingNumber(V, F, beta=positive(2.0 if beta is None else beta, "beta")), Q, report)
-        d, face, closest = TriangleDistance(V, F).query(Q)
+        w = _chunked(FastWindingNumber._of_tree(tt, beta=beta), Q, report)
+        d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
         s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
     S = GridField((s if shell is None else with_shell(s, shell)).reshape(grid.shape), *grid.box)
     if not return_closest:

@@ -43,16 +43,17 @@ Cost: precompute O(m log m) (the tree; moments O(m + k)); a query O(log m) for w
 
 from __future__ import annotations
 
-from contextlib import contextmanager
-
 import numba
 import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_mesh, integer, positive, query_shaped
 from gsdf._memory import SECONDS_PER_QUERY
-from gsdf._normalize import Frame
-from gsdf.spatial._bvh import BVH, build_bvh, build_volume_bvh
+from gsdf.spatial._bvh import BVH, build_bvh
+from gsdf.spatial._triangle_tree import PARALLEL_BUILD_FACES, WIDTH, TriangleTree, single_thread as _single_thread
+from gsdf.spatial._triangle_tree import triangle_elements as _triangle_elements  # noqa: F401 (tests, bench)
+from gsdf.spatial._triangle_tree import triangle_elements_root as _triangle_elements_root  # noqa: F401 (tests)
+from gsdf.spatial._triangle_tree import triangle_tree
 from gsdf.spatial._wide import widen
 from gsdf.threads import run_ranges, run_tasks
 from gsdf.winding._query import map_queries, query_array
@@ -292,49 +293,6 @@ def _leaf_triangles(T, s, e, qx, qy, qz):
                                        T[t, 3] - qx, T[t, 4] - qy, T[t, 5] - qz,
                                        T[t, 6] - qx, T[t, 7] - qy, T[t, 8] - qz)
     return acc
-
-
-def _triangle_elements(V, F):
-    """(m, 9) rows [centroid, box lo, box hi] of the triangles F of V: the input of the tree build."""
-    return _triangle_elements_root(V, F)[0]
-
-
-def _triangle_elements_root(V, F):
-    """The rows of :func:`_triangle_elements` and their bounds (box lo, hi, centroid lo, hi: the tree's root
-    bounds, collected in the same pass instead of one more serial pass over the rows, ~0.4 ms at 89k faces).
-    ~10 ns per face, most of it the first touch of E's pages: on the threads from PARALLEL_BUILD_FACES faces."""
-    m = F.shape[0]
-    E = np.empty((m, 9))
-    if m >= PARALLEL_BUILD_FACES and numba.get_num_threads() > 1:
-        parts = []  # list.append is atomic: one bounds row per range
-        run_ranges(lambda i0, i1: parts.append(_triangle_elements_range(V, F, E, i0, i1)), m, 8192, 1)
-        B = np.array(parts)
-        root = np.concatenate((B[:, 0:3].min(axis=0), B[:, 3:6].max(axis=0), B[:, 6:9].min(axis=0),
-                               B[:, 9:12].max(axis=0)))
-    else:
-        root = _triangle_elements_range(V, F, E, 0, m)
-    return E, root
-
-
-@njit(cache=True, nogil=True)  # one serial, GIL-free kernel: faces i0..i1 (ranges on Python threads)
-def _triangle_elements_range(V, F, E, i0, i1):
-    """Rows i0..i1 of E; returns their bounds (box lo, hi, centroid lo, hi), running in scalars."""
-    lx = ly = lz = cx0 = cy0 = cz0 = np.inf
-    hx = hy = hz = cx1 = cy1 = cz1 = -np.inf
-    for t in range(i0, i1):
-        for d in range(3):
-            a, b, c = V[F[t, 0], d], V[F[t, 1], d], V[F[t, 2], d]
-            E[t, d] = (a + b + c) / 3.0
-            E[t, 3 + d] = min(a, min(b, c))
-            E[t, 6 + d] = max(a, max(b, c))
-        lx, ly, lz = min(lx, E[t, 3]), min(ly, E[t, 4]), min(lz, E[t, 5])
-        hx, hy, hz = max(hx, E[t, 6]), max(hy, E[t, 7]), max(hz, E[t, 8])
-        cx0, cy0, cz0 = min(cx0, E[t, 0]), min(cy0, E[t, 1]), min(cz0, E[t, 2])
-        cx1, cy1, cz1 = max(cx1, E[t, 0]), max(cy1, E[t, 1]), max(cz1, E[t, 2])
-    root = np.empty(12)
-    root[0], root[1], root[2], root[3], root[4], root[5] = lx, ly, lz, hx, hy, hz
-    root[6], root[7], root[8], root[9], root[10], root[11] = cx0, cy0, cz0, cx1, cy1, cz1
-    return root
 
 
 @njit(cache=True, inline="always")
@@ -592,9 +550,8 @@ def _pack_nodes(D, tree):
     return N
 
 
-# children per node of the wide walk (a compile-time constant: the lane loop is unrolled; 4 lanes of doubles fill
-# one AVX2 register)
-WIDTH = 4
+# WIDTH (gsdf.spatial._triangle_tree), children per node of the wide walk: 8 measured no faster than 4 on the CGAL
+# meshes (fewer visits, but 8 lanes do not fit one AVX2 register)
 _WF = 4 + COMPACT_WIDTH - 1  # fields per child slot: centre (3), β²r², the 23 compact coefficients
 
 
@@ -749,24 +706,9 @@ def _check_params(beta, order):
 # Below these sizes the build kernels / the walk run on the calling thread: a numba parallel launch waits
 # for its worker threads, which on a loaded machine can take longer than the work.
 SERIAL_BUILD_FACES = 100_000  # points (clouds)
-# Triangle builds use the threads from this size on (three parallel launches: the tree's lower subtrees,
-# the leaf moments, the lanes).
-PARALLEL_BUILD_FACES = 20_000
+# Triangle builds use the threads from PARALLEL_BUILD_FACES (gsdf.spatial._triangle_tree) on: three parallel
+# launches (the tree's lower subtrees, the leaf moments, the lanes) against ~60 ms of serial work at 75k faces.
 SERIAL_QUERIES = 16_384
-
-
-@contextmanager
-def _single_thread(serial: bool):
-    """numba kernels called inside run on one thread when ``serial`` (numba's setting is per calling thread)."""
-    if not serial:
-        yield
-        return
-    before = numba.get_num_threads()
-    numba.set_num_threads(1)
-    try:
-        yield
-    finally:
-        numba.set_num_threads(before)
 
 
 class _FastWindingBase:
@@ -850,26 +792,31 @@ class FastWindingNumber(_FastWindingBase):
     def __init__(self, V, F, beta: float = 2.0, order: int = 2, leaf_size: int = 4):
         V, F = as_mesh(V, F)
         self.beta, self.order = _check_params(beta, order)
-        leaf_size = integer(leaf_size, "leaf_size", 1)
-        self._frame = Frame.of_mesh(V, F)  # scale invariance: the tree lives in the normalised frame
-        with _single_thread(F.shape[0] < PARALLEL_BUILD_FACES):
-            self._build(V, F, leaf_size)
+        self._build(triangle_tree(V, F, integer(leaf_size, "leaf_size", 1)))
 
-    def _build(self, V, F, leaf_size):
-        """Tree, leaf rows, node moments and the wide walk's lane data (in the normalised frame)."""
-        V = np.ascontiguousarray(self._frame.geometry(V))
-        E, root = _triangle_elements_root(V, F)
-        self.tree = t = build_volume_bvh(E, leaf_size, root)
-        # Far-field radius for triangles (set by _tree_moments): the farthest corner of the node's box from p̃,
-        # which bounds the paper's r (farthest element point).
-        # the (k, 40) moments D are folded into the lanes and dropped (18 MB at 89k faces, a third of the object;
-        # tests rebuild them with _tree_moments)
-        wide = []  # the walk tests the WIDTH children of a node together (see _eval_triangles_wide): the wide
-        # view of the tree, built on the moments' threads
-        self._T, D = _tree_moments(V, F, t.order, t.start, t.end, t.right, t.lo, t.hi,
-                                   lambda: wide.append(widen(t, WIDTH)))
-        self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(D, t, self.beta ** 2, self.order, WIDTH,
-                                                                        wide[0])
+    @classmethod
+    def _of_tree(cls, tt: TriangleTree, beta: float = 2.0, order: int = 2) -> "FastWindingNumber":
+        """The evaluator on an already built :class:`gsdf.spatial._triangle_tree.TriangleTree` (shared with
+        :class:`gsdf.TriangleDistance` by :func:`gsdf.signed_distance`)."""
+        self = cls.__new__(cls)
+        self.beta, self.order = _check_params(beta, order)
+        self._build(tt)
+        return self
+
+    def _build(self, tt: TriangleTree):
+        """Leaf rows, node moments and the wide walk's lane data of the tree ``tt`` (in its normalised frame).
+
+        Far-field radius for triangles (set by _tree_moments): the farthest corner of the node's box from p̃.
+        It bounds the paper's r (farthest element point) and, measured on the CGAL meshes, brings the RMS error
+        at β = 2 from ~1.3e-3 to ~7e-4 — the paper's "β = 2 gives ~1e-3". The (k, 40) moments D are folded into
+        the lanes and dropped (18 MB at 89k faces, a third of the object; tests rebuild them with _tree_moments).
+        """
+        self._frame = tt.frame  # scale invariance: the tree lives in the normalised frame
+        self.tree = t = tt.bvh
+        with _single_thread(tt.F.shape[0] < PARALLEL_BUILD_FACES):
+            self._T, D = _tree_moments(tt.Vf, tt.F, t.order, t.start, t.end, t.right, t.lo, t.hi)
+            self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(D, t, self.beta ** 2, self.order, WIDTH,
+                                                                            tt.wide)
 
     def _kernel(self, q, out):
         with _single_thread(q.shape[0] < SERIAL_QUERIES):
