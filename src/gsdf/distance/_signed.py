@@ -131,6 +131,7 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0, return_cl
         The normal there: the angle-weighted pseudonormal of the closest feature (face, edge or vertex) with
         ``sign="pseudonormal"``, the unit normal of the closest triangle with ``sign="winding"`` (zero for a
         degenerate triangle).
+
     Raises
     ------
     ValueError
