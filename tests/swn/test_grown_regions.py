@@ -20,9 +20,16 @@ import gsdf
 def grown_regions_case(V, F, seed, regions=3, area=(0.1, 0.2), deleted=0.4):
     """(segments (s, 2) oriented vertex pairs, truth (m,) labels, face areas): ``regions`` disjoint regions grown
     by Dijkstra over face centroids from random seed faces (each to a share of the area in ``area``, within its
-    seed's Voronoi cell), their oriented boundaries chained into edge walks, and in every walk of 8+ edges a
-    share ``deleted`` of the edges removed in gaps of 1–5 edges between kept runs of 2–5 edges."""
-    rng = np.random.default_rng(seed)
+    seed's Voronoi cell), the oriented boundary of the labelling chained into edge walks, and in every walk of 8+
+    edges a share ``deleted`` of the edges removed in gaps of 1–5 edges between kept runs of 2–5 edges.
+
+    The curves are the boundary of the truth: where two regions touch, their boundaries cancel (both are
+    labelled 1, nothing separates them). The regions and the walks come from one random stream and the gaps
+    from another, so ``deleted=0.0`` gives the unbroken curves of the same case. The gaps of a walk fit in it
+    (a pattern longer than the walk has its kept runs shortened, down to 1 edge), so no gap wraps into
+    another."""
+    ss = np.random.SeedSequence(seed)
+    rng, rng_gap = (np.random.default_rng(s) for s in ss.spawn(2))
     A = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
     E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
     fid = np.tile(np.arange(len(F)), 3)
@@ -35,43 +42,49 @@ def grown_regions_case(V, F, seed, regions=3, area=(0.1, 0.2), deleted=0.4):
     D = dijkstra(G, directed=False, indices=seeds)
     owner = np.argmin(D, axis=0)
     truth = np.zeros(len(F), np.int64)
-    segs = []
     for r in range(regions):
         cand = np.flatnonzero(owner == r)
         cand = cand[np.argsort(D[r, cand])]
         k = int(np.searchsorted(np.cumsum(A[cand]), rng.uniform(*area) * A.sum()))
-        reg = np.zeros(len(F), bool)
-        reg[cand[:k + 1]] = True
-        truth += reg
-        H = np.concatenate([F[reg][:, [0, 1]], F[reg][:, [1, 2]], F[reg][:, [2, 0]]]).tolist()
-        Hs = set(map(tuple, H))
-        bnd = [tuple(h) for h in H if (h[1], h[0]) not in Hs]
-        nxt = {}
-        for u, v in bnd:
-            nxt.setdefault(u, []).append(v)
-        used = set()
-        for u, v in bnd:
-            if (u, v) in used:
-                continue
-            walk, x = [(u, v)], v
-            used.add((u, v))
-            while True:
-                y = next((y for y in nxt.get(x, []) if (x, y) not in used), None)
-                if y is None:
-                    break
-                used.add((x, y))
-                walk.append((x, y))
-                x = y
-            keep = np.ones(len(walk), bool)
-            if len(walk) >= 8:
-                goal, gone, i, start = int(round(deleted * len(walk))), 0, 0, int(rng.integers(len(walk)))
-                while gone < goal:
-                    i += int(rng.integers(2, 6))
-                    g = min(int(rng.integers(1, 6)), goal - gone)
-                    keep[(start + i + np.arange(g)) % len(walk)] = False
-                    i += g
-                    gone += g
-            segs += [w for w, k in zip(walk, keep) if k]
+        truth[cand[:k + 1]] += 1
+    # the oriented boundary of the labelling (the regions are disjoint: labels 0 / 1): the halfedges of the
+    # labelled faces whose twin is not in a labelled face
+    H = E[truth[fid] > 0]
+    Hs = set(map(tuple, H.tolist()))
+    bnd = [tuple(h) for h in H.tolist() if (h[1], h[0]) not in Hs]
+    nxt = {}
+    for u, v in bnd:
+        nxt.setdefault(u, []).append(v)
+    used = set()
+    segs = []
+    for u, v in bnd:
+        if (u, v) in used:
+            continue
+        walk, x = [(u, v)], v
+        used.add((u, v))
+        while True:
+            y = next((y for y in nxt.get(x, []) if (x, y) not in used), None)
+            if y is None:
+                break
+            used.add((x, y))
+            walk.append((x, y))
+            x = y
+        L = len(walk)
+        keep = np.ones(L, bool)
+        if L >= 8:
+            goal, gaps, runs = int(round(deleted * L)), [], []
+            while sum(gaps) < goal:
+                runs.append(int(rng_gap.integers(2, 6)))
+                gaps.append(min(int(rng_gap.integers(1, 6)), goal - sum(gaps)))
+            runs = np.array(runs, np.int64)
+            while len(runs) and runs.sum() + goal > L - 1 and runs.max() > 1:
+                runs[np.argmax(runs)] -= 1
+            start, i = int(rng_gap.integers(L)), 0
+            for rlen, glen in zip(runs, gaps):
+                i += int(rlen)
+                keep[(start + i + np.arange(glen)) % L] = False
+                i += glen
+        segs += [w for w, k in zip(walk, keep) if k]
     return np.array(segs, np.int64).reshape(-1, 2), truth, A
 
 
