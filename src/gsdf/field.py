@@ -516,9 +516,9 @@ def _load_vti(p: str) -> GridField:
 def _load_npz(path, keys, what: str, kind: str | None = None) -> dict:
     """The arrays ``keys`` of a gsdf ``.npz`` file; FileNotFoundError if missing, else ValueError naming the file.
     With ``kind``: the file's ``kind`` entry, when it has one, must be that string (what ``save`` writes)."""
-    from gsdf._checks import readable_file
+    from gsdf._checks import numpy_file
 
-    p = readable_file(path, "path")
+    p = numpy_file(path, "path")
     try:
         with np.load(p, allow_pickle=False) as d:
             missing = [k for k in keys if k not in d]

@@ -837,3 +837,33 @@ def test_readers_take_regular_files_only(tmp_path, kind, ext):
     for reader in readers:
         with pytest.raises(ValueError, match=why):
             reader(p)
+
+
+def _npy_with_rows(path, rows: bytes):
+    """An .npy of 4 points whose header's row count is replaced by ``rows``."""
+    np.save(path, np.zeros((4, 3)))
+    data = path.read_bytes()
+    m = re.search(rb"'shape': \((\d+)", data[:256])
+    path.write_bytes(data[:m.start(1)] + rows + data[m.end(1):])
+    return path
+
+
+@pytest.mark.parametrize("rows,words", [(b"999999999999", "declares shape (999999999999, 3)"),
+                                        (b"-5", "negative size"), (b"5", "declares shape (5, 3)")])
+def test_npy_header_checked_against_file_size(tmp_path, rows, words):
+    """A header declaring more rows than the file holds (or a negative count) is refused before numpy allocates."""
+    p = _npy_with_rows(tmp_path / "c.npy", rows)
+    with pytest.raises(ValueError, match=errmsg(p)) as e:
+        read_points(p)
+    assert words in str(e.value) and "allocate" not in str(e.value)
+
+
+def test_npz_member_header_checked(tmp_path):
+    inner = _npy_with_rows(tmp_path / "P.npy", b"999999999999")
+    import zipfile
+
+    p = tmp_path / "c.npz"
+    with zipfile.ZipFile(p, "w", zipfile.ZIP_DEFLATED) as z:
+        z.write(inner, "P.npy")
+    with pytest.raises(ValueError, match=errmsg(p) + ".*array 'P'.*declares shape"):
+        read_points(p)

@@ -14,7 +14,7 @@ import warnings
 
 import numpy as np
 
-from gsdf._checks import as_points
+from gsdf._checks import as_points, numpy_file
 from gsdf.io._safe_write import atomic_output
 from gsdf.io._mesh import (
     _check_file,
@@ -82,8 +82,8 @@ def _read_obj_points(p: str, data: bytes):
 
 
 def _read_numpy(p: str, ext: str):
-
     _check_file(p)
+    numpy_file(p)
     try:
         if ext == ".npy":
             A, N = np.load(p, allow_pickle=False), None
