@@ -23,10 +23,6 @@ SAMPLE, SEED, TIMEOUT, JOBS, MAX_SECONDS = 120, 1, 20, 2, 30
 #: Remove an entry when its fix lands (the test fails while a listed case passes).
 KNOWN_OPEN: dict[str, str] = {
     "api:arrays|PolygonMeshSignedHeatSolver|polygons|nan_item": "a NaN index in a polygon list is accepted",
-    "files:vtk|read_mesh|mesh_txt.vtk|huge_count": "a huge VTK count: numpy's 'Unable to allocate' text, no size "
-                                                   "guard",
-    "files:vtk|read_mesh|surface.vtk|nul_byte": "VTK reader: UnicodeDecodeError text in the message",
-    "files:vtk|read_vertex_data|tet.vtk|flip_bytes": "VTK reader: UnicodeDecodeError text in the message",
 }
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

@@ -867,3 +867,28 @@ def test_npz_member_header_checked(tmp_path):
         z.write(inner, "P.npy")
     with pytest.raises(ValueError, match=errmsg(p) + ".*array 'P'.*declares shape"):
         read_points(p)
+
+
+def _vtk_bytes(tmp_path, ext):
+    p = tmp_path / f"m{ext}"
+    write_mesh(p, TET_V, TET_F)
+    return p, p.read_bytes()
+
+
+@pytest.mark.parametrize("ext,edit,words", [
+    (".vtk", lambda b: b.replace(b"# vtk", b"#\xc4vtk", 1), "a byte that is not text (0xc4)"),
+    (".vtk", lambda b: re.sub(rb"POINTS \d+", b"POINTS 999999999999", b, count=1), "POINTS 999999999999 declares"),
+    (".vtu", lambda b: re.sub(rb'NumberOfPoints="\d+"', b'NumberOfPoints="-5"', b, count=1), "is negative"),
+    (".vtu", lambda b: re.sub(rb'NumberOfPoints="\d+"', b'NumberOfPoints="999999999999"', b, count=1),
+     "counts declare an array of shape (999999999999,3)"),
+])
+def test_vtk_malformed_messages_in_words(tmp_path, ext, edit, words):
+    """Broken VTK/VTU files: a ValueError naming the file and the problem, without Python's or numpy's text."""
+    p, data = _vtk_bytes(tmp_path, ext)
+    p.write_bytes(edit(data))
+    for reader in (read_mesh, lambda q: __import__("gsdf").read_vertex_data(q)):
+        with pytest.raises(ValueError, match=errmsg(p)) as e:
+            reader(p)
+        msg = str(e.value)
+        assert words in msg, msg
+        assert not re.search(r"codec|Unable to allocate|cannot reshape|Error:", msg), msg
