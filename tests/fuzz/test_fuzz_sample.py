@@ -21,9 +21,7 @@ SAMPLE, SEED, TIMEOUT, JOBS, MAX_SECONDS = 120, 1, 20, 2, 30
 
 #: cases of the sample that fail because of a known open defect: id -> the defect (repro in the note).
 #: Remove an entry when its fix lands (the test fails while a listed case passes).
-KNOWN_OPEN: dict[str, str] = {
-    "api:arrays|PolygonMeshSignedHeatSolver|polygons|nan_item": "a NaN index in a polygon list is accepted",
-}
+KNOWN_OPEN: dict[str, str] = {}
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
