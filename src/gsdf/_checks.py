@@ -443,7 +443,7 @@ def numpy_file(path, what: str = "file") -> str:
                 continue
             try:
                 member = z.open(info)
-            except Exception:  # noqa: BLE001 - encrypted, unknown compression...: np.load reports it
+            except Exception:  # noqa: BLE001, S112 - encrypted, unknown compression...: np.load reports it
                 continue
             with member:
                 _npy_fits(member, info.file_size, p, f"array {info.filename[:-4]!r}: ")
