@@ -124,7 +124,7 @@ def test_options_dataclasses_refuse_bad_values_at_construction():
     """The fuzz found options objects that took anything until used (or never)."""
     import gsdf
 
-    for cls, kw in ((gsdf.BooleanOptions, {"exact": "no"}), (gsdf.BooleanOptions, {"bisection_steps": "x"}),
+    for cls, kw in ((gsdf.BooleanOptions, {"exact": "no"}), (gsdf.BooleanOptions, {"beta": "x"}),
                     (gsdf.PointsAsToriOptions, {"ridge": np.inf}), (gsdf.PointsAsToriOptions, {"k_fallback": np.nan}),
                     (gsdf.PointsAsToriOptions, {"curvature_cap": "x"}), (gsdf.VolumeHeatOptions, {"mesher": "bogus"}),
                     (gsdf.VolumeHeatOptions, {"soft_weight": b"x"}), (gsdf.BatchOptions, {"resume": 2}),

@@ -61,12 +61,9 @@ class BooleanOptions:
     beta: float = 2.0
     exact: bool = False
 
-
     def __post_init__(self):  # a ValueError naming the attribute, at construction
         positive(self.beta, "beta", most=1e150)
         flag(self.exact, "exact")
-        _steps(self.bisection_steps)
-        flag(self.stitch, "stitch")
 
 _OPS = ("union", "intersection", "difference")
 
