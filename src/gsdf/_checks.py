@@ -418,8 +418,9 @@ def numpy_file(path, what: str = "file") -> str:
     Besides :func:`readable_file`, the header of each array is compared with the data the file holds: a shape
     with a negative size, or one whose data is larger than what follows the header (a ``.npz`` member: larger
     than the member), is a ValueError naming the file and the shape — a truncated file or a corrupt header, which
-    numpy would otherwise answer by trying to allocate the declared size. Headers numpy itself cannot parse, and
-    files that are neither, are left to ``np.load`` and its caller.
+    numpy would otherwise answer by trying to allocate the declared size. A file that is neither ``.npy`` nor
+    ``.npz`` data, or an array of Python objects (which gsdf never loads), is refused too. Headers numpy itself
+    cannot parse are left to ``np.load`` and its caller.
     """
     import os
     import zipfile
@@ -432,7 +433,7 @@ def numpy_file(path, what: str = "file") -> str:
             _npy_fits(fh, os.path.getsize(p), p, "")
             return p
     if magic[:4] != b"PK\x03\x04":
-        return p
+        raise ValueError(f"{p}: not a numpy file (neither .npy nor .npz data)")
     try:
         z = zipfile.ZipFile(p)
     except (zipfile.BadZipFile, OSError, ValueError, EOFError):
@@ -464,7 +465,7 @@ def _npy_fits(fh, total: int, p: str, label: str) -> None:
     except Exception:  # noqa: BLE001 - a header numpy cannot parse: np.load says so
         return
     if dtype.hasobject:
-        return
+        raise ValueError(f"{p}: {label}holds Python objects (pickled data); gsdf reads arrays of numbers only")
     if any(int(s) < 0 for s in shape):
         raise ValueError(f"{p}: {label}the header declares a negative size in shape {tuple(shape)}")
     count = 1

@@ -892,3 +892,35 @@ def test_vtk_malformed_messages_in_words(tmp_path, ext, edit, words):
         msg = str(e.value)
         assert words in msg, msg
         assert not re.search(r"codec|Unable to allocate|cannot reshape|Error:", msg), msg
+
+
+def test_reader_path_not_a_file_name():
+    with pytest.raises(ValueError, match="path: expected a file name, got int"):
+        read_points(3)
+    with pytest.raises(ValueError, match="path: expected a file name, got int"):
+        read_mesh(3)
+
+
+@pytest.mark.parametrize("content,words", [(b"\x80\x03garbage" * 20, "not a numpy file"),
+                                           (None, "holds Python objects")])
+def test_numpy_files_that_are_not_numbers(tmp_path, content, words):
+    p = tmp_path / "c.npy"
+    if content is None:
+        np.save(p, np.array([object(), None]), allow_pickle=True)
+    else:
+        p.write_bytes(content)
+    with pytest.raises(ValueError, match=errmsg(p) + ".*" + words) as e:
+        read_points(p)
+    assert "allow_pickle" not in str(e.value)
+
+
+def test_ply_with_bom_in_words(tmp_path):
+    import gsdf
+
+    p = tmp_path / "c.ply"
+    write_mesh(p, TET_V, TET_F, binary=False)
+    p.write_bytes(b"\xef\xbb\xbf" + p.read_bytes())
+    for reader in (read_points, read_mesh, gsdf.read_vertex_data):
+        with pytest.raises(ValueError, match=errmsg(p)) as e:
+            reader(p)
+        assert "codec" not in str(e.value)

@@ -50,7 +50,7 @@ def _read_trimesh(p: str, ext: str):
         raise ValueError(f"{p}: reading {ext} files needs an optional package trimesh uses ({exc.name or exc}); "
                          "install it, e.g. pip install lxml networkx") from exc
     except Exception as exc:  # trimesh raises many types for malformed files: report them as bad input
-        raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({_why(exc)})") from exc
+        raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({error_words(exc)})") from exc
     Vs, Fs, offset = [], [], 0
     rank = {name: i for i, name in enumerate(scene.geometry)}  # the file's mesh order
     nodes = sorted(scene.graph.nodes_geometry, key=lambda n: (rank.get(scene.graph[n][1], len(rank)), str(n)))
@@ -142,14 +142,14 @@ def _read_meshio_raw(p: str, ext: str):
                 if m is None:
                     raise
     except (Exception, SystemExit) as exc:  # ReadError, ValueError, KeyError, struct errors, SystemExit ...
-        why = " ".join(said.getvalue().split()) or _why(exc)
+        why = " ".join(said.getvalue().split()) or error_words(exc)
         raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({why})") from None
     finally:
         log.setLevel(level)
     return m
 
 
-def _why(exc: BaseException) -> str:
+def error_words(exc: BaseException) -> str:
     """What a library's exception on a malformed file means, in words (not Python's text for the decoding and
     allocation failures)."""
     if isinstance(exc, UnicodeDecodeError):
