@@ -2,6 +2,7 @@
 
 import base64
 import os
+import re
 import xml.etree.ElementTree as ET
 
 import meshio
@@ -428,3 +429,24 @@ def test_load_field_of_a_folder_or_fifo(tmp_path):
     os.mkfifo(tmp_path / "p.vti")
     with pytest.raises(ValueError, match="is a FIFO"):
         load_field(tmp_path / "p.vti")
+
+
+def _vti_ascii(tmp_path, extent="0 1 0 1 0 1", spacing="1 1 1", data="0 1 2 3 4 5 6 7"):
+    p = tmp_path / "g.vti"
+    p.write_text(f'<VTKFile type="ImageData"><ImageData WholeExtent="{extent}" Origin="0 0 0" Spacing="{spacing}">'
+                 f'<Piece Extent="{extent}"><PointData><DataArray type="Float64" Name="values" format="ascii">'
+                 f'{data}</DataArray></PointData></Piece></ImageData></VTKFile>')
+    return p
+
+
+@pytest.mark.parametrize("kw,why", [({"data": "0 1 2 x7 4 5 6 7"}, "non-numeric value 'x7'"),
+                                    ({"extent": "0 1 0 x 0 1"}, "WholeExtent: expected 6 numbers, got '0 1 0 x"),
+                                    ({"extent": "0 1 0 1"}, "WholeExtent: expected 6 numbers, got 4"),
+                                    ({"spacing": "1 1"}, "Spacing: expected 3 numbers, got 2")])
+def test_vti_malformed_named_in_words(tmp_path, kw, why):
+    """A broken .vti: a ValueError naming the file and the attribute or value, not Python's conversion text."""
+    p = _vti_ascii(tmp_path, **kw)
+    with pytest.raises(ValueError, match="^" + str(p) + ".*" + re.escape(why)) as e:
+        load_field(p)
+    assert "could not convert" not in str(e.value) and "invalid literal" not in str(e.value)
+    assert load_field(_vti_ascii(tmp_path)).values.shape == (2, 2, 2)

@@ -64,3 +64,12 @@ def test_bad_grids():
         Grid(([0, 0, np.nan], [1, 1, 1]), (2, 2, 2))
     with pytest.raises(ValueError, match="pad"):
         padded_box(np.eye(3), -0.1)
+
+
+@pytest.mark.parametrize("idx,why", [([0.5], "fractions"), ([-1], "out of range"), ([24], "out of range"),
+                                     ([1j], "complex"), (["a"], "strings"), ([[0, 1]], r"shape \(k,\)")])
+def test_points_flat_index_checked(idx, why):
+    g = Grid(([0, 0, 0], [1, 2, 3]), (2, 3, 4))
+    with pytest.raises(ValueError, match="flat_index: .*" + why):
+        g.points(idx)
+    np.testing.assert_array_equal(g.points([23.0]), g.points()[[23]])

@@ -410,3 +410,70 @@ def readable_file(path, what: str = "file") -> str:
 
         check_bytes(READ_FACTOR * st.st_size, f"{p}: reading a file of {human(st.st_size)}")
     return p
+
+
+def numpy_file(path, what: str = "file") -> str:
+    """Check a ``.npy`` or ``.npz`` file before ``np.load`` reads it; returns its path as ``str``.
+
+    Besides :func:`readable_file`, the header of each array is compared with the data the file holds: a shape
+    with a negative size, or one whose data is larger than what follows the header (a ``.npz`` member: larger
+    than the member), is a ValueError naming the file and the shape — a truncated file or a corrupt header, which
+    numpy would otherwise answer by trying to allocate the declared size. A file that is neither ``.npy`` nor
+    ``.npz`` data, or an array of Python objects (which gsdf never loads), is refused too. Headers numpy itself
+    cannot parse are left to ``np.load`` and its caller.
+    """
+    import os
+    import zipfile
+
+    p = readable_file(path, what)
+    with open(p, "rb") as fh:
+        magic = fh.read(6)
+        if magic == b"\x93NUMPY":
+            fh.seek(0)
+            _npy_fits(fh, os.path.getsize(p), p, "")
+            return p
+    if magic[:4] != b"PK\x03\x04":
+        raise ValueError(f"{p}: not a numpy file (neither .npy nor .npz data)")
+    try:
+        z = zipfile.ZipFile(p)
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError):
+        return p
+    with z:
+        for info in z.infolist():
+            if not info.filename.endswith(".npy"):
+                continue
+            try:
+                member = z.open(info)
+            except Exception:  # noqa: BLE001, S112 - encrypted, unknown compression...: np.load reports it
+                continue
+            with member:
+                _npy_fits(member, info.file_size, p, f"array {info.filename[:-4]!r}: ")
+    return p
+
+
+def _npy_fits(fh, total: int, p: str, label: str) -> None:
+    """Raise when the .npy header read from ``fh`` declares more data than the ``total`` bytes hold."""
+    from numpy.lib import format as npformat
+
+    try:
+        version = npformat.read_magic(fh)
+        read = {(1, 0): npformat.read_array_header_1_0, (2, 0): npformat.read_array_header_2_0}.get(version)
+        if read is None:
+            return
+        shape, _, dtype = read(fh)
+        offset = fh.tell()
+    except Exception:  # noqa: BLE001 - a header numpy cannot parse: np.load says so
+        return
+    if dtype.hasobject:
+        raise ValueError(f"{p}: {label}holds Python objects (pickled data); gsdf reads arrays of numbers only")
+    if any(int(s) < 0 for s in shape):
+        raise ValueError(f"{p}: {label}the header declares a negative size in shape {tuple(shape)}")
+    count = 1
+    for s in shape:
+        count *= int(s)
+    need, have = count * dtype.itemsize, max(int(total) - offset, 0)
+    if need > have:
+        from gsdf._memory import human
+
+        raise ValueError(f"{p}: {label}the header declares shape {tuple(shape)} ({human(need)} of data) but the "
+                         f"file holds {human(have)}; it is truncated or its header is corrupt")

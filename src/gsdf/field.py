@@ -471,6 +471,29 @@ def _load_mesh_field(p: str, ext: str) -> Field:
     raise ValueError(f"{p}: no tetra, triangle or hexahedron cells to hold a field (cells: {sorted(cells)})")
 
 
+def _is_number(t: str) -> bool:
+    try:
+        float(t)
+    except ValueError:
+        return False
+    return True
+
+
+def _vti_numbers(p: str, img, name: str, default, kind, count: int) -> list:
+    """The ``count`` numbers of attribute ``name`` of the ImageData element (``default`` when absent)."""
+    text = img.get(name, default)
+    if text is None:
+        raise ValueError(f"{p}: not a VTK ImageData (.vti) file (no {name})")
+    toks = text.split()
+    try:
+        vals = [kind(t) for t in toks]
+    except ValueError:
+        raise ValueError(f"{p}: ImageData {name}: expected {count} numbers, got {text[:60]!r}") from None
+    if len(vals) != count:
+        raise ValueError(f"{p}: ImageData {name}: expected {count} numbers, got {len(vals)}")
+    return vals
+
+
 def _load_vti(p: str) -> GridField:
     """VTK XML ImageData with one point data array (inline ``binary`` base64 with a UInt32/UInt64 byte-count
     header, uncompressed, or ``ascii``), as :meth:`GridField.save` writes it."""
@@ -479,13 +502,15 @@ def _load_vti(p: str) -> GridField:
 
     try:
         root = ET.parse(p).getroot()
-        img = root.find("ImageData")
-        ext = [int(t) for t in img.get("WholeExtent").split()]
-        origin = np.array([float(t) for t in img.get("Origin", "0 0 0").split()])
-        spacing = np.array([float(t) for t in img.get("Spacing", "1 1 1").split()])
-        arrays = img.findall("Piece/PointData/DataArray")
-    except (ET.ParseError, AttributeError, ValueError) as exc:
+    except ET.ParseError as exc:
         raise ValueError(f"{p}: not a VTK ImageData (.vti) file ({exc})") from exc
+    img = root.find("ImageData")
+    if img is None:
+        raise ValueError(f"{p}: not a VTK ImageData (.vti) file (no ImageData element)")
+    ext = _vti_numbers(p, img, "WholeExtent", None, int, 6)
+    origin = np.array(_vti_numbers(p, img, "Origin", "0 0 0", float, 3))
+    spacing = np.array(_vti_numbers(p, img, "Spacing", "1 1 1", float, 3))
+    arrays = img.findall("Piece/PointData/DataArray")
     if root.get("compressor"):
         raise ValueError(f"{p}: compressed .vti data is not supported (write it uncompressed)")
     named = [a for a in arrays if a.get("Name") == "values"] or arrays
@@ -499,9 +524,16 @@ def _load_vti(p: str) -> GridField:
     n = int(np.prod(shape))
     text = (a.text or "").strip()
     if a.get("format") == "ascii":
-        v = np.array(text.split(), dtype=np.float64)
+        try:
+            v = np.array(text.split(), dtype=np.float64)
+        except ValueError:
+            bad = next(t for t in text.split() if not _is_number(t))
+            raise ValueError(f"{p}: .vti data: non-numeric value {bad[:40]!r}") from None
     elif a.get("format") == "binary":
-        raw = base64.b64decode(text)
+        try:
+            raw = base64.b64decode(text)
+        except ValueError:  # binascii.Error
+            raise ValueError(f"{p}: .vti data: not valid base64 text") from None
         head = 8 if root.get("header_type", "UInt32") == "UInt64" else 4
         v = np.frombuffer(raw[head:head + n * dtype.itemsize], dtype=dtype).astype(np.float64)
     else:
@@ -516,9 +548,9 @@ def _load_vti(p: str) -> GridField:
 def _load_npz(path, keys, what: str, kind: str | None = None) -> dict:
     """The arrays ``keys`` of a gsdf ``.npz`` file; FileNotFoundError if missing, else ValueError naming the file.
     With ``kind``: the file's ``kind`` entry, when it has one, must be that string (what ``save`` writes)."""
-    from gsdf._checks import readable_file
+    from gsdf._checks import numpy_file
 
-    p = readable_file(path, "path")
+    p = numpy_file(path, "path")
     try:
         with np.load(p, allow_pickle=False) as d:
             missing = [k for k in keys if k not in d]

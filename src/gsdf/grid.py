@@ -236,6 +236,22 @@ class Grid:
         """
         return [np.linspace(self.bbox_min[d], self.bbox_max[d], self.shape[d]) for d in range(3)]
 
+    def _flat_index(self, flat_index) -> np.ndarray:
+        """``flat_index`` as int64 node numbers, each an integer in [0, number of nodes)."""
+        from gsdf._checks import as_values
+
+        A = np.atleast_1d(as_values(flat_index, "flat_index", allow_empty=True))
+        if A.ndim != 1:
+            raise ValueError(f"flat_index: expected shape (k,), got {A.shape}")
+        if not (A == np.round(A)).all():
+            raise ValueError("flat_index: expected integer node numbers, got fractions")
+        n = 1
+        for s in self.shape:
+            n *= int(s)
+        if A.size and (A.min() < 0 or A.max() >= n):
+            raise ValueError(f"flat_index: node number out of range for {n:,} nodes")
+        return A.astype(np.int64)
+
     def points(self, flat_index=None) -> np.ndarray:
         """Node positions in C order (the last axis fastest), or only some of them.
 
@@ -262,7 +278,7 @@ class Grid:
         """
         ax = self.axes()
         if flat_index is not None:
-            I = np.unravel_index(np.asarray(flat_index, dtype=np.int64), self.shape)
+            I = np.unravel_index(self._flat_index(flat_index), self.shape)
             return np.column_stack([ax[d][I[d]] for d in range(3)])
         from gsdf._memory import check_bytes, grid_bytes
 

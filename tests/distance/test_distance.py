@@ -469,3 +469,14 @@ def test_signed_distance_return_closest_is_libigls_output():
     assert I[0] == 3 and I[1] == 1
     np.testing.assert_allclose(C[0], [1 / 3] * 3, atol=1e-15)
     np.testing.assert_allclose(N[2], -np.ones(3) / np.sqrt(3), atol=1e-12)  # pseudonormal at the corner vertex
+
+
+def test_return_closest_is_a_switch():
+    """'no' is truthy: a string for return_closest is refused, not taken as True."""
+    import gsdf
+
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    for fn, args in ((gsdf.unsigned_distance, (V, [[0, 1, 2]])), (gsdf.point_cloud_distance, (V,)),
+                     (gsdf.signed_distance, (V, [[0, 1, 2]]))):
+        with pytest.raises(ValueError, match="return_closest: expected True or False"):
+            fn(*args, [[0.2, 0.2, 1.0]], return_closest="no")

@@ -21,20 +21,7 @@ SAMPLE, SEED, TIMEOUT, JOBS, MAX_SECONDS = 120, 1, 20, 2, 30
 
 #: cases of the sample that fail because of a known open defect: id -> the defect (repro in the note).
 #: Remove an entry when its fix lands (the test fails while a listed case passes).
-KNOWN_OPEN: dict[str, str] = {
-    "api:arrays|YukawaTree.direct|Q|complex": "complex queries accepted, imaginary part dropped (no real-dtype check)",
-    "api:arrays|marching_tetrahedra|T|out_of_range": "tet indices not range-checked: raw IndexError",
-    "api:arrays|marching_tetrahedra|X|empty": "no vertices: raw IndexError",
-    "api:arrays|mesh_topology|F|negative": "mesh_topology validates nothing: faces with -1 give a dict",
-    "api:arrays|write_curves|curves|str": "write_curves: int() of a node leaks 'invalid literal for int()'",
-    "api:scalars|SurfaceSignedHeatSolver|intrinsic_delaunay|no": "truthy strings taken as bools ('no' is True)",
-    "api:size|GridField.__call__|Q|huge_rows": "10^9 queries: MemoryError instead of the memory guard's ValueError",
-    "files:npy|read_points|cloud_txt.npy|huge_count": "a huge .npy header: numpy's 'Unable to allocate' text, no "
-                                                      "size guard",
-    "files:txt|read_curves|curves.txt|inf_token": "curve files: Python's 'invalid literal for int()' in the message",
-    "files:vtk|read_mesh|surface.vtk|nul_byte": "VTK reader: UnicodeDecodeError text in the message",
-    "files:vtk|read_vertex_data|tet.vtk|flip_bytes": "VTK reader: UnicodeDecodeError text in the message",
-}
+KNOWN_OPEN: dict[str, str] = {}
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 

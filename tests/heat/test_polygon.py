@@ -249,3 +249,12 @@ def test_step3_reuses_step1_ordering_and_matches_its_own():
     # the induced order's factor solves the reduced system exactly
     b = np.random.default_rng(1).standard_normal(len(free))
     assert np.allclose(A @ fact.solve(b), b, rtol=0, atol=1e-9 * np.abs(b).max())
+
+
+@pytest.mark.parametrize("bad", [[np.nan] * 4, [0.0, 1.5, 6.0, 5.0], [np.inf, 1, 6, 5]])
+def test_polygon_non_integer_indices_refused_not_dropped(bad):
+    """A polygon of NaN or fractional indices is refused (np.unique counts NaNs as one value: it must not be
+    taken for a polygon repeating a vertex and dropped)."""
+    V, Q = _quads(4)
+    with pytest.raises(ValueError, match="polygons: vertex indices must be integers"):
+        PolygonMeshSignedHeatSolver(V, [np.array(bad, float)] + [np.asarray(q) for q in Q])

@@ -197,3 +197,13 @@ def test_box_refusal_names_the_boxes_in_the_callers_units():
         gsdf.signed_heat_volume(mesh=(V, F), bbox_min=[9, -2, -2], bbox_max=[11, 2, 2], resolution=8)
     msg = str(e.value)
     assert "9." in msg and "11." in msg and "8.5" in msg and "11.5" in msg
+
+
+@pytest.mark.parametrize("Q,why", [([[0.0, np.nan, 0.0]], "NaN"), ([[1j, 0, 0]], "complex"),
+                                   (np.zeros((1, 4, 3)), r"expected shape \(n, 3\)"), ("abc", "string")])
+def test_yukawa_nearest_distance_checks_queries(Q, why):
+    """nearest_distance checks its queries as the tree's other methods do (they were handed to the k-d tree)."""
+    tree = YukawaTree(np.eye(3), np.eye(3), t=0.01)
+    with pytest.raises(ValueError, match="Q: .*" + why):
+        tree.nearest_distance(Q)
+    assert tree.nearest_distance(np.zeros((0, 3))).shape == (0,)

@@ -79,3 +79,21 @@ def test_swn_curve_files_read_obj_polylines(tmp_path):
     with open(m, "a") as fh:
         fh.write(f"l {a} {b} {c} {a}\n")
     assert len(read_swn_curves(str(m), F).segments) == 3
+
+
+@pytest.mark.parametrize("F,why", [("abc", "F: expected an array of numbers, got a string"),
+                                   ([[0, 1, -2]], "F: negative vertex index"),
+                                   ([[0, 1, np.nan]], "F: face indices must be integers"),
+                                   ([[0, 1j, 2]], "F: expected integer indices, got complex"),
+                                   ([[0, 1]], r"F: expected shape \(m, 3\)")])
+def test_read_curves_checks_faces(tmp_path, F, why):
+    """``F`` goes through the one check of face indices, also when the file has vertex nodes only."""
+    p = tmp_path / "c.txt"
+    p.write_text("signed_curve\nv 0\nv 1\nv 2\n")
+    with pytest.raises(ValueError, match=why):
+        gsdf.read_curves(p, F)
+
+
+def test_read_curves_path_not_a_file_name():
+    with pytest.raises(ValueError, match="path: expected a file name, got 3"):
+        gsdf.read_curves(3)

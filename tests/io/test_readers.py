@@ -837,3 +837,90 @@ def test_readers_take_regular_files_only(tmp_path, kind, ext):
     for reader in readers:
         with pytest.raises(ValueError, match=why):
             reader(p)
+
+
+def _npy_with_rows(path, rows: bytes):
+    """An .npy of 4 points whose header's row count is replaced by ``rows``."""
+    np.save(path, np.zeros((4, 3)))
+    data = path.read_bytes()
+    m = re.search(rb"'shape': \((\d+)", data[:256])
+    path.write_bytes(data[:m.start(1)] + rows + data[m.end(1):])
+    return path
+
+
+@pytest.mark.parametrize("rows,words", [(b"999999999999", "declares shape (999999999999, 3)"),
+                                        (b"-5", "negative size"), (b"5", "declares shape (5, 3)")])
+def test_npy_header_checked_against_file_size(tmp_path, rows, words):
+    """A header declaring more rows than the file holds (or a negative count) is refused before numpy allocates."""
+    p = _npy_with_rows(tmp_path / "c.npy", rows)
+    with pytest.raises(ValueError, match=errmsg(p)) as e:
+        read_points(p)
+    assert words in str(e.value) and "allocate" not in str(e.value)
+
+
+def test_npz_member_header_checked(tmp_path):
+    inner = _npy_with_rows(tmp_path / "P.npy", b"999999999999")
+    import zipfile
+
+    p = tmp_path / "c.npz"
+    with zipfile.ZipFile(p, "w", zipfile.ZIP_DEFLATED) as z:
+        z.write(inner, "P.npy")
+    with pytest.raises(ValueError, match=errmsg(p) + ".*array 'P'.*declares shape"):
+        read_points(p)
+
+
+def _vtk_bytes(tmp_path, ext):
+    p = tmp_path / f"m{ext}"
+    write_mesh(p, TET_V, TET_F)
+    return p, p.read_bytes()
+
+
+@pytest.mark.parametrize("ext,edit,words", [
+    (".vtk", lambda b: b.replace(b"# vtk", b"#\xc4vtk", 1), "a byte that is not text (0xc4)"),
+    (".vtk", lambda b: re.sub(rb"POINTS \d+", b"POINTS 999999999999", b, count=1), "POINTS 999999999999 declares"),
+    (".vtu", lambda b: re.sub(rb'NumberOfPoints="\d+"', b'NumberOfPoints="-5"', b, count=1), "is negative"),
+    (".vtu", lambda b: re.sub(rb'NumberOfPoints="\d+"', b'NumberOfPoints="999999999999"', b, count=1),
+     "counts declare an array of shape (999999999999,3)"),
+])
+def test_vtk_malformed_messages_in_words(tmp_path, ext, edit, words):
+    """Broken VTK/VTU files: a ValueError naming the file and the problem, without Python's or numpy's text."""
+    p, data = _vtk_bytes(tmp_path, ext)
+    p.write_bytes(edit(data))
+    for reader in (read_mesh, lambda q: __import__("gsdf").read_vertex_data(q)):
+        with pytest.raises(ValueError, match=errmsg(p)) as e:
+            reader(p)
+        msg = str(e.value)
+        assert words in msg, msg
+        assert not re.search(r"codec|Unable to allocate|cannot reshape|Error:", msg), msg
+
+
+def test_reader_path_not_a_file_name():
+    with pytest.raises(ValueError, match="path: expected a file name, got int"):
+        read_points(3)
+    with pytest.raises(ValueError, match="path: expected a file name, got int"):
+        read_mesh(3)
+
+
+@pytest.mark.parametrize("content,words", [(b"\x80\x03garbage" * 20, "not a numpy file"),
+                                           (None, "holds Python objects")])
+def test_numpy_files_that_are_not_numbers(tmp_path, content, words):
+    p = tmp_path / "c.npy"
+    if content is None:
+        np.save(p, np.array([object(), None]), allow_pickle=True)
+    else:
+        p.write_bytes(content)
+    with pytest.raises(ValueError, match=errmsg(p) + ".*" + words) as e:
+        read_points(p)
+    assert "allow_pickle" not in str(e.value)
+
+
+def test_ply_with_bom_in_words(tmp_path):
+    import gsdf
+
+    p = tmp_path / "c.ply"
+    write_mesh(p, TET_V, TET_F, binary=False)
+    p.write_bytes(b"\xef\xbb\xbf" + p.read_bytes())
+    for reader in (read_points, read_mesh, gsdf.read_vertex_data):
+        with pytest.raises(ValueError, match=errmsg(p)) as e:
+            reader(p)
+        assert "codec" not in str(e.value)

@@ -61,3 +61,17 @@ def test_vertex_data_with_several_components(tmp_path):
         write_mesh(tmp_path / "x.ply", V, F, vertex_data={"n": vec, "n_0": V[:, 0]})
     with pytest.raises(ValueError, match=r"shape \(4,\) or \(4, k\)"):
         write_mesh(tmp_path / "x.ply", V, F, vertex_data={"n": vec[:3]})
+
+
+def test_binary_is_a_switch(tmp_path):
+    """'no' is truthy: a string for binary is refused, not taken as True (and nothing is written)."""
+    import os
+
+    import gsdf
+
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    with pytest.raises(ValueError, match="binary: expected True or False"):
+        gsdf.write_mesh(tmp_path / "m.ply", V, [[0, 1, 2]], binary="no")
+    with pytest.raises(ValueError, match="binary: expected True or False"):
+        gsdf.write_points(tmp_path / "p.ply", V, binary="no")
+    assert not os.listdir(tmp_path)

@@ -222,3 +222,9 @@ def test_no_window_without_a_display(monkeypatch):
     V, F = _sphere()
     with pytest.raises(RuntimeError, match="no display.*screenshot="):
         gsdf.view((V, F))
+
+
+def test_view_fill_takes_numpy_floats():
+    assert gsdf.ViewOptions(fill=np.float32(0.86)).fill == np.float32(0.86)
+    with pytest.raises(ValueError, match=r"fill: expected a number in \(0, 1\]"):
+        gsdf.ViewOptions(fill=1.5)

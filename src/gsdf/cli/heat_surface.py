@@ -124,9 +124,9 @@ def _heat_voxels(path, curves_path, spacing, normal_radius, cut, level_set, t_co
         occ, lo, hi = load_voxels(path)
         origin, size = lo, (hi - lo) / np.array(occ.shape)
     else:
-        from gsdf._checks import readable_file
+        from gsdf._checks import numpy_file
 
-        readable_file(path)
+        numpy_file(path)
         try:
             occ = np.load(path, allow_pickle=False)
         except (OSError, ValueError) as exc:

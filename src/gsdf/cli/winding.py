@@ -29,11 +29,11 @@ VALUE_EXTENSIONS = (".npy", ".txt", ".csv")
 
 def read_queries(path: str) -> np.ndarray:
     """Query points (q, 3), q > 0, finite: an .npy array or any point file :func:`gsdf.read_points` reads."""
-    from gsdf._checks import as_points, readable_file
+    from gsdf._checks import as_points, numpy_file
     from gsdf.io import read_points
 
     if path.lower().endswith(".npy"):
-        readable_file(path, "QUERIES")
+        numpy_file(path, "QUERIES")
         try:
             Q = np.load(path, allow_pickle=False)
         except Exception as exc:  # numpy raises ValueError, EOFError, TokenError ... for a broken .npy

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from gsdf._checks import as_points, query_shaped
+from gsdf._checks import as_points, flag, query_shaped
 from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 
@@ -119,6 +119,7 @@ def point_cloud_distance(P, Q, return_closest: bool = False):
     >>> np.round(d, 3).tolist()
     [1.0]
     """
+    return_closest = flag(return_closest, "return_closest")
     d, idx, closest = PointCloudDistance(P).query(Q)
     if return_closest:
         return d, idx, closest

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import as_mesh, as_normals, as_points, as_weights, choice, positive, query_shaped
+from gsdf._checks import as_mesh, as_normals, as_points, as_weights, choice, flag, positive, query_shaped
 from gsdf._memory import SECONDS_PER_QUERY
 from gsdf.mesh._pseudonormals import pseudonormals
 from gsdf.distance._points import point_cloud_distance
@@ -159,8 +159,7 @@ def signed_distance(V, F, Q, sign: str = "winding", beta: float = 2.0, return_cl
     Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
     choice(sign, "sign", SIGN_MODES)
     beta = positive(beta, "beta")
-    if not isinstance(return_closest, (bool, np.bool_)):
-        raise ValueError(f"return_closest: expected True or False, got {return_closest!r}")
+    return_closest = flag(return_closest, "return_closest")
     if shell is not None:
         shell = positive(shell, "shell")
     tt = triangle_tree(V, F)  # one tree for the distance and the winding number

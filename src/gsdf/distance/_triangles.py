@@ -31,7 +31,7 @@ import dataclasses
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_mesh, as_points, integer, query_shaped
+from gsdf._checks import as_mesh, as_points, flag, integer, query_shaped
 from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.spatial._morton import cell_order
@@ -747,6 +747,7 @@ def unsigned_distance(V, F, Q, return_closest: bool = False):
     >>> np.round(d, 3).tolist()
     [0.5, 0.5]
     """
+    return_closest = flag(return_closest, "return_closest")
     V, F = as_mesh(V, F)
     Q = as_points(Q, "Q", seconds_per_row=SECONDS_PER_QUERY)
     d, face, closest = TriangleDistance(V, F).query(Q)

@@ -263,6 +263,7 @@ class YukawaTree:
         >>> tree.nearest_distance([[0.0, 0.0, 0.0]]).round(3).tolist()
         [1.0]
         """
+        Q = as_points(Q, "Q", allow_empty=True, seconds_per_row=SECONDS_PER_QUERY)
         if self._kd is None:
             self._kd = cKDTree(self._src)
         return self._kd.query(Q, workers=-1)[0]

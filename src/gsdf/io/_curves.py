@@ -34,7 +34,6 @@ which is how both demos number them.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -174,7 +173,9 @@ class _Mesh:
     """What the nodes are checked and resolved against: the faces (optional)."""
 
     def __init__(self, F):
-        self.F = None if F is None else np.asarray(F, dtype=np.int64)
+        from gsdf._checks import MAX_INT, as_faces
+
+        self.F = None if F is None else as_faces(F, MAX_INT, "F", allow_empty=True)
         self.n = int(self.F.max()) + 1 if self.F is not None and self.F.size else None
         self.m = None if self.F is None else len(self.F)
         self._gce = None
@@ -376,7 +377,9 @@ def read_curves(path, F=None) -> CurveSources:
     >>> [c.tolist() for c in src.curves], src.swn().segments.tolist()
     ([[0, 1]], [[0, 1]])
     """
-    path = os.fspath(path)
+    from gsdf._checks import readable_file
+
+    path = readable_file(path, "path")
     fmt, nodes, curves, signs, points, mesh = _parse(path, F)
     if not curves and not points:
         if fmt == "swn":

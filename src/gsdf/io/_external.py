@@ -19,6 +19,8 @@ stored, with their polygons.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 __all__ = ["TRIMESH_FORMATS", "MESHIO_FORMATS", "read_external"]
@@ -48,7 +50,7 @@ def _read_trimesh(p: str, ext: str):
         raise ValueError(f"{p}: reading {ext} files needs an optional package trimesh uses ({exc.name or exc}); "
                          "install it, e.g. pip install lxml networkx") from exc
     except Exception as exc:  # trimesh raises many types for malformed files: report them as bad input
-        raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({type(exc).__name__}: {exc})") from exc
+        raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({error_words(exc)})") from exc
     Vs, Fs, offset = [], [], 0
     rank = {name: i for i, name in enumerate(scene.geometry)}  # the file's mesh order
     nodes = sorted(scene.graph.nodes_geometry, key=lambda n: (rank.get(scene.graph[n][1], len(rank)), str(n)))
@@ -123,6 +125,8 @@ def _read_meshio_raw(p: str, ext: str):
 
     import meshio
 
+    if ext in (".vtk", ".vtu"):
+        _check_vtk_counts(p, ext)
     said = io.StringIO()
     log = logging.getLogger("meshio")
     level = log.level
@@ -138,11 +142,63 @@ def _read_meshio_raw(p: str, ext: str):
                 if m is None:
                     raise
     except (Exception, SystemExit) as exc:  # ReadError, ValueError, KeyError, struct errors, SystemExit ...
-        why = " ".join(said.getvalue().split()) or f"{type(exc).__name__}: {exc}"
+        why = " ".join(said.getvalue().split()) or error_words(exc)
         raise ValueError(f"{p}: not a readable {ext[1:].upper()} file ({why})") from None
     finally:
         log.setLevel(level)
     return m
+
+
+def error_words(exc: BaseException) -> str:
+    """What a library's exception on a malformed file means, in words (not Python's text for the decoding and
+    allocation failures)."""
+    if isinstance(exc, UnicodeDecodeError):
+        bad = exc.object[exc.start:exc.start + 1].hex() if exc.start < len(exc.object) else "?"
+        return f"a line that should be text holds a byte that is not text (0x{bad})"
+    m = re.search(r"cannot reshape array of size (\d+) into shape (\([^)]*\))", str(exc))
+    if isinstance(exc, ValueError) and m:
+        return (f"its counts declare an array of shape {m.group(2)} but it stores {int(m.group(1)):,} values; the "
+                "file is corrupt or truncated")
+    if isinstance(exc, IndexError):
+        return "an index or a count in the file does not match its data; the file is corrupt or truncated"
+    if isinstance(exc, MemoryError):
+        return "a count in the file asks for more memory than there is; the file is corrupt or truncated"
+    return f"{type(exc).__name__}: {exc}"
+
+
+#: legacy VTK keywords followed by counts: the values each count stands for (POINTS n: 3n coordinates; the cell
+#: sections' last number is the size of their index list)
+_VTK_COUNTS = re.compile(rb"(?m)^[ \t]*(POINTS|CELLS|POLYGONS|LINES|VERTICES|TRIANGLE_STRIPS|CELL_TYPES|"
+                         rb"POINT_DATA|CELL_DATA)[ \t]+(\d+)(?:[ \t]+(\d+))?")
+#: the counts of a VTU piece
+_VTU_COUNTS = re.compile(rb"(NumberOfPoints|NumberOfCells)\s*=\s*[\"'](-\d+)")
+
+
+def _check_vtk_counts(p: str, ext: str) -> None:
+    """Refuse a VTK file whose counts cannot be right, before meshio allocates arrays of that size or takes
+    them: a legacy ``.vtk`` count larger than the file could hold (every value takes at least one byte, in text
+    and binary files alike), a negative ``.vtu`` point or cell count (VTU data may be compressed, so only the
+    sign of its counts can be checked here)."""
+    import mmap
+    import os
+
+    size = os.path.getsize(p)
+    if size == 0:
+        return
+    with open(p, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+        if ext == ".vtu":
+            m = _VTU_COUNTS.search(data)
+            if m:
+                raise ValueError(f"{p}: not a readable VTU file ({m.group(1).decode()} is negative: "
+                                 f"{m.group(2).decode()})")
+            return
+        for m in _VTK_COUNTS.finditer(data):
+            key, n = m.group(1).decode(), int(m.group(2))
+            values = 3 * n if key == "POINTS" else max(n, int(m.group(3) or 0))
+            if values > size:
+                raise ValueError(f"{p}: not a readable VTK file ({key} {m.group(2).decode()} declares {values:,} "
+                                 f"values, more than the {size:,} bytes of the file hold; it is corrupt or "
+                                 "truncated)")
 
 
 _GMSH_DATA = (b"ElementData", b"NodeData", b"ElementNodeData")

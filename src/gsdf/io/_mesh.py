@@ -26,7 +26,7 @@ import re
 import numpy as np
 
 from gsdf._checks import as_faces, as_points, as_values, flag, readable_file
-from gsdf.io._external import MESHIO_FORMATS, TRIMESH_FORMATS, read_external
+from gsdf.io._external import MESHIO_FORMATS, TRIMESH_FORMATS, error_words, read_external
 from gsdf.io._safe_write import atomic_output
 
 __all__ = ["read_mesh", "write_mesh", "read_vertex_data"]
@@ -45,7 +45,10 @@ MESH_WRITE_FORMATS = MESH_FORMATS + (".vtk", ".vtu")
 
 def _extension(path, supported, what: str) -> tuple[str, str]:
     """Return ``(path as str, lower-case extension)`` or raise for an unsupported extension."""
-    p = os.fspath(path)
+    try:
+        p = os.fsdecode(os.fspath(path))
+    except TypeError:
+        raise ValueError(f"path: expected a file name, got {type(path).__name__} {path!r:.40}") from None
     ext = os.path.splitext(p)[1].lower()
     if ext not in supported:
         raise ValueError(
@@ -319,7 +322,7 @@ def _ply_binary(p: str, head: bytes):
     except OSError:
         raise
     except Exception as exc:  # plyfile raises PlyParseError and assorted errors on broken files
-        raise ValueError(f"{p}: malformed PLY file ({exc})") from exc
+        raise ValueError(f"{p}: malformed PLY file ({error_words(exc)})") from exc
     if "vertex" not in ply:
         raise ValueError(f"{p}: PLY file has no 'vertex' element")
     v = ply["vertex"].data
@@ -695,7 +698,7 @@ def read_vertex_data(path) -> dict:
         try:
             ply = plyfile.PlyData.read(p)
         except Exception as exc:  # plyfile raises PlyParseError and assorted errors on broken files
-            raise ValueError(f"{p}: malformed PLY file ({exc})") from exc
+            raise ValueError(f"{p}: malformed PLY file ({error_words(exc)})") from exc
         if "vertex" not in ply:
             raise ValueError(f"{p}: PLY file has no 'vertex' element")
         v = ply["vertex"].data
@@ -845,6 +848,7 @@ def write_mesh(path, V, F, vertex_data=None, *, binary: bool = True) -> None:
     >>> write_mesh("tet.ply", V, F, vertex_data={"d": V[:, 0]})     # doctest: +SKIP
     """
     p, ext = _extension(path, MESH_WRITE_FORMATS, "mesh")
+    binary = flag(binary, "binary")
     V = as_points(V, "V")
     flat, sizes = _faces_arg(F, len(V))
     if vertex_data and ext not in (".ply", ".vtk", ".vtu"):

@@ -14,7 +14,7 @@ import warnings
 
 import numpy as np
 
-from gsdf._checks import as_points
+from gsdf._checks import as_points, flag, numpy_file
 from gsdf.io._safe_write import atomic_output
 from gsdf.io._mesh import (
     _check_file,
@@ -82,8 +82,8 @@ def _read_obj_points(p: str, data: bytes):
 
 
 def _read_numpy(p: str, ext: str):
-
     _check_file(p)
+    numpy_file(p)
     try:
         if ext == ".npy":
             A, N = np.load(p, allow_pickle=False), None
@@ -186,6 +186,7 @@ def write_points(path, P, N=None, *, binary: bool = True) -> None:
     >>> write_points("cloud.xyz", P, P - 0.5)     # doctest: +SKIP
     """
     p, ext = _extension(path, POINTS_WRITE_FORMATS, "point cloud")
+    binary = flag(binary, "binary")
     P = as_points(P, "P")
     if N is not None:
         N = as_points(N, "N")

@@ -65,7 +65,6 @@ class BooleanOptions:
         positive(self.beta, "beta", most=1e150)
         flag(self.exact, "exact")
 
-
 _OPS = ("union", "intersection", "difference")
 
 

@@ -217,11 +217,11 @@ def save_voxels(path, occ, bbox_min, bbox_max) -> None:
 
 def load_voxels(path):
     """Read a file written by :func:`save_voxels`; returns ``(occupancy, bbox_min, bbox_max)``."""
-    from gsdf._checks import readable_file
+    from gsdf._checks import numpy_file
 
-    path = readable_file(path, "path")
+    path = numpy_file(path, "path")
     try:
-        with np.load(path) as d:
+        with np.load(path, allow_pickle=False) as d:
             return _occupancy(d["occupancy"]), *_bbox(d["bbox_min"], d["bbox_max"])
     except (OSError, KeyError, ValueError) as exc:
         raise ValueError(f"{path}: not a gsdf voxel file ({exc})") from exc

@@ -76,8 +76,12 @@ class ViewOptions:
             from gsdf.render._scene import axis_vector
 
             axis_vector(self.front)
-        if not (isinstance(self.fill, (int, float)) and 0 < self.fill <= 1):
-            raise ValueError(f"fill: expected a number in (0, 1], got {self.fill!r}")
+        from gsdf._checks import positive
+
+        try:
+            positive(self.fill, "fill", most=1.0)
+        except ValueError:
+            raise ValueError(f"fill: expected a number in (0, 1], got {self.fill!r}") from None
         if self.vrange is not None:
             from gsdf.render._scene import colour_range
 

@@ -493,10 +493,14 @@ class PointsAsTori:
         --------
         >>> pat = gsdf.PointsAsTori.load("tori.npz")          # doctest: +SKIP
         """
-        from gsdf._checks import readable_file
+        from gsdf._checks import numpy_file
 
         try:
-            z = np.load(readable_file(path, "path"), allow_pickle=False)
+            p = numpy_file(path, "path")
+        except FileNotFoundError as exc:
+            raise ValueError(f"{path}: not a saved PointsAsTori file (FileNotFoundError: {exc})") from exc
+        try:
+            z = np.load(p, allow_pickle=False)
             files = set(z.files)
         except Exception as exc:
             raise ValueError(f"{path}: not a saved PointsAsTori file ({type(exc).__name__}: {exc})") from exc

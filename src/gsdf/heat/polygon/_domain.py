@@ -58,6 +58,13 @@ from gsdf.heat._domain import VertexSurfaceDomain, tangent_frames
 
 
 # --------------------------------------------------------------------------------------------- geometry helpers
+def integral(q: np.ndarray) -> bool:
+    """Whether ``q`` holds integers only (an integer dtype, or finite floats without a fractional part)."""
+    if q.dtype.kind in "iu":
+        return True
+    return q.dtype.kind == "f" and bool(np.isfinite(q).all()) and bool((q == np.round(q)).all())
+
+
 def _parse_polygons(polygons, n: int):
     """Validate polygons; return their flat layout ``(start, corners)`` in ascending degree (stable):
     ``corners[start[p]:start[p + 1]]`` are the corners of the p-th polygon in that order (int64)."""
@@ -81,18 +88,16 @@ def _parse_polygons(polygons, n: int):
             ragged = None
     if isinstance(polygons, np.ndarray) and polygons.ndim == 2 and polygons.dtype != object:
         arr = polygons
-        if not np.issubdtype(arr.dtype, np.integer):
-            if not (np.issubdtype(arr.dtype, np.floating) and np.all(arr == np.round(arr))):
-                raise ValueError(f"polygons: vertex indices must be integers, got dtype {arr.dtype}")
+        if not integral(arr):
+            raise ValueError(f"polygons: vertex indices must be integers, got dtype {arr.dtype}")
         sizes = np.full(len(arr), arr.shape[1], np.int64)
         flat = arr.astype(np.int64).ravel()
     elif ragged is not None:
         # a ragged list of 1-D index arrays (gsdf.read_mesh(triangulate=False)): one concatenation
         sizes = np.fromiter(map(len, polygons), np.int64, count=len(polygons))
         flat = ragged
-        if flat.size and not np.issubdtype(flat.dtype, np.integer):
-            if not (np.issubdtype(flat.dtype, np.number) and np.all(flat == np.round(flat))):
-                raise ValueError(f"polygons: vertex indices must be integers, got dtype {flat.dtype}")
+        if flat.size and not integral(flat):
+            raise ValueError(f"polygons: vertex indices must be integers, got dtype {flat.dtype}")
         flat = flat.astype(np.int64)
     else:
         try:
@@ -101,9 +106,8 @@ def _parse_polygons(polygons, n: int):
             flat = np.asarray(list(itertools.chain.from_iterable(polygons)))
         except TypeError as exc:
             raise ValueError("polygons: expected a list of vertex-index sequences or an (m, k) int array") from exc
-        if flat.size and not np.issubdtype(flat.dtype, np.integer):
-            if not (np.issubdtype(flat.dtype, np.number) and np.all(flat == np.round(flat))):
-                raise ValueError(f"polygons: vertex indices must be integers, got dtype {flat.dtype}")
+        if flat.size and not integral(flat):
+            raise ValueError(f"polygons: vertex indices must be integers, got dtype {flat.dtype}")
         flat = flat.astype(np.int64)
     if len(sizes) == 0:
         raise ValueError("polygons: is empty (0 faces)")

@@ -11,6 +11,7 @@ from gsdf.heat._core import SignedHeatCore
 from gsdf.heat.polygon._domain import (
     PolygonDomain,
     connection_laplacian,
+    integral,
     tangent_frames,
     virtual_vertex_refinement,
     virtual_vertex_weights,
@@ -131,12 +132,15 @@ class PolygonMeshSignedHeatSolver:
 
 
 def _without_repeats(polygons):
-    """The polygons without those that repeat a vertex (a warning says how many); anything not a list of index
-    sequences is passed on unchanged for the domain to validate."""
+    """The polygons without those that repeat a vertex (a warning says how many); anything not a list of integer
+    index sequences (strings, NaN, fractions, objects) is passed on unchanged for the domain to validate and
+    refuse."""
     import warnings
 
     try:
         polys = [np.asarray(q).ravel() for q in polygons]
+        if not all(integral(q) for q in polys):
+            return polygons
         rep = [len(np.unique(q)) < len(q) for q in polys]
     except (TypeError, ValueError):
         return polygons
@@ -146,3 +150,4 @@ def _without_repeats(polygons):
     warnings.warn(f"polygons: {sum(rep)} polygons repeat a vertex (first: polygon {rep.index(True)}); they are "
                   "dropped", stacklevel=3)
     return keep
+
