@@ -65,6 +65,7 @@ class BooleanOptions:
         positive(self.beta, "beta", most=1e150)
         flag(self.exact, "exact")
 
+
 _OPS = ("union", "intersection", "difference")
 
 
