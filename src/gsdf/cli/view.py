@@ -34,7 +34,7 @@ Examples:
   gsdf view fish.ply fish-unsigned.txt --screenshot fish.png --azimuth 60
 """)
 @click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, exists=True))
-@click.option("--screenshot", "-o", "--output", "output", default=None, metavar="FILE",
+@click.option("-o", "--output", "--screenshot", "output", default=None, metavar="FILE",
               help="Render to this PNG instead of opening a window (no display needed).")
 @click.option("--size", type=SIZE, default="1200x900", show_default=True, help="Screenshot size in pixels: N or WxH.")
 @click.option("--up", type=UP, default="auto", show_default=True,
@@ -58,7 +58,7 @@ def view(files, output, size, up, azimuth, elevation, level, axis, at, field_nam
     from gsdf.render._view import ViewOptions
     from gsdf.render._view import view as show
 
-    check_output(output, (".png",), "--screenshot")
+    check_output(output, (".png",), "-o")
     t = time.perf_counter()
     items = items_from_files(files, field_name, title)
     opts = ViewOptions(level=level, slice_axis=axis, slice_at=at)
