@@ -463,7 +463,7 @@ def run_block(label, V, F, Vr, Fr, works, tools, args, cond, results, est):
             results[(cond, label, work, t)] = r
             # the next (larger) workload of this tool, predicted from this one
             nxt = {"sd1e5": ("sd1e6", 10.0), "occ1e5": ("occ1e6", 10.0), "sd1e6": ("grid", 2.1)}.get(work)
-            if nxt and args.grid == 128:
+            if nxt and (nxt[0] != "grid" or args.grid == 128):  # sd1e6 -> grid holds for 128^3 nodes only
                 est[(t, nxt[0])] = r["time"] * nxt[1]
             if work == "sd1e5":
                 est.setdefault((t, "grid"), r["time"] * 21.0 * (args.grid / 128) ** 3)
@@ -579,8 +579,11 @@ def main(argv=None):
     ap.add_argument("--load", choices=["idle", "busy", "both"], default="both")
     ap.add_argument("--scaling", action="store_true", help="only the scaling section")
     ap.add_argument("--json", help="also dump the raw results here")
+    ap.add_argument("--resume", help="results of an earlier run (its --json): its complete meshes are not rerun")
+    ap.add_argument("--check", type=int, default=CHECK, help="points per workload on which accuracy is measured")
     ap.add_argument("--no-write", action="store_true", help="print only, do not touch RESULTS.md")
     args = ap.parse_args(argv)
+    globals()["CHECK"] = args.check
     if args.scaling:
         return scaling(args)
     labels = args.meshes.split(",") if args.meshes else (QUICK_MESHES if args.quick else [m[0] for m in MESHES])
@@ -621,16 +624,29 @@ def main(argv=None):
         text = "\n".join(body)
         if args.json:
             with open(args.json, "w") as f:
-                json.dump({"|".join(k): v for k, v in results.items()}, f, indent=1)
+                json.dump({"|".join(k): v for k, v in results.items()} | {"loads": loads}, f, indent=1)
         if not args.no_write:
             write_section("sdf-peers-quick" if args.quick else "sdf-peers", text)
         return text
 
     done = []
+    if args.resume:
+        with open(args.resume) as f:
+            old = json.load(f)
+        for k, v in old.items():
+            if k == "loads":
+                for c, lv in v.items():
+                    loads.setdefault(c, []).extend(lv)
+                continue
+            results[tuple(k.split("|"))] = v
     for lab in labels:
         _, recipe, kind = recipes[lab]
         V, F, Vr, Fr = load_mesh(recipe)
         kinds[lab], faces[lab] = kind, len(F)
+        if all(any((c, lab, w, t) in results for t in tools) for c in conds for w in works):
+            print(f"== {lab}: from {args.resume}", flush=True)
+            done.append(lab)
+            continue
         print(f"== {lab}: {len(F)} faces ({kind}) | {uptime()}", flush=True)
         est = {}
         for cond in conds:
