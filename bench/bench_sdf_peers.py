@@ -730,7 +730,7 @@ def scaling(args):
     head_q = ["queries"] + [f"{t} {k} s" for t in tools for k in ("sd", "occ")]
     slope_q = ["log-log slope"] + [f"{_slope(counts, data_q[t][k]):.2f}" for t in tools for k in ("sd", "occ")]
     text = (f"## sdf-peers-scaling: build and query against faces and queries\n\n"
-            f"Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_sdf_peers.py --scaling`. Machine: {info}. "
+            f"Command: `{command('bench_sdf_peers.py', python='/work/anchors/bin/python')}`. Machine: {info}. "
             f"{uptime()} at the end. Faces: bunny00 decimated to 1.2k faces (igl.decimate) and Loop-subdivided "
             f"0–{levels[-1]} times, 1e5 points in the padded box; queries: bunny00 (75k faces). Times include the "
             f"build; median of {args.reps}.\n\n"
