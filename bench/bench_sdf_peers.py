@@ -41,7 +41,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 if "GSDF_CGAL_DATA" not in os.environ and os.path.isdir("/work/cgal/data/meshes"):
     os.environ["GSDF_CGAL_DATA"] = "/work/cgal/data"
-from common import data_dir, machine, table, write_section  # noqa: E402
+from common import command, data_dir, machine, table, write_section  # noqa: E402
 from load import BusyLoad, uptime  # noqa: E402
 
 import gsdf  # noqa: E402
@@ -121,7 +121,14 @@ def _gsdf_structures(V, F):
     from gsdf.distance import TriangleDistance
     from gsdf.winding import FastWindingNumber
 
-    return TriangleDistance(V, F), FastWindingNumber(V, F)
+    try:  # the merged layout: one shared triangle tree (gsdf.spatial._triangle_tree), as signed_distance builds it
+        from gsdf._checks import as_mesh
+        from gsdf.spatial._triangle_tree import triangle_tree
+    except ImportError:
+        return TriangleDistance(V, F), FastWindingNumber(V, F)
+    V, F = as_mesh(V, F)
+    tt = triangle_tree(V, F)
+    return TriangleDistance._of_tree(V, F, tt), FastWindingNumber._of_tree(tt, beta=2.0, order=2)
 
 
 def gsdf_tool(work, V, F, X):
@@ -392,13 +399,13 @@ _WARM = set()
 
 
 def warm_up(V, F, works, tools, n_grid):
-    """Each tool once per workload on 2000 points (an 8^3 grid), untimed: imports, JIT caches, kernel builds."""
+    """Each tool once per workload on this mesh, untimed: imports, JIT caches, kernel builds. On 20000 points
+    (a 28^3 grid) and on the mesh itself: numba's serial and parallel kernels are different functions (gsdf's
+    queries go parallel from 4096 / 16384 points, its tree build from 20000 faces), each loaded at its first call."""
     rng = np.random.default_rng(5)
     for work in works:
-        X = inputs_for(work, V, 8, rng) if work in ("build", "grid") else inputs_for("sd1e5", V, 8, rng)[:2000]
+        X = inputs_for(work, V, 28, rng) if work in ("build", "grid") else inputs_for("sd1e5", V, 8, rng)[:20000]
         for t in tools:
-            if (t, work) in _WARM:
-                continue
             _WARM.add((t, work))
             try:
                 fn = FACTORY[t](work, V, F, X)
@@ -417,7 +424,8 @@ def run_block(label, V, F, Vr, Fr, works, tools, args, cond, results, est):
         runs = {}
         for t in tools:
             key = (t, work)
-            if key in est and est[key] > args.cap:
+            if key in est and est[key] > args.cap and not (t == "mesh-to-sdf" and work != "sd1e5") \
+                    and not (t.startswith("mesh2sdf") and work != "grid"):
                 results[(cond, label, work, t)] = {"skip": f"est. {est[key]:.0f} s"}
                 continue
             try:
@@ -455,7 +463,7 @@ def run_block(label, V, F, Vr, Fr, works, tools, args, cond, results, est):
             results[(cond, label, work, t)] = r
             # the next (larger) workload of this tool, predicted from this one
             nxt = {"sd1e5": ("sd1e6", 10.0), "occ1e5": ("occ1e6", 10.0), "sd1e6": ("grid", 2.1)}.get(work)
-            if nxt and args.grid == 128:
+            if nxt and (nxt[0] != "grid" or args.grid == 128):  # sd1e6 -> grid holds for 128^3 nodes only
                 est[(t, nxt[0])] = r["time"] * nxt[1]
             if work == "sd1e5":
                 est.setdefault((t, "grid"), r["time"] * 21.0 * (args.grid / 128) ** 3)
@@ -542,6 +550,17 @@ def report(results, labels, kinds, faces, works, tools, cond, args, errors):
     out.append("\nAccuracy per tool: max wrong sign % over the closed / the broken (open, soup) meshes; max distance "
                "error ÷ diagonal:\n")
     out.append(table(["tool"] + [w for w in works if w != "build"], acc))
+    # wrong sign per mesh: the issue asks for each tool's wrong-sign % on the soup
+    checked = [w for w in works if w != "build"]
+    rows = []
+    for lab in labels:
+        row = [f"{lab} ({kinds[lab]})"]
+        for t in tools:
+            cells = [results.get((cond, lab, w, t), {}).get("wrong") for w in checked]
+            row.append(" / ".join("—" if c is None else f"{c:.3g}" for c in cells))
+        rows.append(row)
+    out.append(f"\nWrong sign % per mesh and tool ({' / '.join(checked)}):\n")
+    out.append(table(["mesh"] + tools, rows))
     if errors:
         out.append("\n" + "\n".join(f"- {k}: {v}" for k, v in sorted(errors.items())))
     return "\n".join(out)
@@ -560,8 +579,11 @@ def main(argv=None):
     ap.add_argument("--load", choices=["idle", "busy", "both"], default="both")
     ap.add_argument("--scaling", action="store_true", help="only the scaling section")
     ap.add_argument("--json", help="also dump the raw results here")
+    ap.add_argument("--resume", help="results of an earlier run (its --json): its complete meshes are not rerun")
+    ap.add_argument("--check", type=int, default=CHECK, help="points per workload on which accuracy is measured")
     ap.add_argument("--no-write", action="store_true", help="print only, do not touch RESULTS.md")
     args = ap.parse_args(argv)
+    globals()["CHECK"] = args.check
     if args.scaling:
         return scaling(args)
     labels = args.meshes.split(",") if args.meshes else (QUICK_MESHES if args.quick else [m[0] for m in MESHES])
@@ -574,42 +596,68 @@ def main(argv=None):
     t_start = time.time()
     recipes = {m[0]: m for m in MESHES}
     results, kinds, faces, loads = {}, {}, {}, {c: [] for c in conds}
+    cmd = "`" + command("bench_sdf_peers.py", python="/work/anchors/bin/python", env="PYOPENGL_PLATFORM=egl") + "`"
+    start_load = uptime()
+
+    def finish(done, final):
+        """The section of the meshes done so far: printed, and written after every mesh (a run stopped part way
+        keeps what it measured; the heading says how many meshes of how many)."""
+        head = (f"## sdf-peers{' (quick)' if args.quick else ''}: signed distance and occupancy against Open3D, "
+                f"Warp, fcpw, pysdf, mesh2sdf, mesh-to-sdf, libigl, pcu\n\n"
+                f"Command: {cmd}. Machine: {info}; {start_load} at start, {uptime()} at "
+                f"{'end' if final else 'the last write'} (shared machine). {time.strftime('%Y-%m-%d %H:%M')}; "
+                f"{'run took' if final else 'partial: ' + str(len(done)) + ' of ' + str(len(labels)) + ' meshes after'} "
+                f"{(time.time() - t_start) / 60:.0f} min. Median of {args.reps} interleaved calls (one call when "
+                f"slower than {args.slow:g} s; a tool predicted slower than {args.cap:g} s is skipped); every time "
+                f"is build + query; grid = {args.grid}^3 nodes over the padded box made cubic; points uniform in the "
+                "padded box (bounding box + 0.1 × diagonal). Wrong sign against the exact winding number rounded (a "
+                "soup: of the intact mesh); distance error against libigl's exact double-precision distance. Warp "
+                "runs its CPU kernels on one thread; the others use both cores.\n")
+        body = [head]
+        for cond in conds:
+            lv = loads[cond]
+            if not lv:
+                continue
+            body.append(f"\n### {cond}{' (two busy processes, bench/load.py BusyLoad(2))' if cond == 'busy' else ''}"
+                        f" — 1-min load average at the start of each mesh's block: {min(lv):.1f}–{max(lv):.1f}\n")
+            body.append(report(results, done, kinds, faces, works, tools, cond, args, errors))
+        text = "\n".join(body)
+        if args.json:
+            with open(args.json, "w") as f:
+                json.dump({"|".join(k): v for k, v in results.items()} | {"loads": loads}, f, indent=1)
+        if not args.no_write:
+            write_section("sdf-peers-quick" if args.quick else "sdf-peers", text)
+        return text
+
+    done = []
+    if args.resume:
+        with open(args.resume) as f:
+            old = json.load(f)
+        for k, v in old.items():
+            if k == "loads":
+                for c, lv in v.items():
+                    loads.setdefault(c, []).extend(lv)
+                continue
+            results[tuple(k.split("|"))] = v
     for lab in labels:
         _, recipe, kind = recipes[lab]
         V, F, Vr, Fr = load_mesh(recipe)
         kinds[lab], faces[lab] = kind, len(F)
-        print(f"== {lab}: {len(F)} faces ({kind})", flush=True)
+        if all(any((c, lab, w, t) in results for t in tools) for c in conds for w in works):
+            print(f"== {lab}: from {args.resume}", flush=True)
+            done.append(lab)
+            continue
+        print(f"== {lab}: {len(F)} faces ({kind}) | {uptime()}", flush=True)
         est = {}
         for cond in conds:
             with BusyLoad(2 if cond == "busy" else 0):
                 loads[cond].append(os.getloadavg()[0])
                 run_block(lab, V, F, Vr, Fr, works, tools, args, cond, results, est)
+        done.append(lab)
         gc.collect()
-    grid_note = f"{args.grid}^3"
-    cmd = ("`PYOPENGL_PLATFORM=egl PYTHONPATH=src /work/anchors/bin/python bench/bench_sdf_peers.py"
-           + (" --quick" if args.quick else "") + "`")
-    head = (f"## sdf-peers{' (quick)' if args.quick else ''}: signed distance and occupancy against Open3D, Warp, "
-            f"fcpw, pysdf, mesh2sdf, mesh-to-sdf, libigl, pcu\n\n"
-            f"Command: {cmd}. Machine: {info}. {time.strftime('%Y-%m-%d %H:%M')}; run took "
-            f"{(time.time() - t_start) / 60:.0f} min. Median of {args.reps} interleaved calls (one call when slower than "
-            f"{args.slow:.0f} s); every time is build + query; grid = {grid_note} nodes over the padded box made cubic; "
-            "points uniform in the padded box (bounding box + 0.1 × diagonal). Wrong sign against the exact winding "
-            "number rounded (a soup: of the intact mesh); distance error against libigl's exact double-precision "
-            "distance. Warp runs its CPU kernels on one thread; the others use both cores.\n")
-    body = [head]
-    for cond in conds:
-        lv = loads[cond]
-        body.append(f"\n### {cond}{' (two busy processes, bench/load.py BusyLoad(2))' if cond == 'busy' else ''} — "
-                    f"1-min load average at the start of each mesh's block: "
-                    f"{min(lv):.1f}–{max(lv):.1f}\n")
-        body.append(report(results, labels, kinds, faces, works, tools, cond, args, errors))
-    text = "\n".join(body)
-    print(text)
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump({"|".join(k): v for k, v in results.items()}, f, indent=1)
-    if not args.no_write and not args.meshes and not args.tools and not args.work:
-        write_section("sdf-peers-quick" if args.quick else "sdf-peers", text)
+        if lab != labels[-1]:
+            finish(done, False)
+    print(finish(done, True))
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -682,7 +730,7 @@ def scaling(args):
     head_q = ["queries"] + [f"{t} {k} s" for t in tools for k in ("sd", "occ")]
     slope_q = ["log-log slope"] + [f"{_slope(counts, data_q[t][k]):.2f}" for t in tools for k in ("sd", "occ")]
     text = (f"## sdf-peers-scaling: build and query against faces and queries\n\n"
-            f"Command: `PYTHONPATH=src /work/anchors/bin/python bench/bench_sdf_peers.py --scaling`. Machine: {info}. "
+            f"Command: `{command('bench_sdf_peers.py', python='/work/anchors/bin/python')}`. Machine: {info}. "
             f"{uptime()} at the end. Faces: bunny00 decimated to 1.2k faces (igl.decimate) and Loop-subdivided "
             f"0–{levels[-1]} times, 1e5 points in the padded box; queries: bunny00 (75k faces). Times include the "
             f"build; median of {args.reps}.\n\n"
