@@ -138,6 +138,7 @@ SECONDS_PER_QUERY = 1e-6         #: a tree query: fast winding number, distance,
 SECONDS_PER_NODE = 2e-7          #: a node of a grid solve, a field evaluation, an isosurface or voxel pass
 SECONDS_PER_PAIR = 2e-9          #: one query × element term of a direct sum (exact winding numbers)
 SECONDS_PER_CELL = 1e-9          #: one voxel of an elementwise pass over a boolean grid
+SECONDS_PER_FACE_STEP = 5e-8     #: one face in one step of an iterative sweep over a mesh (two sparse products)
 
 _TIME_SUFFIX = {"": 1.0, "S": 1.0, "M": 60.0, "H": 3600.0, "D": 86400.0}
 
