@@ -180,13 +180,21 @@ def test_task_bad_options():
 
     for bad, match in [({"n_samples": True}, "n_samples"), ({"margin": float("nan")}, "margin"),
                        ({"sigmas": "a,b"}, "sigmas: expected a number"), ({"beta": -1}, "beta"),
-                       ({"dtype": "int8"}, "dtype"), ({"uniform_fraction": "x"}, "uniform_fraction")]:
+                       ({"dtype": "int8"}, "dtype"), ({"uniform_fraction": "x"}, "uniform_fraction"),
+                       ({"margin": 1e308}, "margin: must be a finite number >= 0 and <= 1e"),
+                       ({"sigmas": "1e308"}, "sigmas: must be a finite positive number <= 1e"),
+                       ({"beta": 1e308}, "beta: must be a finite positive number <= 1e")]:
         with pytest.raises(ValueError, match=match):
             check_options("sdf-samples", bad)
     with pytest.raises(ValueError, match="method"):
         check_options("surface", {"method": "pat"})
     with pytest.raises(ValueError, match="options"):
         sdf_samples(g, options={"margin": 0.1})
+    with pytest.raises(ValueError, match="estimate_normals: expected True or False"):
+        SdfSamplesOptions(estimate_normals="yes")
+    with pytest.raises(ValueError, match="estimate_normals: expected True or False"):
+        sdf_grid(g, resolution=8, estimate_normals="yes")
+    assert check_options("sdf-samples", {"estimate_normals": "yes"})["estimate_normals"] is True  # a CSV cell
     from gsdf.batch import run_task
 
     with pytest.raises(ValueError, match="'bisection' does not apply"):
