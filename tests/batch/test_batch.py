@@ -475,6 +475,18 @@ def test_unreachable_scheduler_leaves_nothing(dataset, tmp_path):
     assert os.listdir(tmp_path) == []  # neither the lock nor the folders this run created
 
 
+@pytest.mark.parametrize("args", [["--workers", "1000000000"], ["--dask-local", "1000000000"],
+                                  ["--scheduler", ""], ["--sigmas", "1e308"], ["--beta", "1e308"]])
+def test_refused_executor_or_option_leaves_nothing(dataset, tmp_path, args):
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "-o", str(out),
+                                  "--n-points", "200", "--quiet", *args])
+    assert r.exit_code in (1, 2), r.output
+    assert ("--scheduler" if args[0] == "--scheduler" else args[0][2:].replace("-", "_")
+            if args[0] != "--dask-local" else "workers") in r.output
+    assert not out.exists()
+
+
 def test_two_runs_on_one_folder(dataset, tmp_path, local1):
     from gsdf.batch._run import LOCK_NAME, _Lock
 
