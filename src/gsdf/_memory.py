@@ -65,6 +65,16 @@ def available_bytes() -> int:
     return min(_machine_bytes(), _address_space_left())
 
 
+def check_environment() -> None:
+    """Read ``GSDF_MEMORY_LIMIT`` and ``GSDF_WORK_LIMIT`` now: a ValueError naming the variable when either is
+    set to something that is not a size / a time, so that a command refuses it before any work even when its
+    request is too small to consult the limits."""
+    env = os.environ.get(ENV)
+    if env:
+        _parse(env)
+    work_limit()
+
+
 def _machine_bytes() -> int:
     try:
         with open("/proc/meminfo") as f:
