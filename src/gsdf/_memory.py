@@ -185,10 +185,10 @@ def work_limit() -> float:
 
 
 def _threads() -> int:
-    try:
-        from gsdf.threads import get_num_threads
+    try:  # threads beyond the cores do not shorten the work
+        from gsdf.threads import available_cpus, get_num_threads
 
-        return max(1, int(get_num_threads()))
+        return max(1, min(int(get_num_threads()), available_cpus()))
     except Exception:  # pragma: no cover - thread setting unreadable: assume one
         return 1
 
