@@ -681,6 +681,11 @@ def test_read_vertex_data_errors(tmp_path):
     (tmp_path / "g.vtu").write_bytes(GARBAGE)
     with pytest.raises(ValueError, match=errmsg(tmp_path / "g.vtu")):
         read_vertex_data(tmp_path / "g.vtu")
+    p = tmp_path / "inf.ply"
+    write_mesh(p, TET_V, TET_F, vertex_data={"d": np.arange(4.0) + 0.5}, binary=False)
+    p.write_bytes(p.read_bytes().replace(b" 2.5\n", b" inf\n"))
+    with pytest.raises(ValueError, match=errmsg(p) + ": vertex property 'd': contains NaN or infinite"):
+        read_vertex_data(p)
 
 
 def test_3mf_without_its_optional_packages_is_a_clear_error(tmp_path):
