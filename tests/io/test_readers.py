@@ -919,6 +919,16 @@ def test_numpy_files_that_are_not_numbers(tmp_path, content, words):
     assert "allow_pickle" not in str(e.value)
 
 
+def test_npy_with_a_byte_inserted_in_its_data(tmp_path):
+    p = tmp_path / "c.npy"
+    np.save(p, TET_V)
+    data = p.read_bytes()
+    k = len(data) - 40
+    p.write_bytes(data[:k] + b"\x00" + data[k:])
+    with pytest.raises(ValueError, match=errmsg(p) + ".*1 more bytes follow; the file is damaged"):
+        read_points(p)
+
+
 def test_ply_with_bom_in_words(tmp_path):
     import gsdf
 
