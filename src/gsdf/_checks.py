@@ -122,6 +122,21 @@ def as_occupancy(x, name: str = "occupancy") -> np.ndarray:
     return np.ascontiguousarray(A)
 
 
+def as_mask(x, n: int, name: str = "mask") -> np.ndarray:
+    """Validate a selection: a boolean array of shape (n,) (0/1 numbers accepted); returns it as bool.
+    Strings, floats other than 0 and 1, and other shapes are refused (``"no"`` would otherwise select)."""
+    A = _array(x, name)
+    if A.shape != (n,):
+        raise ValueError(f"{name}: expected {n} booleans (shape ({n},)), got shape {A.shape}")
+    if A.dtype != bool:
+        if A.dtype.kind not in _REAL_KINDS:
+            raise ValueError(f"{name}: expected booleans, got {_dtype_words(A)}")
+        if not np.isin(A, (0, 1)).all():
+            raise ValueError(f"{name}: expected booleans (or 0/1 values), got dtype {A.dtype} with other values")
+        A = A.astype(bool)
+    return A
+
+
 def flag(x, name: str) -> bool:
     """Validate a switch: ``True``/``False`` (or numpy's bool); strings such as ``"no"``, numbers and None are
     refused (``"no"`` is truthy: accepting it would do the opposite of what was asked)."""
