@@ -39,6 +39,15 @@ def test_parse_rejects(bad):
         threads.parse_num_threads(bad)
 
 
+def test_thread_count_beyond_any_machine_refused():
+    before = threads.get_num_threads()
+    with pytest.raises(ValueError, match="threads must be at most 65536"):
+        threads.parse_num_threads(10**9)
+    with pytest.raises(ValueError, match="at most 65536"):
+        threads.set_num_threads(10**9)
+    assert threads.get_num_threads() == before
+
+
 def test_parse_accepts():
     assert threads.parse_num_threads("3") == 3
     assert threads.parse_num_threads(" 2 ") == 2

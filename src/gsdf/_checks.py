@@ -122,6 +122,21 @@ def as_occupancy(x, name: str = "occupancy") -> np.ndarray:
     return np.ascontiguousarray(A)
 
 
+def as_mask(x, n: int, name: str = "mask") -> np.ndarray:
+    """Validate a selection: a boolean array of shape (n,) (0/1 numbers accepted); returns it as bool.
+    Strings, floats other than 0 and 1, and other shapes are refused (``"no"`` would otherwise select)."""
+    A = _array(x, name)
+    if A.shape != (n,):
+        raise ValueError(f"{name}: expected {n} booleans (shape ({n},)), got shape {A.shape}")
+    if A.dtype != bool:
+        if A.dtype.kind not in _REAL_KINDS:
+            raise ValueError(f"{name}: expected booleans, got {_dtype_words(A)}")
+        if not np.isin(A, (0, 1)).all():
+            raise ValueError(f"{name}: expected booleans (or 0/1 values), got dtype {A.dtype} with other values")
+        A = A.astype(bool)
+    return A
+
+
 def flag(x, name: str) -> bool:
     """Validate a switch: ``True``/``False`` (or numpy's bool); strings such as ``"no"``, numbers and None are
     refused (``"no"`` is truthy: accepting it would do the opposite of what was asked)."""
@@ -416,9 +431,9 @@ def numpy_file(path, what: str = "file") -> str:
     """Check a ``.npy`` or ``.npz`` file before ``np.load`` reads it; returns its path as ``str``.
 
     Besides :func:`readable_file`, the header of each array is compared with the data the file holds: a shape
-    with a negative size, or one whose data is larger than what follows the header (a ``.npz`` member: larger
-    than the member), is a ValueError naming the file and the shape — a truncated file or a corrupt header, which
-    numpy would otherwise answer by trying to allocate the declared size. A file that is neither ``.npy`` nor
+    with a negative size, or one whose data is larger or smaller than what follows the header (a ``.npz``
+    member: than the member), is a ValueError naming the file and the shape — a truncated or damaged file or a
+    corrupt header, which numpy would otherwise answer by allocating the declared size or reading shifted data. A file that is neither ``.npy`` nor
     ``.npz`` data, or an array of Python objects (which gsdf never loads), is refused too. Headers numpy itself
     cannot parse are left to ``np.load`` and its caller.
     """
@@ -477,3 +492,6 @@ def _npy_fits(fh, total: int, p: str, label: str) -> None:
 
         raise ValueError(f"{p}: {label}the header declares shape {tuple(shape)} ({human(need)} of data) but the "
                          f"file holds {human(have)}; it is truncated or its header is corrupt")
+    if need < have:  # numpy writes the data and nothing after it: a byte inserted, or two files joined
+        raise ValueError(f"{p}: {label}the header declares shape {tuple(shape)} ({need:,} bytes of data) but "
+                         f"{have - need:,} more bytes follow; the file is damaged")

@@ -65,6 +65,16 @@ def available_bytes() -> int:
     return min(_machine_bytes(), _address_space_left())
 
 
+def check_environment() -> None:
+    """Read ``GSDF_MEMORY_LIMIT`` and ``GSDF_WORK_LIMIT`` now: a ValueError naming the variable when either is
+    set to something that is not a size / a time, so that a command refuses it before any work even when its
+    request is too small to consult the limits."""
+    env = os.environ.get(ENV)
+    if env:
+        _parse(env)
+    work_limit()
+
+
 def _machine_bytes() -> int:
     try:
         with open("/proc/meminfo") as f:
@@ -138,6 +148,7 @@ SECONDS_PER_QUERY = 1e-6         #: a tree query: fast winding number, distance,
 SECONDS_PER_NODE = 2e-7          #: a node of a grid solve, a field evaluation, an isosurface or voxel pass
 SECONDS_PER_PAIR = 2e-9          #: one query × element term of a direct sum (exact winding numbers)
 SECONDS_PER_CELL = 1e-9          #: one voxel of an elementwise pass over a boolean grid
+SECONDS_PER_FACE_STEP = 5e-8     #: one face in one step of an iterative sweep over a mesh (two sparse products)
 
 _TIME_SUFFIX = {"": 1.0, "S": 1.0, "M": 60.0, "H": 3600.0, "D": 86400.0}
 
@@ -174,10 +185,10 @@ def work_limit() -> float:
 
 
 def _threads() -> int:
-    try:
-        from gsdf.threads import get_num_threads
+    try:  # threads beyond the cores do not shorten the work
+        from gsdf.threads import available_cpus, get_num_threads
 
-        return max(1, int(get_num_threads()))
+        return max(1, min(int(get_num_threads()), available_cpus()))
     except Exception:  # pragma: no cover - thread setting unreadable: assume one
         return 1
 

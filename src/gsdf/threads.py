@@ -45,6 +45,11 @@ ENV_VAR = "GSDF_NUM_THREADS"
 _setting: int | None = None   # set by set_num_threads / limit; None: the environment variable or all cores
 
 
+#: Most threads accepted: more than a process can start on common systems (Linux's default pid_max is 32768);
+#: BLAS would try to start that many.
+MAX_THREADS = 1 << 16
+
+
 def parse_num_threads(value, name: str = "threads") -> int:
     """Validate a thread count: a positive integer (or a string of one, as from the environment).
 
@@ -63,7 +68,7 @@ def parse_num_threads(value, name: str = "threads") -> int:
     Raises
     ------
     ValueError
-        ``value`` is a bool, not an integer, or < 1.
+        ``value`` is a bool, not an integer, < 1 or more than :data:`MAX_THREADS`.
 
     Example
     -------
@@ -88,6 +93,8 @@ def parse_num_threads(value, name: str = "threads") -> int:
                              f"({type(value).__name__})") from None
     if n < 1:
         raise ValueError(f"{name} must be a positive integer (>= 1), got {n}")
+    if n > MAX_THREADS:
+        raise ValueError(f"{name} must be at most {MAX_THREADS} (more threads than a process can start), got {n}")
     return int(n)
 
 
@@ -270,7 +277,7 @@ def set_num_threads(n) -> None:
     Parameters
     ----------
     n : int
-        Positive number of threads. numba's share is capped at its pool size (``NUMBA_NUM_THREADS``,
+        Positive number of threads, at most 65536. numba's share is capped at its pool size (``NUMBA_NUM_THREADS``,
         the cores by default); every BLAS in the process (loaded now or later) gets ``n`` threads.
 
     Raises

@@ -180,13 +180,21 @@ def test_task_bad_options():
 
     for bad, match in [({"n_samples": True}, "n_samples"), ({"margin": float("nan")}, "margin"),
                        ({"sigmas": "a,b"}, "sigmas: expected a number"), ({"beta": -1}, "beta"),
-                       ({"dtype": "int8"}, "dtype"), ({"uniform_fraction": "x"}, "uniform_fraction")]:
+                       ({"dtype": "int8"}, "dtype"), ({"uniform_fraction": "x"}, "uniform_fraction"),
+                       ({"margin": 1e308}, "margin: must be a finite number >= 0 and <= 1e"),
+                       ({"sigmas": "1e308"}, "sigmas: must be a finite positive number <= 1e"),
+                       ({"beta": 1e308}, "beta: must be a finite positive number <= 1e")]:
         with pytest.raises(ValueError, match=match):
             check_options("sdf-samples", bad)
     with pytest.raises(ValueError, match="method"):
         check_options("surface", {"method": "pat"})
     with pytest.raises(ValueError, match="options"):
         sdf_samples(g, options={"margin": 0.1})
+    with pytest.raises(ValueError, match="estimate_normals: expected True or False"):
+        SdfSamplesOptions(estimate_normals="yes")
+    with pytest.raises(ValueError, match="estimate_normals: expected True or False"):
+        sdf_grid(g, resolution=8, estimate_normals="yes")
+    assert check_options("sdf-samples", {"estimate_normals": "yes"})["estimate_normals"] is True  # a CSV cell
     from gsdf.batch import run_task
 
     with pytest.raises(ValueError, match="'bisection' does not apply"):
@@ -465,6 +473,18 @@ def test_unreachable_scheduler_leaves_nothing(dataset, tmp_path):
         run_batch(str(dataset), "occupancy", str(tmp_path / "new" / "out"), executor="tcp://127.0.0.1:9",
                   batch_options=BatchOptions(scheduler_timeout=1))
     assert os.listdir(tmp_path) == []  # neither the lock nor the folders this run created
+
+
+@pytest.mark.parametrize("args", [["--workers", "1000000000"], ["--dask-local", "1000000000"],
+                                  ["--scheduler", ""], ["--sigmas", "1e308"], ["--beta", "1e308"]])
+def test_refused_executor_or_option_leaves_nothing(dataset, tmp_path, args):
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["batch", str(dataset), "--task", "sdf-samples", "-o", str(out),
+                                  "--n-points", "200", "--quiet", *args])
+    assert r.exit_code in (1, 2), r.output
+    assert ("--scheduler" if args[0] == "--scheduler" else args[0][2:].replace("-", "_")
+            if args[0] != "--dask-local" else "workers") in r.output
+    assert not out.exists()
 
 
 def test_two_runs_on_one_folder(dataset, tmp_path, local1):

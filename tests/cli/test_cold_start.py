@@ -134,6 +134,9 @@ def test_cli_prints_notice_on_cold_cache_only(tmp_path):
 def test_warmup_rejects_unknown_job():
     res = CliRunner().invoke(main, ["warmup", "--only", "nonsense"])
     assert res.exit_code == 1 and "unknown warm-up job 'nonsense'" in res.output
+    for empty in ("", " , "):
+        res = CliRunner().invoke(main, ["warmup", "--only", empty])
+        assert res.exit_code == 1 and "--only: expected comma-separated job names" in res.output
     from gsdf.cli.warmup import warm
 
     with pytest.raises(ValueError, match="unknown warm-up job"):

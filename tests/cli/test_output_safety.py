@@ -348,6 +348,15 @@ def test_memory_error_is_one_line(inputs, tmp_path, monkeypatch):
     assert os.listdir(tmp_path) == []
 
 
+@pytest.mark.parametrize("var, value", [("GSDF_MEMORY_LIMIT", "nan"), ("GSDF_MEMORY_LIMIT", "x"),
+                                        ("GSDF_WORK_LIMIT", "soon")])
+def test_limit_variables_checked_before_any_work(inputs, tmp_path, monkeypatch, var, value):
+    monkeypatch.setenv(var, value)
+    r = invoke(["sdf", inputs["mesh"], "--resolution", "6", "-q", "-o", tmp_path / "g.npz"])
+    assert var in assert_clean_failure(r)
+    assert os.listdir(tmp_path) == []
+
+
 @pytest.mark.parametrize("kind", ["fifo", "dir", "dev"])
 def test_inputs_that_are_not_regular_files(inputs, tmp_path, kind):
     p = tmp_path / "in.off"

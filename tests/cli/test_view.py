@@ -95,6 +95,13 @@ def test_errors_are_one_line(tmp_path, monkeypatch):
     assert r.exit_code == 1 and "refusing to overwrite an input" in r.output
     r = _run(tmp_path / "m.off", "--axis", "w")
     assert r.exit_code == 2 and "--axis" in r.output
+    r = _run(tmp_path / "m.off", "--field", "", "--screenshot", tmp_path / "x.png")
+    assert r.exit_code == 1 and "--field: expected the name of a vertex property" in r.output
+    r = _run(tmp_path / "m.off", "--field", "distance", "--screenshot", tmp_path / "x.png")
+    assert r.exit_code == 1 and "--field distance: none of the files" in r.output
+    gsdf.write_mesh(tmp_path / "d.ply", V, F, vertex_data={"distance": V[:, 0]})
+    r = _run(tmp_path / "d.ply", "--field", "other", "--screenshot", tmp_path / "x.png")
+    assert r.exit_code == 1 and "no vertex property 'other'" in r.output
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     if sys.platform.startswith("linux"):          # elsewhere a window can always open

@@ -54,3 +54,18 @@ def test_contouring_functions_returning_non_real_values(bad, why):
         gsdf.extract_isosurface(bad, [-1] * 3, [1] * 3, resolution=8, level=0)
     with pytest.raises(ValueError, match=why):
         gsdf.slice_contours(bad, [0.0], [-1] * 3, [1] * 3, resolution=8, level=0)
+
+
+def test_region_boundary_curves_checks_its_arrays():
+    from gsdf.contour._surface_curves import region_boundary_curves
+
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    assert [c.tolist() for c in region_boundary_curves(F, [1, 1])] == [[0, 1, 2, 3, 0]]
+    with pytest.raises(ValueError, match="F: expected integer indices, got booleans"):
+        region_boundary_curves(F.astype(bool), [True, True])
+    with pytest.raises(ValueError, match="face_mask: expected booleans, got strings"):
+        region_boundary_curves(F, np.array(["no", "no"]))
+    with pytest.raises(ValueError, match="face_mask: expected booleans .or 0/1 values."):
+        region_boundary_curves(F, [0.5, 1.0])
+    with pytest.raises(ValueError, match=r"face_mask: expected 2 booleans \(shape \(2,\)\), got shape \(3,\)"):
+        region_boundary_curves(F, [True, True, False])

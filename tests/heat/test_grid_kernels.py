@@ -104,6 +104,15 @@ def test_yukawa_tree_matches_direct_sum():
     assert (np.linalg.norm(exact - Xd, axis=1) / np.linalg.norm(Xd, axis=1)).max() < 1e-6
 
 
+def test_yukawa_tree_refuses_a_progress_that_is_not_callable():
+    tree = YukawaTree(np.eye(3), np.eye(3), t=0.01)
+    with pytest.raises(ValueError, match="progress: expected a callable"):
+        tree([[0.5, 0.0, 0.2]], progress=3)
+    seen = []
+    tree([[0.5, 0.0, 0.2]], progress=lambda stage, f: seen.append(f))
+    assert seen == [1.0]
+
+
 @pytest.mark.parametrize("k", [5, 41, 161])
 def test_candidate_search_same_sets_as_kd_tree(k):
     P = np.random.default_rng(k).random((700, 3))

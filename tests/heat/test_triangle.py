@@ -252,6 +252,10 @@ def test_sharpening_keeps_sign_and_lipschitz(disk):
     assert _eps(solver, phi, exact) < 1.2 * _eps(solver, phi0, exact) + 1e-3
     with pytest.raises(ValueError, match="phi0"):
         solver.sharpen(phi0[:-1], curves)
+    with pytest.raises(ValueError, match="phi0: expected real numbers, got strings"):
+        solver.sharpen(phi0.astype(str), curves)
+    with pytest.raises(ValueError, match="iterations=1,000,000,000 .* would take"):
+        solver.sharpen(phi0, curves, iterations=10**9)
 
 
 def test_faces_repeating_a_vertex_are_dropped_with_a_warning():

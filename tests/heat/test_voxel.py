@@ -327,6 +327,9 @@ def test_bad_input():
     for bad in (np.nan, -1.0, 0.0, [1, 1], [1, np.inf, 1], True, "x"):
         with pytest.raises(ValueError, match="spacing"):
             VoxelSurfaceSignedHeatSolver(occ, spacing=bad)
+    for bad in (1e308, [1.0, 1.0, 1e200]):
+        with pytest.raises(ValueError, match="spacing: .* is too large"):
+            VoxelSurfaceSignedHeatSolver(occ, spacing=bad)
     for bad in (-1.0, np.nan, True, "x"):
         with pytest.raises(ValueError, match="normal_radius"):
             VoxelSurfaceSignedHeatSolver(occ, normal_radius=bad)

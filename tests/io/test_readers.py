@@ -681,6 +681,11 @@ def test_read_vertex_data_errors(tmp_path):
     (tmp_path / "g.vtu").write_bytes(GARBAGE)
     with pytest.raises(ValueError, match=errmsg(tmp_path / "g.vtu")):
         read_vertex_data(tmp_path / "g.vtu")
+    p = tmp_path / "inf.ply"
+    write_mesh(p, TET_V, TET_F, vertex_data={"d": np.arange(4.0) + 0.5}, binary=False)
+    p.write_bytes(p.read_bytes().replace(b" 2.5\n", b" inf\n"))
+    with pytest.raises(ValueError, match=errmsg(p) + ": vertex property 'd': contains NaN or infinite"):
+        read_vertex_data(p)
 
 
 def test_3mf_without_its_optional_packages_is_a_clear_error(tmp_path):
@@ -912,6 +917,16 @@ def test_numpy_files_that_are_not_numbers(tmp_path, content, words):
     with pytest.raises(ValueError, match=errmsg(p) + ".*" + words) as e:
         read_points(p)
     assert "allow_pickle" not in str(e.value)
+
+
+def test_npy_with_a_byte_inserted_in_its_data(tmp_path):
+    p = tmp_path / "c.npy"
+    np.save(p, TET_V)
+    data = p.read_bytes()
+    k = len(data) - 40
+    p.write_bytes(data[:k] + b"\x00" + data[k:])
+    with pytest.raises(ValueError, match=errmsg(p) + ".*1 more bytes follow; the file is damaged"):
+        read_points(p)
 
 
 def test_ply_with_bom_in_words(tmp_path):

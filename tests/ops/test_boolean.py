@@ -120,3 +120,12 @@ def test_arrangement_shares_exact_intersection_points():
                                     .transpose(1, 0, 2)), axis=1).sum() / 2
         T = V[F[f]]
         assert a == pytest.approx(np.linalg.norm(np.cross(T[1] - T[0], T[2] - T[0])) / 2, rel=1e-12)
+
+
+@pytest.mark.parametrize("s", [1e150, 1e-150])
+def test_scaled_operands_give_the_scaled_result(s):
+    A, B = box([0.0] * 3, [1.0] * 3), box([0.5] * 3, [1.5] * 3)
+    V0, F0 = mesh_boolean(*A, *B, "union")
+    Vs, Fs = mesh_boolean(A[0] * s, A[1], B[0] * s, B[1], "union")
+    assert np.array_equal(Fs, F0)
+    np.testing.assert_allclose(Vs / s, V0, rtol=1e-12, atol=0)

@@ -228,3 +228,10 @@ def test_view_fill_takes_numpy_floats():
     assert gsdf.ViewOptions(fill=np.float32(0.86)).fill == np.float32(0.86)
     with pytest.raises(ValueError, match=r"fill: expected a number in \(0, 1\]"):
         gsdf.ViewOptions(fill=1.5)
+
+
+@pytest.mark.parametrize("bad", [b"viridis", "", 3])
+def test_colormap_must_be_a_name(bad):
+    with pytest.raises(ValueError, match="colormap: expected the name of a polyscope colour map"):
+        gsdf.ViewOptions(colormap=bad)
+    assert gsdf.ViewOptions(colormap="turbo").colormap == "turbo"

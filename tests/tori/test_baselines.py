@@ -50,3 +50,20 @@ def test_given_areas_and_lambda_scale_too():
         gsdf.SignedHopfCole(P, P, areas=a + 1j)
     with pytest.raises(ValueError, match="areas: contains NaN"):
         gsdf.SignedHopfCole(P, P, areas=a * np.nan)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_neighbour_counts_beyond_the_cloud_are_refused(name):
+    P = fibonacci_sphere(300)
+    for key in ("k_eval", "k_fallback"):
+        with pytest.raises(ValueError, match=f"{key}: 1000000000 neighbours asked for"):
+            getattr(gsdf, name)(P, P, **{key: 10**9})
+
+
+def test_winding_pipeline_checks_the_corner_it_is_given():
+    P = fibonacci_sphere(300)
+    for key, bad in (("bbox_min", []), ("bbox_max", [1.0, 2.0]), ("bbox_min", "abc")):
+        with pytest.raises(ValueError, match=key):
+            gsdf.WindingNumberPipeline(P, P, resolution=16, **{key: bad})
+    W = gsdf.WindingNumberPipeline(P, P, resolution=16, bbox_min=[-1.5, -1.5, -1.5])
+    assert W.V.min() > -1.5

@@ -108,6 +108,8 @@ def test_bad_input():
         point_areas(P, U, k=2.5)
     with pytest.raises(ValueError, match="boundary"):
         point_areas(P, U, boundary="disk")
+    with pytest.raises(ValueError, match="candidates: expected an integer <= 100"):
+        point_areas(P, U, candidates=10**9)
     with pytest.raises(ValueError, match="at least 3 points"):
         estimate_normals(P[:2])
     with pytest.raises(ValueError, match="orient_towards"):

@@ -234,12 +234,23 @@ def _remove_stale_parts(out) -> None:
                     pass
 
 
+#: Memory of one worker process at rest (Python, numpy, numba and gsdf loaded): a lower bound, so that a worker
+#: count the machine cannot start is refused before any process is.
+WORKER_BYTES = 100 << 20
+
+
 def _executor_spec(workers, executor):
     """Validate ``workers`` / ``executor`` before any work; returns a function that builds the executor (None:
     the caller's own executor object)."""
     from gsdf.batch._executors import DaskExecutor, LocalExecutor
 
-    _count("workers", workers)
+    if _count("workers", workers) is not None:
+        from gsdf._memory import check_bytes
+
+        check_bytes(workers * WORKER_BYTES, f"workers: {workers:,} worker processes")
+    if isinstance(executor, str) and not executor.strip():
+        raise ValueError("executor: expected 'local', 'dask' or a scheduler address like tcp://host:8786, got an "
+                         "empty string")
     if executor is None or isinstance(executor, str):
         kind = executor or "local"
         if kind not in ("local", "dask") and workers is not None:

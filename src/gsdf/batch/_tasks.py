@@ -42,7 +42,7 @@ import os
 
 import numpy as np
 
-from gsdf._checks import _real, choice, integer, positive
+from gsdf._checks import _real, choice, flag, integer, nonnegative, positive
 from gsdf._memory import SECONDS_PER_QUERY, check_bytes, check_work
 from gsdf.grid import Grid
 from gsdf.io._geometry import Geometry, load_geometry
@@ -163,7 +163,7 @@ class SdfSamplesOptions:
     sigmas : sequence of float, default (0.05, 0.0158)
         Near-surface offset scales, fractions of the frame scale: DeepSDF's variances 0.0025 and 0.00025 in the
         unit sphere.
-    margin : float, default 0.05
+    margin : float in [0, 1e6], default 0.05
         The task's cube has half-side ``1 + margin`` frame scales (the module docstring).
     heat_resolution : int, default 64
         With ``sign="heat"``: nodes along the longest side of the signed heat method's grid.
@@ -201,7 +201,7 @@ class OccupancyOptions:
         Share of the points drawn uniformly in the task's cube (the rest: near the surface).
     sigmas : sequence of float, default (0.01,)
         Near-surface offset scales, fractions of the frame scale.
-    margin : float, default 0.1
+    margin : float in [0, 1e6], default 0.1
         The task's cube has half-side ``1 + margin`` frame scales (the module docstring).
     beta : float, optional
         Fast winding number accuracy (default 2 for meshes, 2.3 for clouds).
@@ -227,7 +227,9 @@ def _check_fields(opts) -> None:
     """A ValueError naming the attribute of an options dataclass, at construction (the checks of the flags)."""
     for f in dataclasses.fields(opts):
         v = getattr(opts, f.name)
-        if v is not None or f.name != "beta":
+        if isinstance(f.default, bool):
+            flag(v, f.name)  # a switch given in Python: True or False, not the words of a CSV cell
+        elif v is not None or f.name != "beta":
             _CHECKS[f.name](v, f.name)
 
 
@@ -243,7 +245,7 @@ def _task_options(task, values: dict) -> dict:
         if not isinstance(opts, cls):
             raise ValueError(f"options: expected a gsdf.batch.{cls.__name__}, got {type(opts).__name__}")
         flat.update(dataclasses.asdict(opts))
-    return check_options(task, flat)
+    return check_options(task, flat, python=True)
 
 
 def sdf_samples(source, n_samples: int = 250_000, sign: str = "winding", normalize: str = "none", seed: int = 0,
@@ -385,7 +387,7 @@ def sdf_grid(source, resolution: int = 128, method: str = "fast", normalize: str
     >>> out["sdf"].shape                                    # doctest: +SKIP
     (64, 64, 64)
     """
-    o = check_options("sdf-grid", locals_without_source(locals()))
+    o = check_options("sdf-grid", locals_without_source(locals()), python=True)
     check_grid_size(o["resolution"])
     geo = _geometry(source, o["estimate_normals"])
     if o["method"] == "pat" and geo.is_mesh:
@@ -430,7 +432,7 @@ def surface(source, resolution: int = 128, method: str = "winding", normalize: s
     >>> out["faces"].shape[1]                               # doctest: +SKIP
     3
     """
-    o = check_options("surface", locals_without_source(locals()))
+    o = check_options("surface", locals_without_source(locals()), python=True)
     check_grid_size(o["resolution"])
     geo = _geometry(source, o["estimate_normals"])
     c, s, c0, s0 = frame(geo.X, o["normalize"])
@@ -495,11 +497,13 @@ def _unit(x, name):
     return x
 
 
+#: Largest ``margin`` and ``sigmas`` (frame scales): a cube or an offset a million times the input's size says
+#: nothing of its shape, and near 1e308 the cube's side overflows (NaN samples).
+SPREAD_MAX = 1e6
+
+
 def _nonneg(x, name):
-    x = _float(x, name)
-    if not (np.isfinite(x) and x >= 0):
-        raise ValueError(f"{name}: must be a finite number >= 0, got {x}")
-    return x
+    return nonnegative(_float(x, name), name, most=SPREAD_MAX)
 
 
 def _sigmas(x, name):
@@ -507,7 +511,7 @@ def _sigmas(x, name):
         x = [t for t in x.split(",") if t.strip()]
     if np.ndim(x) != 1:
         raise ValueError(f"{name}: expected a list of positive numbers, got {x!r}")
-    return tuple(positive(_float(v, name), name) for v in x)
+    return tuple(positive(_float(v, name), name, most=SPREAD_MAX) for v in x)
 
 
 def _flag(x, name):
@@ -530,7 +534,9 @@ def _int(lo):
 
 
 def _optional_positive(x, name):
-    return None if x is None or x == "" else positive(_float(x, name), name)
+    from gsdf.winding._fast import BETA_MAX
+
+    return None if x is None or x == "" else positive(_float(x, name), name, most=BETA_MAX)
 
 
 _CHECKS = {
@@ -564,9 +570,10 @@ def task_defaults(task) -> dict:
     return out
 
 
-def check_options(task, options: dict, where: str = "") -> dict:
+def check_options(task, options: dict, where: str = "", python: bool = False) -> dict:
     """Validate the options of ``task``: every key must be one of its parameters; returns them with defaults
     filled in and values converted (strings from CSV manifests are parsed). Raises ValueError naming the option.
+    ``python``: the options come from a Python call, where a switch must be True or False (not ``"yes"``).
     """
     task = task_name(task)
     defaults = task_defaults(task)
@@ -583,6 +590,8 @@ def check_options(task, options: dict, where: str = "") -> dict:
         elif k == "surface_format":
             out[k] = None if v in (None, "", "none") else choice(str(v).lower().lstrip("."), f"{prefix}{k}",
                                                                   SURFACE_FORMATS)
+        elif python and isinstance(defaults[k], bool):
+            out[k] = flag(v, f"{prefix}{k}")
         elif v is not None or k != "beta":
             out[k] = _CHECKS[k](v, f"{prefix}{k}")
     if "uniform_fraction" in out and out["uniform_fraction"] < 1 and not out["sigmas"]:

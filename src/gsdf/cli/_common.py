@@ -34,6 +34,7 @@ import warnings
 import click
 import numpy as np
 
+from gsdf._memory import check_environment
 from gsdf.io._geometry import Geometry, load_geometry  # noqa: F401  (the CLI commands import them from here)
 from gsdf.io._safe_write import _FILE_MODE, check_output_path, extension_of, same_file
 
@@ -322,6 +323,7 @@ def report_errors(fn):
         no_clobber = bool(kwargs.pop("no_clobber", False))
         ctx = click.get_current_context(silent=True)
         try:
+            check_environment()
             with outputs(_input_paths(ctx), overwrite=not no_clobber) as out, warnings.catch_warnings():
                 warnings.showwarning = _plain_warnings(warnings.showwarning)
                 for name in OUTPUT_PARAMS:

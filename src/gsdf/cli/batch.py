@@ -128,6 +128,9 @@ def batch(inputs, task, output_dir, workers, dask_local, scheduler, scheduler_ti
               if v is not None]
     if len(chosen) > 1:
         raise click.UsageError(f"conflicting options: {' and '.join(chosen)} (choose one executor)")
+    if scheduler is not None and not scheduler.strip():
+        raise click.BadParameter("expected an address like tcp://host:8786, got an empty string",
+                                 param_hint="--scheduler")
     given = _library_options(task, task_options)
     bar = None
     counts = {"done": 0, "failed": 0, "skipped": 0}

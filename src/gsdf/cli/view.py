@@ -79,10 +79,14 @@ def view(files, output, size, up, azimuth, elevation, level, axis, at, field_nam
 def items_from_files(paths, field_name=None, title=None) -> list:
     """What :func:`gsdf.view` shows of each file (see the command's help); curve files go on the mesh before them.
     ``title`` names the first field."""
-    items, mesh = [], None
+    if field_name is not None and not field_name.strip():
+        raise ValueError("--field: expected the name of a vertex property, got an empty string")
+    items, mesh, used = [], None, []
     for p in paths:
-        (name, item), mesh = _item(p, mesh, field_name)
+        (name, item), mesh = _item(p, mesh, field_name, used)
         items.append([name, item, os.path.basename(p)])
+    if field_name is not None and not used:
+        raise ValueError(f"--field {field_name}: none of the files is a PLY/VTK/VTU mesh with vertex properties")
     fields = [it for it in items if _has_field(it[1])]
     for it in fields:
         if title is not None:
@@ -99,8 +103,9 @@ def _has_field(item) -> bool:
     return isinstance(item, Field) or (isinstance(item, tuple) and len(item) == 3)
 
 
-def _item(p, mesh, field_name):
-    """(item for gsdf.view, the mesh (V, F) that later curve files refer to)."""
+def _item(p, mesh, field_name, used=None):
+    """(item for gsdf.view, the mesh (V, F) that later curve files refer to); appends ``p`` to ``used`` when
+    ``field_name`` picked one of its vertex properties."""
     from gsdf.io import read_mesh, read_points
 
     name = os.path.basename(p)
@@ -134,6 +139,8 @@ def _item(p, mesh, field_name):
             key = field_name if field_name is not None else next(iter(data))
             if key not in data:
                 raise ValueError(f"{p}: no vertex property {key!r} (it has {', '.join(data)})")
+            if field_name is not None and used is not None:
+                used.append(p)
             unit = " [model units]" if key in ("distance", "values", "sdf") else ""
             return (f"{key}{unit}", (V, F, data[key])), (V, F)
     return (name, (V, F)), (V, F)

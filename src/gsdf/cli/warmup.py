@@ -215,6 +215,8 @@ Example:
 @report_errors
 def warmup(only, workers, quiet):
     names = None if only is None else [t.strip() for t in only.split(",") if t.strip()]
+    if names == []:
+        raise ValueError(f"--only: expected comma-separated job names ({', '.join(JOBS)}), got {only!r}")
     t0 = time.perf_counter()
     if not quiet:
         click.echo(f"compiling gsdf's kernels ({', '.join(names or JOBS)}) ...")

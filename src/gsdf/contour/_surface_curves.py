@@ -125,7 +125,7 @@ def region_boundary_curves(F, face_mask) -> list:
     Raises
     ------
     ValueError
-        ``face_mask`` not one bool per face.
+        ``F`` not an array of vertex indices, ``face_mask`` not one bool per face.
 
     Examples
     --------
@@ -134,10 +134,8 @@ def region_boundary_curves(F, face_mask) -> list:
     >>> [c.tolist() for c in gsdf.region_boundary_curves(F, np.array([True, True]))]
     [[0, 1, 2, 3, 0]]
     """
-    F = np.asarray(F, dtype=np.int64)
-    mask = np.asarray(face_mask, dtype=bool)
-    if mask.shape != (len(F),):
-        raise ValueError(f"face_mask: expected shape ({len(F)},), got {mask.shape}")
+    F = _checks.as_faces(F, _checks.MAX_INT, "F", corners=None, allow_empty=True)
+    mask = _checks.as_mask(face_mask, len(F), "face_mask")
     Fr = F[mask]
     he = np.stack([Fr.ravel(), np.roll(Fr, -1, axis=1).ravel()], axis=1)   # halfedges i -> j
     n = int(F.max()) + 1 if len(F) else 0

@@ -37,7 +37,7 @@ import numpy as np
 from numba import njit, prange
 from scipy.spatial import cKDTree
 
-from gsdf._checks import as_points, as_values, integer, nonnegative, positive
+from gsdf._checks import as_points, as_values, integer, nonnegative, positive, progress_callback
 from gsdf._memory import SECONDS_PER_PAIR, SECONDS_PER_QUERY
 from gsdf.spatial._bvh import build_bvh
 
@@ -193,7 +193,7 @@ class YukawaTree:
         Vector charges ``|f| N_f`` (area-weighted normals, or normals × point areas).
     t : float
         Diffusion time (square model units, > 0); λ = 1/√t.
-    theta : float, default 0.5
+    theta : float >= 0, default 0.5
         Cluster acceptance tolerance: a tree node of radius ρ at distance r is used through its second-order
         expansion when ``E³ exp(λρ − λ(r − d*)) < theta³``, E = ρ (λ + 1/r). Smaller is more accurate and
         slower; 0 disables clustering.
@@ -280,6 +280,7 @@ class YukawaTree:
             dref = as_values(dref, "dref", (len(Q),), allow_empty=True)
         slack = nonnegative(slack, "slack")
         chunk = integer(chunk, "chunk", 1)
+        progress = progress_callback(progress)
         out = np.empty((len(Q), 3))
         t = self.tree
         band = self.tau / self.lam + 2.0 * float(slack)
@@ -288,8 +289,7 @@ class YukawaTree:
             d = self.nearest_distance(q) if dref is None else dref[s:s + chunk]
             _tree_kernel(q, d, self._B, self._W, self._D, self._erho, t.lo, t.hi, t.right, t.skip, t.start, t.end,
                          self.lam, self.theta, band, self._rmin, out[s:s + chunk])
-            if progress is not None:
-                progress("Yukawa sums", (s + len(q)) / len(Q))
+            progress("Yukawa sums", (s + len(q)) / len(Q))
         return out
 
     def direct(self, Q) -> np.ndarray:

@@ -683,6 +683,11 @@ def read_vertex_data(path) -> dict:
     dict of str -> (n,) or (n, k) float64 ndarray
         In file order; aligned with the ``V`` of :func:`read_mesh` on the same file.
 
+    Raises
+    ------
+    ValueError
+        A malformed file, or a property holding NaN, infinite or non-numeric values.
+
     Examples
     --------
     >>> write_mesh("m.ply", V, F, vertex_data={"distance": d})      # doctest: +SKIP
@@ -708,7 +713,7 @@ def read_vertex_data(path) -> dict:
                 continue
             if v[name].dtype == object:
                 raise ValueError(f"{p}: vertex property {name!r} is a list, not a scalar")
-            out[name] = np.asarray(v[name], dtype=np.float64)
+            out[name] = as_values(v[name], f"{p}: vertex property {name!r}", allow_empty=True)
         return out
     from gsdf.io._external import _read_meshio_raw
 
@@ -717,9 +722,9 @@ def read_vertex_data(path) -> dict:
     for name, a in m.point_data.items():
         a = np.asarray(a)
         if a.ndim == 1 or (a.ndim == 2 and a.shape[1] == 1):
-            out[name] = a.reshape(-1).astype(np.float64)
+            out[name] = as_values(a.reshape(-1), f"{p}: point data {name!r}", allow_empty=True)
         elif a.ndim == 2:
-            out[name] = a.astype(np.float64)
+            out[name] = as_values(a, f"{p}: point data {name!r}", allow_empty=True)
     return out
 
 

@@ -220,6 +220,9 @@ def _separated(V, F, I, J):
     """Pairs certainly meeting in nothing more than their shared vertices: the unshared vertices of one are all
     certainly on one side of the other's plane."""
     out = np.zeros(len(I), bool)
+    big = float(np.abs(V).max()) if V.size else 0.0
+    if big > 0.0:  # a power of two (exact, signs unchanged): no overflow of the products at 1e150
+        V = np.ldexp(V, -int(np.frexp(big)[1]))
     for X, Y in ((I, J), (J, I)):
         T, U = F[X], F[Y]
         pos = np.ones(len(X), bool)

@@ -380,11 +380,14 @@ def mesh_boolean(VA, FA, VB, FB, op, winding_a=None, winding_b=None, options: Bo
             fields.append((lambda g: lambda Q: g(frame.queries(Q)))(f))
     # each piece: the regions just in front of it and just behind it (a thousandth of its inradius away, along
     # the normal of its input triangle, which is exact)
+    # lengths, areas and normals with the coordinates scaled by the frame's power of two (exact: the same bits
+    # at ordinary scales), so that squares and cross products of 1e150 coordinates do not overflow
     X = arr.V[arr.F]
-    e = np.linalg.norm(X - X[:, [1, 2, 0]], axis=2).sum(axis=1)
-    area2 = np.linalg.norm(np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]), axis=1)
-    inradius = area2 / np.maximum(e, np.finfo(float).tiny)
-    P = V[F[arr.parent]]
+    Xs = np.ldexp(X, -frame.exponent)
+    e = np.linalg.norm(Xs - Xs[:, [1, 2, 0]], axis=2).sum(axis=1)
+    area2 = np.linalg.norm(np.cross(Xs[:, 1] - Xs[:, 0], Xs[:, 2] - Xs[:, 0]), axis=1)
+    inradius = np.ldexp(area2 / np.maximum(e, np.finfo(float).tiny), frame.exponent)
+    P = np.ldexp(V[F[arr.parent]], -frame.exponent)
     n = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     c = X.mean(axis=1)

@@ -82,6 +82,9 @@ class ViewOptions:
             positive(self.fill, "fill", most=1.0)
         except ValueError:
             raise ValueError(f"fill: expected a number in (0, 1], got {self.fill!r}") from None
+        if self.colormap is not None and (not isinstance(self.colormap, str) or not self.colormap.strip()):
+            raise ValueError(f"colormap: expected the name of a polyscope colour map such as 'viridis', got "
+                             f"{self.colormap!r}")
         if self.vrange is not None:
             from gsdf.render._scene import colour_range
 

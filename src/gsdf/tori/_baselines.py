@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_points, as_weights, integer, positive, query_shaped
+from gsdf._checks import as_points, as_values, as_weights, integer, neighbours, positive, query_shaped
 from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.tori._blend import NeighbourBlend
@@ -89,7 +89,8 @@ class _Convolution:
         self.C = positive(C, "C")
         self.lam = 0.0 if lam is None else positive(lam, "lam")
         r_eval = None if r_eval is None else positive(r_eval, "r_eval")
-        k_eval, k_fallback = integer(k_eval, "k_eval"), integer(k_fallback, "k_fallback")
+        k_eval = neighbours(k_eval, len(self.P), "k_eval", default=64)
+        k_fallback = neighbours(k_fallback, len(self.P), "k_fallback", default=32)
         # scale invariance: points, areas, λ and R_eval scaled by the power of two of the cloud's normalised frame
         # (gsdf._normalize; not centred: scaling by 2^k is exact, so at ordinary scales the sums are bitwise
         # those of the input units, while a translation would move the truncated neighbour sums by ~1e-6)
@@ -352,7 +353,8 @@ class WindingNumberPipeline:
     P, N : (n, 3) float
         Oriented points (outward normals), model units.
     bbox_min, bbox_max : (3,) float, optional
-        Box contoured (default: the cloud's bounding box grown by 0.1 of its diagonal on every side).
+        Box contoured (default: the cloud's bounding box grown by 0.1 of its diagonal on every side; a corner
+        not given is that box's).
     resolution : int or gsdf.Grid, default 64
         Marching-cubes grid nodes along the longest side of the box (64 as in §7.2); or the
         :class:`gsdf.Grid` to contour on (then omit the box).
@@ -393,7 +395,9 @@ class WindingNumberPipeline:
         P = as_points(P, "P")
         fwn = FastWindingNumberPoints(P, N, areas=areas)
         if (bbox_min is None or bbox_max is None) and not isinstance(resolution, Grid):
-            bbox_min, bbox_max = padded_box(P)
+            lo, hi = padded_box(P)  # the corner not given
+            bbox_min = lo if bbox_min is None else as_values(bbox_min, "bbox_min", (3,))
+            bbox_max = hi if bbox_max is None else as_values(bbox_max, "bbox_max", (3,))
         self.V, self.F = extract_isosurface(fwn, bbox_min, bbox_max, resolution, level=0.5, inside="above")
         if len(self.F) == 0:
             raise ValueError("the winding number of the cloud never crosses 1/2 in the box: no surface to measure")

@@ -695,9 +695,13 @@ def _eval_points(Q, P, NA, N, C, beta2, order, out):
         out[qi] = acc
 
 
+#: Largest accuracy parameter β: β² multiplies node radii² in the walk, and beyond 1e150 it overflows (every node
+#: would be opened anyway).
+BETA_MAX = 1e150
+
+
 def _check_params(beta, order):
-    # β² multiplies node radii² in the walk: beyond 1e150 it overflows (every node would be opened anyway)
-    beta = positive(beta, "beta", most=1e150)
+    beta = positive(beta, "beta", most=BETA_MAX)
     if isinstance(order, (bool, np.bool_)) or np.ndim(order) != 0 or order not in (0, 1, 2):
         raise ValueError(f"order: must be 0, 1 or 2, got {order!r}")
     return beta, int(order)

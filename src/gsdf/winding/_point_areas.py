@@ -448,7 +448,9 @@ def _point_areas(P: np.ndarray, N: np.ndarray, k: int = 20, boundary: str = "hul
     if n < 2:
         raise ValueError(f"P: need at least 2 points to estimate point areas, got {n}")
     kk = min(k, n - 1)
-    kc = min(n - 1, kk * min(integer(candidates, "candidates", 1), n))
+    # more than n candidates per neighbour is more than the cloud holds: refused rather than clamped
+    candidates = integer(candidates, "candidates", 1, hi=max(n, 8))
+    kc = min(n - 1, kk * min(candidates, n))
     # scale invariance: areas are computed in the cloud's normalised frame and scaled back (gsdf._normalize)
     frame = Frame.of(P)
     P = frame.geometry(P, "P")

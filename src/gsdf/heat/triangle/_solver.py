@@ -401,9 +401,12 @@ class SurfaceSignedHeatSolver:
         """
         from gsdf.heat.triangle._sharpen import sharpen
 
-        phi0 = np.asarray(phi0, dtype=np.float64)
-        if phi0.shape != (self.ops.n_vertices,) or not np.isfinite(phi0).all():
-            raise ValueError(f"phi0: expected {self.ops.n_vertices} finite values, got shape {phi0.shape}")
+        from gsdf._memory import SECONDS_PER_FACE_STEP, check_work
+
+        phi0 = _checks.as_values(phi0, "phi0", (self.ops.n_vertices,))
+        iterations = _checks.integer(iterations, "iterations")
+        check_work(iterations * self.ops.n_faces, SECONDS_PER_FACE_STEP,
+                   f"sharpen: iterations={iterations:,} on {self.ops.n_faces:,} faces", parallel=False)
         phi0 = self.frame.inverse_length(phi0)
         curves, points, _ = self._kept_faces(curves, points, None)
         ops0 = self.input_ops
@@ -419,7 +422,7 @@ class SurfaceSignedHeatSolver:
         values = phi0.copy()
         fixed[vertex[vertex >= 0]] = True
         values[vertex[vertex >= 0]] = 0.0
-        out = sharpen(self.ops, phi0, fixed, values, iterations=_checks.integer(iterations, "iterations"))[0]
+        out = sharpen(self.ops, phi0, fixed, values, iterations=iterations)[0]
         return self.frame.length(out)
 
     def split_curve(self, curve) -> list:

@@ -41,7 +41,7 @@ class VolumeHeatOptions:
     t_scale : {"grid", "input"}
         The h of t = t_coef · h²: the grid spacing (default; on tets the lattice spacing near the input), or the
         input's own spacing (:func:`input_spacing`: mean edge length, or mean neighbour distance of a cloud).
-    theta : float
+    theta : float >= 0
         Cluster error tolerance of the tree-accelerated Yukawa sum of Step I (:class:`YukawaTree`); 0 sums
         every source directly.
     mesher : {"delaunay", "tetgen"}

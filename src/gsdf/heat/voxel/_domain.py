@@ -347,6 +347,11 @@ class VoxelSurfaceSignedHeatSolver:
         # entry into [1, 2) (exact; e = 0 for unit voxels), and scale lengths back by 2^e on output
         sp = as_spacing(spacing)
         self.exponent = e = int(np.frexp(float(sp.max()))[1]) - 1
+        # the grid's extent (spacing × voxels) and the diffusion time (∝ spacing²) must be representable
+        n_max = max((int(x) for x in np.shape(occupancy)), default=1) + 1
+        if not (np.isfinite(float(sp.max()) * n_max) and np.isfinite(np.ldexp(4.0 * _checks.T_COEF_MAX, 2 * e))):
+            raise ValueError(f"spacing: {float(sp.max()):g} is too large: the grid's extent or the diffusion time "
+                             "(proportional to spacing²) overflows; use smaller units")
         self.domain = d = VoxelSurfaceDomain(occupancy, np.ldexp(sp, -e), normal_radius, t_coef=t_coef)
         self.vertices, self.face_centres = np.ldexp(d.vertices, e), np.ldexp(d.face_centres, e)
         self.faces, self.normals = d.faces, d.normals
