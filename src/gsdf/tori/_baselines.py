@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_points, as_values, as_weights, integer, neighbours, positive, query_shaped
+from gsdf._checks import as_points, as_values, as_weights, neighbours, positive, query_shaped
 from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.tori._blend import NeighbourBlend
