@@ -220,3 +220,13 @@ def test_kernels_compile_once(tmp_path, job):
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=900)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "", out.stdout
+
+
+def test_warmup_refuses_a_worker_count_the_machine_cannot_start():
+    """gsdf warmup --workers 10^9 was accepted (found by the fuzz suite); refused like gsdf batch's, at once."""
+    from click.testing import CliRunner
+
+    from gsdf.cli.main import main
+
+    r = CliRunner().invoke(main, ["warmup", "--quiet", "--workers", "1000000000"])
+    assert r.exit_code == 1 and "workers: 1,000,000,000 worker processes" in r.output

@@ -166,7 +166,12 @@ def warm(jobs=None, processes=None, echo=None) -> list[tuple[str, float, str]]:
     from concurrent.futures import ProcessPoolExecutor, as_completed
     import multiprocessing
 
+    from gsdf._memory import check_bytes
+    from gsdf.batch._run import WORKER_BYTES
     from gsdf.threads import get_num_threads
+
+    if processes is not None:  # the same rule as gsdf batch: a count the machine cannot start is refused at once
+        check_bytes(int(processes) * WORKER_BYTES, f"workers: {int(processes):,} worker processes")
 
     names = list(JOBS) if jobs is None else list(jobs)
     for n in names:
