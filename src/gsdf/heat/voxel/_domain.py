@@ -349,7 +349,10 @@ class VoxelSurfaceSignedHeatSolver:
         self.exponent = e = int(np.frexp(float(sp.max()))[1]) - 1
         # the grid's extent (spacing × voxels) and the diffusion time (∝ spacing²) must be representable
         n_max = max((int(x) for x in np.shape(occupancy)), default=1) + 1
-        if not (np.isfinite(float(sp.max()) * n_max) and np.isfinite(np.ldexp(4.0 * _checks.T_COEF_MAX, 2 * e))):
+        with np.errstate(over="ignore"):  # the overflow is the answer looked for
+            representable = np.isfinite(float(sp.max()) * n_max) and np.isfinite(np.ldexp(4.0 * _checks.T_COEF_MAX,
+                                                                                         2 * e))
+        if not representable:
             raise ValueError(f"spacing: {float(sp.max()):g} is too large: the grid's extent or the diffusion time "
                              "(proportional to spacing²) overflows; use smaller units")
         self.domain = d = VoxelSurfaceDomain(occupancy, np.ldexp(sp, -e), normal_radius, t_coef=t_coef)
