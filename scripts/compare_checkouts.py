@@ -3,7 +3,8 @@
     python scripts/compare_checkouts.py OLD_SRC NEW_SRC [--rounds 5] [--only a,b]
 
 Each workload runs in its own process per checkout (``PYTHONPATH=<src>``, numba caches kept apart), once to
-warm the compilation cache, then ``--rounds`` times alternating old / new; the table prints the median wall
+warm the compilation cache, then ``--rounds`` times alternating old / new, timing the second of two runs in each
+process (``--cold``: the first, kernels loaded from the cache inside the clock); the table prints the median wall
 time of each side, their ratio, and the largest relative difference of the outputs (0 = bit-identical). Only the
 public API (``gsdf.<name>`` and the options both checkouts accept) is called, so the two layouts can differ.
 """
@@ -80,10 +81,55 @@ P = shapes["ellipsoid"]
 t = time.perf_counter(); V2, F2 = gsdf.reconstruct_simply_connected(P); seconds = time.perf_counter() - t
 out = {"V": V2, "F": F2.astype(np.float64)}
 """,
+    # the peers' workloads and dataset-scale jobs on real meshes (skipped without the CGAL data)
+    "build (bunny00, 75k faces)": """
+V, F = cgal("bunny00.off")
+t = time.perf_counter(); s = gsdf.signed_distance(V, F, V[:1] + 1.0); seconds = time.perf_counter() - t
+out = {"s": s}
+""",
+    "signed distance (bunny00, 1e6)": """
+V, F = cgal("bunny00.off")
+Q = box_points(V, 1_000_000)
+t = time.perf_counter(); s = gsdf.signed_distance(V, F, Q); seconds = time.perf_counter() - t
+out = {"s": s}
+""",
+    "occupancy (bunny00 soup, 1e6)": """
+V, F = soup(*cgal("bunny00.off"))
+Q = box_points(V, 1_000_000)
+t = time.perf_counter(); inside = gsdf.FastWindingNumber(V, F)(Q) > 0.5; seconds = time.perf_counter() - t
+out = {"inside": inside.astype(np.float64)}
+""",
+    "occupancy (fandisk, 1e5)": """
+V, F = cgal("fandisk.off")
+Q = box_points(V, 100_000)
+t = time.perf_counter(); inside = gsdf.FastWindingNumber(V, F)(Q) > 0.5; seconds = time.perf_counter() - t
+out = {"inside": inside.astype(np.float64)}
+""",
+    "signed_distance_grid (bunny00, 128)": """
+V, F = cgal("bunny00.off")
+t = time.perf_counter(); S = gsdf.signed_distance_grid(V, F, resolution=128); seconds = time.perf_counter() - t
+out = {"S": np.asarray(S.values)}
+""",
+    "batch sdf-samples (6 meshes, 250k)": """
+import tempfile, glob
+with tempfile.TemporaryDirectory() as d:
+    t = time.perf_counter()
+    gsdf.run_batch(batch_inputs(), "sdf-samples", d, {"n_samples": 250_000}, workers=2)
+    seconds = time.perf_counter() - t
+    out = {os.path.basename(f): np.load(f)["sdf"] for f in sorted(glob.glob(os.path.join(d, "**", "*.npz"), recursive=True))}
+""",
+    "batch sdf-grid (6 meshes, 128^3)": """
+import tempfile, glob
+with tempfile.TemporaryDirectory() as d:
+    t = time.perf_counter()
+    gsdf.run_batch(batch_inputs(), "sdf-grid", d, {"resolution": 128}, workers=2)
+    seconds = time.perf_counter() - t
+    out = {os.path.basename(f): np.load(f)["sdf"] for f in sorted(glob.glob(os.path.join(d, "**", "*.npz"), recursive=True))}
+""",
 }
 
 PRELUDE = r'''
-import sys, time, json
+import os, sys, time, json
 import numpy as np
 import gsdf
 rng = np.random.default_rng(0)
@@ -123,6 +169,28 @@ flip = g.random(len(Fsoup)) < 0.1
 Fsoup[flip] = Fsoup[flip][:, ::-1]
 Pc = g.normal(size=(20_000, 3)); Pc /= np.linalg.norm(Pc, axis=1, keepdims=True)
 Pe = g.normal(size=(600, 3)) * [1.0, 0.7, 0.5]; Pe /= np.linalg.norm(Pe / [1.0, 0.7, 0.5], axis=1)[:, None]
+CGAL = os.path.join(os.environ.get("GSDF_CGAL_DATA", "/work/cgal/data"), "meshes")
+
+def cgal(name):
+    return gsdf.read_mesh(os.path.join(CGAL, name))
+
+def soup(V, F, seed=0):  # 10 % of the faces deleted, 5 % duplicated, 10 % flipped (bench/bench_sdf_peers.py)
+    r = np.random.default_rng(seed)
+    F = F[r.random(len(F)) >= 0.10]
+    F = np.vstack([F, F[r.random(len(F)) < 0.05]])
+    f = r.random(len(F)) < 0.10
+    F[f] = F[f][:, ::-1]
+    return V, np.ascontiguousarray(F)
+
+def box_points(V, n):  # uniform in the bounding box grown by 0.1 of its diagonal
+    lo, hi = V.min(0), V.max(0)
+    pad = 0.1 * np.linalg.norm(hi - lo)
+    return np.random.default_rng(2).uniform(lo - pad, hi + pad, (n, 3))
+
+def batch_inputs():
+    return [os.path.join(CGAL, f) for f in ("bunny00.off", "camel.off", "elephant-with-holes.off", "fandisk.off",
+                                            "holes.off", "mech-holes-shark.off")]
+
 shapes = {"sphere": (Vs, Fs), "soup": (Vs, Fsoup), "cloud": (Pc, Pc.copy()), "torus": _torus(), "ellipsoid": Pe}
 '''
 
@@ -132,9 +200,10 @@ print(json.dumps({"seconds": seconds}))
 '''
 
 
-def run(src, code, path, cache):
+def run(src, code, path, cache, cold=False):
     env = dict(os.environ, PYTHONPATH=src, NUMBA_CACHE_DIR=cache, PYTHONDONTWRITEBYTECODE="1")
-    r = subprocess.run([sys.executable, "-c", PRELUDE + code + EPILOGUE, path], env=env, capture_output=True,
+    body = code if cold else code + code        # warm: the second run in the process is timed
+    r = subprocess.run([sys.executable, "-c", PRELUDE + body + EPILOGUE, path], env=env, capture_output=True,
                        text=True)
     if r.returncode:
         raise RuntimeError(r.stderr[-2000:])
@@ -156,12 +225,14 @@ def main(argv=None):
     ap.add_argument("new")
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--only", default=None, help="comma-separated substrings of workload names")
+    ap.add_argument("--cold", action="store_true",
+                    help="time the first run in each process (kernels loaded from the cache inside the clock)")
     args = ap.parse_args(argv)
     names = [n for n in WORKLOADS if not args.only or any(s in n for s in args.only.split(","))]
     tmp = tempfile.mkdtemp(prefix="gsdf-compare-")
     caches = {side: os.path.join(tmp, f"numba-{side}") for side in ("old", "new")}
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
-          f"load {os.getloadavg()[0]:.1f}; rounds {args.rounds}")
+          f"load {os.getloadavg()[0]:.1f}; rounds {args.rounds}; {'cold' if args.cold else 'warm'} calls")
     print(f"| workload | old s (median) | new s (median) | new / old | max relative output difference |")
     print("|---|---|---|---|---|")
     for name in names:
@@ -172,7 +243,7 @@ def main(argv=None):
         times = {"old": [], "new": []}
         for _ in range(args.rounds):
             for side, src in (("old", args.old), ("new", args.new)):
-                times[side].append(run(src, code, paths[side], caches[side]))
+                times[side].append(run(src, code, paths[side], caches[side], args.cold))
         a, b = np.load(paths["old"]), np.load(paths["new"])
         diff = max(rel_diff(a[k], b[k]) for k in a.files) if sorted(a.files) == sorted(b.files) else float("inf")
         to, tn = statistics.median(times["old"]), statistics.median(times["new"])
