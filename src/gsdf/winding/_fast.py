@@ -57,6 +57,7 @@ from gsdf.spatial._triangle_tree import triangle_elements_root as _triangle_elem
 from gsdf.spatial._triangle_tree import triangle_tree
 from gsdf.spatial._wide import widen
 from gsdf.threads import run_ranges, run_tasks
+from gsdf.winding import _inside
 from gsdf.winding._query import map_queries, query_array
 from gsdf.winding._exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w
 
@@ -817,8 +818,8 @@ class FastWindingNumber(_FastWindingBase):
         the lanes and dropped (18 MB at 89k faces, a third of the object; tests rebuild them with _tree_moments).
         """
         self._frame = tt.frame  # scale invariance: the tree lives in the normalised frame
-        self._mesh = (tt.Vf, tt.F)  # for inside(): the boundary chain, computed on first use
-        self._grids = None
+        self._mesh = (tt.Vf, tt.F)  # for inside(): closed or not (computed on first use), cell grids by size
+        self._closed, self._grids = None, {}
         self._pending = None
         self.tree = t = tt.bvh
         with _single_thread(tt.F.shape[0] < PARALLEL_BUILD_FACES):
@@ -834,7 +835,7 @@ class FastWindingNumber(_FastWindingBase):
         self.beta, self.order = _check_params(beta, order)
         self._frame = Frame.of_mesh(V, F)
         self._mesh = (np.ascontiguousarray(self._frame.geometry(V)), F)
-        self._grids = None
+        self._closed, self._grids = None, {}
         self._pending = V
         return self
 
@@ -847,14 +848,14 @@ class FastWindingNumber(_FastWindingBase):
 
     @query_shaped()
     def inside(self, Q, progress=None) -> np.ndarray:
-        """Inside / outside at the query points ``Q``: winding number > 1/2, settled per grid cell where possible.
+        """Inside / outside at the query points ``Q``: winding number > 1/2, the answer of ``self(Q) > 0.5``.
 
-        The same answer as ``self(Q) > 0.5`` (the exact generalized winding number rounded, up to the far-field
-        error), much faster for many queries: the winding number's gradient comes from the mesh's boundary edges
-        only (Biot–Savart), so it is constant on the grid cells free of triangles of a closed oriented mesh and
-        varies by a bounded amount on those of a mesh with few boundary edges; queries in such cells take the
-        value at the cell centre and only the others walk the tree (see :mod:`gsdf.winding._inside`). Triangle
-        soups (many boundary edges) walk the tree for every query.
+        For a closed oriented mesh (every directed edge used as often as its reverse: also several, nested or
+        intersecting components) the winding number is an integer, constant off the surface: the queries are
+        settled by the cells of a grid that no triangle touches (one value per connected component of them)
+        and by signed crossing counts along x to such a cell, and only the queries whose count cannot be
+        decided (on the surface, or a crossing within a relative 1e-12 of a face's edge) walk the tree (see
+        :mod:`gsdf.winding._inside`). Meshes with a boundary (holes, soups) walk the tree for every query.
 
         Parameters
         ----------
@@ -881,30 +882,25 @@ class FastWindingNumber(_FastWindingBase):
         >>> gsdf.FastWindingNumber(V, F).inside([[0.1, 0.1, 0.1], [1, 1, 1]])
         array([ True, False])
         """
+        if self._closed is None:
+            Vf, F = self._mesh
+            self._closed = _inside.is_closed(F, Vf.shape[0])
+        if not self._closed:  # w is not constant off the surface: the walk
+            return self(Q, progress=progress) > 0.5
         return map_queries(self._inside_kernel, Q, progress=progress, frame=self._frame) > 0.5
 
     def _inside_kernel(self, q, out):
-        from gsdf.winding import _inside
-
         Vf, F = self._mesh
-        if self._grids is None:
-            self._grids = {"boundary": _inside.boundary_chain(F, Vf.shape[0])}
-        B = self._grids["boundary"]
-        closed = B[0].shape[0] == 0
         n = q.shape[0]
-        if n < 2048:
+        if n < 2048:  # the grid would cost more than the walks
             self._kernel(q, out)
             out[:] = out > 0.5
             return
-        if closed:
-            cells = int(n * _inside.CELLS_PER_QUERY)
-            key = int(round(cells ** (1.0 / 3.0)))
-            grid = self._grids.get(key)
-            if grid is None:
-                grid = self._grids[key] = _inside.build_grid(Vf, F, B, cells, self._values)
-        else:
-            grid = _inside.build_grid(Vf, F, B, int(n / _inside.QUERIES_PER_CELL), self._values,
-                                      (q.min(axis=0), q.max(axis=0)))
+        cells = int(n * _inside.CELLS_PER_QUERY)
+        key = int(round(cells ** (1.0 / 3.0)))
+        grid = self._grids.get(key)
+        if grid is None:
+            grid = self._grids[key] = _inside.build_grid(Vf, F, cells, self._values)
         _inside.classify(grid, q, out, self._kernel, Vf, F)
 
     def _values(self, P):
