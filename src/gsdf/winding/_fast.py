@@ -899,8 +899,9 @@ class FastWindingNumber(_FastWindingBase):
         cells = int(n * _inside.CELLS_PER_QUERY)
         key = int(round(cells ** (1.0 / 3.0)))
         grid = self._grids.get(key)
-        if grid is None:
-            grid = self._grids[key] = _inside.build_grid(Vf, F, cells, self._values)
+        if grid is None:  # one grid kept (the last size): repeated calls of one size reuse it
+            grid = _inside.build_grid(Vf, F, cells, self._values)
+            self._grids = {key: grid}
         _inside.classify(grid, q, out, self._kernel, Vf, F)
 
     def _values(self, P):
