@@ -21,7 +21,7 @@ import numpy as np
 import gsdf
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_sdf_peers import load_mesh, MESHES  # noqa: E402
+from bench_sdf_peers import MESHES, load_mesh
 
 DEFAULT = "bunny00-soup,bunny00,fandisk,elephant-with-holes,camel,armadillo"
 
@@ -47,13 +47,13 @@ def main():
             V32, F32 = o3d.core.Tensor(V.astype(np.float32)), o3d.core.Tensor(F.astype(np.uint32))
             P = o3d.core.Tensor(X.astype(np.float32))
 
-            def o3docc():
+            def o3docc(V32=V32, F32=F32, P=P):
                 s = o3d.t.geometry.RaycastingScene()
                 s.add_triangles(V32, F32)
                 return s.compute_occupancy(P).numpy() > 0.5
 
-            tools = {"inside": lambda: gsdf.inside(V, F, X),
-                     "walk": lambda: gsdf.FastWindingNumber(V, F)(X) > 0.5, "open3d": o3docc}
+            tools = {"inside": lambda V=V, F=F, X=X: gsdf.inside(V, F, X),
+                     "walk": lambda V=V, F=F, X=X: gsdf.FastWindingNumber(V, F)(X) > 0.5, "open3d": o3docc}
             for f in tools.values():  # compile / load every kernel first
                 f()
             times = {k: [] for k in tools}

@@ -828,7 +828,7 @@ class FastWindingNumber(_FastWindingBase):
                                                                             tt.wide)
 
     @classmethod
-    def _deferred(cls, V, F, beta: float = 2.0, order: int = 2) -> "FastWindingNumber":
+    def _deferred(cls, V, F, beta: float = 2.0, order: int = 2) -> FastWindingNumber:
         """The evaluator of the validated mesh (V, F) whose tree and moments are built at the first walk (for
         :func:`inside`, whose queries on a closed mesh may need none)."""
         self = cls.__new__(cls)
@@ -897,7 +897,7 @@ class FastWindingNumber(_FastWindingBase):
             out[:] = out > 0.5
             return
         cells = int(n * _inside.CELLS_PER_QUERY)
-        key = int(round(cells ** (1.0 / 3.0)))
+        key = round(cells ** (1.0 / 3.0))
         grid = self._grids.get(key)
         if grid is None:  # one grid kept (the last size): repeated calls of one size reuse it
             grid = _inside.build_grid(Vf, F, cells, self._values)
