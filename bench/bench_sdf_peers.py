@@ -137,6 +137,8 @@ def gsdf_tool(work, V, F, X):
     if work.startswith("sd"):
         return lambda: gsdf.signed_distance(V, F, X)
     if work.startswith("occ"):
+        if hasattr(gsdf, "inside"):  # the occupancy entry point (closed meshes: grid cells and crossing counts)
+            return lambda: gsdf.inside(V, F, X)
         return lambda: gsdf.FastWindingNumber(V, F)(X) > 0.5
     if work == "grid":
         return lambda: gsdf.signed_distance_grid(V, F, resolution=X).values.ravel()

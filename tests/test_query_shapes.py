@@ -24,6 +24,8 @@ CALLS = {
     "unsigned_distance closest": lambda Q: gsdf.unsigned_distance(V, F, Q, return_closest=True),
     "point_cloud_distance": lambda Q: gsdf.point_cloud_distance(P, Q, return_closest=True),
     "FastWindingNumber": lambda Q: gsdf.FastWindingNumber(V, F)(Q),
+    "inside": lambda Q: gsdf.inside(V, F, Q),
+    "FastWindingNumber.inside": lambda Q: gsdf.FastWindingNumber(V, F).inside(Q),
     "ExactWindingNumber": lambda Q: gsdf.ExactWindingNumber(V, F)(Q),
     "TriangleDistance.query": lambda Q: gsdf.TriangleDistance(V, F).query(Q),
     "TriangleDistance.query_barycentric": lambda Q: gsdf.TriangleDistance(V, F).query_barycentric(Q),

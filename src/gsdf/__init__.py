@@ -19,7 +19,7 @@ _EXPORTS = {
     # winding numbers
     "winding_number": "winding", "winding_number_2d": "winding", "winding_number_points": "winding",
     "FastWindingNumber": "winding", "ExactWindingNumber": "winding", "FastWindingNumberPoints": "winding",
-    "fast_winding_number": "winding", "fast_winding_number_points": "winding",
+    "fast_winding_number": "winding", "fast_winding_number_points": "winding", "inside": "winding",
     "point_areas": "winding", "estimate_normals": "winding",
     # surface winding numbers (thesis ch. 6)
     "SurfaceWindingNumbers": "swn", "surface_winding_number": "swn", "SWNOptions": "swn",

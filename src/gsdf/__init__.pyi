@@ -91,6 +91,7 @@ from gsdf.winding import (
     estimate_normals as estimate_normals,
     fast_winding_number as fast_winding_number,
     fast_winding_number_points as fast_winding_number_points,
+    inside as inside,
     point_areas as point_areas,
     winding_number as winding_number,
     winding_number_2d as winding_number_2d,

@@ -58,6 +58,7 @@ def test_compute_occupancy(o3d):
     """test_raycasting_scene.py::test_compute_occupancy — centre 1, outside point 0."""
     w = gsdf.winding_number(o3d["box_V"], o3d["box_F"], QUERIES[:2])
     np.testing.assert_allclose((w >= 0.5).astype(float), [1.0, 0.0])
+    assert gsdf.inside(o3d["box_V"], o3d["box_F"], QUERIES[:2]).tolist() == [True, False]
 
 
 @pytest.mark.parametrize("shape", [[11], [1, 2, 3], [32, 14], [0]])
@@ -93,6 +94,11 @@ def test_sphere_wrong_occupancy(o3d):
     q = np.stack(np.meshgrid(*xyz_range.T), axis=-1).astype(np.float32)
     occ = (gsdf.winding_number(V, F, q) >= 0.5).astype(np.float32)  # (6, 6, 6, 3) queries -> (6, 6, 6)
     np.testing.assert_equal(occ, EXPECTED)
+    np.testing.assert_equal(gsdf.inside(V, F, q).astype(np.float32), EXPECTED)
+    # the same grid refined to 48^3 (the grid-cell path of gsdf.inside): the fast winding number's answers
+    fine = np.linspace(V.min(0) * 1.1, V.max(0) * 1.1, num=48)
+    qf = np.stack(np.meshgrid(*fine.T), axis=-1).reshape(-1, 3)
+    np.testing.assert_equal(gsdf.inside(V, F, qf), gsdf.FastWindingNumber(V, F)(qf) > 0.5)
 
 
 def test_create_isosurfaces():

@@ -7,6 +7,7 @@ from gsdf.winding._fast import (
     FastWindingNumberPoints,
     fast_winding_number,
     fast_winding_number_points,
+    inside,
 )
 
 __all__ = [
@@ -18,6 +19,7 @@ __all__ = [
     "FastWindingNumberPoints",
     "fast_winding_number",
     "fast_winding_number_points",
+    "inside",
     "point_areas",
     "estimate_normals",
 ]

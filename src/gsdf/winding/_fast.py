@@ -49,6 +49,7 @@ from numba import njit, prange
 
 from gsdf._checks import as_mesh, integer, positive, query_shaped
 from gsdf._memory import SECONDS_PER_QUERY
+from gsdf._normalize import Frame
 from gsdf.spatial._bvh import BVH, build_bvh
 from gsdf.spatial._triangle_tree import PARALLEL_BUILD_FACES, WIDTH, TriangleTree, single_thread as _single_thread
 from gsdf.spatial._triangle_tree import triangle_elements as _triangle_elements  # noqa: F401 (tests, bench)
@@ -56,6 +57,7 @@ from gsdf.spatial._triangle_tree import triangle_elements_root as _triangle_elem
 from gsdf.spatial._triangle_tree import triangle_tree
 from gsdf.spatial._wide import widen
 from gsdf.threads import run_ranges, run_tasks
+from gsdf.winding import _inside
 from gsdf.winding._query import map_queries, query_array
 from gsdf.winding._exact import INV_4PI, dipole_w, oriented_area_normals, solid_angle_w
 
@@ -816,15 +818,97 @@ class FastWindingNumber(_FastWindingBase):
         the lanes and dropped (18 MB at 89k faces, a third of the object; tests rebuild them with _tree_moments).
         """
         self._frame = tt.frame  # scale invariance: the tree lives in the normalised frame
+        self._mesh = (tt.Vf, tt.F)  # for inside(): closed or not (computed on first use), cell grids by size
+        self._closed, self._grids = None, {}
+        self._pending = None
         self.tree = t = tt.bvh
         with _single_thread(tt.F.shape[0] < PARALLEL_BUILD_FACES):
             self._T, D = _tree_moments(tt.Vf, tt.F, t.order, t.start, t.end, t.right, t.lo, t.hi)
             self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(D, t, self.beta ** 2, self.order, WIDTH,
                                                                             tt.wide)
 
+    @classmethod
+    def _deferred(cls, V, F, beta: float = 2.0, order: int = 2) -> FastWindingNumber:
+        """The evaluator of the validated mesh (V, F) whose tree and moments are built at the first walk (for
+        :func:`inside`, whose queries on a closed mesh may need none)."""
+        self = cls.__new__(cls)
+        self.beta, self.order = _check_params(beta, order)
+        self._frame = Frame.of_mesh(V, F)
+        self._mesh = (np.ascontiguousarray(self._frame.geometry(V)), F)
+        self._closed, self._grids = None, {}
+        self._pending = V
+        return self
+
     def _kernel(self, q, out):
+        if self._pending is not None:
+            V, self._pending = self._pending, None
+            self._build(triangle_tree(V, self._mesh[1], 4, frame=self._frame))
         with _single_thread(q.shape[0] < SERIAL_QUERIES):
             _eval_triangles_wide(q, self._T, self._W, self._CH, self._LS, self._LE, self._stack, out)
+
+    @query_shaped()
+    def inside(self, Q, progress=None) -> np.ndarray:
+        """Inside / outside at the query points ``Q``: winding number > 1/2, the answer of ``self(Q) > 0.5``.
+
+        For a closed oriented mesh (every directed edge used as often as its reverse: also several, nested or
+        intersecting components) the winding number is an integer, constant off the surface: the queries are
+        settled by the cells of a grid that no triangle touches (one value per connected component of them)
+        and by signed crossing counts along x to such a cell, and only the queries whose count cannot be
+        decided (on the surface, or a crossing within a relative 1e-12 of a face's edge) walk the tree (see
+        :mod:`gsdf.winding._inside`). Meshes with a boundary (holes, soups) walk the tree for every query.
+
+        Parameters
+        ----------
+        Q : (q, 3) float
+            Query points, in the input's units.
+        progress : callable, optional
+            ``progress(stage, fraction)``, called after each chunk of queries with ``fraction`` in (0, 1].
+
+        Returns
+        -------
+        (q,) bool
+            True inside (winding number > 1/2).
+
+        Raises
+        ------
+        ValueError
+            ``Q`` is not an (q, 3) array of finite numbers, or ``progress`` is not callable.
+
+        Examples
+        --------
+        >>> import numpy as np, gsdf
+        >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.]])
+        >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        >>> gsdf.FastWindingNumber(V, F).inside([[0.1, 0.1, 0.1], [1, 1, 1]])
+        array([ True, False])
+        """
+        if self._closed is None:
+            Vf, F = self._mesh
+            self._closed = _inside.is_closed(F, Vf.shape[0])
+        if not self._closed:  # w is not constant off the surface: the walk
+            return self(Q, progress=progress) > 0.5
+        return map_queries(self._inside_kernel, Q, progress=progress, frame=self._frame) > 0.5
+
+    def _inside_kernel(self, q, out):
+        Vf, F = self._mesh
+        n = q.shape[0]
+        if n < 2048:  # the grid would cost more than the walks
+            self._kernel(q, out)
+            out[:] = out > 0.5
+            return
+        cells = int(n * _inside.CELLS_PER_QUERY)
+        key = round(cells ** (1.0 / 3.0))
+        grid = self._grids.get(key)
+        if grid is None:  # one grid kept (the last size): repeated calls of one size reuse it
+            grid = _inside.build_grid(Vf, F, cells, self._values)
+            self._grids = {key: grid}
+        _inside.classify(grid, q, out, self._kernel, Vf, F)
+
+    def _values(self, P):
+        w = np.empty(P.shape[0])
+        if P.shape[0]:
+            self._kernel(np.ascontiguousarray(P, dtype=np.float64), w)
+        return w
 
 
 class FastWindingNumberPoints(_FastWindingBase):
@@ -918,6 +1002,49 @@ def fast_winding_number(V, F, Q, beta: float = 2.0, order: int = 2) -> np.ndarra
     """
     query_array(Q)  # the size guard before the tree is built
     return FastWindingNumber(V, F, beta=beta, order=order)(Q)
+
+
+@query_shaped()
+def inside(V, F, Q, beta: float = 2.0) -> np.ndarray:
+    """Inside / outside of a triangle mesh or soup at ``Q``: the generalized winding number > 1/2, in one call.
+
+    The answer of ``FastWindingNumber(V, F).inside(Q)`` (see :meth:`FastWindingNumber.inside`); for a closed
+    oriented mesh the queries are settled by free grid cells and signed crossing counts, and the tree of the
+    fast winding number (Barill et al. 2018, Algorithm 1) is built only if some query needs it (a query on
+    the surface, or a crossing too close to an edge to be decided).
+
+    Parameters
+    ----------
+    V : (n, 3) float
+        Vertex positions.
+    F : (m, 3) int
+        Triangles; soups, holes, self-intersections and flipped components are all fine.
+    Q : (q, 3) float
+        Query points.
+    beta : float, default 2.0
+        Accuracy parameter β of the fast winding number where it is used (see :class:`FastWindingNumber`).
+
+    Returns
+    -------
+    (q,) bool
+        True where the winding number exceeds 1/2.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, NaN or infinite coordinates, face indices out of range, ``beta <= 0``.
+
+    Examples
+    --------
+    >>> import numpy as np, gsdf
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    >>> F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])          # outward tetrahedron
+    >>> gsdf.inside(V, F, [[0.1, 0.1, 0.1], [2.0, 2.0, 2.0]])
+    array([ True, False])
+    """
+    query_array(Q)  # the size guard before anything is built
+    V, F = as_mesh(V, F)
+    return FastWindingNumber._deferred(V, F, beta=beta).inside(Q)
 
 
 @query_shaped()
