@@ -63,7 +63,7 @@ from gsdf.dec._hodge import HodgeDecomposition
 from gsdf.dec._triangle import TriangleDEC
 from gsdf.linalg._dual_l1 import dual_graph_l1
 from gsdf.linalg._graph import forest_potentials
-from gsdf.swn._gaps import GAP_EPS, GAP_MAX_EDGES, gap_shift as _gap_shift
+from gsdf.swn._gaps import GAP_EPS, GAP_MAX_EDGES, gap_shift as _gap_shift, least_cut_labels
 
 __all__ = ["SurfaceWindingNumbers", "SWNOptions", "SWNResult", "surface_winding_number", "bounding_segments",
            "METHODS"]
@@ -548,6 +548,13 @@ class SurfaceWindingNumbers:
         else:
             shift = np.zeros(dec.n_faces)
         W = np.round(wf - s - shift)
+        if labels == "gaps" and bends.any():
+            # the least cut near w's level (gsdf's step, see least_cut_labels): faces it relabels get the
+            # shift that centres their value on the new label
+            L = least_cut_labels(dec, wf - s - shift, bounding)
+            moved = L != W
+            shift = np.where(moved, wf - s - L, shift)
+            W = L.astype(float)
         # label 0 on the right of the curves: the length-weighted most frequent label of the right faces
         ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
         if len(ce):
