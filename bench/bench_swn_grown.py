@@ -14,6 +14,8 @@ Variants (all after the default solve, on its bounding part and face values):
   the label across their longest boundary when smaller than that neighbour.
 * ``no-cut`` — the labels before the least cut (``gsdf.swn._gaps.least_cut_labels``): rounding at the global
   level with the gap shifts only.
+* ``cut`` — the least cut with ``--eps`` as the weight floor, or (``--level global``) h measured from the global
+  level, without the gap shifts.
 * ``area`` — each face takes the label of the larger part of its area (w linear on the face) instead of the value
   at its centroid.
 * ``oracle-paths`` — every deleted stretch closed by the shortest edge path (by length, off the kept curves)
@@ -22,8 +24,9 @@ Variants (all after the default solve, on its bounding part and face values):
 * ``oracle-levels`` — the faces touching each deleted stretch rounded at the level (of 41 in a unit) that fits
   the truth best there: the floor of any per-gap choice of level.
 
-``--where`` splits the mislabelled area of the default labels into faces touching a deleted edge (a vertex of
-one), faces within 2 more rings, and elsewhere. ``--refine k`` splits every triangle into 4, k times, the regions
+``--where`` splits the mislabelled area of the default labels (and of ``no-cut``) into faces touching a deleted
+edge (a vertex of one), faces within 2 more rings, and elsewhere, and gives the default's error per deleted
+stretch by its length (6: 6 or more, stretches that meet). ``--refine k`` splits every triangle into 4, k times, the regions
 and the curves carried over exactly (children take the parent's truth; a curve edge becomes 2 collinear edges);
 with ``--fresh`` the cases are grown on the refined mesh instead (gaps of 1–5 of its shorter edges).
 
@@ -209,14 +212,39 @@ def where(F, n, segs, full, wrong, A):
     return [A[wrong].sum() / T, A[wrong & fa].sum() / T, A[wrong & near & ~fa].sum() / T, A[wrong & ~near].sum() / T]
 
 
-def no_cut(swn, res):
-    """The labels before the least cut: the global level with the gap shifts."""
+def per_gap(swn, segs, full, wrong, A, out):
+    """Mislabelled area on the faces touching each deleted stretch, in units of their mean area, by length."""
+    dec, n, E, F = swn.dec, swn.dec.n_vertices, swn.dec.edges, swn.dec.F
+    gone = np.flatnonzero(swn.chain(full) - swn.chain(segs))
+    _, lab = connected_components(sp.coo_matrix((np.ones(len(gone)), (E[gone, 0], E[gone, 1])), shape=(n, n)),
+                                  directed=False)
+    gl = lab[E[gone, 0]]
+    for c in np.unique(gl):
+        vs = np.zeros(n, bool)
+        vs[E[gone[gl == c]].ravel()] = True
+        f = vs[F].any(1)
+        out.setdefault(min(int((gl == c).sum()), 6), []).append(A[f & wrong].sum() / A[f].mean())
+    return out
+
+
+def no_cut(swn, res, values=False):
+    """The labels before the least cut: the global level with the gap shifts (or the values they round)."""
     dec = swn.dec
     w = res.corner_values + res.offset + res.label_shift[:, None]
     wf = w.mean(1)
     bends = res.endpoints | dec.chain_endpoints(np.round(res.bounding), tol=0.5)
     shift = swn.gap_shift(wf, res.bounding, bends, res.offset) if bends.any() else 0.0
-    return np.round(wf - res.offset - shift)
+    return (wf - res.offset - shift) if values else np.round(wf - res.offset - shift)
+
+
+def cut_labels(swn, res, eps, level):
+    """The least cut with another weight floor, or with h measured from the global level (no gap shifts)."""
+    from gsdf.swn._gaps import least_cut_labels
+
+    wl = no_cut(swn, res, values=True)
+    if level == "global":
+        wl = res.corner_values.mean(1) + res.label_shift
+    return least_cut_labels(swn.dec, wl, res.bounding, eps)
 
 
 def area_labels(res):
@@ -300,12 +328,13 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("meshes", nargs="*", default=["cow", "bull", "camel", "dino"])
     ap.add_argument("--variant", default="no-cut",
-                    choices=["closed-greedy", "closed-assign", "closed-true", "islands", "no-cut", "area",
+                    choices=["closed-greedy", "closed-assign", "closed-true", "islands", "no-cut", "cut", "area",
                              "oracle-paths", "oracle-levels"])
     ap.add_argument("--where", action="store_true", help="split the default's error by distance to the gaps")
     ap.add_argument("--refine", type=int, default=0, help="split every triangle into 4, this many times")
     ap.add_argument("--fresh", action="store_true", help="grow the cases on the refined mesh")
     ap.add_argument("--eps", type=float, default=0.1)
+    ap.add_argument("--level", default="gaps", choices=["gaps", "global"], help="cut: h from which level")
     ap.add_argument("--cases", type=int, default=4)
     a = ap.parse_args()
     for name in a.meshes:
@@ -313,7 +342,7 @@ def main():
         V, F, _, _, _, _ = refine(V0, F0, np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64),
                                   np.zeros(len(F0), np.int64), a.refine)
         swn = SurfaceWindingNumbers(V, F)
-        e0, e1, rows = [], [], []
+        e0, e1, rows, by_len = [], [], [], {}
         for s in range(a.cases):
             if a.fresh or a.refine == 0:
                 segs, truth, A = grown_regions_case(V, F, s)
@@ -324,14 +353,22 @@ def main():
                 _, _, segs, full, truth, A = refine(V0, F0, segs, full, truth, a.refine)
             res = swn.solve(segs)
             if a.where:
-                k = min(range(-6, 7), key=lambda k: A[(res.face_labels + k) != truth].sum())
-                rows.append(where(F, len(V), segs, full, (res.face_labels + k) != truth, A))
-                print(f"  {name}:{s} " + " / ".join(f"{100 * x:.2f}" for x in rows[-1]), flush=True)
+                r = []
+                for W in (res.face_labels, no_cut(swn, res)):
+                    k = min(range(-6, 7), key=lambda k: A[(W + k) != truth].sum())
+                    r.append(where(F, len(V), segs, full, (W + k) != truth, A))
+                    if len(r) == 1:
+                        by_len = per_gap(swn, segs, full, (W + k) != truth, A, by_len)
+                rows.append(r)
+                print(f"  {name}:{s} default " + " / ".join(f"{100 * x:.2f}" for x in r[0]) + "; no-cut "
+                      + " / ".join(f"{100 * x:.2f}" for x in r[1]), flush=True)
                 continue
             if a.variant == "islands":
                 W = islands(swn, res.face_labels, res.chain)
             elif a.variant == "no-cut":
                 W = no_cut(swn, res)
+            elif a.variant == "cut":
+                W = cut_labels(swn, res, a.eps, a.level)
             elif a.variant == "area":
                 W = area_labels(res)
             elif a.variant == "oracle-paths":
@@ -347,9 +384,12 @@ def main():
             e1.append(mislabelled(W, truth, A))
         tag = f"{name} ({len(F)} faces{f', refined {a.refine}x' if a.refine else ''}{', fresh' if a.fresh else ''})"
         if a.where:
-            m = 100 * np.mean(rows, axis=0)
-            print(f"{tag}: mislabelled {m[0]:.2f} %: touching a deleted edge {m[1]:.2f}, within 2 rings "
-                  f"{m[2]:.2f}, elsewhere {m[3]:.2f}", flush=True)
+            for j, lab in enumerate(["default", "no-cut"]):
+                m = 100 * np.mean([r[j] for r in rows], axis=0)
+                print(f"{tag} {lab}: mislabelled {m[0]:.2f} %: touching a deleted edge {m[1]:.2f}, within 2 rings "
+                      f"{m[2]:.2f}, elsewhere {m[3]:.2f}", flush=True)
+            print(f"{tag} default, mislabelled faces per deleted stretch (in mean faces beside it) by its length: "
+                  + ", ".join(f"{n} edges {np.mean(v):.2f} ({len(v)})" for n, v in sorted(by_len.items())), flush=True)
             continue
         print(f"{tag}: default {100 * np.mean(e0):.2f} %, {a.variant} {100 * np.mean(e1):.2f} % (cases "
               f"{', '.join(f'{100 * x:.2f}' for x in e1)})", flush=True)
