@@ -187,11 +187,9 @@ def refine(V, F, segs, full, truth, times):
         F = np.concatenate([np.c_[a, ab, ca], np.c_[ab, b, bc], np.c_[ca, bc, c], np.c_[ab, bc, ca]])
         truth = np.tile(truth, 4)
         key = ue[:, 0] * n + ue[:, 1]
-
-        def sub(S):
-            m = n + np.searchsorted(key, S.min(1) * n + S.max(1))
-            return np.stack([np.c_[S[:, 0], m], np.c_[m, S[:, 1]]], 1).reshape(-1, 2)
-        segs, full = sub(segs), sub(full)
+        segs, full = (np.stack([np.c_[S[:, 0], n + np.searchsorted(key, S.min(1) * n + S.max(1))],
+                                np.c_[n + np.searchsorted(key, S.min(1) * n + S.max(1)), S[:, 1]]], 1).reshape(-1, 2)
+                      for S in (segs, full))
     A = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
     return V, F, segs, full, truth, A
 
@@ -214,7 +212,7 @@ def where(F, n, segs, full, wrong, A):
 
 def per_gap(swn, segs, full, wrong, A, out):
     """Mislabelled area on the faces touching each deleted stretch, in units of their mean area, by length."""
-    dec, n, E, F = swn.dec, swn.dec.n_vertices, swn.dec.edges, swn.dec.F
+    n, E, F = swn.dec.n_vertices, swn.dec.edges, swn.dec.F
     gone = np.flatnonzero(swn.chain(full) - swn.chain(segs))
     _, lab = connected_components(sp.coo_matrix((np.ones(len(gone)), (E[gone, 0], E[gone, 1])), shape=(n, n)),
                                   directed=False)
@@ -308,7 +306,7 @@ def oracle_paths(swn, segs, full):
 
 
 def oracle_levels(swn, res, segs, full, truth, A):
-    dec, n, E, F = swn.dec, swn.dec.n_vertices, swn.dec.edges, swn.dec.F
+    n, E, F = swn.dec.n_vertices, swn.dec.edges, swn.dec.F
     gone = np.flatnonzero(swn.chain(full) - swn.chain(segs))
     _, lab = connected_components(sp.coo_matrix((np.ones(len(gone)), (E[gone, 0], E[gone, 1])), shape=(n, n)),
                                   directed=False)

@@ -8,7 +8,6 @@ import itertools
 
 import numpy as np
 
-import gsdf
 from gsdf.data._shapes import grid_mesh
 from gsdf.swn._gaps import least_cut_labels
 from gsdf.swn._solver import SurfaceWindingNumbers

@@ -175,7 +175,6 @@ def gap_shift(dec, wf, curve, ends, s, eps=GAP_EPS, max_edges=GAP_MAX_EDGES):
     return shift, k, int((npath > 0).sum())
 
 
-
 RELABEL_EPS = 0.1   # cut weight ℓ · (distance of w to the label level + RELABEL_EPS) off the curves
 
 

@@ -132,8 +132,8 @@ class SWNResult:
         input was decomposed again (step ⑤)
     label_shift : (m,) the per-face shift of the rounding level at the gaps (see
         :meth:`SurfaceWindingNumbers.gap_shift`; zeros with ``method="none"``; a face the least cut rounds the
-        other way, :func:`gsdf.swn._gaps.least_cut_labels`, has the shift that centres it on its label): ``face_labels ==
-        round(mean of corners)`` and, up to one integer shift, the labels of one global rounding level are
+        other way, :func:`gsdf.swn._gaps.least_cut_labels`, has the shift that centres it on its label):
+        ``face_labels == round(mean of corners)`` and, up to one integer shift, the labels of one global rounding level are
         ``round(corner_values.mean(1) + label_shift)``
     timings : dict of seconds per step ("lp" is the HiGHS part of "residual"; "total" the sum of the steps)
     """
