@@ -3,7 +3,8 @@
 The rule: :meth:`gsdf.swn._solver.SurfaceWindingNumbers.gap_shift`. This module holds the
 kernel — one numba pass of point-to-point Dijkstra searches over all gaps (each search stops when it settles its
 target and resets only the vertices it touched, so the pass costs about the gaps' neighbourhoods, not |gaps| × |V|)
-— and the vectorised pairing and level steps around it (no Python loop over gaps).
+— and the vectorised pairing and level steps around it (no Python loop over gaps); and the least cut that then
+rounds each face up or down (:func:`least_cut_labels`).
 """
 
 from __future__ import annotations
@@ -172,3 +173,68 @@ def gap_shift(dec, wf, curve, ends, s, eps=GAP_EPS, max_edges=GAP_MAX_EDGES):
     cnt = np.bincount(touch.col, minlength=m)
     shift = np.where(cnt > 0, acc / np.maximum(cnt, 1), 0.0)
     return shift, k, int((npath > 0).sum())
+
+
+RELABEL_EPS = 0.1   # cut weight ℓ · (distance of w to the label level + RELABEL_EPS) off the curves
+
+
+def least_cut_labels(dec, wl, bounding, eps=RELABEL_EPS):
+    """Labels L, each face rounded up or down (``L ∈ {⌊wl⌋, ⌊wl⌋ + 1}``), minimising the cut
+    ``Σ_off ℓ (h + eps) |L_A − L_B| + Σ_curves ℓ |b| |L_A − L_B − b|``: a label boundary off the curves is cheap
+    where w crosses the label level (h, the distance of the mean of the edge's two face values to the nearest
+    half-integer, is small there) and short; a curve edge whose jump b the labels do not keep is paid in full.
+
+    dec : TriangleDEC; wl : (m,) face values in label units (the level at the half-integers, so that
+    ``round(wl)`` are the labels of rounding); bounding : (nE,) the bounding curves as a rounded edge chain;
+    eps > 0. The terms are convex in ``L_A − L_B``, so the choice up / down per face is one minimum s–t cut
+    (capacities scaled to integers; ``scipy.sparse.csgraph.maximum_flow``). Returns (m,) int64 labels.
+
+    Not in the thesis (its labels are ``round(w)``, §6.1): inside a gap w's level sets form a pencil through the
+    gap's ends, and rounding picks one member per gap; the cut prefers, among the faces' up / down choices, the
+    short boundary that stays near the level — it closes a broken loop round a cap whose w sits at the level,
+    where rounding labelled the whole cap inside (docs/decisions.md, "Surface winding numbers")."""
+    from scipy.sparse.csgraph import breadth_first_order, maximum_flow
+
+    topo, m = dec.topology, dec.n_faces
+    base = np.floor(wl).astype(np.int64)
+    inter = np.flatnonzero(topo.edge_face_count == 2)
+    if len(inter) == 0:
+        return np.round(wl).astype(np.int64)
+    A, B = topo.edge_faces[inter, 0], topo.edge_faces[inter, 1]
+    b = np.round(bounding[inter])
+    wm = 0.5 * (wl[A] + wl[B])
+    h = 0.5 - np.abs(wm - np.round(wm))
+    ell = dec.edge_len[inter]
+    w = np.where(b != 0, ell * np.abs(b), ell * (h + eps))
+    # E(x_A, x_B) = w |c + x_A − x_B| (x = 1: rounded up) = E00 + t x_A − t x_B + p [x_A ≠ x_B] with
+    # t = (E10 − E01) / 2 and p = (E01 + E10) / 2 − E00 ≥ 0 (convexity; E11 = E00): p = w where c = 0 and
+    # t = ±w where |c| ≥ 1, so only the faces along jumps of the rounded-down labels carry unary terms
+    c = base[A] - base[B] - b
+    e00 = w * np.abs(c)
+    e10 = w * np.abs(c + 1)
+    e01 = w * np.abs(c - 1)
+    t = 0.5 * (e10 - e01)
+    unary = np.bincount(A, weights=t, minlength=m) - np.bincount(B, weights=t, minlength=m)
+    pair = 0.5 * (e01 + e10) - e00
+    total = np.abs(unary).sum() + 2 * pair.sum()
+    if not total > 0:
+        return np.round(wl).astype(np.int64)
+    scale = 2.0 ** 30 / total
+    cu = np.rint(np.abs(unary) * scale).astype(np.int64)
+    cp = np.rint(pair * scale).astype(np.int64)
+    src, snk = m, m + 1
+    up = (unary > 0) & (cu > 0)                     # cost of rounding up: source → face (cut when x = 1)
+    dn = (unary < 0) & (cu > 0)                     # cost of rounding down: face → sink (cut when x = 0)
+    keep = cp > 0
+    rows = np.concatenate([np.full(int(up.sum()), src), np.flatnonzero(dn), A[keep], B[keep]])
+    cols = np.concatenate([np.flatnonzero(up), np.full(int(dn.sum()), snk), B[keep], A[keep]])
+    cap = np.concatenate([cu[up], cu[dn], cp[keep], cp[keep]]).astype(np.int32)
+    C = sp.csr_matrix((cap, (rows, cols)), shape=(m + 2, m + 2))
+    C.sum_duplicates()
+    flow = maximum_flow(C, src, snk).flow
+    R = (C - flow).tocsr()
+    R.data = (R.data > 0).astype(np.int32)
+    R.eliminate_zeros()
+    x = np.ones(m + 2, np.int64)
+    x[breadth_first_order(R, src, directed=True, return_predecessors=False)] = 0   # source side: rounded down
+    return base + x[:m]

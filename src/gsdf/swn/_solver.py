@@ -33,7 +33,9 @@ the spec notes (``wave2-swn-recon-voxel.md`` §1(b)):
    offset s the level of w on the input curves minus ½ (:meth:`SurfaceWindingNumbers.rounding_offset`); with
    an LP the faces at each gap of the bounding curves are rounded at the level of w across that gap instead —
    the mean level along the |Δw|-weighted shortest path that closes the gap
-   (:meth:`SurfaceWindingNumbers.gap_shift`, :mod:`gsdf.swn._gaps`). Then the labels are shifted so that the
+   (:meth:`SurfaceWindingNumbers.gap_shift`, :mod:`gsdf.swn._gaps`), and where the bounding curves have
+   endpoints every face is then rounded up or down by the least cut near that level
+   (:func:`gsdf.swn._gaps.least_cut_labels`, gsdf's step, not the thesis'). Then the labels are shifted so that the
    faces to the right of the curves get label 0 (the thesis' "+1 crossing from the right").
 
 Boundaries (spec §1(e).5): the jump Laplace problem has zero-Neumann conditions, so a loop around a hole bounds
@@ -63,7 +65,7 @@ from gsdf.dec._hodge import HodgeDecomposition
 from gsdf.dec._triangle import TriangleDEC
 from gsdf.linalg._dual_l1 import dual_graph_l1
 from gsdf.linalg._graph import forest_potentials
-from gsdf.swn._gaps import GAP_EPS, GAP_MAX_EDGES, gap_shift as _gap_shift
+from gsdf.swn._gaps import GAP_EPS, GAP_MAX_EDGES, gap_shift as _gap_shift, least_cut_labels
 
 __all__ = ["SurfaceWindingNumbers", "SWNOptions", "SWNResult", "surface_winding_number", "bounding_segments",
            "METHODS"]
@@ -129,8 +131,9 @@ class SWNResult:
     passes : number of decompositions (steps ①–④) run: 0 without an LP, more than 1 when a remainder of the
         input was decomposed again (step ⑤)
     label_shift : (m,) the per-face shift of the rounding level at the gaps (see
-        :meth:`SurfaceWindingNumbers.gap_shift`; zeros with ``method="none"``): ``face_labels ==
-        round(mean of corners)`` and, up to one integer shift, the labels of one global rounding level are
+        :meth:`SurfaceWindingNumbers.gap_shift`; zeros with ``method="none"``; a face the least cut rounds the
+        other way, :func:`gsdf.swn._gaps.least_cut_labels`, has the shift that centres it on its label):
+        ``face_labels == round(mean of corners)`` and, up to one integer shift, the labels of one global rounding level are
         ``round(corner_values.mean(1) + label_shift)``
     timings : dict of seconds per step ("lp" is the HiGHS part of "residual"; "total" the sum of the steps)
     """
@@ -388,7 +391,9 @@ class SurfaceWindingNumbers:
         values round the endpoint, :meth:`gsdf.dec.TriangleDEC.branch_coordinates`), excluded with projective
         interpolation of their corners on the others (:meth:`_jump_solve`). Face labels: with ``method="lp"`` or
         ``"reduced"`` the faces at each gap of the bounding curves are rounded at the level of w across that gap
-        (:meth:`gap_shift`); ``method="none"`` rounds at one global level (:meth:`rounding_offset`).
+        (:meth:`gap_shift`) and each face rounded up or down by the least cut near that level
+        (:func:`gsdf.swn._gaps.least_cut_labels`); ``method="none"`` rounds at one global level
+        (:meth:`rounding_offset`).
         """
         if method not in METHODS:
             raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
@@ -548,6 +553,13 @@ class SurfaceWindingNumbers:
         else:
             shift = np.zeros(dec.n_faces)
         W = np.round(wf - s - shift)
+        if labels == "gaps" and bends.any():
+            # the least cut near w's level (gsdf's step, see least_cut_labels): faces it relabels get the
+            # shift that centres their value on the new label
+            L = least_cut_labels(dec, wf - s - shift, bounding)
+            moved = L != W
+            shift = np.where(moved, wf - s - L, shift)
+            W = L.astype(float)
         # label 0 on the right of the curves: the length-weighted most frequent label of the right faces
         ce = np.flatnonzero((g != 0) & (topo.edge_face_count == 2))
         if len(ce):
