@@ -48,7 +48,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_mesh, integer, positive, query_shaped
-from gsdf._memory import SECONDS_PER_QUERY
+from gsdf._memory import SECONDS_PER_QUERY, scratch
 from gsdf.spatial._bvh import BVH, build_bvh
 from gsdf.spatial._triangle_tree import PARALLEL_BUILD_FACES, WIDTH, TriangleTree, single_thread as _single_thread
 from gsdf.spatial._triangle_tree import triangle_elements as _triangle_elements  # noqa: F401 (tests, bench)
@@ -305,7 +305,7 @@ def _area_normal(T, j):
 
 
 
-def _tree_moments(V, F, order, start, end, right, lo, hi, also=None):
+def _tree_moments(V, F, order, start, end, right, lo, hi, also=None, reuse=False):
     """Leaf rows and Taylor moments of every node of a triangle tree, children before parents.
 
     Returns T (m, 10): per triangle in tree order its 9 corner coordinates, then 1.0 (0.0 for a zero-area
@@ -320,13 +320,15 @@ def _tree_moments(V, F, order, start, end, right, lo, hi, also=None):
     so the build costs O(m + k) instead of the O(m log m) of summing every node's triangles.
 
     ``also``: an optional callable of other work (the wide view of the tree) run as one more task on the
-    same threads, so it costs no serial time of its own.
+    same threads, so it costs no serial time of its own. ``reuse``: D goes to the calling thread's scratch
+    buffer (:func:`gsdf._memory.scratch`; for a caller done with it before the next build).
     """
     m = order.shape[0]
     k = start.shape[0]
     T = np.empty((m, 10))
-    D = np.empty((k, NODE_WIDTH))  # every entry written (leaves, parents, _finish_moment): no zero pass
-    W = np.empty((k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
+    # every entry of D written (leaves, parents, _finish_moment): no zero pass
+    D = scratch("fwn.D", (k, NODE_WIDTH)) if reuse else np.empty((k, NODE_WIDTH))
+    W = scratch("fwn.W", (k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
     threads = numba.get_num_threads()
     if m < PARALLEL_BUILD_FACES or threads == 1:
         if also is not None:
@@ -818,7 +820,7 @@ class FastWindingNumber(_FastWindingBase):
         self._frame = tt.frame  # scale invariance: the tree lives in the normalised frame
         self.tree = t = tt.bvh
         with _single_thread(tt.F.shape[0] < PARALLEL_BUILD_FACES):
-            self._T, D = _tree_moments(tt.Vf, tt.F, t.order, t.start, t.end, t.right, t.lo, t.hi)
+            self._T, D = _tree_moments(tt.Vf, tt.F, t.order, t.start, t.end, t.right, t.lo, t.hi, reuse=True)
             self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(D, t, self.beta ** 2, self.order, WIDTH,
                                                                             tt.wide)
 
