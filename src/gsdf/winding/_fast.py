@@ -305,7 +305,7 @@ def _area_normal(T, j):
 
 
 
-def _tree_moments(V, F, order, start, end, right, lo, hi, also=None, reuse=False):
+def _tree_moments(V, F, order, start, end, right, lo, hi, also=None):
     """Leaf rows and Taylor moments of every node of a triangle tree, children before parents.
 
     Returns T (m, 10): per triangle in tree order its 9 corner coordinates, then 1.0 (0.0 for a zero-area
@@ -320,14 +320,13 @@ def _tree_moments(V, F, order, start, end, right, lo, hi, also=None, reuse=False
     so the build costs O(m + k) instead of the O(m log m) of summing every node's triangles.
 
     ``also``: an optional callable of other work (the wide view of the tree) run as one more task on the
-    same threads, so it costs no serial time of its own. ``reuse``: D goes to the calling thread's scratch
-    buffer (:func:`gsdf._memory.scratch`; for a caller done with it before the next build).
+    same threads, so it costs no serial time of its own. (The evaluator's build uses the one-pass
+    :func:`_moments_lanes`; this two-pass form is its reference.)
     """
     m = order.shape[0]
     k = start.shape[0]
     T = np.empty((m, 10))
-    # every entry of D written (leaves, parents, _finish_moment): no zero pass
-    D = scratch("fwn.D", (k, NODE_WIDTH)) if reuse else np.empty((k, NODE_WIDTH))
+    D = np.empty((k, NODE_WIDTH))  # every entry written (leaves, parents, _finish_moment): no zero pass
     W = scratch("fwn.W", (k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
     threads = numba.get_num_threads()
     if m < PARALLEL_BUILD_FACES or threads == 1:
@@ -957,10 +956,11 @@ class FastWindingNumber(_FastWindingBase):
     def _build(self, tt: TriangleTree):
         """Leaf rows, node moments and the wide walk's lane data of the tree ``tt`` (in its normalised frame).
 
-        Far-field radius for triangles (set by _tree_moments): the farthest corner of the node's box from p̃.
+        Far-field radius for triangles (set as in _tree_moments): the farthest corner of the node's box from p̃.
         It bounds the paper's r (farthest element point) and, measured on the CGAL meshes, brings the RMS error
-        at β = 2 from ~1.3e-3 to ~7e-4 — the paper's "β = 2 gives ~1e-3". The (k, 40) moments D are folded into
-        the lanes and dropped (18 MB at 89k faces, a third of the object; tests rebuild them with _tree_moments).
+        at β = 2 from ~1.3e-3 to ~7e-4 — the paper's "β = 2 gives ~1e-3". Each node's (40) moments are folded
+        into its lane as soon as they are done (:func:`_moments_lanes`); the (k, 40) moments of every node are
+        never stored (18 MB at 89k faces; tests build them with _tree_moments).
         """
         self._frame = tt.frame  # scale invariance: the tree lives in the normalised frame
         self.tree = t = tt.bvh
