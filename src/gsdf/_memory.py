@@ -268,8 +268,8 @@ _scratch_local = None
 def scratch(name: str, shape, dtype="float64"):
     """An uninitialised array of ``shape`` that the calling thread reuses across calls under ``name``.
 
-    For the temporaries of a build (rows being sorted, node rows before they are copied out, moments before
-    they are folded): a fresh ``np.empty`` of a few MB is a fresh mapping whose every page faults on first
+    For the temporaries of a build (element rows being sorted, node rows before they are copied out, the
+    lane map of the wide view): a fresh ``np.empty`` of a few MB is a fresh mapping whose every page faults on first
     touch (measured: 1221 faults, ~3.7 ms of system time, in a 14 ms build of the shared triangle tree over
     13k faces). The buffer is kept per thread (so concurrent builds never share one) and grown when too short;
     a request over :data:`SCRATCH_BYTES` is a plain ``np.empty``. The caller must be done with the array
