@@ -257,3 +257,46 @@ def chunk_rows(bytes_per_row: float, total: int, budget: float | None = None) ->
     if budget is None:
         budget = min(available_bytes() / 8, 256 << 20)
     return int(max(1, min(max(total, 1), budget // max(bytes_per_row, 1))))
+
+
+#: Most bytes of one reused scratch buffer (:func:`scratch`); larger requests get a fresh array each time.
+SCRATCH_BYTES = 32 << 20
+
+_scratch_local = None
+
+
+def scratch(name: str, shape, dtype="float64"):
+    """An uninitialised array of ``shape`` that the calling thread reuses across calls under ``name``.
+
+    For the temporaries of a build (element rows being sorted, node rows before they are copied out, the
+    lane map of the wide view): a fresh ``np.empty`` of a few MB is a fresh mapping whose every page faults on first
+    touch (measured: 1221 faults, ~3.7 ms of system time, in a 14 ms build of the shared triangle tree over
+    13k faces). The buffer is kept per thread (so concurrent builds never share one) and grown when too short;
+    a request over :data:`SCRATCH_BYTES` is a plain ``np.empty``. The caller must be done with the array
+    before it asks for the same ``name`` again on the same thread.
+
+    Example
+    -------
+    >>> a = scratch("doc", (4, 3))
+    >>> a.shape, scratch("doc", (2, 3)).base is a.base
+    ((4, 3), True)
+    """
+    import numpy as np
+
+    global _scratch_local
+    dtype = np.dtype(dtype)
+    shape = tuple(int(s) for s in (shape if isinstance(shape, tuple) else (shape,)))
+    nbytes = dtype.itemsize * math.prod(shape)
+    if nbytes > SCRATCH_BYTES:
+        return np.empty(shape, dtype)
+    if _scratch_local is None:
+        import threading
+
+        _scratch_local = threading.local()
+    pool = getattr(_scratch_local, "pool", None)
+    if pool is None:
+        pool = _scratch_local.pool = {}
+    buf = pool.get(name)
+    if buf is None or buf.nbytes < nbytes:
+        buf = pool[name] = np.empty(max(nbytes, 64), np.uint8)
+    return buf[:nbytes].view(dtype).reshape(shape)

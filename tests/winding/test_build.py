@@ -203,3 +203,21 @@ def test_new_build_winding_numbers_match_brute_force_on_a_soup(order):
     far = np.array([[10.0, 10.0, 10.0], [-9.0, 0.5, 0.5]])
     np.testing.assert_allclose(gsdf.FastWindingNumber(V, F, order=order)(far), gsdf.winding_number(V, F, far),
                                rtol=(0.1 ** (order + 1)), atol=0)
+
+
+@pytest.mark.parametrize("m", [3000, fast.PARALLEL_BUILD_FACES + 5000])  # serial, and subtrees on the threads
+def test_one_pass_moments_and_lanes_equal_the_two_pass_form_bit_for_bit(m):
+    from gsdf._checks import as_mesh
+    from gsdf.spatial._triangle_tree import triangle_tree
+
+    V, F = as_mesh(*_soup(m=m, seed=4))
+    tt = triangle_tree(V, F)
+    t = tt.bvh
+    for order in (0, 1, 2):
+        T, D = fast._tree_moments(tt.Vf, tt.F, t.order, t.start, t.end, t.right, t.lo, t.hi)
+        ref = fast._pack_wide(D, t, 4.0, order, fast.WIDTH, tt.wide)
+        got = fast._moments_lanes(tt.Vf, tt.F, t, tt.wide, 4.0, order)
+        assert np.array_equal(got[0], T)
+        for a, b in zip(ref[:4], got[1:5]):
+            assert np.array_equal(a, b)
+        assert got[5] == ref[4]

@@ -34,6 +34,8 @@ import numba
 import numpy as np
 from numba import njit
 
+from gsdf._memory import scratch
+
 NBINS = 32
 #: Nodes with at most this many elements are split by an exhaustive sweep instead of bins (2 × 32 bins cost
 #: about as much as sorting and sweeping 24 elements along 2 axes).
@@ -414,14 +416,15 @@ def build_volume_rows(E, leaf_size, threads=1, root=None):
     if threads > 1 and n > PARALLEL_ELEMENTS:
         cutoff = max(leaf_size + 1, n // 64)
         # task t's subtree goes to rows 2 s .. 2 e − 1 (s:e its elements): disjoint, and never too short
-        sub_i = np.empty((2 * n, 4), np.int64)
-        sub_b = np.empty((2 * n, 6))
+        sub_i = scratch("tree.node_i", (2 * n, 4), np.int64)
+        sub_b = scratch("tree.node_b", (2 * n, 6))
         kt, top_i, top_b, ntask, task_i, counts = _parallel_grow(E, order, root, leaf_size, cutoff, threads,
                                                                  sub_i, sub_b)
         start, end, right, lo, hi = _splice(kt, top_i, top_b, task_i[:ntask], counts, sub_i, sub_b)
     else:
-        k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, root, leaf_size, 0, np.empty((2 * n, 4), np.int64),
-                                           np.empty((2 * n, 6)), 0)
+        node_i = scratch("tree.node_i", (2 * n, 4), np.int64)  # temporaries: the columns are copied out
+        node_b = scratch("tree.node_b", (2 * n, 6))
+        k, node_i, node_b, _, _, _ = _grow(E, order, 0, n, root, leaf_size, 0, node_i, node_b, 0)
         start, end, right = (node_i[:k, c].copy() for c in range(3))
         lo, hi = node_b[:k, 0:3].copy(), node_b[:k, 3:6].copy()
     return order, start, end, right, _skips(right), lo, hi

@@ -48,7 +48,7 @@ import numpy as np
 from numba import njit, prange
 
 from gsdf._checks import as_mesh, integer, positive, query_shaped
-from gsdf._memory import SECONDS_PER_QUERY
+from gsdf._memory import SECONDS_PER_QUERY, scratch
 from gsdf._normalize import Frame
 from gsdf.spatial._bvh import BVH, build_bvh
 from gsdf.spatial._triangle_tree import PARALLEL_BUILD_FACES, WIDTH, TriangleTree, single_thread as _single_thread
@@ -322,13 +322,14 @@ def _tree_moments(V, F, order, start, end, right, lo, hi, also=None):
     so the build costs O(m + k) instead of the O(m log m) of summing every node's triangles.
 
     ``also``: an optional callable of other work (the wide view of the tree) run as one more task on the
-    same threads, so it costs no serial time of its own.
+    same threads, so it costs no serial time of its own. (The evaluator's build uses the one-pass
+    :func:`_moments_lanes`; this two-pass form is its reference.)
     """
     m = order.shape[0]
     k = start.shape[0]
     T = np.empty((m, 10))
     D = np.empty((k, NODE_WIDTH))  # every entry written (leaves, parents, _finish_moment): no zero pass
-    W = np.empty((k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
+    W = scratch("fwn.W", (k, 7))  # Σ area, Σ area·x (3), Σ x (3): the centres of the parents
     threads = numba.get_num_threads()
     if m < PARALLEL_BUILD_FACES or threads == 1:
         if also is not None:
@@ -492,14 +493,17 @@ def _leaf_moment(V, F, order, s, e, T, D, W, i):
 @njit(cache=True)
 def _parent_moment(start, end, right, D, W, i):
     """Internal node i of :func:`_tree_moments` from its two children (their rows done)."""
-    r = right[i]
-    l = i + 1
+    _parent_rows(end[i] - start[i], D, W, i, i + 1, right[i])
+
+
+@njit(cache=True, inline="always")
+def _parent_rows(cnt, D, W, i, l, r):
+    """Rows i of D and W: the node of ``cnt`` elements whose children's rows are l (left) and r (right)."""
     for q in range(7):
         W[i, q] = W[l, q] + W[r, q]
     if W[i, 0] > 0.0:
         cx, cy, cz = W[i, 1] / W[i, 0], W[i, 2] / W[i, 0], W[i, 3] / W[i, 0]
     else:
-        cnt = end[i] - start[i]
         cx, cy, cz = W[i, 4] / cnt, W[i, 5] / cnt, W[i, 6] / cnt
     D[i, 0], D[i, 1], D[i, 2] = cx, cy, cz
     # row i is uninitialised: the left child's terms are stored, the right child's added (no zero pass)
@@ -526,6 +530,12 @@ def _parent_moment(start, end, right, D, W, i):
 @njit(cache=True)
 def _finish_moment(lo, hi, D, i):
     """u, v and r² of node i (its moments done)."""
+    _finish_row(lo, hi, i, D, i)
+
+
+@njit(cache=True, inline="always")
+def _finish_row(lo, hi, node, D, i):
+    """u, v and r² in row i of D, the moments of node ``node`` (its box lo, hi)."""
     # u_a = Σ_b S_ab,b and v_c = Σ_a S_aa,c (see the module docstring)
     for c in range(3):
         D[i, _VV + c] = D[i, _S + 6 * c] + D[i, _S + 6 * c + 1] + D[i, _S + 6 * c + 2]
@@ -535,9 +545,145 @@ def _finish_moment(lo, hi, D, i):
     # far-field radius: the farthest corner of the node's box from p̃ (see FastWindingNumber._build)
     r2 = 0.0
     for d in range(3):
-        g = max(abs(lo[i, d] - D[i, d]), abs(hi[i, d] - D[i, d]))
+        g = max(abs(lo[node, d] - D[i, d]), abs(hi[node, d] - D[i, d]))
         r2 += g * g
     D[i, _R2] = r2
+
+
+def _moments_lanes(V, F, tree, wt, beta2, order, width=WIDTH):
+    """:func:`_tree_moments` and :func:`_pack_wide` in one pass, without the (k, NODE_WIDTH) moments of every
+    node: the nodes are done children first (descending preorder ids: both children of i have larger ids),
+    their moments kept on a stack of at most depth + 2 rows, and each node's far-field data folded into its lane
+    of the wide view as soon as it is done. The same arithmetic as the two-pass form (the same rows, lanes and
+    leaf rows, bit for bit); at 1.2M faces the moments array alone was 256 MB of fresh pages.
+
+    Returns (T, W, CH, LS, LE, stack_size) as :func:`_tree_moments` (T) and :func:`_pack_wide` (the rest)."""
+    order_, start, end, right, lo, hi = tree.order, tree.start, tree.end, tree.right, tree.lo, tree.hi
+    m, k = order_.shape[0], start.shape[0]
+    kids, child, depth = wt.kids, wt.child, wt.depth
+    shift = 1 if right[0] >= 0 else 0
+    if shift:  # the first wide node holds the root alone (see _pack_wide)
+        top = np.full((1, width), -1, np.int64)
+        top[0, 0] = 0
+        kids = np.vstack([top, kids])
+        top[0, :] = -2
+        top[0, 0] = 1
+        child = np.vstack([top, np.where(child >= 0, child + 1, child)])
+        depth += 1
+    keep = (3, 10, COMPACT_WIDTH - 1)[order]
+    w = kids.shape[0]
+    # n * width + c of each binary node's lane; −1 for a node that the wide view skipped (its children are kids)
+    lane = scratch("fwn.lane", k, np.int64)
+    lane.fill(-1)
+    nn, cc = np.nonzero(kids >= 0)
+    lane[kids[nn, cc]] = nn * width + cc
+    T = np.empty((m, 10))
+    WL = np.empty((w, _WF, width))
+    LS = np.empty((w, width), np.int64)
+    LE = np.empty((w, width), np.int64)
+    empty = kids < 0  # never far (β²r² = ∞), zero centre and coefficients, empty range
+    WLt = WL.transpose(0, 2, 1)
+    WLt[empty] = 0.0
+    WL[:, 3, :][empty] = np.inf
+    LS[empty] = 0
+    LE[empty] = 0
+    rows = _max_depth(right) + 2
+    threads = numba.get_num_threads()
+    if m < PARALLEL_BUILD_FACES or threads == 1:
+        RD, RW = np.empty((1, NODE_WIDTH)), np.empty((1, 7))
+        _subtree_lanes(V, F, order_, start, end, right, lo, hi, T, 0, k, lane, beta2, keep, WL, LS, LE,
+                       np.empty((rows, NODE_WIDTH)), np.empty((rows, 7)), RD, RW, 0)
+    else:
+        roots, above = _split_top(start, end, right, 8 * threads)
+        nr = len(roots)
+        RD, RW = np.empty((nr + len(above), NODE_WIDTH)), np.empty((nr + len(above), 7))
+
+        def task(t):
+            r = roots[t]
+            _subtree_lanes(V, F, order_, start, end, right, lo, hi, T, r, _subtree_end(right, r), lane, beta2, keep,
+                           WL, LS, LE, np.empty((rows, NODE_WIDTH)), np.empty((rows, 7)), RD, RW, t)
+
+        run_tasks(task, range(nr), threads)
+        ids = np.array(roots + sorted(above, reverse=True), np.int64)
+        _above_lanes(start, end, right, lo, hi, ids, nr, lane, beta2, keep, WL, LS, LE, RD, RW)
+    return T, WL, np.ascontiguousarray(child), LS, LE, depth * (width - 1) + 2
+
+
+@njit(cache=True)
+def _max_depth(right):
+    """Most edges from the root to a node of the preorder tree."""
+    k = right.shape[0]
+    depth = np.zeros(k, np.int64)
+    most = 0
+    for i in range(k):
+        r = right[i]
+        if r >= 0:
+            depth[i + 1] = depth[i] + 1
+            depth[r] = depth[i] + 1
+            most = max(most, depth[i] + 1)
+    return most
+
+
+@njit(cache=True, inline="always")
+def _to_lane(start, end, i, lane, beta2, keep, WL, LS, LE, SD, j, row):
+    """Node i's far-field data (row j of SD, its moments finished) into its lane, if it has one."""
+    if lane[i] < 0:
+        return
+    width = WL.shape[2]
+    n, c = lane[i] // width, lane[i] % width
+    WL[n, 0, c] = SD[j, 0]
+    WL[n, 1, c] = SD[j, 1]
+    WL[n, 2, c] = SD[j, 2]
+    WL[n, 3, c] = beta2 * SD[j, _R2]
+    _fold_into(SD, j, row, keep)
+    for q in range(COMPACT_WIDTH - 1):
+        WL[n, 4 + q, c] = row[q]
+    LS[n, c] = start[i]
+    LE[n, c] = end[i]
+
+
+@njit(cache=True, nogil=True)  # one serial, GIL-free kernel for both drivers (subtrees on Python threads)
+def _subtree_lanes(V, F, order, start, end, right, lo, hi, T, i0, i1, lane, beta2, keep, WL, LS, LE, SD, SW, RD,
+                   RW, t):
+    """Nodes i1 − 1 down to i0 (a whole subtree, i0 its root): leaf rows of T, moments on the stack SD / SW
+    (a child's rows wait there for its parent's), lanes; the root's moments go to row t of RD / RW."""
+    row = np.empty(COMPACT_WIDTH - 1)
+    sp = 0
+    for i in range(i1 - 1, i0 - 1, -1):
+        if right[i] < 0:
+            _leaf_moment(V, F, order, start[i], end[i], T, SD, SW, sp)
+        else:  # the left child (done last) on top, the right child below it
+            _parent_rows(end[i] - start[i], SD, SW, sp, sp - 1, sp - 2)
+            for q in range(NODE_WIDTH):
+                SD[sp - 2, q] = SD[sp, q]
+            for q in range(7):
+                SW[sp - 2, q] = SW[sp, q]
+            sp -= 2
+        _finish_row(lo, hi, i, SD, sp)
+        _to_lane(start, end, i, lane, beta2, keep, WL, LS, LE, SD, sp, row)
+        sp += 1
+    for q in range(NODE_WIDTH):
+        RD[t, q] = SD[0, q]
+    for q in range(7):
+        RW[t, q] = SW[0, q]
+
+
+@njit(cache=True)
+def _above_lanes(start, end, right, lo, hi, ids, nr, lane, beta2, keep, WL, LS, LE, RD, RW):
+    """The nodes above the subtrees (ids[nr:], descending) from their children's rows: row j of RD / RW holds
+    node ids[j] (the subtrees' roots first)."""
+    row = np.empty(COMPACT_WIDTH - 1)
+    for j in range(nr, ids.shape[0]):
+        i = ids[j]
+        l = r = -1
+        for q in range(j):
+            if ids[q] == i + 1:
+                l = q
+            elif ids[q] == right[i]:
+                r = q
+        _parent_rows(end[i] - start[i], RD, RW, j, l, r)
+        _finish_row(lo, hi, i, RD, j)
+        _to_lane(start, end, i, lane, beta2, keep, WL, LS, LE, RD, j, row)
 
 
 def _pack_nodes(D, tree):
@@ -812,10 +958,11 @@ class FastWindingNumber(_FastWindingBase):
     def _build(self, tt: TriangleTree):
         """Leaf rows, node moments and the wide walk's lane data of the tree ``tt`` (in its normalised frame).
 
-        Far-field radius for triangles (set by _tree_moments): the farthest corner of the node's box from p̃.
+        Far-field radius for triangles (set as in _tree_moments): the farthest corner of the node's box from p̃.
         It bounds the paper's r (farthest element point) and, measured on the CGAL meshes, brings the RMS error
-        at β = 2 from ~1.3e-3 to ~7e-4 — the paper's "β = 2 gives ~1e-3". The (k, 40) moments D are folded into
-        the lanes and dropped (18 MB at 89k faces, a third of the object; tests rebuild them with _tree_moments).
+        at β = 2 from ~1.3e-3 to ~7e-4 — the paper's "β = 2 gives ~1e-3". Each node's (40) moments are folded
+        into its lane as soon as they are done (:func:`_moments_lanes`); the (k, 40) moments of every node are
+        never stored (18 MB at 89k faces; tests build them with _tree_moments).
         """
         self._frame = tt.frame  # scale invariance: the tree lives in the normalised frame
         self._mesh = (tt.Vf, tt.F)  # for inside(): closed or not (computed on first use), cell grids by size
@@ -823,9 +970,8 @@ class FastWindingNumber(_FastWindingBase):
         self._pending = None
         self.tree = t = tt.bvh
         with _single_thread(tt.F.shape[0] < PARALLEL_BUILD_FACES):
-            self._T, D = _tree_moments(tt.Vf, tt.F, t.order, t.start, t.end, t.right, t.lo, t.hi)
-            self._W, self._CH, self._LS, self._LE, self._stack = _pack_wide(D, t, self.beta ** 2, self.order, WIDTH,
-                                                                            tt.wide)
+            self._T, self._W, self._CH, self._LS, self._LE, self._stack = _moments_lanes(
+                tt.Vf, tt.F, t, tt.wide, self.beta ** 2, self.order)
 
     @classmethod
     def _deferred(cls, V, F, beta: float = 2.0, order: int = 2) -> FastWindingNumber:
