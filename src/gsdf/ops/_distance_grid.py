@@ -10,6 +10,7 @@ closest face, closest point, normal.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from gsdf._checks import as_mesh, as_normals, as_points, choice, positive, progress_callback
 from gsdf._memory import SECONDS_PER_QUERY, check_work
@@ -137,11 +138,18 @@ def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: st
     else:
         from gsdf.winding import FastWindingNumber
 
-        # the winding numbers first: on a cold cache `gsdf sdf` compiles the distance kernels in a background
-        # process meanwhile (gsdf.cli._background), which are then ready when the distance is reached
-        w = _chunked(FastWindingNumber._of_tree(tt, beta=beta), Q, report)
-        d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
-        s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
+        fwn = FastWindingNumber._of_tree(tt, beta=beta)
+        if _is_cycle(F, V.shape[0]):
+            # closed: the winding number is constant between nodes the surface does not separate, evaluated
+            # once per such region (_region_inside)
+            d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
+            inside = _region_inside(fwn, Q, d, grid, report)
+        else:
+            # the winding numbers first: on a cold cache `gsdf sdf` compiles the distance kernels in a background
+            # process meanwhile (gsdf.cli._background), which are then ready when the distance is reached
+            inside = _chunked(fwn, Q, report) > 0.5
+            d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
+        s = np.where(inside, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
     S = GridField((s if shell is None else with_shell(s, shell)).reshape(grid.shape), *grid.box)
     if not return_closest:
         return S
@@ -173,3 +181,94 @@ def _chunked(winding, Q, progress, stage: str = "winding numbers") -> np.ndarray
         w[s:e] = winding(Q[s:e])
         progress(stage, e / n)
     return w
+
+
+def _is_cycle(F, n_vertices: int) -> bool:
+    """True when the triangles form a cycle: every directed edge (a, b) occurs as often as (b, a) (closed,
+    consistently oriented, any number of components, non-manifold edges and cancelling duplicates allowed).
+    The generalized winding number of a cycle is an integer, constant on every connected region of the
+    complement of the surface (Jacobson et al. 2013 §3)."""
+    if F.shape[0] == 0:
+        return False
+    a = F.ravel().astype(np.int64)
+    b = F[:, [1, 2, 0]].ravel().astype(np.int64)
+    n = np.int64(max(n_vertices, 1))
+    return bool(np.array_equal(np.sort(a * n + b), np.sort(b * n + a)))
+
+
+def _region_inside(winding, Q, d, grid, progress) -> np.ndarray:
+    """``winding(Q) > 0.5`` on the nodes ``Q`` of ``grid`` for a closed surface (:func:`_is_cycle`), with the
+    winding number evaluated on few nodes.
+
+    Two neighbouring nodes p, q with ``max(d(p), d(q)) > |p − q|`` (``d`` the distance to the surface) lie in
+    one open ball free of the surface, so the segment pq does not cross it and their exact winding numbers are
+    equal. The regions these pairs connect (:func:`_regions`) are evaluated at two nodes each, the one farthest
+    from the surface and the first; a region whose two rounded values disagree is evaluated at every node (the
+    fast winding number's error exceeded 1/2 somewhere: then the per-node values stand, as without regions)."""
+    shape = tuple(int(x) for x in grid.shape)
+    lo, hi = grid.box
+    h = (np.asarray(hi, float) - np.asarray(lo, float)) / np.maximum(np.array(shape) - 1, 1)
+    h = np.where(np.array(shape) > 1, h * (1.0 + 1e-6), np.inf)  # the margin covers the rounding of d and Q
+    label, far, first = _regions(np.ascontiguousarray(d, np.float64), *shape, *(float(x) for x in h))
+    roots = np.flatnonzero(label == np.arange(label.shape[0]))
+    reps = np.unique(np.concatenate([far[roots], first[roots]]))
+    w = np.empty(label.shape[0])
+    w[reps] = _chunked(winding, Q[reps], progress)
+    ins = w > 0.5
+    bad = roots[ins[far[roots]] != ins[first[roots]]]
+    inside = ins[far[label]]
+    if bad.size:
+        rows = np.flatnonzero(np.isin(label, bad))
+        inside[rows] = np.asarray(winding(Q[rows])) > 0.5
+    return inside
+
+
+@njit(cache=True, inline="always")
+def _find(parent, x):
+    while parent[x] != x:
+        parent[x] = parent[parent[x]]  # path halving
+        x = parent[x]
+    return x
+
+
+@njit(cache=True)
+def _regions(d, nx, ny, nz, hx, hy, hz):
+    """Union-find over the nodes of an (nx, ny, nz) grid (C order) joining 6-neighbours p, q with
+    ``max(d[p], d[q]) > h`` along their axis. Returns the region label of every node (a node of the region),
+    and per label the node of the region farthest from the surface and its first node."""
+    n = nx * ny * nz
+    parent = np.arange(n)
+    for i in range(nx):
+        for j in range(ny):
+            for k in range(nz):
+                p = (i * ny + j) * nz + k
+                for axis in range(3):
+                    if axis == 0:
+                        if k + 1 >= nz or max(d[p], d[p + 1]) <= hz:
+                            continue
+                        q = p + 1
+                    elif axis == 1:
+                        if j + 1 >= ny or max(d[p], d[p + nz]) <= hy:
+                            continue
+                        q = p + nz
+                    else:
+                        if i + 1 >= nx or max(d[p], d[p + ny * nz]) <= hx:
+                            continue
+                        q = p + ny * nz
+                    a = _find(parent, p)
+                    b = _find(parent, q)
+                    if a < b:
+                        parent[b] = a
+                    elif b < a:
+                        parent[a] = b
+    far = np.empty(n, np.int64)
+    first = np.empty(n, np.int64)
+    for p in range(n):
+        r = _find(parent, p)
+        parent[p] = r
+        if r == p:  # the smallest node of its region: visited first
+            far[r] = p
+            first[r] = p
+        elif d[p] > d[far[r]]:
+            far[r] = p
+    return parent, far, first
