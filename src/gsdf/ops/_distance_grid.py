@@ -141,7 +141,10 @@ def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: st
         fwn = FastWindingNumber._of_tree(tt, beta=beta)
         if _is_cycle(F, V.shape[0]):
             # closed: the winding number is constant between nodes the surface does not separate, evaluated
-            # once per such region (_region_inside)
+            # once per such region (_region_inside), after the distance. One node first: on a cold cache its
+            # kernels compile here while `gsdf sdf` compiles the distance kernels in a background process
+            # (gsdf.cli._background)
+            fwn(Q[:1])
             d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
             inside = _region_inside(fwn, Q, d, grid, report)
         else:
