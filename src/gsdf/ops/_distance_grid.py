@@ -25,7 +25,10 @@ def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: st
     ``|S|`` is the exact distance to the triangles (:class:`gsdf.TriangleDistance`) or to the nearest point of a
     cloud (:class:`gsdf.PointCloudDistance`); the sign is negative where the fast winding number exceeds 1/2
     (Barill et al. 2018 §4: robust to holes and soups), or, with ``sign="pseudonormal"``, the sign of the
-    angle-weighted pseudonormal of the closest feature (Bærentzen & Aanæs 2005; closed manifold meshes).
+    angle-weighted pseudonormal of the closest feature (Bærentzen & Aanæs 2005; closed manifold meshes). On a
+    closed surface (every directed edge matched by its reverse) the winding number is integer and constant between
+    nodes the surface does not separate (Feng 2026, thesis §2.3.3), so it is evaluated once per such region of
+    nodes, with the same signs as per node.
 
     Parameters
     ----------
@@ -190,7 +193,7 @@ def _is_cycle(F, n_vertices: int) -> bool:
     """True when the triangles form a cycle: every directed edge (a, b) occurs as often as (b, a) (closed,
     consistently oriented, any number of components, non-manifold edges and cancelling duplicates allowed).
     The generalized winding number of a cycle is an integer, constant on every connected region of the
-    complement of the surface (Jacobson et al. 2013 §3)."""
+    complement of the surface (Feng 2026, thesis §2.3.3: piecewise constant and integer for a closed surface)."""
     if F.shape[0] == 0:
         return False
     a = F.ravel().astype(np.int64)
@@ -210,18 +213,16 @@ def _region_inside(winding, Q, d, grid, progress) -> np.ndarray:
     fast winding number's error exceeded 1/2 somewhere: then the per-node values stand, as without regions)."""
     shape = tuple(int(x) for x in grid.shape)
     lo, hi = grid.box
-    h = (np.asarray(hi, float) - np.asarray(lo, float)) / np.maximum(np.array(shape) - 1, 1)
-    h = np.where(np.array(shape) > 1, h * (1.0 + 1e-6), np.inf)  # the margin covers the rounding of d and Q
+    h = (np.asarray(hi, float) - np.asarray(lo, float)) / (np.array(shape) - 1)
+    h = h * (1.0 + 1e-6)  # the margin covers the rounding of d and of the node coordinates
     label, far, first = _regions(np.ascontiguousarray(d, np.float64), *shape, *(float(x) for x in h))
-    roots = np.flatnonzero(label == np.arange(label.shape[0]))
-    reps = np.unique(np.concatenate([far[roots], first[roots]]))
-    w = np.empty(label.shape[0])
-    w[reps] = _chunked(winding, Q[reps], progress)
-    ins = w > 0.5
-    bad = roots[ins[far[roots]] != ins[first[roots]]]
-    inside = ins[far[label]]
-    if bad.size:
-        rows = np.flatnonzero(np.isin(label, bad))
+    reps = np.unique(np.concatenate([far, first]))
+    ins = np.asarray(_chunked(winding, Q[reps], progress)) > 0.5
+    ins_far = ins[np.searchsorted(reps, far)]
+    bad = ins_far != ins[np.searchsorted(reps, first)]
+    inside = ins_far[label]
+    if bad.any():
+        rows = np.flatnonzero(bad[label])
         inside[rows] = np.asarray(winding(Q[rows])) > 0.5
     return inside
 
@@ -237,8 +238,8 @@ def _find(parent, x):
 @njit(cache=True)
 def _regions(d, nx, ny, nz, hx, hy, hz):
     """Union-find over the nodes of an (nx, ny, nz) grid (C order) joining 6-neighbours p, q with
-    ``max(d[p], d[q]) > h`` along their axis. Returns the region label of every node (a node of the region),
-    and per label the node of the region farthest from the surface and its first node."""
+    ``max(d[p], d[q]) > h`` along their axis. Returns the region (0, 1, ...) of every node, and per region the
+    node farthest from the surface and the first node."""
     n = nx * ny * nz
     parent = np.arange(n)
     for i in range(nx):
@@ -260,18 +261,29 @@ def _regions(d, nx, ny, nz, hx, hy, hz):
                         q = p + ny * nz
                     a = _find(parent, p)
                     b = _find(parent, q)
-                    if a < b:
+                    if a < b:  # the root of a region is its smallest node
                         parent[b] = a
                     elif b < a:
                         parent[a] = b
-    far = np.empty(n, np.int64)
-    first = np.empty(n, np.int64)
+    count = 0
     for p in range(n):
-        r = _find(parent, p)
-        parent[p] = r
-        if r == p:  # the smallest node of its region: visited first
-            far[r] = p
-            first[r] = p
-        elif d[p] > d[far[r]]:
-            far[r] = p
+        parent[p] = _find(parent, p)
+        count += parent[p] == p
+    far = np.empty(count, np.int64)
+    first = np.empty(count, np.int64)
+    count = 0
+    for p in range(n):  # parent[] becomes -(region + 1): a root (smallest node) is met before its region
+        r = parent[p]
+        if r == p:
+            far[count] = p
+            first[count] = p
+            parent[p] = -(count + 1)
+            count += 1
+        else:
+            g = -parent[r] - 1
+            parent[p] = -(g + 1)
+            if d[p] > d[far[g]]:
+                far[g] = p
+    for p in range(n):
+        parent[p] = -parent[p] - 1
     return parent, far, first
