@@ -10,6 +10,7 @@ closest face, closest point, normal.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from gsdf._checks import as_mesh, as_normals, as_points, choice, positive, progress_callback
 from gsdf._memory import SECONDS_PER_QUERY, check_work
@@ -24,7 +25,10 @@ def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: st
     ``|S|`` is the exact distance to the triangles (:class:`gsdf.TriangleDistance`) or to the nearest point of a
     cloud (:class:`gsdf.PointCloudDistance`); the sign is negative where the fast winding number exceeds 1/2
     (Barill et al. 2018 §4: robust to holes and soups), or, with ``sign="pseudonormal"``, the sign of the
-    angle-weighted pseudonormal of the closest feature (Bærentzen & Aanæs 2005; closed manifold meshes).
+    angle-weighted pseudonormal of the closest feature (Bærentzen & Aanæs 2005; closed manifold meshes). On a
+    closed surface (every directed edge matched by its reverse) the winding number is integer and constant between
+    nodes the surface does not separate (Feng 2026, thesis §2.3.3), so it is evaluated once per such region of
+    nodes, with the same signs as per node.
 
     Parameters
     ----------
@@ -137,11 +141,21 @@ def signed_distance_grid(V=None, F=None, *, points=None, resolution=64, sign: st
     else:
         from gsdf.winding import FastWindingNumber
 
-        # the winding numbers first: on a cold cache `gsdf sdf` compiles the distance kernels in a background
-        # process meanwhile (gsdf.cli._background), which are then ready when the distance is reached
-        w = _chunked(FastWindingNumber._of_tree(tt, beta=beta), Q, report)
-        d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
-        s = np.where(w > 0.5, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
+        fwn = FastWindingNumber._of_tree(tt, beta=beta)
+        if _is_cycle(F, V.shape[0]):
+            # closed: the winding number is constant between nodes the surface does not separate, evaluated
+            # once per such region (_region_inside), after the distance. One node first: on a cold cache its
+            # kernels compile here while `gsdf sdf` compiles the distance kernels in a background process
+            # (gsdf.cli._background)
+            fwn(Q[:1])
+            d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
+            inside = _region_inside(fwn, Q, d, grid, report)
+        else:
+            # the winding numbers first: on a cold cache `gsdf sdf` compiles the distance kernels in a background
+            # process meanwhile (gsdf.cli._background), which are then ready when the distance is reached
+            inside = _chunked(fwn, Q, report) > 0.5
+            d, face, closest = TriangleDistance._of_tree(V, F, tt).query(Q)
+        s = np.where(inside, -d, d)  # Barill et al. 2018 §4: inside where the winding number exceeds 1/2
     S = GridField((s if shell is None else with_shell(s, shell)).reshape(grid.shape), *grid.box)
     if not return_closest:
         return S
@@ -173,3 +187,103 @@ def _chunked(winding, Q, progress, stage: str = "winding numbers") -> np.ndarray
         w[s:e] = winding(Q[s:e])
         progress(stage, e / n)
     return w
+
+
+def _is_cycle(F, n_vertices: int) -> bool:
+    """True when the triangles form a cycle: every directed edge (a, b) occurs as often as (b, a) (closed,
+    consistently oriented, any number of components, non-manifold edges and cancelling duplicates allowed).
+    The generalized winding number of a cycle is an integer, constant on every connected region of the
+    complement of the surface (Feng 2026, thesis §2.3.3: piecewise constant and integer for a closed surface)."""
+    if F.shape[0] == 0:
+        return False
+    a = F.ravel().astype(np.int64)
+    b = F[:, [1, 2, 0]].ravel().astype(np.int64)
+    n = np.int64(max(n_vertices, 1))
+    return bool(np.array_equal(np.sort(a * n + b), np.sort(b * n + a)))
+
+
+def _region_inside(winding, Q, d, grid, progress) -> np.ndarray:
+    """``winding(Q) > 0.5`` on the nodes ``Q`` of ``grid`` for a closed surface (:func:`_is_cycle`), with the
+    winding number evaluated on few nodes.
+
+    Two neighbouring nodes p, q with ``max(d(p), d(q)) > |p − q|`` (``d`` the distance to the surface) lie in
+    one open ball free of the surface, so the segment pq does not cross it and their exact winding numbers are
+    equal. The regions these pairs connect (:func:`_regions`) are evaluated at two nodes each, the one farthest
+    from the surface and the first; a region whose two rounded values disagree is evaluated at every node (the
+    fast winding number's error exceeded 1/2 somewhere: then the per-node values stand, as without regions)."""
+    shape = tuple(int(x) for x in grid.shape)
+    lo, hi = grid.box
+    h = (np.asarray(hi, float) - np.asarray(lo, float)) / (np.array(shape) - 1)
+    h = h * (1.0 + 1e-6)  # the margin covers the rounding of d and of the node coordinates
+    label, far, first = _regions(np.ascontiguousarray(d, np.float64), *shape, *(float(x) for x in h))
+    reps = np.unique(np.concatenate([far, first]))
+    ins = np.asarray(_chunked(winding, Q[reps], progress)) > 0.5
+    ins_far = ins[np.searchsorted(reps, far)]
+    bad = ins_far != ins[np.searchsorted(reps, first)]
+    inside = ins_far[label]
+    if bad.any():
+        rows = np.flatnonzero(bad[label])
+        inside[rows] = np.asarray(winding(Q[rows])) > 0.5
+    return inside
+
+
+@njit(cache=True, inline="always")
+def _find(parent, x):
+    while parent[x] != x:
+        parent[x] = parent[parent[x]]  # path halving
+        x = parent[x]
+    return x
+
+
+@njit(cache=True)
+def _regions(d, nx, ny, nz, hx, hy, hz):
+    """Union-find over the nodes of an (nx, ny, nz) grid (C order) joining 6-neighbours p, q with
+    ``max(d[p], d[q]) > h`` along their axis. Returns the region (0, 1, ...) of every node, and per region the
+    node farthest from the surface and the first node."""
+    n = nx * ny * nz
+    parent = np.arange(n)
+    for i in range(nx):
+        for j in range(ny):
+            for k in range(nz):
+                p = (i * ny + j) * nz + k
+                for axis in range(3):
+                    if axis == 0:
+                        if k + 1 >= nz or max(d[p], d[p + 1]) <= hz:
+                            continue
+                        q = p + 1
+                    elif axis == 1:
+                        if j + 1 >= ny or max(d[p], d[p + nz]) <= hy:
+                            continue
+                        q = p + nz
+                    else:
+                        if i + 1 >= nx or max(d[p], d[p + ny * nz]) <= hx:
+                            continue
+                        q = p + ny * nz
+                    a = _find(parent, p)
+                    b = _find(parent, q)
+                    if a < b:  # the root of a region is its smallest node
+                        parent[b] = a
+                    elif b < a:
+                        parent[a] = b
+    count = 0
+    for p in range(n):
+        parent[p] = _find(parent, p)
+        count += parent[p] == p
+    far = np.empty(count, np.int64)
+    first = np.empty(count, np.int64)
+    count = 0
+    for p in range(n):  # parent[] becomes -(region + 1): a root (smallest node) is met before its region
+        r = parent[p]
+        if r == p:
+            far[count] = p
+            first[count] = p
+            parent[p] = -(count + 1)
+            count += 1
+        else:
+            g = -parent[r] - 1
+            parent[p] = -(g + 1)
+            if d[p] > d[far[g]]:
+                far[g] = p
+    for p in range(n):
+        parent[p] = -parent[p] - 1
+    return parent, far, first
