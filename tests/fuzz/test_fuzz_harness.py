@@ -157,3 +157,14 @@ def test_hypothesis_draws_are_deterministic():
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
     V, F = a
     assert np.isfinite(V).all() and F.min() >= 0 and F.max() < len(V)
+
+
+def test_a_changed_value_counts_only_when_the_reader_reads_it():
+    P = np.arange(6.0).reshape(2, 3)
+    read = {"same": lambda p: (P.copy(), None), "changed": lambda p: (P + 1, None), "nothing": lambda p: None}
+    u = _execute._unread_change
+    assert u("inf_token", (P, None), read["same"], "x.ply")            # e.g. inf in an extra PLY property
+    assert u("npz_ravel", (P, None), read["same"], "pat.npz")           # a tampered array the reader ignores
+    assert not u("inf_token", (P, None), read["changed"], "x.ply")      # the reader read it: accepted bad
+    assert not u("inf_token", None, read["nothing"], "x.ply")           # no arrays to compare: no excuse
+    assert not u("garbage", (P, None), read["same"], "x.ply")           # only value mutations qualify

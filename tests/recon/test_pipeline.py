@@ -203,7 +203,8 @@ def test_bad_input(P, N, kw, msg):
         gsdf.reconstruct_simply_connected(P, N, **kw)
 
 
-@pytest.mark.parametrize("kw, msg", [({"max_iterations": 0}, "max_iterations"), ({"band": -1.0}, "band"),
+@pytest.mark.parametrize("kw, msg", [({"max_iterations": 0}, "max_iterations"),
+                                     ({"max_iterations": 10 ** 9}, "<= 20"), ({"band": -1.0}, "band"),
                                      ({"outlier_gap": float("nan")}, "outlier_gap"),
                                      ({"cluster_gap": True}, "cluster_gap"), ({"fit_k": 2}, "fit_k")])
 def test_bad_options(kw, msg):
