@@ -225,9 +225,13 @@ def test_no_window_without_a_display(monkeypatch):
 
 
 def test_view_fill_takes_numpy_floats():
-    assert gsdf.ViewOptions(fill=np.float32(0.86)).fill == np.float32(0.86)
-    with pytest.raises(ValueError, match=r"fill: expected a number in \(0, 1\]"):
-        gsdf.ViewOptions(fill=1.5)
+    opts = gsdf.ViewOptions(fill=np.float32(0.86), vrange=(np.float32(-1), 2))
+    assert opts.fill == np.float32(0.86) and type(opts.fill) is float        # float32 made the framing float32
+    assert opts.vrange == (-1.0, 2.0) and all(type(x) is float for x in opts.vrange)
+    for bad in (1.5, 0.0, 1e-308, 0.009):                # a tiny fill made the framing loop forever
+        with pytest.raises(ValueError, match=r"fill: expected a number in \[0.01, 1\]"):
+            gsdf.ViewOptions(fill=bad)
+    assert gsdf.ViewOptions(fill=0.01).fill == 0.01
 
 
 @pytest.mark.parametrize("bad", [b"viridis", "", 3])
