@@ -168,3 +168,15 @@ def test_a_changed_value_counts_only_when_the_reader_reads_it():
     assert not u("inf_token", (P, None), read["changed"], "x.ply")      # the reader read it: accepted bad
     assert not u("inf_token", None, read["nothing"], "x.ply")           # no arrays to compare: no excuse
     assert not u("garbage", (P, None), read["same"], "x.ply")           # only value mutations qualify
+
+
+def test_a_documented_bound_beats_the_name():
+    """``normal_radius`` is a positive quantity by name, but the voxel solver documents 0 (trivial normals)."""
+    import inspect
+
+    import gsdf
+
+    cls = gsdf.VoxelSurfaceSignedHeatSolver
+    sp = _knowledge.specs("VoxelSurfaceSignedHeatSolver", inspect.signature(cls), cls)["normal_radius"]
+    m = _knowledge.scalar_mutations(sp)
+    assert m["zero"] == "either" and m["negative"] == "refuse"
