@@ -437,7 +437,7 @@ def write_sample_file(fx: Fixtures, name: str, how: str, opts: dict, d: str):
         return {"values": fx.grid_vals}
     if how == "surface_save":
         gsdf.SurfaceField(V, F, V[:, 2].copy()).save(p)
-        return {"values": V[:, 2].copy()}
+        return {"values": V[:, 2].copy(), "V": V, "F": F}        # load_field reads the values, read_mesh the mesh
     if how == "tet_save":
         X = np.vstack([fx.Xt, [[1.0, 1.0, 1.0]]])
         T = np.array([[0, 1, 2, 3], [1, 2, 3, 4]])
