@@ -166,15 +166,44 @@ def classify_exception(e: BaseException, mutation: str, expect: str):
 
 
 # ------------------------------------------------------------------------------------------------ API
+def _positional(fn, args, kwargs):
+    """``fn(*args, **kwargs)`` with the parameters before a ``*items`` parameter moved into ``args`` when
+    ``*items`` gets values (``save_png(path, *items)``: ``path=`` as a keyword would be given twice)."""
+    if not args:
+        return args, kwargs
+    try:
+        ps = list(inspect.signature(fn).parameters.values())
+    except (TypeError, ValueError):
+        return args, kwargs
+    if not any(p.kind == p.VAR_POSITIONAL for p in ps):
+        return args, kwargs
+    lead, kw = [], dict(kwargs)
+    for p in ps:
+        if p.kind == p.VAR_POSITIONAL:
+            break
+        if p.kind != p.POSITIONAL_OR_KEYWORD:
+            return args, kwargs
+        if p.name in kw:
+            lead.append(kw.pop(p.name))
+        elif p.default is not p.empty:
+            lead.append(p.default)
+        else:
+            return args, kwargs
+    return lead + list(args), kw
+
+
 def call_target(target: str, args, kwargs, ctor=None):
     obj, meth = _cases.resolve(target)
     if meth is None:
-        return obj(*args, **kwargs)
+        a, k = _positional(obj, args, kwargs)
+        return obj(*a, **k)
     raw = vars(obj).get(meth)
     if isinstance(raw, (classmethod, staticmethod)):
-        return getattr(obj, meth)(*args, **kwargs)
-    inst = obj(*ctor[0], **ctor[1])
-    return getattr(inst, meth)(*args, **kwargs)
+        fn = getattr(obj, meth)
+    else:
+        fn = getattr(obj(*ctor[0], **ctor[1]), meth)
+    a, k = _positional(fn, args, kwargs)
+    return fn(*a, **k)
 
 
 def build(sig, combo: dict, fx: Fixtures, target: str):

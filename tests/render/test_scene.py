@@ -239,3 +239,16 @@ def test_colormap_must_be_a_name(bad):
     with pytest.raises(ValueError, match="colormap: expected the name of a polyscope colour map"):
         gsdf.ViewOptions(colormap=bad)
     assert gsdf.ViewOptions(colormap="turbo").colormap == "turbo"
+
+
+@pytest.mark.parametrize("view, why", [("x", "string"), ([1j, 0, 0], "complex"), ([object()] * 3, "objects"),
+                                       ([0, 0, 0], r"\[0, 0, 0\]"), ([1, 0], r"\[1, 0\]"), ([np.nan, 0, 1], "NaN")])
+def test_save_png_checks_view_and_options_before_drawing(tmp_path, view, why):
+    """A bad view direction leaked numpy's own errors (could not convert string to float, TypeError)."""
+    V, F = _sphere()
+    out = tmp_path / "p.png"
+    with pytest.raises(ValueError, match=f"view: expected a nonzero direction.*{why}"):
+        gsdf.save_png(out, (V, F), view=view, renderer="gsdf")
+    with pytest.raises(ValueError, match="options: expected a gsdf.ViewOptions"):
+        gsdf.save_png(out, (V, F), options={"fill": 0.5}, renderer="gsdf")
+    assert not out.exists()

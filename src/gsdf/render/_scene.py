@@ -500,8 +500,13 @@ def camera_direction(up, front, azimuth: float, elevation: float, extent) -> tup
 def direction_camera(view_dir, up="auto") -> tuple:
     """A camera along a given direction (from the scene towards the camera): the unit direction and the up
     vector (``up``, or y unless the direction is within 15° of it, then z)."""
-    d = np.asarray(view_dir, float).reshape(-1)
-    if d.shape != (3,) or not np.isfinite(d).all() or not np.linalg.norm(d) > 0:
+    from gsdf._checks import as_values
+
+    try:
+        d = as_values(view_dir, "view").reshape(-1)
+    except ValueError as exc:
+        raise ValueError(f"view: expected a nonzero direction (x, y, z), got {view_dir!r} ({exc})") from None
+    if d.shape != (3,) or not np.linalg.norm(d) > 0:
         raise ValueError(f"view: expected a nonzero direction (x, y, z), got {view_dir!r}")
     d = d / np.linalg.norm(d)
     if not (isinstance(up, str) and up == "auto"):
