@@ -252,3 +252,20 @@ def test_save_png_checks_view_and_options_before_drawing(tmp_path, view, why):
     with pytest.raises(ValueError, match="options: expected a gsdf.ViewOptions"):
         gsdf.save_png(out, (V, F), options={"fill": 0.5}, renderer="gsdf")
     assert not out.exists()
+
+
+@pytest.mark.parametrize("kw, why", [(dict(isolines="x"), "isolines: expected a count"),
+                                     (dict(isolines=[1j]), "isolines: expected a count"),
+                                     (dict(vrange="ab"), "vrange: expected"), (dict(vrange=()), "vrange: expected"),
+                                     (dict(vrange=("a", "b")), "vrange: expected"),
+                                     (dict(front=b"x"), "front: expected an axis"), (dict(front=1), "front: expected")])
+def test_view_options_refuse_what_numpy_would_choke_on(kw, why):
+    with pytest.raises(ValueError, match=why):
+        gsdf.ViewOptions(**kw)
+
+
+@pytest.mark.parametrize("up", [b"x", 1, True, "w", [0, 0, 0], ["a", "b", "c"]])
+def test_view_up_is_an_axis_name_or_a_vector(tmp_path, up):
+    V, F = _sphere()
+    with pytest.raises(ValueError, match="up: expected an axis"):
+        gsdf.view((V, F), screenshot=str(tmp_path / "x.png"), up=up)

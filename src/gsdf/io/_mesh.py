@@ -783,6 +783,8 @@ def _faces_arg(F, nv: int):
 
 def _vertex_data(vertex_data, n: int) -> dict:
     """name -> (n,) or (n, k) float64 arrays, validated."""
+    if vertex_data is not None and not isinstance(vertex_data, dict):
+        raise ValueError(f"vertex_data: expected a dict of name -> per-vertex values, got {type(vertex_data).__name__}")
     out = {}
     for name, values in (vertex_data or {}).items():
         if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) or name in ("x", "y", "z"):

@@ -59,7 +59,7 @@ class ViewOptions:
     vrange: tuple | None = None
 
     def __post_init__(self):
-        from gsdf._checks import finite
+        from gsdf._checks import as_values, finite
 
         if self.level is not None:
             object.__setattr__(self, "level", finite(self.level, "level"))
@@ -68,8 +68,10 @@ class ViewOptions:
         iso = self.isolines
         if isinstance(iso, (bool, np.bool_)) or not (isinstance(iso, (int, np.integer)) and 0 <= iso <= 1000):
             try:
-                iso = tuple(float(x) for x in iso)
-            except TypeError:
+                if isinstance(iso, (str, bytes, bool, np.bool_)) or np.ndim(iso) != 1:
+                    raise ValueError
+                iso = tuple(float(x) for x in as_values(iso, "isolines", finite=False, allow_empty=True))
+            except (TypeError, ValueError):
                 raise ValueError(f"isolines: expected a count (0..1000) or a sequence of isovalues, got "
                                  f"{self.isolines!r}") from None
             if not all(math.isfinite(x) for x in iso):
@@ -80,7 +82,7 @@ class ViewOptions:
         if self.front != "auto":
             from gsdf.render._scene import axis_vector
 
-            axis_vector(self.front)
+            axis_vector(self.front, "front")
         from gsdf._checks import positive
 
         try:
@@ -186,7 +188,7 @@ def render(items, screenshot, size, up, angles, options, view_dir=None):
         raise ValueError(f"size: expected (width, height), got {size!r}") from None
     size = (integer(w, "size[0]", lo=64, hi=8192), integer(h, "size[1]", lo=64, hi=8192))
     if not (isinstance(up, str) and up == "auto"):
-        _scene.axis_vector(up)
+        _scene.axis_vector(up, "up")
     if screenshot is not None:
         from gsdf.io._safe_write import check_output_path
 
