@@ -180,3 +180,15 @@ def test_a_documented_bound_beats_the_name():
     sp = _knowledge.specs("VoxelSurfaceSignedHeatSolver", inspect.signature(cls), cls)["normal_radius"]
     m = _knowledge.scalar_mutations(sp)
     assert m["zero"] == "either" and m["negative"] == "refuse"
+
+
+def test_round_trip_meshes_compare_faces_in_any_order_but_keep_orientation():
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    t = _execute._triangles
+    same = t(V[F[::-1][:, [1, 2, 0]]], True)                      # faces reordered and rotated
+    assert np.array_equal(same, t(V[F], True))
+    flipped = t(V[F[:, ::-1]], True)
+    assert not np.array_equal(flipped, t(V[F], True)) and np.array_equal(t(V[F[:, ::-1]], False), t(V[F], False))
+    assert _execute._roundtrip((V, F[::-1]), {"V": V, "F": F}) is None
+    assert _execute._roundtrip((V, F[:, ::-1]), {"V": V, "F": F}) == "mesh read back differs"
