@@ -186,6 +186,8 @@ def main(argv=None) -> int:
                     help="skip the cases of a target / command whose baseline takes longer (reported as skipped)")
     ap.add_argument("--mem-gb", type=float, default=6.0, help="address-space cap of each case process (GiB)")
     ap.add_argument("--only", default="", help="only cases whose id contains this text")
+    ap.add_argument("--ids", default=None, help="only the cases whose ids this file lists, one per line (e.g. the "
+                                               "failures of a --json report, to confirm their fixes)")
     ap.add_argument("--list", action="store_true", help="print the case ids and exit (no run)")
     ap.add_argument("--gaps", action="store_true", help="print the coverage gaps and exit (no run)")
     ap.add_argument("--json", default=None, help="write every case with its outcome (and the run's summary) here")
@@ -232,6 +234,10 @@ def _run(args, areas, root, t_start) -> int:
 
     pairs = prepare(root)
     cases = [c for c in _cases.all_cases(areas, pairs) if args.only in c["id"]]
+    if args.ids:
+        with open(args.ids) as fh:
+            wanted = {line.strip() for line in fh if line.strip()}
+        cases = [c for c in cases if c["id"] in wanted]
     n_all = len(cases)
     if args.sample:
         cases = _cases.sample(cases, args.sample, args.seed)
