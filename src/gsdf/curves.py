@@ -67,7 +67,7 @@ def index_array(a, name: str, ndim: int | None = 1) -> np.ndarray:
     out = arr.astype(np.int64)
     if out.size and out.min() < 0:
         k = int(np.argmax(out.ravel() < 0))
-        raise ValueError(f"{name}: negative vertex index {out.ravel()[k]} (at flat position {k})")
+        raise ValueError(f"{name}: negative vertex index {out.ravel()[k]} out of range (at flat position {k})")
     return out
 
 
