@@ -207,7 +207,8 @@ def test_hierarchical_exact_matches_direct_on_a_broken_soup():
         gsdf.winding_number(V, F, Q, method="fast")
 
 
-@pytest.mark.parametrize("make", [lambda V, F: gsdf.ExactWindingNumber(V, F), lambda V, F: gsdf.FastWindingNumber(V, F)])
+@pytest.mark.parametrize("make", [lambda V, F: gsdf.ExactWindingNumber(V, F),
+                                  lambda V, F: gsdf.FastWindingNumber(V, F)])
 def test_a_progress_that_is_not_callable_is_refused_before_any_query(make):
     V, F = cube()
     ewn = make(V, F)
