@@ -197,6 +197,8 @@ def test_normals_given_and_duplicates():
     (np.random.default_rng(0).normal(size=(50, 3)), None, {"outliers": "maybe"}, "outliers"),
     (np.random.default_rng(0).normal(size=(50, 3)), None, {"clusters": 1}, "clusters"),
     (np.random.default_rng(0).normal(size=(50, 3)), None, {"options": {"band": 1.0}}, "options"),
+    (np.random.default_rng(0).normal(size=(50, 3)), None, {"return_report": "no"}, "return_report"),  # was obeyed
+    (np.random.default_rng(0).normal(size=(50, 3)), None, {"return_report": 2}, "return_report"),
 ])
 def test_bad_input(P, N, kw, msg):
     with pytest.raises(ValueError, match=msg):

@@ -55,7 +55,7 @@ import numpy as np
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-from gsdf._checks import choice, integer, progress_callback
+from gsdf._checks import choice, flag, integer, progress_callback
 from gsdf.dec._tet import TetComplex
 from gsdf.mesh._tet_ops import signed_volumes
 from gsdf.recon._cloud import dense_points, on_side, on_surface, pca_normals, prefilter, prepare_cloud
@@ -193,6 +193,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     outliers = choice(outliers, "outliers", ("auto", "none"))
     if not isinstance(clusters, (bool, np.bool_)):
         raise ValueError(f"clusters: expected a bool, got {type(clusters).__name__}")
+    return_report = flag(return_report, "return_report")        # "no" is a true string: refused, not obeyed
     if options is None:
         options = ReconstructionOptions()
     elif not isinstance(options, ReconstructionOptions):
