@@ -389,6 +389,20 @@ def test_tet_field_checks_its_tets():
             TetField(T, tets, np.zeros(4))
 
 
+def test_tet_field_checks_its_delaunay_locator():
+    from scipy.spatial import Delaunay
+
+    P = np.vstack([np.eye(4, 3), [[1.0, 1.0, 1.0]]])
+    D = Delaunay(P)
+    f = TetField(P, D.simplices, P[:, 0], delaunay=D)
+    assert f([[0.2, 0.2, 0.2]]) == pytest.approx([0.2])
+    for bad in (float("nan"), 1j, object(), "delaunay"):
+        with pytest.raises(ValueError, match="delaunay: expected a scipy.spatial.Delaunay"):
+            TetField(P, D.simplices, P[:, 0], delaunay=bad)
+    with pytest.raises(ValueError, match="are not the 1 tets"):
+        TetField(P, D.simplices[:1], P[:, 0], delaunay=D)
+
+
 def test_surface_field_takes_lists_and_empty_queries():
     V = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
     F = [[0, 1, 2], [0, 2, 3]]

@@ -73,3 +73,13 @@ def test_points_flat_index_checked(idx, why):
     with pytest.raises(ValueError, match="flat_index: .*" + why):
         g.points(idx)
     np.testing.assert_array_equal(g.points([23.0]), g.points()[[23]])
+
+
+def test_a_grid_too_large_for_any_address_space_is_refused_at_construction():
+    from gsdf.grid import MAX_NODES
+    for make in (lambda: Grid.around(np.eye(3), 10 ** 9), lambda: Grid.fit(([0, 0, 0], [1, 1, 1]), 10 ** 6),
+                 lambda: Grid(([0, 0, 0], [1, 1, 1]), (2 ** 20, 2 ** 20, 2 ** 15))):
+        with pytest.raises(ValueError, match=r"grid has .* nodes, more than a grid can have .*resolution"):
+            make()
+    assert Grid(([0, 0, 0], [1, 1, 1]), (2 ** 20, 2 ** 20, 2 ** 14)).size == MAX_NODES   # lazy: still fine
+    assert Grid.fit(([0, 0, 0], [1, 1e-9, 1e-9]), 10 ** 9).shape[1:] == (2, 2)             # long and thin: fine

@@ -149,6 +149,7 @@ SECONDS_PER_NODE = 2e-7          #: a node of a grid solve, a field evaluation, 
 SECONDS_PER_PAIR = 2e-9          #: one query × element term of a direct sum (exact winding numbers)
 SECONDS_PER_CELL = 1e-9          #: one voxel of an elementwise pass over a boolean grid
 SECONDS_PER_FACE_STEP = 5e-8     #: one face in one step of an iterative sweep over a mesh (two sparse products)
+SECONDS_PER_SLICE = 3e-4         #: one slice of slice_contours beyond its nodes (marching squares, bisection; serial)
 
 _TIME_SUFFIX = {"": 1.0, "S": 1.0, "M": 60.0, "H": 3600.0, "D": 86400.0}
 

@@ -39,8 +39,8 @@ def _surface_point(item, name: str, expected: str):
         e, b = item
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name}: expected {expected}, got {item!r}") from exc
-    if not _is_index_scalar(e):
-        raise ValueError(f"{name}: element index must be an integer, got {e!r}")
+    if not _is_index_scalar(e) or e < 0:
+        raise ValueError(f"{name}: element index must be an integer >= 0, got {e!r}")
     from gsdf._checks import as_values
 
     try:
@@ -64,7 +64,11 @@ def index_array(a, name: str, ndim: int | None = 1) -> np.ndarray:
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
         if not (np.issubdtype(arr.dtype, np.floating) and np.isfinite(arr).all() and np.all(arr == np.round(arr))):
             raise ValueError(f"{name}: vertex indices must be integers, got dtype {arr.dtype}")
-    return arr.astype(np.int64)
+    out = arr.astype(np.int64)
+    if out.size and out.min() < 0:
+        k = int(np.argmax(out.ravel() < 0))
+        raise ValueError(f"{name}: negative vertex index {out.ravel()[k]} out of range (at flat position {k})")
+    return out
 
 
 def _looks_like_point_list(items) -> bool:
@@ -116,7 +120,7 @@ class Curve:
     ------
     ValueError
         Fewer than 2 nodes, an empty edge list, negative or non-integer indices, malformed surface points (the
-        message starts with ``name``).
+        message starts with ``name``), a ``name`` that is not a string.
 
     Examples
     --------
@@ -128,6 +132,8 @@ class Curve:
     """
 
     def __init__(self, nodes, signed: bool = True, name: str = "curve"):
+        if not isinstance(name, str):
+            raise ValueError(f"name: expected a string, got {type(name).__name__}")
         if isinstance(nodes, Curve):
             nodes = nodes.nodes
         if not isinstance(signed, (bool, np.bool_)):

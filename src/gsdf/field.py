@@ -643,7 +643,8 @@ class TetField(Field):
     Raises
     ------
     ValueError
-        Bad shapes, indices out of range, NaN or infinite values.
+        Bad shapes, indices out of range, NaN or infinite values, a ``delaunay`` that is not a
+        ``scipy.spatial.Delaunay`` of as many simplices and points as ``tets`` and ``vertices``.
 
     Notes
     -----
@@ -664,6 +665,15 @@ class TetField(Field):
         self.vertices = as_points(vertices, "vertices")
         self.tets = as_faces(tets, len(self.vertices), "tets", corners=4)
         self.values = as_values(values, "values", (len(self.vertices),))
+        if delaunay is not None:
+            from scipy.spatial import Delaunay
+
+            if not isinstance(delaunay, Delaunay):
+                raise ValueError(f"delaunay: expected a scipy.spatial.Delaunay or None, got "
+                                 f"{type(delaunay).__name__}")
+            if delaunay.simplices.shape != self.tets.shape or len(delaunay.points) != len(self.vertices):
+                raise ValueError(f"delaunay: its {len(delaunay.simplices)} simplices over {len(delaunay.points)} "
+                                 f"points are not the {len(self.tets)} tets over {len(self.vertices)} vertices")
         self._delaunay = delaunay
         self.meta: dict = {}
 

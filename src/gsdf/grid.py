@@ -38,6 +38,11 @@ __all__ = ["Grid", "PAD", "padded_box", "grid_points"]
 #: The default padding of a box around an input: a fraction of its bounding-box diagonal, on every side.
 PAD = 0.1
 
+#: The most nodes a grid may have: one float64 value per node must fit the address space of any 64-bit
+#: process (2**57 bytes with 5-level paging). What fits but cannot be allocated now is refused by each function
+#: that allocates (``gsdf._memory``), so a large grid stays usable for sampling a few of its nodes.
+MAX_NODES = 1 << 54
+
 
 def _corner(x, name: str) -> np.ndarray:
     P = as_points(x, name)
@@ -111,7 +116,8 @@ class Grid:
     Raises
     ------
     ValueError
-        A box that is empty or inverted on some axis, or fewer than 2 nodes on an axis.
+        A box that is empty or inverted on some axis, fewer than 2 nodes on an axis, or more than
+        :data:`MAX_NODES` (2⁵⁴) nodes in all.
 
     Build one from a resolution with :meth:`fit` (a given box) or :meth:`around` (the padded bounding box of
     an input). Every grid-making function of gsdf takes one as its ``resolution``.
@@ -136,6 +142,11 @@ class Grid:
         shape = tuple(integer(v, "shape", lo=2) for v in s.tolist())
         if np.any(hi <= lo):
             raise ValueError(f"box: bbox_max {hi} must exceed bbox_min {lo} on every axis")
+        n = math.prod(shape)
+        if n > MAX_NODES:
+            raise ValueError(f"shape: a {'x'.join(str(v) for v in shape)} grid has {n:.3g} nodes, more than a grid "
+                             f"can have ({MAX_NODES:.3g}: one float64 per node must fit a 64-bit address space); "
+                             "lower the resolution")
         self.bbox_min = lo
         self.bbox_max = hi
         self.shape = shape
@@ -160,7 +171,7 @@ class Grid:
         Raises
         ------
         ValueError
-            An empty or inverted box, ``resolution < 2``.
+            An empty or inverted box, ``resolution < 2``, more than :data:`MAX_NODES` nodes.
 
         Examples
         --------
@@ -195,7 +206,8 @@ class Grid:
         Raises
         ------
         ValueError
-            Empty or non-finite ``X``, ``resolution < 2``, a negative ``pad``.
+            Empty or non-finite ``X``, ``resolution < 2``, a negative ``pad``, more than :data:`MAX_NODES`
+            nodes.
 
         Examples
         --------

@@ -641,6 +641,28 @@ def test_bad_inputs_are_clear_errors(dataset, tmp_path):
     assert not (tmp_path / "o").exists()  # nothing was created for a refused run
 
 
+def test_numpy_integers_are_counts_like_their_value(dataset, tmp_path, monkeypatch):
+    """BatchOptions(max_retries=np.int32(2)) was accepted by the dataclass, then refused by run_batch."""
+    from gsdf.batch import _run
+
+    bo = BatchOptions(max_retries=np.int32(2), threads=np.int64(1), scheduler_timeout=np.float32(5))
+    assert (bo.max_retries, bo.threads) == (2, 1) and type(bo.max_retries) is int and type(bo.threads) is int
+    assert _run._count("workers", np.int16(3)) == 3
+    with pytest.raises(ValueError, match="workers: expected a positive integer"):
+        _run._count("workers", np.bool_(True))
+
+
+def test_sizes_that_do_not_depend_on_the_input_are_refused_before_any_item(dataset, tmp_path):
+    """n_points=10^9 failed item by item (exit 3, a manifest of failures); heat_resolution=10^9 was accepted."""
+    out = tmp_path / "o"
+    with pytest.raises(ValueError, match="n_points: 1,000,000,000 samples: needs about"):
+        run_batch(str(dataset), "occupancy", str(out), {"n_points": 10 ** 9})
+    with pytest.raises(ValueError, match="heat_resolution: 1,000,000,000 nodes per side make a grid of 1e"):
+        sdf_samples(str(next(iter(sorted(dataset.iterdir())))), n_samples=100,
+                    options=SdfSamplesOptions(heat_resolution=10 ** 9))
+    assert not out.exists()
+
+
 def test_unreachable_scheduler_fails_fast(dataset, tmp_path):
     pytest.importorskip("distributed")
     t0 = time.perf_counter()

@@ -51,3 +51,20 @@ def test_a_face_at_the_level_between_two_tets_below_gives_no_fin():
     vn = np.zeros_like(V)
     np.add.at(vn, F.ravel(), np.repeat(n, 3, axis=0))
     assert (np.linalg.norm(vn, axis=1) > 0).all()
+
+
+def test_a_level_no_tet_crosses_is_refused_not_leaked():
+    """Values beyond the level only at vertices in no tet, or in another tet: numpy's 'need at least one array to
+    concatenate' leaked."""
+    import pytest
+
+    X = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0], [2, 2, 2]])
+    T = np.array([[0, 1, 2, 3]])
+    with pytest.raises(ValueError, match=r"outside the field's range \[1, 1\] \(over the tets\): no surface"):
+        marching_tetrahedra(X, T, np.array([1.0, 1, 1, 1, -1]), 0.0)
+    X2 = np.vstack([X[:4], X[:4] + 5.0])
+    T2 = np.array([[0, 1, 2, 3], [4, 5, 6, 7]])
+    with pytest.raises(ValueError, match="cuts no tet"):
+        marching_tetrahedra(X2, T2, np.r_[np.full(4, -1.0), np.full(4, 1.0)], 0.0)
+    V, F = marching_tetrahedra(X2, T2, np.r_[X2[:4, 0] - 0.5, np.full(4, 1.0)], 0.0)
+    assert F.shape == (1, 3) and np.allclose(V[:, 0], 0.5)

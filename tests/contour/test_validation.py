@@ -69,3 +69,6 @@ def test_region_boundary_curves_checks_its_arrays():
         region_boundary_curves(F, [0.5, 1.0])
     with pytest.raises(ValueError, match=r"face_mask: expected 2 booleans \(shape \(2,\)\), got shape \(3,\)"):
         region_boundary_curves(F, [True, True, False])
+    for bad in (F[:, :2], F[:, :1]):                       # edges are not faces (an empty answer before)
+        with pytest.raises(ValueError, match="F: expected faces of at least 3 corners"):
+            region_boundary_curves(bad, [True, True])

@@ -2,7 +2,9 @@
 
 * ``python -m tests.fuzz`` — every generated case (hours on 2 cores); ``--sample N --seed S`` a stratified
   sample; ``--areas api,cli,files`` (or ``api:scale``, ``cli:env`` ...); ``--jobs J``; ``--json out.json``;
-  ``--list`` the case ids; ``--gaps`` the parameters without a known valid value; ``--only TEXT``.
+  ``--list`` the case ids; ``--gaps`` the parameters without a known valid value; ``--only TEXT``; ``--ids FILE``
+  exactly the listed cases. A case that hangs is run once more (a cold numba cache); ``GSDF_WORK_LIMIT`` is half
+  the case timeout unless set.
 * ``tests/fuzz/test_fuzz_sample.py`` — the fixed sample run by pytest in CI, with the explicit list of cases
   that still fail because of a known open defect (``KNOWN_OPEN``).
 

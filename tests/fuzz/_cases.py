@@ -248,6 +248,8 @@ def _ptype(p):
 
 
 SIZE_OPTIONS = {"resolution", "n_points", "layers", "size", "workers", "dask_local"}
+#: options whose text is shown, not parsed (a colour-bar title): any text is valid
+FREE_TEXT_OPTIONS = {"title"}
 
 #: free-text values by the type's metavar (a new type gets the generic list)
 TEXT_VALUES = {
@@ -262,6 +264,7 @@ TEXT_VALUES = {
           ("nan", "refuse")],
     "generic": [("", "refuse"), (",", "refuse"), ("nan", "refuse"), ("1,nan", "refuse"), ("x", "refuse"),
                 ("1e308", "either"), ("inf", "refuse")],
+    "free": [("", "either"), ("x", "either"), ("nan", "either"), ("1,nan", "either"), ("é ü", "either")],
 }
 PATH_ARG_MUTATIONS = ("missing", "directory", "fifo", "dev_zero", "empty_file", "garbage")
 CLI_FILE_MUTATIONS = {m: e for m, e in FILE_MUTATIONS.items() if m not in ("empty", "garbage")}
@@ -332,7 +335,7 @@ def cli_mutations(cmd) -> list:
             for m, e in CLI_FILE_MUTATIONS.items():
                 out.append((p.name, "file:" + m, flag, e, "cli:files"))
         else:
-            metavar = kind.split(":", 1)[1]
+            metavar = "free" if p.name in FREE_TEXT_OPTIONS else kind.split(":", 1)[1]
             for v, e in TEXT_VALUES.get(metavar, TEXT_VALUES["generic"]):
                 out.append((p.name, "=" + v, flag, e, "cli:options"))
     return out
@@ -437,12 +440,15 @@ def write_sample_file(fx: Fixtures, name: str, how: str, opts: dict, d: str):
         return {"values": fx.grid_vals}
     if how == "surface_save":
         gsdf.SurfaceField(V, F, V[:, 2].copy()).save(p)
-        return {"values": V[:, 2].copy()}
+        return {"values": V[:, 2].copy(), "V": V, "F": F}        # load_field reads the values, read_mesh the mesh
     if how == "tet_save":
         X = np.vstack([fx.Xt, [[1.0, 1.0, 1.0]]])
         T = np.array([[0, 1, 2, 3], [1, 2, 3, 4]])
         gsdf.TetField(X, T, X[:, 0].copy()).save(p)
-        return {"values": X[:, 0].copy()}
+        # read_mesh reads a tet file as the tets' boundary: the faces that belong to one tet only
+        tri = np.sort(T[:, [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]].reshape(-1, 3), axis=1)
+        u, cnt = np.unique(tri, axis=0, return_counts=True)
+        return {"values": X[:, 0].copy(), "V": X, "F_unoriented": u[cnt == 1]}
     if how == "save_voxels":
         gsdf.save_voxels(p, fx.occ, [-1.5] * 3, [1.5] * 3)
         return {}

@@ -80,6 +80,10 @@ class Fixtures:
         with open(p("curves_swn.txt"), "w") as fh:        # the surface-winding-number demo's node format
             fh.write("".join(f"v {int(v)}\n" for v in self.loop[:-1]) + "l 0 1 2 0\n")
         gsdf.GridField(self.grid_vals, [-1.5] * 3, [1.5] * 3).save(p("field.npz"))
+        # the saved state of every class with a load(): each loader gets a file of its own kind
+        gsdf.SurfaceField(self.V, self.F, self.V[:, 2].copy()).save(p("surface_field.npz"))
+        gsdf.TetField(self.Xt, self.Tt, self.Xt[:, 0].copy()).save(p("tet_field.npz"))
+        gsdf.PointsAsTori(self.V, self.V, k=16).save(p("pat.npz"))
         os.makedirs(p("in_dir"), exist_ok=True)
         gsdf.write_mesh(p("in_dir/m.off"), self.V, self.F)
 
@@ -139,7 +143,8 @@ class Fixtures:
         if "path" not in t:
             if READER.search(target):
                 t["path"] = [lambda f=f: p(f) for f in ("mesh.off", "cloud.xyz", "curves.txt", "field.npz",
-                                                          "mesh.ply", "mesh.obj")]
+                                                          "mesh.ply", "mesh.obj", "surface_field.npz",
+                                                          "tet_field.npz", "pat.npz")]
             elif WRITER.search(target):
                 t["path"] = [lambda e=e: f"out{e}" for e in (".ply", ".off", ".xyz", ".txt", ".npz", ".svg",
                                                                ".png", ".npy")]

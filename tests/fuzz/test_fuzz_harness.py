@@ -157,3 +157,38 @@ def test_hypothesis_draws_are_deterministic():
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
     V, F = a
     assert np.isfinite(V).all() and F.min() >= 0 and F.max() < len(V)
+
+
+def test_a_changed_value_counts_only_when_the_reader_reads_it():
+    P = np.arange(6.0).reshape(2, 3)
+    read = {"same": lambda p: (P.copy(), None), "changed": lambda p: (P + 1, None), "nothing": lambda p: None}
+    u = _execute._unread_change
+    assert u("inf_token", (P, None), read["same"], "x.ply")            # e.g. inf in an extra PLY property
+    assert u("npz_ravel", (P, None), read["same"], "pat.npz")           # a tampered array the reader ignores
+    assert not u("inf_token", (P, None), read["changed"], "x.ply")      # the reader read it: accepted bad
+    assert not u("inf_token", None, read["nothing"], "x.ply")           # no arrays to compare: no excuse
+    assert not u("garbage", (P, None), read["same"], "x.ply")           # only value mutations qualify
+
+
+def test_a_documented_bound_beats_the_name():
+    """``normal_radius`` is a positive quantity by name, but the voxel solver documents 0 (trivial normals)."""
+    import inspect
+
+    import gsdf
+
+    cls = gsdf.VoxelSurfaceSignedHeatSolver
+    sp = _knowledge.specs("VoxelSurfaceSignedHeatSolver", inspect.signature(cls), cls)["normal_radius"]
+    m = _knowledge.scalar_mutations(sp)
+    assert m["zero"] == "either" and m["negative"] == "refuse"
+
+
+def test_round_trip_meshes_compare_faces_in_any_order_but_keep_orientation():
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    t = _execute._triangles
+    same = t(V[F[::-1][:, [1, 2, 0]]], True)                      # faces reordered and rotated
+    assert np.array_equal(same, t(V[F], True))
+    flipped = t(V[F[:, ::-1]], True)
+    assert not np.array_equal(flipped, t(V[F], True)) and np.array_equal(t(V[F[:, ::-1]], False), t(V[F], False))
+    assert _execute._roundtrip((V, F[::-1]), {"V": V, "F": F}) is None
+    assert _execute._roundtrip((V, F[:, ::-1]), {"V": V, "F": F}) == "mesh read back differs"

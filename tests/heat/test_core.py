@@ -94,6 +94,17 @@ def test_bad_curves_name_the_argument():
         solver.compute_distance([gsdf.Curve(loop)], curve_signs=[False])
 
 
+def test_curve_refuses_negative_indices_and_a_name_that_is_not_text():
+    import gsdf
+
+    for nodes in (np.array([-1, 1, 2, 3]), np.array([[0, 1], [1, -2]]), [(-1, np.array([1.0, 0, 0])), (1, ())]):
+        with pytest.raises(ValueError, match=r"curve.*(negative vertex index|>= 0)"):
+            gsdf.Curve(nodes)
+    for name in (b"x", None, 3):
+        with pytest.raises(ValueError, match="name: expected a string"):
+            gsdf.Curve([0, 1, 2], name=name)
+
+
 def test_every_front_end_takes_curve_and_rejects_bools():
     import gsdf
 

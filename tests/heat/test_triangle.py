@@ -278,3 +278,22 @@ def test_faces_repeating_a_vertex_are_dropped_with_a_warning():
     np.testing.assert_allclose(sb.compute_distance([curve]), s.compute_distance([[(5, b), (19, b), (40, b)]]))
     with pytest.raises(ValueError, match="face 5 repeats a vertex"):
         sb.compute_distance([], points=[(5, b)])
+
+
+def test_the_step_methods_check_what_they_are_given():
+    """unit_field(X) of another size leaked an IndexError; diffuse(anything) an AttributeError."""
+    import gsdf
+    from tests.shapes import uv_sphere
+
+    V, F = uv_sphere(12, 8)
+    s = gsdf.SurfaceSignedHeatSolver(V, F)
+    X = s.diffuse(s.core.sources([np.array([0, 1, 2])], (), None))
+    Y = s.unit_field(X)
+    assert Y.shape == (len(F), 3)
+    np.testing.assert_array_equal(s.unit_field(X.real), s.unit_field(X.real + 0j))
+    for bad, why in ((np.zeros((len(V), 3)), r"shape \(264,\)"), (X[:-1], r"shape \(264,\)"),
+                     (np.where(np.arange(len(X)) == 3, np.nan, X), "NaN"), (["a"] * len(X), "strings")):
+        with pytest.raises(ValueError, match="X: " + ".*" + why):
+            s.unit_field(bad)
+    with pytest.raises(ValueError, match="sources: expected the assembled sources"):
+        s.diffuse(np.zeros(3))

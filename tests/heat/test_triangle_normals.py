@@ -60,6 +60,10 @@ def test_curve_normals_bad_input():
         s.compute_distance(curves, curve_normals=[np.ones((2, 3))])
     with pytest.raises(ValueError, match="curve_normals"):
         s.compute_distance(curves, curve_normals=[None, None])
+    for bad, match in (("x", "curve_normals: expected a list"), ([object()], r"curve_normals\[0\]"),
+                       (["xyz"], r"curve_normals\[0\]"), ([np.array([0, 0, np.nan])], r"curve_normals\[0\]")):
+        with pytest.raises(ValueError, match=match):                   # numpy's own errors leaked before
+            s.compute_distance(curves, curve_normals=bad)
     with pytest.raises(ValueError, match="curve_normals"):
         SurfaceSignedHeatSolver(V, F, intrinsic_delaunay=True).compute_distance(
             [np.array([0, 1, 10, 0])], curve_normals=[np.array([0, 0, 1.0])])

@@ -207,3 +207,11 @@ def test_yukawa_nearest_distance_checks_queries(Q, why):
     with pytest.raises(ValueError, match="Q: .*" + why):
         tree.nearest_distance(Q)
     assert tree.nearest_distance(np.zeros((0, 3))).shape == (0,)
+
+
+@pytest.mark.parametrize("leaf_size", [2.5, float("nan"), "8", True, 1j, 0, 2 ** 64])
+def test_yukawa_tree_checks_its_leaf_size(leaf_size):
+    """leaf_size went unchecked to the tree build (a numba TypingError, NaN to int, fractions accepted)."""
+    with pytest.raises(ValueError, match="leaf_size"):
+        YukawaTree(np.eye(3), np.eye(3), t=0.01, leaf_size=leaf_size)
+    assert YukawaTree(np.eye(3), np.eye(3), t=0.01, leaf_size=np.int32(1)).m == 3

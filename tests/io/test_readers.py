@@ -488,6 +488,11 @@ def test_npz_without_known_keys(tmp_path):
     np.savez(p, a=P0, b=N0)
     with pytest.raises(ValueError, match=errmsg(p) + ".*'P'"):
         read_points(p)
+    np.savez(p, N=N0)                                           # lone normals were read as the points
+    with pytest.raises(ValueError, match=errmsg(p) + ".*'P'"):
+        read_points(p)
+    np.savez(p, P0)                                             # arr_0: the one array is the cloud
+    np.testing.assert_array_equal(read_points(p)[0], P0)
 
 
 def test_writer_argument_errors(tmp_path):
@@ -634,6 +639,31 @@ def test_negative_ply_counts(tmp_path, binary):
         read_mesh(p)
     with pytest.raises(ValueError, match=errmsg(p)):
         read_points(p)
+    from gsdf.io import read_vertex_data                  # plyfile's "negative dimensions" leaked from here
+
+    with pytest.raises(ValueError, match=errmsg(p) + ": line 3: negative element count -3"):
+        read_vertex_data(p)
+
+
+def test_bytes_after_the_binary_ply_elements_are_refused(tmp_path):
+    """A byte inserted into the data shifts every value after it; only the length shows it."""
+    from gsdf.io import read_vertex_data
+
+    p = tmp_path / "c.ply"
+    write_points(p, P0, N0)
+    good = p.read_bytes()
+    k = len(good) // 3
+    p.write_bytes(good[:k] + b"\x00" + good[k:])
+    for read in (read_points, read_vertex_data):
+        with pytest.raises(ValueError, match=errmsg(p) + ": 1 bytes after the PLY elements"):
+            read(p)
+    p.write_bytes(good + b"\n")                                 # a final newline some writers add: fine
+    np.testing.assert_array_equal(read_points(p)[0], P0)
+    q = tmp_path / "m.ply"
+    write_mesh(q, TET_V, TET_F)
+    q.write_bytes(q.read_bytes() + b"\x07")
+    with pytest.raises(ValueError, match="1 bytes after the PLY elements"):
+        read_mesh(q)
 
 
 def test_binary_curve_file(tmp_path):

@@ -75,3 +75,14 @@ def test_binary_is_a_switch(tmp_path):
     with pytest.raises(ValueError, match="binary: expected True or False"):
         gsdf.write_points(tmp_path / "p.ply", V, binary="no")
     assert not os.listdir(tmp_path)
+
+
+@pytest.mark.parametrize("bad", ["x", [1.0, 2.0], 3])
+def test_vertex_data_must_be_a_dict(tmp_path, bad):
+    """A string leaked AttributeError: 'str' object has no attribute 'items'."""
+    from gsdf.io import write_mesh
+
+    p = tmp_path / "m.ply"
+    with pytest.raises(ValueError, match="vertex_data: expected a dict"):
+        write_mesh(p, np.eye(3), [[0, 1, 2]], vertex_data=bad)
+    assert not p.exists()

@@ -197,13 +197,16 @@ def test_normals_given_and_duplicates():
     (np.random.default_rng(0).normal(size=(50, 3)), None, {"outliers": "maybe"}, "outliers"),
     (np.random.default_rng(0).normal(size=(50, 3)), None, {"clusters": 1}, "clusters"),
     (np.random.default_rng(0).normal(size=(50, 3)), None, {"options": {"band": 1.0}}, "options"),
+    (np.random.default_rng(0).normal(size=(50, 3)), None, {"return_report": "no"}, "return_report"),  # was obeyed
+    (np.random.default_rng(0).normal(size=(50, 3)), None, {"return_report": 2}, "return_report"),
 ])
 def test_bad_input(P, N, kw, msg):
     with pytest.raises(ValueError, match=msg):
         gsdf.reconstruct_simply_connected(P, N, **kw)
 
 
-@pytest.mark.parametrize("kw, msg", [({"max_iterations": 0}, "max_iterations"), ({"band": -1.0}, "band"),
+@pytest.mark.parametrize("kw, msg", [({"max_iterations": 0}, "max_iterations"),
+                                     ({"max_iterations": 10 ** 9}, "<= 20"), ({"band": -1.0}, "band"),
                                      ({"outlier_gap": float("nan")}, "outlier_gap"),
                                      ({"cluster_gap": True}, "cluster_gap"), ({"fit_k": 2}, "fit_k")])
 def test_bad_options(kw, msg):

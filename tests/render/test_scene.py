@@ -225,9 +225,13 @@ def test_no_window_without_a_display(monkeypatch):
 
 
 def test_view_fill_takes_numpy_floats():
-    assert gsdf.ViewOptions(fill=np.float32(0.86)).fill == np.float32(0.86)
-    with pytest.raises(ValueError, match=r"fill: expected a number in \(0, 1\]"):
-        gsdf.ViewOptions(fill=1.5)
+    opts = gsdf.ViewOptions(fill=np.float32(0.86), vrange=(np.float32(-1), 2))
+    assert opts.fill == np.float32(0.86) and type(opts.fill) is float        # float32 made the framing float32
+    assert opts.vrange == (-1.0, 2.0) and all(type(x) is float for x in opts.vrange)
+    for bad in (1.5, 0.0, 1e-308, 0.009):                # a tiny fill made the framing loop forever
+        with pytest.raises(ValueError, match=r"fill: expected a number in \[0.01, 1\]"):
+            gsdf.ViewOptions(fill=bad)
+    assert gsdf.ViewOptions(fill=0.01).fill == 0.01
 
 
 @pytest.mark.parametrize("bad", [b"viridis", "", 3])
@@ -235,3 +239,33 @@ def test_colormap_must_be_a_name(bad):
     with pytest.raises(ValueError, match="colormap: expected the name of a polyscope colour map"):
         gsdf.ViewOptions(colormap=bad)
     assert gsdf.ViewOptions(colormap="turbo").colormap == "turbo"
+
+
+@pytest.mark.parametrize("view, why", [("x", "string"), ([1j, 0, 0], "complex"), ([object()] * 3, "objects"),
+                                       ([0, 0, 0], r"\[0, 0, 0\]"), ([1, 0], r"\[1, 0\]"), ([np.nan, 0, 1], "NaN")])
+def test_save_png_checks_view_and_options_before_drawing(tmp_path, view, why):
+    """A bad view direction leaked numpy's own errors (could not convert string to float, TypeError)."""
+    V, F = _sphere()
+    out = tmp_path / "p.png"
+    with pytest.raises(ValueError, match=f"view: expected a nonzero direction.*{why}"):
+        gsdf.save_png(out, (V, F), view=view, renderer="gsdf")
+    with pytest.raises(ValueError, match="options: expected a gsdf.ViewOptions"):
+        gsdf.save_png(out, (V, F), options={"fill": 0.5}, renderer="gsdf")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("kw, why", [(dict(isolines="x"), "isolines: expected a count"),
+                                     (dict(isolines=[1j]), "isolines: expected a count"),
+                                     (dict(vrange="ab"), "vrange: expected"), (dict(vrange=()), "vrange: expected"),
+                                     (dict(vrange=("a", "b")), "vrange: expected"),
+                                     (dict(front=b"x"), "front: expected an axis"), (dict(front=1), "front: expected")])
+def test_view_options_refuse_what_numpy_would_choke_on(kw, why):
+    with pytest.raises(ValueError, match=why):
+        gsdf.ViewOptions(**kw)
+
+
+@pytest.mark.parametrize("up", [b"x", 1, True, "w", [0, 0, 0], ["a", "b", "c"]])
+def test_view_up_is_an_axis_name_or_a_vector(tmp_path, up):
+    V, F = _sphere()
+    with pytest.raises(ValueError, match="up: expected an axis"):
+        gsdf.view((V, F), screenshot=str(tmp_path / "x.png"), up=up)

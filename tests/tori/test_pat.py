@@ -219,6 +219,16 @@ def test_pat_bad_input():
     np.testing.assert_allclose(PointsAsTori(P, 3 * N)(X), pat(X), atol=1e-12)
 
 
+@pytest.mark.parametrize("field", ["k_eval", "k_fallback"])
+def test_pat_neighbour_counts_follow_the_baselines_rule(field):
+    from gsdf import PointsAsToriOptions
+
+    P, N = _sphere_cloud(200)
+    with pytest.raises(ValueError, match=f"{field}: 1000000000 neighbours asked for, but the cloud has 200"):
+        PointsAsTori(P, N, options=PointsAsToriOptions(**{field: 10 ** 9}))
+    PointsAsTori(P[:40], N[:40], k=20, options=PointsAsToriOptions(**{field: 32}))   # the clamp up to the default
+
+
 def test_baselines_on_a_sphere():
     P, N = _sphere_cloud(2000)
     X = S.grid(12)

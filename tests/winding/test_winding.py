@@ -205,3 +205,16 @@ def test_hierarchical_exact_matches_direct_on_a_broken_soup():
     np.testing.assert_allclose(ex(Q), direct, atol=1e-11)
     with pytest.raises(ValueError, match="method"):
         gsdf.winding_number(V, F, Q, method="fast")
+
+
+@pytest.mark.parametrize("make", [lambda V, F: gsdf.ExactWindingNumber(V, F),
+                                  lambda V, F: gsdf.FastWindingNumber(V, F)])
+def test_a_progress_that_is_not_callable_is_refused_before_any_query(make):
+    V, F = cube()
+    ewn = make(V, F)
+    for bad in (3, object()):
+        with pytest.raises(ValueError, match="progress: expected a callable"):
+            ewn(np.zeros((5, 3)), progress=bad)
+    seen = []
+    ewn(np.zeros((5, 3)), progress=lambda s, f: seen.append(f))
+    assert seen == [1.0]

@@ -74,10 +74,11 @@ class BatchOptions:
     def __post_init__(self):  # a ValueError naming the attribute, at construction
         flag(self.resume, "resume")
         flag(self.retry_failed, "retry_failed")
-        integer(self.max_retries, "max_retries", lo=0)
+        # stored as Python numbers (numpy integers are accepted like their value)
+        object.__setattr__(self, "max_retries", integer(self.max_retries, "max_retries", lo=0))
         if self.threads is not None:
-            integer(self.threads, "threads", lo=1)
-        positive(self.scheduler_timeout, "scheduler_timeout")
+            object.__setattr__(self, "threads", integer(self.threads, "threads", lo=1))
+        object.__setattr__(self, "scheduler_timeout", positive(self.scheduler_timeout, "scheduler_timeout"))
 
 
 @dataclass
@@ -138,11 +139,13 @@ class BatchResult:
 def _count(name, value, lo=1):
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, int):
+    import numpy as np
+
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
         raise ValueError(f"{name}: expected a positive integer, got {value!r}")
     if value < lo:
         raise ValueError(f"{name}: must be >= {lo}, got {value}")
-    return value
+    return int(value)
 
 
 def _check_out(out) -> str:
@@ -244,7 +247,8 @@ def _executor_spec(workers, executor):
     the caller's own executor object)."""
     from gsdf.batch._executors import DaskExecutor, LocalExecutor
 
-    if _count("workers", workers) is not None:
+    workers = _count("workers", workers)
+    if workers is not None:
         from gsdf._memory import check_bytes
 
         check_bytes(workers * WORKER_BYTES, f"workers: {workers:,} worker processes")

@@ -533,6 +533,20 @@ def _int(lo):
     return check
 
 
+def _grid_side(lo):
+    """A grid's nodes per side: an integer >= ``lo`` whose cube a grid can have (:data:`gsdf.grid.MAX_NODES`),
+    whether or not this item uses it (``heat_resolution`` only with ``sign="heat"``)."""
+    def check(x, name):
+        from gsdf.grid import MAX_NODES
+
+        r = _int(lo)(x, name)
+        if r ** 3 > MAX_NODES:
+            raise ValueError(f"{name}: {r:,} nodes per side make a grid of {float(r) ** 3:.3g} nodes, more than a "
+                             f"grid can have ({MAX_NODES:.3g})")
+        return r
+    return check
+
+
 def _optional_positive(x, name):
     from gsdf.winding._fast import BETA_MAX
 
@@ -540,8 +554,8 @@ def _optional_positive(x, name):
 
 
 _CHECKS = {
-    "n_samples": _int(1), "n_points": _int(1), "resolution": _int(2), "bisection": _int(0),
-    "heat_resolution": _int(8), "seed": _int(0),
+    "n_samples": _int(1), "n_points": _int(1), "resolution": _grid_side(2), "bisection": _int(0),
+    "heat_resolution": _grid_side(8), "seed": _int(0),
     "sign": lambda x, n: choice(x, n, {"winding", "heat"}),
     "normalize": lambda x, n: choice(x, n, set(NORMALIZE)),
     "dtype": lambda x, n: choice(x, n, set(DTYPES)),
@@ -596,6 +610,9 @@ def check_options(task, options: dict, where: str = "", python: bool = False) ->
             out[k] = _CHECKS[k](v, f"{prefix}{k}")
     if "uniform_fraction" in out and out["uniform_fraction"] < 1 and not out["sigmas"]:
         raise ValueError(f"{prefix}sigmas: empty, but uniform_fraction < 1 asks for near-surface samples")
+    for k in ("n_samples", "n_points"):    # sizes that do not depend on the input: refused before any item runs
+        if k in out:
+            check_samples_size(out[k], f"{prefix}{k}")
     return out
 
 

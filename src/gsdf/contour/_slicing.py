@@ -15,7 +15,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from gsdf._checks import as_points, as_values, choice, integer
-from gsdf._memory import check_bytes, check_work, seconds_per_point
+from gsdf._memory import SECONDS_PER_SLICE, _threads, check_bytes, check_work, seconds_per_point
 from gsdf.contour._isosurface import (CHUNK, _check_bbox, _check_func, _edges_of_vertices, _evaluate, _finite,
                                       refine_on_edges)
 
@@ -205,7 +205,8 @@ def slice_contours(
     # values (8 B) and inside/outside masks (2 B) per node of every slice; per plane node: its position (24 B),
     # meshgrid copies (16 B) and one chunk of queries; per slice: a padded copy for marching squares
     check_bytes(10 * ns * nu * nv + 64 * nu * nv + 48 * min(CHUNK, ns * nu * nv), what)
-    check_work(ns * nu * nv, seconds_per_point(func), what)
+    # the nodes' evaluations (parallel) plus each slice's serial contouring, which dominates at low resolution
+    check_work(1, ns * nu * nv * seconds_per_point(func) / _threads() + ns * SECONDS_PER_SLICE, what, parallel=False)
     ax = grid.axes()
     gu, gv = ax[ua], ax[va]
     h = grid.spacing[[ua, va]]

@@ -125,7 +125,7 @@ def region_boundary_curves(F, face_mask) -> list:
     Raises
     ------
     ValueError
-        ``F`` not an array of vertex indices, ``face_mask`` not one bool per face.
+        ``F`` not an array of vertex indices of at least 3 per face, ``face_mask`` not one bool per face.
 
     Examples
     --------
@@ -135,6 +135,8 @@ def region_boundary_curves(F, face_mask) -> list:
     [[0, 1, 2, 3, 0]]
     """
     F = _checks.as_faces(F, _checks.MAX_INT, "F", corners=None, allow_empty=True)
+    if F.shape[1] < 3:
+        raise ValueError(f"F: expected faces of at least 3 corners (m, 3) or (m, 4), got shape {F.shape}")
     mask = _checks.as_mask(face_mask, len(F), "face_mask")
     Fr = F[mask]
     he = np.stack([Fr.ravel(), np.roll(Fr, -1, axis=1).ravel()], axis=1)   # halfedges i -> j

@@ -91,7 +91,7 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     Raises
     ------
     ValueError
-        ``level`` not finite or outside the range of ``values`` (no surface).
+        ``level`` not finite, outside the range of ``values`` over the tets, or cutting no tet (no surface).
 
     Examples
     --------
@@ -108,8 +108,10 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
     T = as_faces(T, len(X), "T", corners=4)
     report = flag(report, "report")
     s = as_values(values, "values", (len(X),)) - finite(level, "level")
-    if not (s.min() < 0 < s.max()):
-        raise ValueError(f"level {level} is outside the field's range [{s.min() + level:.6g}, {s.max() + level:.6g}]: no surface")
+    st = s[T]          # the range that counts is the tets' (vertices in no tet carry values no tet interpolates)
+    if not (st.min() < 0 < st.max()):
+        raise ValueError(f"level {level} is outside the field's range [{st.min() + level:.6g}, "
+                         f"{st.max() + level:.6g}] (over the tets): no surface")
     # values within round-off of the level are put exactly on it, and a node on the level counts as below it:
     # crossings at such a node then coincide exactly and are welded below
     s = np.where(np.abs(s) <= 1e-12 * float(np.abs(s).max()), 0.0, s)
@@ -136,6 +138,9 @@ def marching_tetrahedra(X, T, values, level: float = 0.0, report: bool = False):
         tris.append(np.stack([e_ac, e_ad, e_bd], 1))
         tris.append(np.stack([e_ac, e_bd, e_bc], 1))
         tet_of += [np.flatnonzero(sel)] * 2
+    if not tris:       # below and above the level, but in different tets: no tet is cut
+        raise ValueError(f"level {level} cuts no tet (the values below and above it lie in different tets): "
+                         "no surface")
     E = np.concatenate(tris)  # (k, 3 corners, 2 endpoints)
     tet_of = np.concatenate(tet_of)
     Es = np.sort(E.reshape(-1, 2), axis=1)

@@ -200,13 +200,13 @@ class YukawaTree:
     eps : float, default 1e-6
         Relative pruning tolerance of the exponential decay, in (0, 1/2]: sources whose weight has decayed
         below ``eps`` times the nearest one's are skipped.
-    leaf_size : int, default 8
+    leaf_size : int >= 1, default 8
         Sources per tree leaf; changes speed only.
 
     Raises
     ------
     ValueError
-        ``t <= 0``, ``theta < 0``, ``eps`` outside (0, 1/2].
+        ``t <= 0``, ``theta < 0``, ``eps`` outside (0, 1/2], ``leaf_size`` not an integer >= 1.
 
     Notes
     -----
@@ -233,7 +233,7 @@ class YukawaTree:
         self.lam = 1.0 / np.sqrt(positive(t, "t"))
         self.theta = nonnegative(theta, "theta")
         self.tau = float(np.log(1.0 / positive(eps, "eps", most=0.5)))  # eps in (0, 1/2]: a relative tolerance
-        self.tree = build_bvh(B, B, B, leaf_size)
+        self.tree = build_bvh(B, B, B, integer(leaf_size, "leaf_size", lo=1))
         o = self.tree.order
         self._B = np.ascontiguousarray(B[o])
         self._W = np.ascontiguousarray(W[o])

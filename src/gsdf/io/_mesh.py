@@ -301,6 +301,27 @@ def _ply_ascii_faces(tab: _Table, rows, props):
     return flat, sizes
 
 
+def _trailing_bytes(p: str, ply, body: int) -> None:
+    """Refuse bytes after the binary elements the header declares (beyond a final run of whitespace): a byte
+    inserted into the data shifts every value after it, and only the file's length shows it. Checked when every
+    element has fixed-size records (plyfile then maps them; their sizes give the end)."""
+    try:
+        ends = [e.data.nbytes for e in ply.elements]
+        if any(e.data.dtype.hasobject for e in ply.elements):
+            return
+    except (AttributeError, TypeError):
+        return
+    end = body + sum(ends)
+    size = os.path.getsize(p)
+    if size > end:
+        with open(p, "rb") as fh:
+            fh.seek(end)
+            tail = fh.read(min(size - end, 1 << 16))
+        if tail.strip(b" \t\r\n") or size - end > len(tail):
+            raise ValueError(f"{p}: {size - end} bytes after the PLY elements the header declares (a byte "
+                             "inserted or a count too small?)")
+
+
 def _ply_binary(p: str, head: bytes):
     import plyfile
 
@@ -325,6 +346,7 @@ def _ply_binary(p: str, head: bytes):
         raise ValueError(f"{p}: malformed PLY file ({error_words(exc)})") from exc
     if "vertex" not in ply:
         raise ValueError(f"{p}: PLY file has no 'vertex' element")
+    _trailing_bytes(p, ply, _ply_header(p, head)[2])
     v = ply["vertex"].data
     V, N = _ply_pick(p, list(v.dtype.names), lambda i: v[v.dtype.names[i]])
     if "face" not in ply or ply["face"].count == 0:
@@ -700,12 +722,19 @@ def read_vertex_data(path) -> dict:
     if ext == ".ply":
         import plyfile
 
+        with open(p, "rb") as fh:                # gsdf's header checks first (counts, format), as read_mesh
+            head = fh.read(1 << 16)
+            if b"end_header" not in head:
+                head += fh.read()
+        fmt, _, body, _ = _ply_header(p, head)
         try:
             ply = plyfile.PlyData.read(p)
         except Exception as exc:  # plyfile raises PlyParseError and assorted errors on broken files
             raise ValueError(f"{p}: malformed PLY file ({error_words(exc)})") from exc
         if "vertex" not in ply:
             raise ValueError(f"{p}: PLY file has no 'vertex' element")
+        if fmt != "ascii":
+            _trailing_bytes(p, ply, body)
         v = ply["vertex"].data
         out = {}
         for name in v.dtype.names:
@@ -754,6 +783,8 @@ def _faces_arg(F, nv: int):
 
 def _vertex_data(vertex_data, n: int) -> dict:
     """name -> (n,) or (n, k) float64 arrays, validated."""
+    if vertex_data is not None and not isinstance(vertex_data, dict):
+        raise ValueError(f"vertex_data: expected a dict of name -> per-vertex values, got {type(vertex_data).__name__}")
     out = {}
     for name, values in (vertex_data or {}).items():
         if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) or name in ("x", "y", "z"):

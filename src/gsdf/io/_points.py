@@ -91,8 +91,8 @@ def _read_numpy(p: str, ext: str):
             with np.load(p, allow_pickle=False) as z:
                 arrays = {k: z[k] for k in z.files}
             pk = next((k for k in ("P", "points") if k in arrays), None)
-            if pk is None and len(arrays) == 1:
-                pk = next(iter(arrays))
+            if pk is None and len(arrays) == 1 and next(iter(arrays)) not in ("N", "normals"):
+                pk = next(iter(arrays))          # np.savez(path, P) names its array arr_0; lone normals are no cloud
             if pk is None:
                 raise ValueError(f"{p}: expected arrays named 'P'/'N' or 'points'/'normals', found {sorted(arrays)}")
             A = arrays[pk]

@@ -55,7 +55,7 @@ import numpy as np
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay, QhullError, cKDTree
 
-from gsdf._checks import choice, integer, progress_callback
+from gsdf._checks import choice, flag, integer, progress_callback
 from gsdf.dec._tet import TetComplex
 from gsdf.mesh._tet_ops import signed_volumes
 from gsdf.recon._cloud import dense_points, on_side, on_surface, pca_normals, prefilter, prepare_cloud
@@ -65,6 +65,9 @@ from gsdf.recon._steiner import octree_steiner_points
 
 __all__ = ["reconstruct_simply_connected", "ReconstructionOptions"]
 
+#: the largest ``max_iterations``: each round is a full inside-field solve and growth, and the paper needs 1–4
+MAX_ITERATIONS = 20
+
 
 @dataclass(frozen=True)
 class ReconstructionOptions:
@@ -72,8 +75,9 @@ class ReconstructionOptions:
 
     Attributes
     ----------
-    max_iterations : int ≥ 1
-        Rounds of the alternation F0 ← F0 ∩ F* (seed 003 §3.3; the paper reports 1–4).
+    max_iterations : int in 1..20
+        Rounds of the alternation F0 ← F0 ∩ F* (seed 003 §3.3; the paper reports 1–4), at most; the rounds stop
+        earlier when the points in use are stable. The range is the CLI's ``--max-iterations``.
     outlier_gap : float > 0
         In the alternation, points farther than this many median spacings from the output are judged outliers
         for the next round (and in the report).
@@ -117,7 +121,8 @@ class ReconstructionOptions:
     fit_k: int = 8
 
     def __post_init__(self):
-        object.__setattr__(self, "max_iterations", integer(self.max_iterations, "max_iterations", lo=1))
+        object.__setattr__(self, "max_iterations", integer(self.max_iterations, "max_iterations", lo=1,
+                                                                  hi=MAX_ITERATIONS))
         object.__setattr__(self, "subdivide", integer(self.subdivide, "subdivide", lo=0, hi=3))
         object.__setattr__(self, "fit_k", integer(self.fit_k, "fit_k", lo=3, hi=64))
         if not isinstance(self.fit, (bool, np.bool_)):
@@ -188,6 +193,7 @@ def reconstruct_simply_connected(P, N=None, *, outliers: str = "auto", clusters:
     outliers = choice(outliers, "outliers", ("auto", "none"))
     if not isinstance(clusters, (bool, np.bool_)):
         raise ValueError(f"clusters: expected a bool, got {type(clusters).__name__}")
+    return_report = flag(return_report, "return_report")        # "no" is a true string: refused, not obeyed
     if options is None:
         options = ReconstructionOptions()
     elif not isinstance(options, ReconstructionOptions):

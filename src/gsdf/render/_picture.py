@@ -75,8 +75,15 @@ def save_png(path, *items, view=None, size=(1200, 900), options=None, renderer: 
     from gsdf._checks import choice
     from gsdf.io._safe_write import check_output_path
 
+    from gsdf.render._scene import direction_camera
+    from gsdf.render._view import ViewOptions
+
     renderer = choice(renderer, "renderer", ("auto", "polyscope", "gsdf"))
     check_output_path(path, extensions=(".png",), what="png")
+    if view is not None:                     # every option checked before anything is drawn
+        direction_camera(view)
+    if options is not None and not isinstance(options, ViewOptions):
+        raise ValueError(f"options: expected a gsdf.ViewOptions or None, got {type(options).__name__}")
     if renderer == "polyscope" or (renderer == "auto" and polyscope_reason() is None):
         from gsdf.render._view import render
 

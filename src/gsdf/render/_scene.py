@@ -370,7 +370,14 @@ def colour_range(v, kind: str, vrange=None) -> tuple:
     ("signed"); [0, 1] ("winding"); else the data range."""
     v = np.asarray(v, float)
     if vrange is not None:
-        lo, hi = (float(x) for x in vrange)
+        from gsdf._checks import as_values
+
+        try:
+            if isinstance(vrange, (str, bytes)):
+                raise ValueError
+            lo, hi = (float(x) for x in as_values(vrange, "vrange", (2,)))
+        except ValueError:
+            lo = hi = math.nan
         if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
             raise ValueError(f"vrange: expected (low, high) with low < high, got {vrange!r}")
         return lo, hi
@@ -434,23 +441,27 @@ def polyline_graph(polys) -> tuple:
 # camera
 # ---------------------------------------------------------------------------------------------------------------
 
-def axis_vector(spec) -> np.ndarray:
-    """"x", "-y", "+z" (or 0/1/2, or a 3-vector) as a unit vector."""
-    if not isinstance(spec, (str, int, np.integer)):
-        v = np.asarray(spec, dtype=float).ravel()
-        n = float(np.linalg.norm(v)) if v.shape == (3,) and np.all(np.isfinite(v)) else 0.0
+def axis_vector(spec, name: str = "axis") -> np.ndarray:
+    """"x", "-y", "+z" (or a nonzero 3-vector of real numbers) as a unit vector; anything else is a ValueError
+    naming ``name``."""
+    if not isinstance(spec, str):
+        from gsdf._checks import as_values
+
+        try:
+            if isinstance(spec, (bytes, bool, int, float, np.generic)):
+                raise ValueError
+            v = as_values(spec, name).ravel()
+        except ValueError:
+            v = np.zeros(0)
+        n = float(np.linalg.norm(v)) if v.shape == (3,) else 0.0
         if not n > 0:
-            raise ValueError(f"expected an axis x, y, z, -x, -y, -z or a nonzero 3-vector, got {spec!r}")
+            raise ValueError(f"{name}: expected an axis x, y, z, -x, -y, -z or a nonzero 3-vector, got {spec!r}")
         return v / n
-    if isinstance(spec, (int, np.integer)) and 0 <= int(spec) <= 2:
-        v = np.zeros(3)
-        v[int(spec)] = 1.0
-        return v
     s = str(spec).strip().lower()
     sign = -1.0 if s.startswith("-") else 1.0
     s = s.lstrip("+-")
     if s not in _AXES:
-        raise ValueError(f"expected an axis x, y, z, -x, -y or -z, got {spec!r}")
+        raise ValueError(f"{name}: expected an axis x, y, z, -x, -y or -z, got {spec!r}")
     v = np.zeros(3)
     v[_AXES[s]] = sign
     return v
@@ -475,7 +486,7 @@ def camera_direction(up, front, azimuth: float, elevation: float, extent) -> tup
         else:
             upv = np.array([0.0, 1.0, 0.0])
     else:
-        upv = axis_vector(up)
+        upv = axis_vector(up, "up")
     a_up = int(np.argmax(np.abs(upv)))
     if front == "auto":
         cand = [i for i in range(3) if i != a_up]
@@ -488,7 +499,7 @@ def camera_direction(up, front, azimuth: float, elevation: float, extent) -> tup
         if a_up == 2 and f == 1:
             fr[1] = -1.0                  # z up: the camera in front of the -y face, as in CAD programs
     else:
-        fr = axis_vector(front)
+        fr = axis_vector(front, "front")
         if abs(fr @ upv) > 0.5:
             raise ValueError(f"front {front!r} is parallel to up {up!r}")
     right = np.cross(upv, fr)
@@ -500,12 +511,17 @@ def camera_direction(up, front, azimuth: float, elevation: float, extent) -> tup
 def direction_camera(view_dir, up="auto") -> tuple:
     """A camera along a given direction (from the scene towards the camera): the unit direction and the up
     vector (``up``, or y unless the direction is within 15° of it, then z)."""
-    d = np.asarray(view_dir, float).reshape(-1)
-    if d.shape != (3,) or not np.isfinite(d).all() or not np.linalg.norm(d) > 0:
+    from gsdf._checks import as_values
+
+    try:
+        d = as_values(view_dir, "view").reshape(-1)
+    except ValueError as exc:
+        raise ValueError(f"view: expected a nonzero direction (x, y, z), got {view_dir!r} ({exc})") from None
+    if d.shape != (3,) or not np.linalg.norm(d) > 0:
         raise ValueError(f"view: expected a nonzero direction (x, y, z), got {view_dir!r}")
     d = d / np.linalg.norm(d)
     if not (isinstance(up, str) and up == "auto"):
-        upv = axis_vector(up)
+        upv = axis_vector(up, "up")
     else:
         upv = np.array([0.0, 1.0, 0.0]) if abs(d[1]) < math.cos(math.radians(15)) else np.array([0.0, 0.0, 1.0])
     if np.linalg.norm(np.cross(d, upv)) < 1e-6:

@@ -7,6 +7,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+#: The smallest ``ViewOptions.fill``: a scene spanning 1 % of the picture is already a dot; at 1e-308 the camera
+#: distance radius / sin(atan(fill)) overflowed and the framing never ended.
+MIN_FILL = 0.01
+
 
 @dataclass(frozen=True)
 class ViewOptions:
@@ -28,7 +32,8 @@ class ViewOptions:
         The side the camera faces at azimuth 0: it looks towards ``-front``. "auto": the thinner of the two sides
         across the up axis (so the broad side faces the camera).
     fill : float, default 0.86
-        Fraction of the picture's shorter side that the scene spans (perspective), in (0, 1].
+        Fraction of the picture's shorter side that the scene spans (perspective), in [0.01, 1] (below, the
+        scene is a dot and the camera distance overflows).
     colormap : str, optional
         A polyscope colour map ("viridis", "coolwarm", "blues", "reds", "turbo", ...). Default: "coolwarm"
         (white at 0, or at 1/2 for winding numbers) for fields that change sign and for winding numbers,
@@ -54,7 +59,7 @@ class ViewOptions:
     vrange: tuple | None = None
 
     def __post_init__(self):
-        from gsdf._checks import finite
+        from gsdf._checks import as_values, finite
 
         if self.level is not None:
             object.__setattr__(self, "level", finite(self.level, "level"))
@@ -63,8 +68,10 @@ class ViewOptions:
         iso = self.isolines
         if isinstance(iso, (bool, np.bool_)) or not (isinstance(iso, (int, np.integer)) and 0 <= iso <= 1000):
             try:
-                iso = tuple(float(x) for x in iso)
-            except TypeError:
+                if isinstance(iso, (str, bytes, bool, np.bool_)) or np.ndim(iso) != 1:
+                    raise ValueError
+                iso = tuple(float(x) for x in as_values(iso, "isolines", finite=False, allow_empty=True))
+            except (TypeError, ValueError):
                 raise ValueError(f"isolines: expected a count (0..1000) or a sequence of isovalues, got "
                                  f"{self.isolines!r}") from None
             if not all(math.isfinite(x) for x in iso):
@@ -75,20 +82,23 @@ class ViewOptions:
         if self.front != "auto":
             from gsdf.render._scene import axis_vector
 
-            axis_vector(self.front)
+            axis_vector(self.front, "front")
         from gsdf._checks import positive
 
         try:
-            positive(self.fill, "fill", most=1.0)
+            fill = positive(self.fill, "fill", most=1.0)
+            if fill < MIN_FILL:
+                raise ValueError
         except ValueError:
-            raise ValueError(f"fill: expected a number in (0, 1], got {self.fill!r}") from None
+            raise ValueError(f"fill: expected a number in [{MIN_FILL}, 1], got {self.fill!r}") from None
+        object.__setattr__(self, "fill", fill)       # a Python float: np.float32 would make the framing float32
         if self.colormap is not None and (not isinstance(self.colormap, str) or not self.colormap.strip()):
             raise ValueError(f"colormap: expected the name of a polyscope colour map such as 'viridis', got "
                              f"{self.colormap!r}")
         if self.vrange is not None:
             from gsdf.render._scene import colour_range
 
-            colour_range(np.zeros(1), "plain", self.vrange)
+            object.__setattr__(self, "vrange", colour_range(np.zeros(1), "plain", self.vrange))
 
 
 def view(*items, screenshot=None, size=(1200, 900), up="auto", azimuth: float = 35.0, elevation: float = 25.0,
@@ -178,7 +188,7 @@ def render(items, screenshot, size, up, angles, options, view_dir=None):
         raise ValueError(f"size: expected (width, height), got {size!r}") from None
     size = (integer(w, "size[0]", lo=64, hi=8192), integer(h, "size[1]", lo=64, hi=8192))
     if not (isinstance(up, str) and up == "auto"):
-        _scene.axis_vector(up)
+        _scene.axis_vector(up, "up")
     if screenshot is not None:
         from gsdf.io._safe_write import check_output_path
 

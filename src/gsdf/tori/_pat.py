@@ -22,7 +22,7 @@ import dataclasses
 import numpy as np
 from numba import njit, prange
 
-from gsdf._checks import as_points, choice, finite, integer, nonnegative, positive, query_shaped
+from gsdf._checks import as_points, choice, finite, integer, neighbours, nonnegative, positive, query_shaped
 from gsdf._memory import SECONDS_PER_QUERY
 from gsdf._normalize import Frame
 from gsdf.grid import PAD, Grid, padded_box
@@ -139,9 +139,11 @@ class PointsAsToriOptions:
     Attributes
     ----------
     k_eval : int, default 64
-        Most points summed per query (neighbour query size).
+        Most points summed per query (neighbour query size); above both the cloud's n - 1 and 64 it is refused
+        by :class:`PointsAsTori`.
     k_fallback : int, default 32
-        Points always summed per query, even beyond R_eval (the 32 nearest of §5.1.3).
+        Points always summed per query, even beyond R_eval (the 32 nearest of §5.1.3); above both n - 1 and 32
+        it is refused.
     normal_weight : float, default 1.0
         Jet fitting: weight of the normal (slope) rows.
     ridge : float, default 1e-3
@@ -269,6 +271,9 @@ class PointsAsTori:
             self.P, self.N, coefficients, tori, framed = _state
         else:
             self.P, self.N = _clean_cloud(P, N, self.k)
+        # the baselines' rule: above both n - 1 and the default is refused, up to the default is clamped
+        self.k_eval = neighbours(self.k_eval, len(self.P), "k_eval", default=64)
+        self.k_fallback = neighbours(self.k_fallback, len(self.P), "k_fallback", default=32)
         # scale invariance: tori, neighbour search and kernel work in the cloud's normalised frame
         self._frame = fr = Frame.of(self.P)
         self._Pf = fr.geometry(self.P, "P")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gsdf._checks import _array, _dtype_words
+from gsdf._checks import _array, _dtype_words, progress_callback
 from gsdf._memory import SECONDS_PER_QUERY, check_bytes, check_work
 from gsdf.spatial._morton import cell_order, gather_rows
 from gsdf.threads import apply_env
@@ -26,6 +26,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
     memory checked by :func:`gsdf._memory.check_bytes`) run before the first pass over ``Q``.
     """
     apply_env()  # GSDF_NUM_THREADS
+    say = progress_callback(progress)
     A = query_array(Q, dim, cost, chunk)
     n = A.shape[0]
     out = np.empty(n, dtype=np.float64)
@@ -44,8 +45,7 @@ def map_queries(kernel, Q, dim: int = 3, chunk: int = CHUNK, progress=None, cohe
             out[s:e][o] = tmp
         else:
             kernel(q, out[s:e])
-        if progress is not None:
-            progress("winding numbers", e / n)
+        say("winding numbers", e / n)
     return out
 
 

@@ -170,15 +170,20 @@ class SurfaceSignedHeatSolver:
 
         Returns
         -------
-        (nE,) complex128 or (2 nE,) float64
-            The diffused vector field, one complex number per edge (nE edges; the real block form on
-            inconsistently oriented meshes).
+        (nE,) complex128
+            The diffused vector field, one complex number per edge (nE edges; on inconsistently oriented meshes
+            solved in the real block form and returned as complex numbers).
 
         Examples
         --------
         >>> S = solver.core.sources([curve], (), None)               # doctest: +SKIP
         >>> Y = solver.unit_field(solver.diffuse(S))                 # doctest: +SKIP
         """
+        from gsdf.heat._sources import Sources
+
+        if not isinstance(sources, Sources):
+            raise ValueError(f"sources: expected the assembled sources of solver.core.sources(curves, points, "
+                             f"curve_signs), got {type(sources).__name__}")
         return self.vector_heat_factorization.solve(sources.X0)
 
     def unit_field(self, X: np.ndarray) -> np.ndarray:
@@ -186,19 +191,34 @@ class SurfaceSignedHeatSolver:
 
         Parameters
         ----------
-        X : array
-            The output of :meth:`diffuse`.
+        X : (nE,) complex array
+            The output of :meth:`diffuse`: one finite complex number per edge (real numbers are taken as
+            complex).
 
         Returns
         -------
         (m, 3) float64
             Unit vectors per face, zero where the diffused field vanishes.
 
+        Raises
+        ------
+        ValueError
+            ``X`` not one finite number per edge.
+
         Examples
         --------
         >>> Y = solver.unit_field(solver.diffuse(S))                 # doctest: +SKIP
         """
-        return self.core.unit_field(X)
+        nE = self.core.domain.ops.n_edges
+        A = _checks._array(X, "X")
+        if A.dtype.kind not in "iufc":
+            raise ValueError(f"X: expected the complex edge vectors of diffuse(), got {_checks._dtype_words(A)}")
+        if A.shape != (nE,):
+            raise ValueError(f"X: expected one value per edge, shape ({nE},) (the output of diffuse()), got "
+                             f"shape {A.shape}")
+        if not np.isfinite(A).all():
+            raise ValueError("X: contains NaN or infinite values")
+        return self.core.unit_field(A.astype(np.complex128, copy=False))
 
     def _kept_faces(self, curves, points, curve_signs):
         """Curves and point sources with their face indices mapped to the faces kept (when faces that repeat a

@@ -286,14 +286,20 @@ def _to_face(F, f, b, g):
 def per_curve_normals(curve_normals, n_curves: int):
     """``curve_normals`` as a list with one entry per curve (None stays None): one (3,) vector is used for
     every curve; a list must have ``n_curves`` entries (ValueError otherwise)."""
+    from gsdf._checks import as_values
+
     if curve_normals is None:
         return None
     if isinstance(curve_normals, np.ndarray) and curve_normals.shape == (3,):
-        return [curve_normals] * n_curves
+        return [as_values(curve_normals, "curve_normals")] * n_curves
+    if isinstance(curve_normals, (str, bytes)) or not isinstance(curve_normals, (list, tuple, np.ndarray)):
+        raise ValueError(f"curve_normals: expected a list with one entry per curve, got "
+                         f"{type(curve_normals).__name__}")
     curve_normals = list(curve_normals)
     if len(curve_normals) != n_curves:
         raise ValueError(f"curve_normals: has {len(curve_normals)} entries but there are {n_curves} curves")
-    return curve_normals
+    # every entry real and finite (None: the face normals); shapes are checked per curve part
+    return [None if c is None else as_values(c, f"curve_normals[{k}]") for k, c in enumerate(curve_normals)]
 
 
 def _parse_normals(part: CurvePart, n_nodes: int):

@@ -99,7 +99,7 @@ class VoxelSurfaceDomain(VertexSurfaceDomain):
         Occupied voxels; voxel (i, j, k) is the box ``[i, i+1]·s_x × [j, j+1]·s_y × [k, k+1]·s_z``.
     spacing : float or (3,) float
         Voxel size.
-    normal_radius : float
+    normal_radius : float >= 0
         Radius of the integral-invariant ball in voxels (times the smallest spacing); 0 gives the trivial
         normals.
     normals : None, "trivial", or (m, 3) float
@@ -316,7 +316,7 @@ class VoxelSurfaceSignedHeatSolver:
         Voxel size (world units per voxel along x, y, z). Any scale: the solve runs with the spacing divided by
         a power of two (exact), so φ scales with it from 1e-150 to 1e150; ``vertices``, ``face_centres``, ``t``
         and φ are in world units.
-    normal_radius : float
+    normal_radius : float >= 0
         Integral-invariant radius of the corrected normals, in voxels (of the smallest spacing); 0 = trivial
         normals. Default 3 (DGtal's). A fixed radius in voxels leaves a normal bias that stops the convergence
         under refinement; for convergence let it grow like ``0.5 · N^(2/3)`` voxels for an object N voxels
